@@ -1,0 +1,11 @@
+//! pinhole: a CPU ray tracer and a CPU rasterizer that render the same scene
+//! through one shading routine, with the tools to compare and debug them.
+//!
+//! The core (everything but `app`) has no GUI types.
+
+pub mod image_io;
+pub mod math;
+pub mod metrics;
+pub mod render;
+pub mod scene;
+pub mod app;

@@ -1,0 +1,273 @@
+//! Renderers and what they share: settings, the scene query (closest hit and
+//! shadow rays), the sample pattern, statistics and the frame loop.
+//!
+//! A renderer answers visibility for one sample pass: for every pixel of the
+//! requested rows it finds the `SurfaceHit` the sample sees and hands it to
+//! `resolve_sample`, which shades it (or draws a debug view).
+
+pub mod debug;
+pub mod frame;
+pub mod prepared;
+pub mod raster;
+pub mod raytrace;
+pub mod shade;
+pub mod trace;
+
+pub use frame::{render_frame, FrameResult};
+pub use prepared::PreparedScene;
+
+use crate::math::{Radiance, Ray, Vec2};
+use crate::scene::{CameraView, PrimitiveKind, SurfaceHit};
+use std::ops::Range;
+use std::sync::atomic::AtomicBool;
+use trace::Recorder;
+
+/// How shadow visibility is resolved.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ShadowMode {
+    None,
+    Ray,
+    Map,
+}
+
+impl ShadowMode {
+    pub const ALL: [ShadowMode; 3] = [ShadowMode::None, ShadowMode::Ray, ShadowMode::Map];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            ShadowMode::None => "none",
+            ShadowMode::Ray => "ray",
+            ShadowMode::Map => "map",
+        }
+    }
+
+    pub fn parse(s: &str) -> Result<ShadowMode, String> {
+        Self::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| format!("unknown shadow mode \"{s}\" (expected none, ray or map)"))
+    }
+}
+
+/// Per-render knobs. Scene-level values (background, ambient, exposure) stay
+/// in `Scene::render`.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct RenderSettings {
+    pub width: u32,
+    pub height: u32,
+    /// Samples per pixel (stratified; 1 = the pixel centre).
+    pub spp: u32,
+    pub shadows: ShadowMode,
+    /// CGPP's `rayBumpEpsilon`: how far shadow and secondary rays start off the surface.
+    pub shadow_bump: f32,
+    /// Maximum depth of mirror and refraction rays.
+    pub max_depth: u32,
+    pub view: debug::View,
+}
+
+impl RenderSettings {
+    pub fn for_scene(scene: &crate::scene::Scene) -> RenderSettings {
+        RenderSettings {
+            width: scene.render.width,
+            height: scene.render.height,
+            spp: 1,
+            shadows: ShadowMode::Ray,
+            shadow_bump: 1e-4,
+            max_depth: 4,
+            view: debug::View::Shaded,
+        }
+    }
+}
+
+/// Counters of rays cast (per frame in the statistics).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RayCounts {
+    pub primary: u64,
+    pub shadow: u64,
+    pub secondary: u64,
+    /// BVH nodes visited and primitives tested, by every ray.
+    pub nodes: u64,
+    pub tests: u64,
+    /// Rasterizer: samples tested against triangles, covered, and fragments shaded.
+    pub samples_tested: u64,
+    pub samples_covered: u64,
+    pub fragments_shaded: u64,
+    pub depth_fails: u64,
+}
+
+impl std::ops::AddAssign for RayCounts {
+    fn add_assign(&mut self, o: RayCounts) {
+        self.primary += o.primary;
+        self.shadow += o.shadow;
+        self.secondary += o.secondary;
+        self.nodes += o.nodes;
+        self.tests += o.tests;
+        self.samples_tested += o.samples_tested;
+        self.samples_covered += o.samples_covered;
+        self.fragments_shaded += o.fragments_shaded;
+        self.depth_fails += o.depth_fails;
+    }
+}
+
+/// Closest-hit and any-hit queries against the scene. The brute-force caster
+/// and the BVH implement it; `shade()` uses it for shadow and secondary rays.
+pub trait SceneQuery: Sync {
+    /// The closest surface along `ray` with `0 < t < t_max`. `inside` lets a
+    /// refracted ray hit the sphere it travels in from inside.
+    fn closest<R: Recorder>(&self, ray: &Ray, t_max: f32, inside: bool, counts: &mut RayCounts, rec: &mut R) -> Option<SurfaceHit>;
+    /// The first surface found along `ray` with `0 < t < t_max`, as
+    /// (kind, index, t); `None` when the segment is clear.
+    fn occluder<R: Recorder>(&self, ray: &Ray, t_max: f32, counts: &mut RayCounts, rec: &mut R) -> Option<(PrimitiveKind, u32, f32)>;
+}
+
+/// One sample pass of a frame: every pixel sampled at the same sub-pixel offset.
+pub struct PassJob<'a> {
+    pub prepared: &'a PreparedScene,
+    pub view: &'a CameraView,
+    pub settings: &'a RenderSettings,
+    /// Sub-pixel position of this pass's sample in [0, 1)^2 (0.5, 0.5 = centre).
+    pub offset: Vec2,
+    /// Rows to render; `out` holds `width * rows.len()` pixels.
+    pub rows: Range<u32>,
+    pub cancel: &'a AtomicBool,
+}
+
+impl PassJob<'_> {
+    pub fn cancelled(&self) -> bool {
+        self.cancel.load(std::sync::atomic::Ordering::Relaxed)
+    }
+
+    /// Image position of this pass's sample in pixel `(x, y)`.
+    pub fn sample_position(&self, x: u32, y: u32) -> Vec2 {
+        Vec2::new(x as f32 + self.offset.x, y as f32 + self.offset.y)
+    }
+}
+
+/// A rendering method: `raytrace:brute`, `raytrace:bvh`, `rasterize:...`.
+pub trait Renderer: Sync + Send {
+    fn name(&self) -> &'static str;
+    fn description(&self) -> &'static str;
+    /// Renders `job.rows` of one sample pass into `out` (row-major), in
+    /// parallel, and returns what it counted. Result must not depend on the
+    /// number of threads.
+    fn render_pass(&self, job: &PassJob, out: &mut [Radiance]) -> RayCounts;
+}
+
+/// Every registered renderer, reference first.
+pub fn renderers() -> Vec<Box<dyn Renderer>> {
+    let mut all: Vec<Box<dyn Renderer>> = vec![Box::new(raytrace::brute::BruteForce), Box::new(raytrace::bvh::BvhRayTracer)];
+    all.extend(raster::renderers());
+    all
+}
+
+/// Names accepted by `--renderer`, with the aliases `raytrace` and `rasterize`.
+pub fn renderer_names() -> Vec<&'static str> {
+    renderers().iter().map(|r| r.name()).collect()
+}
+
+pub const DEFAULT_RAYTRACE: &str = "raytrace:bvh";
+
+/// Looks a renderer up by name; `raytrace` and `rasterize` name the defaults.
+pub fn renderer_by_name(name: &str) -> Result<Box<dyn Renderer>, String> {
+    let wanted = match name {
+        "raytrace" => DEFAULT_RAYTRACE,
+        "rasterize" => raster::DEFAULT_RASTERIZE,
+        other => other,
+    };
+    renderers()
+        .into_iter()
+        .find(|r| r.name() == wanted)
+        .ok_or_else(|| format!("unknown renderer \"{name}\" (choose from raytrace, rasterize, {})", renderer_names().join(", ")))
+}
+
+/// The value one sample contributes, given what it sees: `shade()` for the
+/// shaded view, a debug colour otherwise, the background on a miss.
+#[inline]
+pub fn resolve_sample<Q: SceneQuery, R: Recorder>(
+    job: &PassJob,
+    query: &Q,
+    ray: &Ray,
+    hit: Option<&SurfaceHit>,
+    counts: &mut RayCounts,
+    rec: &mut R,
+) -> Radiance {
+    let scene = &job.prepared.scene;
+    match job.settings.view {
+        debug::View::Shaded => match hit {
+            Some(h) => shade::shade(scene, query, job.settings, h, -ray.dir, 0, counts, rec),
+            None => scene.render.background,
+        },
+        view => debug::view_color(view, job.view, ray, hit),
+    }
+}
+
+/// Stratified sub-pixel positions: an n x n grid of cell centres when `spp`
+/// is a square, otherwise a Latin hypercube (one sample per row and per
+/// column of an spp x spp grid) with a fixed shuffle. Index 0 of 1 is the
+/// pixel centre. Both families of renderers use these positions, so their
+/// images agree at any spp.
+pub fn sample_offset(index: u32, spp: u32) -> Vec2 {
+    let spp = spp.max(1);
+    let n = (spp as f32).sqrt().round() as u32;
+    if n * n == spp {
+        let (i, j) = (index % n, index / n);
+        return Vec2::new((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
+    }
+    // A fixed permutation of the columns: multiply by a number coprime to spp.
+    let mut k = (spp as f32 * 0.618_034).round() as u32 | 1;
+    while gcd(k, spp) != 1 {
+        k += 2;
+    }
+    let col = (index as u64 * k as u64 % spp as u64) as u32;
+    Vec2::new((index as f32 + 0.5) / spp as f32, (col as f32 + 0.5) / spp as f32)
+}
+
+fn gcd(a: u32, b: u32) -> u32 {
+    if b == 0 { a } else { gcd(b, a % b) }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn one_sample_is_the_centre() {
+        assert_eq!(sample_offset(0, 1), Vec2::splat(0.5));
+    }
+
+    #[test]
+    fn samples_are_stratified() {
+        for spp in [2u32, 3, 4, 5, 8, 9, 16, 64] {
+            let pts: Vec<Vec2> = (0..spp).map(|i| sample_offset(i, spp)).collect();
+            let n = (spp as f32).sqrt().round() as u32;
+            let cells = if n * n == spp { n } else { spp };
+            // One sample in each column stratum and in each row stratum.
+            let mut cols: Vec<u32> = pts.iter().map(|p| (p.x * cells as f32) as u32).collect();
+            let mut rows: Vec<u32> = pts.iter().map(|p| (p.y * cells as f32) as u32).collect();
+            cols.sort();
+            rows.sort();
+            cols.dedup();
+            rows.dedup();
+            if n * n != spp {
+                assert_eq!(cols.len(), spp as usize, "spp {spp}");
+                assert_eq!(rows.len(), spp as usize, "spp {spp}");
+            } else {
+                assert_eq!(cols.len(), n as usize);
+                assert_eq!(rows.len(), n as usize);
+            }
+            let mean = pts.iter().copied().sum::<Vec2>() / spp as f32;
+            assert!((mean - Vec2::splat(0.5)).length() < 0.5 / spp as f32 + 1e-6, "spp {spp}: {mean}");
+        }
+    }
+
+    #[test]
+    fn every_name_resolves() {
+        for n in renderer_names() {
+            assert_eq!(renderer_by_name(n).unwrap().name(), n);
+        }
+        assert_eq!(renderer_by_name("raytrace").unwrap().name(), DEFAULT_RAYTRACE);
+        assert!(renderer_by_name("rasterize").is_ok());
+        assert!(renderer_by_name("nope").err().unwrap().contains("raytrace:brute"));
+    }
+}

@@ -1,0 +1,184 @@
+//! Ray-primitive intersection, shared by every method that casts rays (and by
+//! the rasterizer's analytic spheres), so all of them agree bit for bit.
+
+use crate::math::{Ray, Vec3};
+use crate::scene::{Sphere, Triangle};
+
+/// A triangle prepared for Möller-Trumbore: one vertex and two edges.
+#[derive(Clone, Copy, Debug)]
+pub struct TriangleEdges {
+    pub v0: Vec3,
+    pub e1: Vec3,
+    pub e2: Vec3,
+    pub two_sided: bool,
+}
+
+impl TriangleEdges {
+    pub fn new(t: &Triangle) -> TriangleEdges {
+        TriangleEdges { v0: t.v[0], e1: t.v[1] - t.v[0], e2: t.v[2] - t.v[0], two_sided: t.two_sided }
+    }
+}
+
+/// Why a ray-primitive test did not produce a hit (shown by the pixel inspector).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Miss {
+    /// The ray runs parallel to the triangle's plane.
+    Parallel,
+    /// A single-sided triangle seen from behind.
+    BackFace,
+    /// The line meets the plane (or sphere) outside the primitive.
+    Outside,
+    /// The hit is behind the ray origin.
+    Behind,
+    /// The hit is beyond the current closest hit or the ray's end.
+    Farther,
+}
+
+/// Outcome of one ray-triangle test: `t` and the barycentric weights of v1, v2.
+pub type TriangleTest = Result<(f32, f32, f32), Miss>;
+
+/// Möller-Trumbore ray-triangle test (CGPP listing 15.16 derives the same
+/// weights). Accepts hits with `0 < t < t_max`; single-sided triangles are hit
+/// only from the front, where the winding is counter-clockwise.
+#[inline(always)]
+pub fn intersect_triangle(ray: &Ray, tri: &TriangleEdges, t_max: f32) -> TriangleTest {
+    let p = ray.dir.cross(tri.e2);
+    let det = tri.e1.dot(p);
+    // det = -dir . (e1 x e2): positive when the ray meets the front face.
+    if tri.two_sided {
+        if det == 0.0 || !det.is_finite() {
+            return Err(Miss::Parallel);
+        }
+    } else if det <= 0.0 {
+        return Err(if det == 0.0 { Miss::Parallel } else { Miss::BackFace });
+    }
+    let inv = 1.0 / det;
+    let s = ray.origin - tri.v0;
+    let b1 = s.dot(p) * inv;
+    if !(0.0..=1.0).contains(&b1) {
+        return Err(Miss::Outside);
+    }
+    let q = s.cross(tri.e1);
+    let b2 = ray.dir.dot(q) * inv;
+    if b2 < 0.0 || b1 + b2 > 1.0 {
+        return Err(Miss::Outside);
+    }
+    let t = tri.e2.dot(q) * inv;
+    if t <= 0.0 {
+        return Err(Miss::Behind);
+    }
+    if t >= t_max {
+        return Err(Miss::Farther);
+    }
+    Ok((t, b1, b2))
+}
+
+/// Ray-sphere test. Spheres are closed and hit from outside only: a ray that
+/// starts inside (or on) the sphere does not hit it, which also keeps shadow
+/// rays from re-hitting the sphere they leave. Refracted rays travelling inside
+/// pass `allow_inside = true` to find the exit point of the sphere they are in.
+///
+/// The discriminant is formed from the perpendicular distance of the centre to
+/// the line (Ray Tracing Gems, ch. 7) to stay accurate for huge spheres.
+#[inline]
+pub fn intersect_sphere(ray: &Ray, s: &Sphere, t_max: f32, allow_inside: bool) -> Result<f32, Miss> {
+    let f = ray.origin - s.center;
+    let b = -f.dot(ray.dir);
+    let l = f + ray.dir * b; // centre-to-line vector
+    let dist = l.length();
+    let disc = (s.radius - dist) * (s.radius + dist);
+    if disc < 0.0 {
+        return Err(Miss::Outside);
+    }
+    let h = disc.sqrt();
+    let (t_near, t_far) = (b - h, b + h);
+    let origin_outside = f.length() > s.radius;
+    let t = if origin_outside { t_near } else if allow_inside { t_far } else { return Err(Miss::Behind) };
+    if t <= 0.0 {
+        return Err(Miss::Behind);
+    }
+    if t >= t_max {
+        return Err(Miss::Farther);
+    }
+    Ok(t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec2;
+
+    fn tri(v: [Vec3; 3], two_sided: bool) -> TriangleEdges {
+        TriangleEdges::new(&Triangle { v, n: [Vec3::Z; 3], uv: [Vec2::ZERO; 3], material: 0, object: 0, two_sided })
+    }
+
+    fn book_triangle() -> TriangleEdges {
+        tri([Vec3::new(0.0, 1.0, -2.0), Vec3::new(-1.9, -1.0, -2.0), Vec3::new(1.6, -0.5, -2.0)], false)
+    }
+
+    #[test]
+    fn hit_by_hand() {
+        // Ray down -z through (0, 0): the plane z = -2 is at t = 2. Solving
+        // (0,0) = v0 + b1 (v1 - v0) + b2 (v2 - v0): -1.9 b1 + 1.6 b2 = 0 and
+        // -2 b1 - 1.5 b2 = -1, so b1 = 16/62 * ... computed exactly below.
+        let r = Ray::new(Vec3::ZERO, Vec3::new(0.0, 0.0, -1.0));
+        let (t, b1, b2) = intersect_triangle(&r, &book_triangle(), f32::INFINITY).unwrap();
+        // From -1.9 b1 + 1.6 b2 = 0: b2 = 1.1875 b1; -2 b1 - 1.78125 b1 = -1 => b1 = 1/3.78125.
+        let e_b1 = 1.0 / 3.78125;
+        assert!((t - 2.0).abs() < 1e-6);
+        assert!((b1 - e_b1).abs() < 1e-6, "{b1}");
+        assert!((b2 - 1.1875 * e_b1).abs() < 1e-6, "{b2}");
+    }
+
+    #[test]
+    fn rejects_with_reasons() {
+        let t = book_triangle();
+        let down = Vec3::new(0.0, 0.0, -1.0);
+        // Outside: far to the right.
+        assert_eq!(intersect_triangle(&Ray::new(Vec3::new(5.0, 0.0, 0.0), down), &t, 1e9), Err(Miss::Outside));
+        // Behind: origin past the triangle.
+        assert_eq!(intersect_triangle(&Ray::new(Vec3::new(0.0, 0.0, -3.0), -down), &t, 1e9), Err(Miss::BackFace));
+        assert_eq!(intersect_triangle(&Ray::new(Vec3::new(0.0, 0.0, -3.0), down), &t, 1e9), Err(Miss::Behind));
+        // Farther than t_max.
+        assert_eq!(intersect_triangle(&Ray::new(Vec3::ZERO, down), &t, 1.5), Err(Miss::Farther));
+        // Parallel.
+        assert_eq!(intersect_triangle(&Ray::new(Vec3::ZERO, Vec3::X), &t, 1e9), Err(Miss::Parallel));
+    }
+
+    #[test]
+    fn two_sided_hits_from_behind() {
+        let mut t = book_triangle();
+        t.two_sided = true;
+        let r = Ray::new(Vec3::new(0.0, 0.0, -3.0), Vec3::Z);
+        let (dist, _, _) = intersect_triangle(&r, &t, 1e9).unwrap();
+        assert!((dist - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn sphere_by_hand() {
+        let s = Sphere { center: Vec3::new(0.0, 0.0, -5.0), radius: 1.0, material: 0, object: 0 };
+        let r = Ray::new(Vec3::ZERO, Vec3::new(0.0, 0.0, -1.0));
+        assert_eq!(intersect_sphere(&r, &s, 1e9, false), Ok(4.0));
+        assert_eq!(intersect_sphere(&r, &s, 3.0, false), Err(Miss::Farther));
+        // Grazing at x = 0.6: t = 5 - sqrt(1 - 0.36) = 4.2.
+        let r = Ray::new(Vec3::new(0.6, 0.0, 0.0), Vec3::new(0.0, 0.0, -1.0));
+        assert!((intersect_sphere(&r, &s, 1e9, false).unwrap() - 4.2).abs() < 1e-5);
+        let r = Ray::new(Vec3::new(1.01, 0.0, 0.0), Vec3::new(0.0, 0.0, -1.0));
+        assert_eq!(intersect_sphere(&r, &s, 1e9, false), Err(Miss::Outside));
+        // From inside: only refracted rays see the exit.
+        let r = Ray::new(Vec3::new(0.0, 0.0, -5.0), Vec3::new(0.0, 0.0, -1.0));
+        assert_eq!(intersect_sphere(&r, &s, 1e9, false), Err(Miss::Behind));
+        assert_eq!(intersect_sphere(&r, &s, 1e9, true), Ok(1.0));
+    }
+
+    #[test]
+    fn huge_sphere_stays_accurate() {
+        // The ground of the spheres scene: radius 5000, top at y = -1.
+        let s = Sphere { center: Vec3::new(0.0, -5001.0, 0.0), radius: 5000.0, material: 0, object: 0 };
+        let r = Ray::new(Vec3::ZERO, Vec3::new(0.0, -1.0, 1.0).normalize());
+        let t = intersect_sphere(&r, &s, 1e9, false).unwrap();
+        let p = r.at(t);
+        assert!(((p - s.center).length() - 5000.0).abs() < 2e-3, "{p}");
+        assert!((p.y + 1.0).abs() < 1e-3);
+    }
+}

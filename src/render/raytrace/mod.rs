@@ -1,0 +1,48 @@
+//! Ray casting: for each pixel, find the closest surface along the eye ray.
+//! `brute` is the book's reference (every primitive, in scene order); `bvh`
+//! is the fast method checked against it.
+
+pub mod brute;
+pub mod bvh;
+pub mod intersect;
+
+use super::trace::{NoRecord, Recorder};
+use super::{resolve_sample, PassJob, RayCounts, SceneQuery};
+use crate::math::Radiance;
+use rayon::prelude::*;
+
+/// Casts one eye ray per pixel of `job.rows` through `query`, rows in parallel.
+pub fn cast_pass<Q: SceneQuery>(job: &PassJob, query: &Q, out: &mut [Radiance]) -> RayCounts {
+    let width = job.view.width as usize;
+    out.par_chunks_mut(width)
+        .enumerate()
+        .map(|(i, row)| {
+            let mut counts = RayCounts::default();
+            if job.cancelled() {
+                return counts;
+            }
+            let y = job.rows.start + i as u32;
+            for (x, px) in row.iter_mut().enumerate() {
+                *px = cast_pixel(job, query, x as u32, y, &mut counts, &mut NoRecord);
+            }
+            counts
+        })
+        .reduce(RayCounts::default, |mut a, b| {
+            a += b;
+            a
+        })
+}
+
+/// One eye ray: the sample of pixel `(x, y)` in this pass. `pinhole pixel`
+/// calls this with a recording `rec` to replay exactly what the frame did.
+#[inline]
+pub fn cast_pixel<Q: SceneQuery, R: Recorder>(job: &PassJob, query: &Q, x: u32, y: u32, counts: &mut RayCounts, rec: &mut R) -> Radiance {
+    let p = job.sample_position(x, y);
+    let ray = job.view.eye_ray(p.x, p.y);
+    let t_max = job.view.far_t(p.x, p.y);
+    counts.primary += 1;
+    rec.ray(&ray, t_max, 0);
+    let hit = query.closest(&ray, t_max, false, counts, rec);
+    rec.closest(hit.as_ref());
+    resolve_sample(job, query, &ray, hit.as_ref(), counts, rec)
+}

@@ -1,0 +1,175 @@
+//! The one shading routine (CGPP listing 15.17): every renderer hands a
+//! `SurfaceHit` to `shade()`. Lights, shadows, BSDF and secondary rays live
+//! here and nowhere else.
+
+use super::trace::{LightSample, Recorder};
+use super::{RayCounts, RenderSettings, SceneQuery, ShadowMode};
+use crate::math::{Radiance, Ray, Vec3};
+use crate::scene::{Light, Material, Scene, SurfaceHit};
+use std::f32::consts::PI;
+
+/// The BSDF of CGPP listing 15.19: Lambertian plus normalized Blinn-Phong,
+/// `f = k_L / pi + k_G (s + 8) / (8 pi) max(0, n.h)^s`. The glossy lobe is
+/// skipped when k_G = 0.
+#[inline]
+pub fn bsdf(material: &Material, albedo: Vec3, n: Vec3, w_i: Vec3, w_o: Vec3) -> Vec3 {
+    let mut f = albedo * (1.0 / PI);
+    if material.has_glossy() {
+        let w_h = (w_i + w_o).normalize_or_zero();
+        let s = material.sharpness;
+        f += material.glossy * ((s + 8.0) / (8.0 * PI) * n.dot(w_h).max(0.0).powf(s));
+    }
+    f
+}
+
+/// Outgoing radiance towards `w_o` (unit, pointing away from the surface) at `hit`.
+pub fn shade<Q: SceneQuery, R: Recorder>(
+    scene: &Scene,
+    query: &Q,
+    settings: &RenderSettings,
+    hit: &SurfaceHit,
+    w_o: Vec3,
+    depth: u32,
+    counts: &mut RayCounts,
+    rec: &mut R,
+) -> Radiance {
+    let material = &scene.materials[hit.material as usize];
+    let n = hit.shading_normal;
+    let p = hit.position;
+    let albedo = material.albedo(hit.uv);
+    let mut l_o = albedo * scene.render.ambient;
+
+    for (index, light) in scene.lights.iter().enumerate() {
+        let (w_i, distance, incident) = match *light {
+            Light::Point { position, power } => {
+                let offset = position - p;
+                let d = offset.length();
+                if d <= 0.0 {
+                    continue;
+                }
+                (offset / d, d, power / (4.0 * PI * d * d))
+            }
+            Light::Directional { direction, irradiance } => (-direction, f32::INFINITY, irradiance),
+        };
+        let cos_theta = w_i.dot(n);
+        if cos_theta <= 0.0 || incident == Vec3::ZERO {
+            if R::ENABLED {
+                rec.light(LightSample { light: index, w_i, distance, incident, cos_theta, shadow_ray: None, blocker: None, bsdf: Vec3::ZERO, contribution: Vec3::ZERO });
+            }
+            continue;
+        }
+        let mut shadow_ray = None;
+        let mut blocker = None;
+        if settings.shadows == ShadowMode::Ray {
+            // CGPP listing 15.20: start a little along the ray so it does not re-hit P.
+            let eps = settings.shadow_bump;
+            let ray = Ray::new(p + w_i * eps, w_i);
+            let t_max = distance - eps;
+            counts.shadow += 1;
+            rec.in_shadow_ray(true);
+            rec.ray(&ray, t_max, depth + 1);
+            blocker = query.occluder(&ray, t_max, counts, rec);
+            rec.in_shadow_ray(false);
+            shadow_ray = Some((ray, t_max));
+        }
+        let f = bsdf(material, albedo, n, w_i, w_o);
+        let contribution = if blocker.is_some() { Vec3::ZERO } else { incident * f * cos_theta };
+        l_o += contribution;
+        if R::ENABLED {
+            rec.light(LightSample { light: index, w_i, distance, incident, cos_theta, shadow_ray, blocker, bsdf: f, contribution });
+        }
+    }
+
+    if material.has_secondary() && depth < settings.max_depth {
+        l_o += secondary(scene, query, settings, hit, material, w_o, depth, counts, rec);
+    }
+    rec.shaded(depth, l_o);
+    l_o
+}
+
+/// Perfect mirror reflection and Fresnel-weighted refraction.
+fn secondary<Q: SceneQuery, R: Recorder>(
+    scene: &Scene,
+    query: &Q,
+    settings: &RenderSettings,
+    hit: &SurfaceHit,
+    material: &Material,
+    w_o: Vec3,
+    depth: u32,
+    counts: &mut RayCounts,
+    rec: &mut R,
+) -> Radiance {
+    let n = hit.geometric_normal;
+    let cos_o = w_o.dot(n).clamp(-1.0, 1.0);
+    let reflect_dir = (2.0 * cos_o * n - w_o).normalize();
+    let mut reflect_weight = material.mirror;
+    let mut result = Vec3::ZERO;
+    if material.transmission != Vec3::ZERO {
+        // Entering when the front side faces us (spheres flip `back_face` inside).
+        let (eta_i, eta_t) = if hit.back_face { (material.ior, 1.0) } else { (1.0, material.ior) };
+        let eta = eta_i / eta_t;
+        let sin2_t = eta * eta * (1.0 - cos_o * cos_o).max(0.0);
+        // Schlick's approximation of the Fresnel reflectance.
+        let r0 = ((eta_i - eta_t) / (eta_i + eta_t)).powi(2);
+        let fresnel = if sin2_t >= 1.0 { 1.0 } else { r0 + (1.0 - r0) * (1.0 - cos_o.abs()).powi(5) };
+        reflect_weight += material.transmission * fresnel;
+        if sin2_t < 1.0 {
+            let cos_t = (1.0 - sin2_t).sqrt();
+            let dir = (-w_o * eta + n * (eta * cos_o - cos_t)).normalize();
+            let ray = Ray::new(hit.position - n * settings.shadow_bump, dir);
+            result += material.transmission * (1.0 - fresnel) * trace(scene, query, settings, &ray, depth + 1, true, counts, rec);
+        }
+    }
+    if reflect_weight != Vec3::ZERO {
+        let ray = Ray::new(hit.position + n * settings.shadow_bump, reflect_dir);
+        result += reflect_weight * trace(scene, query, settings, &ray, depth + 1, false, counts, rec);
+    }
+    result
+}
+
+/// Radiance along a secondary ray: closest hit, then `shade()`; the background on a miss.
+#[allow(clippy::too_many_arguments)]
+pub fn trace<Q: SceneQuery, R: Recorder>(
+    scene: &Scene,
+    query: &Q,
+    settings: &RenderSettings,
+    ray: &Ray,
+    depth: u32,
+    inside: bool,
+    counts: &mut RayCounts,
+    rec: &mut R,
+) -> Radiance {
+    counts.secondary += 1;
+    rec.ray(ray, f32::INFINITY, depth);
+    let hit = query.closest(ray, f32::INFINITY, inside, counts, rec);
+    rec.closest(hit.as_ref());
+    match hit {
+        Some(h) => shade(scene, query, settings, &h, -ray.dir, depth, counts, rec),
+        None => scene.render.background,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lambertian_is_albedo_over_pi() {
+        let mut m = Material::black();
+        m.lambertian = Vec3::new(0.5, 0.25, 1.0);
+        let f = bsdf(&m, m.lambertian, Vec3::Z, Vec3::Z, Vec3::X);
+        assert!((f - m.lambertian / PI).length() < 1e-7);
+    }
+
+    #[test]
+    fn blinn_phong_peak_by_hand() {
+        // At the mirror direction n.h = 1: f = k_G (s + 8) / (8 pi).
+        let mut m = Material::black();
+        m.glossy = Vec3::splat(0.2);
+        m.sharpness = 100.0;
+        let w = Vec3::new(0.0, 0.6, 0.8);
+        let w_o = Vec3::new(0.0, -0.6, 0.8);
+        let f = bsdf(&m, Vec3::ZERO, Vec3::Z, w, w_o);
+        assert!((f.x - 0.2 * 108.0 / (8.0 * PI)).abs() < 1e-5, "{f}");
+    }
+}

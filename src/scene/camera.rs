@@ -1,0 +1,279 @@
+//! The pinhole camera: eye rays for pixel positions and the inverse projection.
+//!
+//! Conventions (CGPP 15.4.1): the camera looks down its local -z, +y is up,
+//! pixel (x, y) has its centre at (x + 0.5, y + 0.5) with y growing downwards.
+//! Eye rays start on the near plane, so nothing nearer than `near` is seen by
+//! the ray tracer, just as the rasterizer's near-plane clip removes it.
+
+use crate::math::{Mat3, Ray, Vec2, Vec3};
+
+/// Which image edges the field of view spans.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Fov {
+    /// Full angle between the left and right image edges, degrees.
+    X(f32),
+    /// Full angle between the top and bottom image edges, degrees.
+    Y(f32),
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Camera {
+    pub eye: Vec3,
+    pub target: Vec3,
+    pub up: Vec3,
+    pub fov: Fov,
+    pub near: f32,
+    pub far: f32,
+}
+
+impl Default for Camera {
+    fn default() -> Self {
+        Camera {
+            eye: Vec3::ZERO,
+            target: Vec3::new(0.0, 0.0, -1.0),
+            up: Vec3::Y,
+            fov: Fov::Y(60.0),
+            near: 0.1,
+            far: 100.0,
+        }
+    }
+}
+
+impl Camera {
+    /// Checks the camera can form an image; the message names the field at fault.
+    pub fn validate(&self) -> Result<(), String> {
+        for (name, v) in [("eye", self.eye), ("target", self.target), ("up", self.up)] {
+            if !crate::math::is_finite(v) {
+                return Err(format!("camera.{name} is not finite"));
+            }
+        }
+        let forward = self.target - self.eye;
+        if forward.length_squared() < 1e-20 {
+            return Err("camera.eye and camera.target are the same point".into());
+        }
+        if forward.normalize().cross(self.up).length_squared() < 1e-12 {
+            return Err("camera.up is parallel to the view direction".into());
+        }
+        let deg = match self.fov {
+            Fov::X(d) | Fov::Y(d) => d,
+        };
+        if !(deg > 0.0 && deg < 180.0) {
+            return Err(format!("camera field of view {deg} is not between 0 and 180 degrees"));
+        }
+        if !(self.near > 0.0 && self.near < self.far && self.far.is_finite()) {
+            return Err(format!(
+                "camera.near ({}) and camera.far ({}) must satisfy 0 < near < far",
+                self.near, self.far
+            ));
+        }
+        Ok(())
+    }
+
+    /// The view for one image size (aspect ratio fixes the other field of view).
+    pub fn view(&self, width: u32, height: u32) -> CameraView {
+        CameraView::new(self, width, height)
+    }
+}
+
+/// A camera fixed to one resolution, with everything per-frame precomputed.
+#[derive(Clone, Debug)]
+pub struct CameraView {
+    pub width: u32,
+    pub height: u32,
+    pub eye: Vec3,
+    /// Columns: camera x (right), y (up), z (backwards) in world space.
+    pub camera_to_world: Mat3,
+    pub world_to_camera: Mat3,
+    /// Half extents of the image at distance 1 in front of the eye: tan(fov / 2).
+    pub half_x: f32,
+    pub half_y: f32,
+    pub near: f32,
+    pub far: f32,
+}
+
+impl CameraView {
+    pub fn new(camera: &Camera, width: u32, height: u32) -> CameraView {
+        let forward = (camera.target - camera.eye).normalize();
+        let right = forward.cross(camera.up).normalize();
+        let up = right.cross(forward);
+        let camera_to_world = Mat3::from_cols(right, up, -forward);
+        let aspect = width as f32 / height as f32;
+        let (half_x, half_y) = match camera.fov {
+            Fov::X(deg) => {
+                let hx = (deg.to_radians() * 0.5).tan();
+                (hx, hx / aspect)
+            }
+            Fov::Y(deg) => {
+                let hy = (deg.to_radians() * 0.5).tan();
+                (hy * aspect, hy)
+            }
+        };
+        CameraView {
+            width,
+            height,
+            eye: camera.eye,
+            camera_to_world,
+            world_to_camera: camera_to_world.transpose(),
+            half_x,
+            half_y,
+            near: camera.near,
+            far: camera.far,
+        }
+    }
+
+    /// Camera-space direction (z = -1) through the image position `(px, py)`
+    /// in pixels (pixel centres are at +0.5).
+    pub fn camera_dir(&self, px: f32, py: f32) -> Vec3 {
+        let sx = (2.0 * px / self.width as f32 - 1.0) * self.half_x;
+        let sy = (1.0 - 2.0 * py / self.height as f32) * self.half_y;
+        Vec3::new(sx, sy, -1.0)
+    }
+
+    /// The eye ray through image position `(px, py)`, starting on the near plane.
+    pub fn eye_ray(&self, px: f32, py: f32) -> Ray {
+        let d = self.camera_dir(px, py);
+        let origin = self.eye + self.camera_to_world * (d * self.near);
+        Ray::new(origin, (self.camera_to_world * d).normalize())
+    }
+
+    /// The ray parameter at which an eye ray through `(px, py)` reaches the far plane.
+    pub fn far_t(&self, px: f32, py: f32) -> f32 {
+        (self.far - self.near) * self.camera_dir(px, py).length()
+    }
+
+    pub fn to_camera(&self, world: Vec3) -> Vec3 {
+        self.world_to_camera * (world - self.eye)
+    }
+
+    /// Distance along the view axis (camera -z) of a world point.
+    pub fn view_depth(&self, world: Vec3) -> f32 {
+        -self.to_camera(world).z
+    }
+
+    /// Projects a camera-space point with z < 0 to image position (pixels) .
+    pub fn project_camera(&self, c: Vec3) -> Vec2 {
+        let inv = 1.0 / -c.z;
+        Vec2::new(
+            (c.x * inv / self.half_x + 1.0) * 0.5 * self.width as f32,
+            (1.0 - c.y * inv / self.half_y) * 0.5 * self.height as f32,
+        )
+    }
+
+    /// Projects a world point to image position and view depth; `None` when
+    /// the point is not in front of the near plane.
+    pub fn project(&self, world: Vec3) -> Option<(Vec2, f32)> {
+        let c = self.to_camera(world);
+        if -c.z < self.near {
+            return None;
+        }
+        Some((self.project_camera(c), -c.z))
+    }
+
+    /// Unit world-space view direction (camera -z).
+    pub fn forward(&self) -> Vec3 {
+        -self.camera_to_world.z_axis
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn book_camera() -> CameraView {
+        // CGPP 15.3.4: at the origin, looking down -z, 90 degree horizontal fov, 800x500.
+        let cam = Camera { fov: Fov::X(90.0), near: 0.1, far: 100.0, ..Camera::default() };
+        cam.view(800, 500)
+    }
+
+    #[test]
+    fn centre_pixel_ray_looks_down_minus_z() {
+        let v = book_camera();
+        let r = v.eye_ray(400.0, 250.0);
+        assert!((r.dir - Vec3::new(0.0, 0.0, -1.0)).length() < 1e-6);
+        assert!((r.origin - Vec3::new(0.0, 0.0, -0.1)).length() < 1e-6);
+    }
+
+    #[test]
+    fn pixel_zero_zero_by_hand() {
+        // Pixel (0, 0) centre (0.5, 0.5): s = 2 tan 45 = 2, aspect 500/800.
+        // x = (0.5/800 - 0.5) * 2 = -0.99875, y = -(0.5/500 - 0.5) * 2 * 0.625 = 0.62375.
+        let v = book_camera();
+        let r = v.eye_ray(0.5, 0.5);
+        let d = Vec3::new(-0.99875, 0.62375, -1.0);
+        assert!((r.dir - d.normalize()).length() < 1e-6, "{:?}", r.dir);
+        assert!((r.origin - d * 0.1).length() < 1e-6, "{:?}", r.origin);
+    }
+
+    #[test]
+    fn last_pixel_is_mirror_of_first() {
+        let v = book_camera();
+        let a = v.eye_ray(0.5, 0.5).dir;
+        let b = v.eye_ray(799.5, 499.5).dir;
+        assert!((a + Vec3::new(b.x, b.y, -b.z)).length() < 1e-6);
+    }
+
+    #[test]
+    fn fov_y_sets_vertical_edges() {
+        let cam = Camera { fov: Fov::Y(90.0), ..Camera::default() };
+        let v = cam.view(200, 100);
+        // Top edge of the image at 45 degrees above the axis.
+        let r = v.eye_ray(100.0, 0.0);
+        assert!((r.dir.y / -r.dir.z - 1.0).abs() < 1e-6);
+        // Horizontal extent follows the 2:1 aspect.
+        let r = v.eye_ray(200.0, 50.0);
+        assert!((r.dir.x / -r.dir.z - 2.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn projection_inverts_eye_ray() {
+        let cam = Camera {
+            eye: Vec3::new(1.0, 2.0, 3.0),
+            target: Vec3::new(-1.0, 0.5, -2.0),
+            up: Vec3::Y,
+            fov: Fov::Y(40.0),
+            near: 0.05,
+            far: 50.0,
+        };
+        let v = cam.view(640, 360);
+        for &(px, py) in &[(0.5, 0.5), (320.0, 180.0), (600.25, 17.75), (12.0, 359.0)] {
+            let r = v.eye_ray(px, py);
+            let p = r.at(7.0);
+            let (q, depth) = v.project(p).unwrap();
+            assert!((q - Vec2::new(px, py)).length() < 2e-3, "{q:?} vs {px},{py}");
+            assert!((depth - v.view_depth(p)).abs() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn project_by_hand() {
+        // A point on the axis at depth 2 lands at the image centre; a point at
+        // x = 2 (the 45 degree edge at depth 2) lands on the right edge.
+        let v = book_camera();
+        let (q, d) = v.project(Vec3::new(0.0, 0.0, -2.0)).unwrap();
+        assert_eq!((q, d), (Vec2::new(400.0, 250.0), 2.0));
+        let (q, _) = v.project(Vec3::new(2.0, 0.0, -2.0)).unwrap();
+        assert!((q.x - 800.0).abs() < 1e-4);
+        assert!(v.project(Vec3::new(0.0, 0.0, -0.05)).is_none());
+    }
+
+    #[test]
+    fn far_t_reaches_far_plane() {
+        let v = book_camera();
+        let r = v.eye_ray(10.5, 20.5);
+        let p = r.at(v.far_t(10.5, 20.5));
+        assert!((v.view_depth(p) - 100.0).abs() < 1e-3);
+    }
+
+    #[test]
+    fn validate_rejects_bad_cameras() {
+        let mut c = Camera::default();
+        c.near = 0.0;
+        assert!(c.validate().unwrap_err().contains("near"));
+        let mut c = Camera::default();
+        c.up = Vec3::new(0.0, 0.0, 1.0);
+        assert!(c.validate().unwrap_err().contains("up"));
+        let mut c = Camera::default();
+        c.eye.x = f32::NAN;
+        assert!(c.validate().unwrap_err().contains("eye"));
+    }
+}

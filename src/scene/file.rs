@@ -1,0 +1,505 @@
+//! Scene files (SCENE_FORMAT.md): TOML parsed with serde into plain
+//! descriptions, then checked and turned into a `Scene`. Every error names the
+//! file, the line and the key or table at fault.
+
+use super::{obj, Camera, Fov, Light, Material, ObjectInfo, RenderDefaults, Scene, Sphere, Triangle};
+use crate::math::{Vec2, Vec3};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use toml::Spanned;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SceneDesc {
+    camera: Option<Spanned<CameraDesc>>,
+    render: Option<Spanned<RenderDesc>>,
+    #[serde(default)]
+    light: Vec<Spanned<LightDesc>>,
+    #[serde(default)]
+    materials: BTreeMap<String, Spanned<MaterialDesc>>,
+    #[serde(default)]
+    object: Vec<Spanned<ObjectDesc>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CameraDesc {
+    eye: Option<[f32; 3]>,
+    target: Option<[f32; 3]>,
+    up: Option<[f32; 3]>,
+    fov_y_deg: Option<f32>,
+    fov_x_deg: Option<f32>,
+    near: Option<f32>,
+    far: Option<f32>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RenderDesc {
+    width: Option<i64>,
+    height: Option<i64>,
+    background: Option<[f32; 3]>,
+    ambient: Option<[f32; 3]>,
+    exposure: Option<f32>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LightDesc {
+    #[serde(rename = "type")]
+    kind: String,
+    position: Option<[f32; 3]>,
+    power: Option<[f32; 3]>,
+    direction: Option<[f32; 3]>,
+    irradiance: Option<[f32; 3]>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MaterialDesc {
+    lambertian: Option<[f32; 3]>,
+    glossy: Option<[f32; 3]>,
+    sharpness: Option<f32>,
+    mirror: Option<[f32; 3]>,
+    transmission: Option<[f32; 3]>,
+    ior: Option<f32>,
+    texture: Option<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum ScaleDesc {
+    Uniform(f32),
+    PerAxis([f32; 3]),
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ObjectDesc {
+    #[serde(rename = "type")]
+    kind: String,
+    file: Option<String>,
+    normals: Option<Normals>,
+    material: Option<String>,
+    two_sided: Option<bool>,
+    translate: Option<[f32; 3]>,
+    rotate_deg: Option<[f32; 3]>,
+    scale: Option<ScaleDesc>,
+    vertices: Option<Vec<[f32; 3]>>,
+    uvs: Option<Vec<[f32; 2]>>,
+    center: Option<[f32; 3]>,
+    radius: Option<f32>,
+    // `normals` for triangles is a list of vectors; meshes use the mode string.
+}
+
+/// How a mesh gets its shading normals.
+#[derive(Deserialize, Clone, Copy, Debug, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum NormalMode {
+    /// The file's normals, else smooth.
+    Auto,
+    Smooth,
+    Flat,
+}
+
+/// `normals` is a mode string on meshes and a list of three vectors on triangles.
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum Normals {
+    Mode(NormalMode),
+    PerVertex(Vec<[f32; 3]>),
+}
+
+/// Reads and parses a scene file from disk.
+pub fn load_scene_file(path: &Path) -> Result<Scene, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: cannot read scene file: {e}", path.display()))?;
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
+    parse_scene(&text, &path.display().to_string(), &base, &name)
+}
+
+/// Parses scene TOML. `origin` names the source in messages; `base` resolves
+/// relative paths.
+pub fn parse_scene(text: &str, origin: &str, base: &Path, name: &str) -> Result<Scene, String> {
+    let desc: SceneDesc = toml::from_str(text).map_err(|e| toml_error(origin, text, &e))?;
+    let at = |span: std::ops::Range<usize>| format!("{origin}:{}", line_of(text, span.start));
+    let mut scene = Scene { name: name.to_string(), ..Scene::default() };
+
+    if let Some(cam) = &desc.camera {
+        let c = cam.get_ref();
+        let where_ = at(cam.span());
+        let fov = match (c.fov_x_deg, c.fov_y_deg) {
+            (Some(_), Some(_)) => return Err(format!("{where_}: [camera] gives both fov_x_deg and fov_y_deg; give one")),
+            (Some(x), None) => Fov::X(x),
+            (None, Some(y)) => Fov::Y(y),
+            (None, None) => Fov::Y(60.0),
+        };
+        let d = Camera::default();
+        scene.camera = Camera {
+            eye: c.eye.map(Vec3::from).unwrap_or(d.eye),
+            target: c.target.map(Vec3::from).unwrap_or(d.target),
+            up: c.up.map(Vec3::from).unwrap_or(d.up),
+            fov,
+            near: c.near.unwrap_or(d.near),
+            far: c.far.unwrap_or(d.far),
+        };
+        scene.camera.validate().map_err(|e| format!("{where_}: {e}"))?;
+    }
+
+    if let Some(r) = &desc.render {
+        let where_ = at(r.span());
+        let r = r.get_ref();
+        let d = RenderDefaults::default();
+        let dim = |v: Option<i64>, key: &str, def: u32| -> Result<u32, String> {
+            match v {
+                None => Ok(def),
+                Some(n) if (1..=16384).contains(&n) => Ok(n as u32),
+                Some(n) => Err(format!("{where_}: render.{key} = {n} is not between 1 and 16384")),
+            }
+        };
+        scene.render = RenderDefaults {
+            width: dim(r.width, "width", d.width)?,
+            height: dim(r.height, "height", d.height)?,
+            background: color(r.background, d.background, &where_, "render.background")?,
+            ambient: color(r.ambient, d.ambient, &where_, "render.ambient")?,
+            exposure: r.exposure.unwrap_or(d.exposure),
+        };
+        if !(scene.render.exposure.is_finite() && scene.render.exposure >= 0.0) {
+            return Err(format!("{where_}: render.exposure must be a finite number >= 0"));
+        }
+    }
+
+    for (i, l) in desc.light.iter().enumerate() {
+        let where_ = format!("{}: light {}", at(l.span()), i + 1);
+        let l = l.get_ref();
+        let light = match l.kind.as_str() {
+            "point" => {
+                reject(&where_, "point light", &[("direction", l.direction.is_some()), ("irradiance", l.irradiance.is_some())])?;
+                Light::Point {
+                    position: finite(l.position, &where_, "position")?.ok_or(format!("{where_}: a point light needs `position`"))?,
+                    power: color(l.power, Vec3::ZERO, &where_, "power")?,
+                }
+            }
+            "directional" => {
+                reject(&where_, "directional light", &[("position", l.position.is_some()), ("power", l.power.is_some())])?;
+                let dir = finite(l.direction, &where_, "direction")?.ok_or(format!("{where_}: a directional light needs `direction`"))?;
+                if dir.length_squared() < 1e-20 {
+                    return Err(format!("{where_}: direction must not be zero"));
+                }
+                Light::Directional { direction: dir.normalize(), irradiance: color(l.irradiance, Vec3::ZERO, &where_, "irradiance")? }
+            }
+            other => return Err(format!("{where_}: unknown light type \"{other}\" (expected \"point\" or \"directional\")")),
+        };
+        scene.lights.push(light);
+    }
+
+    for (mat_name, m) in &desc.materials {
+        let where_ = format!("{}: material \"{mat_name}\"", at(m.span()));
+        let m = m.get_ref();
+        let mut mat = Material::black();
+        mat.name = mat_name.clone();
+        mat.lambertian = color(m.lambertian, Vec3::ZERO, &where_, "lambertian")?;
+        mat.glossy = color(m.glossy, Vec3::ZERO, &where_, "glossy")?;
+        mat.mirror = color(m.mirror, Vec3::ZERO, &where_, "mirror")?;
+        mat.transmission = color(m.transmission, Vec3::ZERO, &where_, "transmission")?;
+        mat.sharpness = m.sharpness.unwrap_or(100.0);
+        if !(mat.sharpness.is_finite() && mat.sharpness >= 0.0) {
+            return Err(format!("{where_}: sharpness must be a finite number >= 0"));
+        }
+        mat.ior = m.ior.unwrap_or(1.5);
+        if !(mat.ior.is_finite() && mat.ior > 0.0) {
+            return Err(format!("{where_}: ior must be a finite number > 0"));
+        }
+        if let Some(tex) = &m.texture {
+            mat.texture = Some(Arc::new(load_texture(&base.join(tex)).map_err(|e| format!("{where_}: texture: {e}"))?));
+        }
+        scene.materials.push(mat);
+    }
+
+    for (i, o) in desc.object.iter().enumerate() {
+        let where_ = format!("{}: object {}", at(o.span()), i + 1);
+        add_object(&mut scene, o.get_ref(), i as u32, &where_, base)?;
+    }
+    Ok(scene)
+}
+
+fn add_object(scene: &mut Scene, o: &ObjectDesc, object: u32, where_: &str, base: &Path) -> Result<(), String> {
+    let two_sided = o.two_sided.unwrap_or(false);
+    let placement = placement(o, where_)?;
+    let explicit_material = match &o.material {
+        Some(name) => Some(
+            scene
+                .materials
+                .iter()
+                .position(|m| &m.name == name)
+                .ok_or(format!("{where_}: material \"{name}\" is not defined in [materials]"))? as u32,
+        ),
+        None => None,
+    };
+    let first = scene.triangles.len();
+    let kind = o.kind.as_str();
+    let only = |allowed: &[&str]| -> Result<(), String> {
+        let present = [
+            ("file", o.file.is_some()),
+            ("normals", o.normals.is_some()),
+            ("vertices", o.vertices.is_some()),
+            ("uvs", o.uvs.is_some()),
+            ("center", o.center.is_some()),
+            ("radius", o.radius.is_some()),
+        ];
+        for (key, here) in present {
+            if here && !allowed.contains(&key) {
+                return Err(format!("{where_}: `{key}` is not a key of a {kind} object"));
+            }
+        }
+        Ok(())
+    };
+    match kind {
+        "mesh" => {
+            only(&["file", "normals"])?;
+            let file = o.file.as_ref().ok_or(format!("{where_}: a mesh needs `file`"))?;
+            let mode = match &o.normals {
+                None => NormalMode::Auto,
+                Some(Normals::Mode(m)) => *m,
+                Some(Normals::PerVertex(_)) => return Err(format!("{where_}: mesh `normals` must be \"auto\", \"smooth\" or \"flat\"")),
+            };
+            let path = base.join(file);
+            let loaded = obj::load_obj(&path, mode).map_err(|e| format!("{where_}: {e}"))?;
+            if loaded.degenerate > 0 {
+                scene.warnings.push(format!("{}: skipped {} triangles with zero area", path.display(), loaded.degenerate));
+            }
+            // MTL materials are added under "<file>/<name>" so they never clash with the scene's.
+            let mut mtl_index = Vec::new();
+            for m in loaded.materials {
+                scene.materials.push(m);
+                mtl_index.push((scene.materials.len() - 1) as u32);
+            }
+            let fallback = match explicit_material {
+                Some(m) => m,
+                None => scene.default_material_index(),
+            };
+            for mut t in loaded.triangles {
+                t.material = match (explicit_material, t.material) {
+                    (Some(m), _) => m,
+                    (None, u32::MAX) => fallback,
+                    (None, k) => mtl_index[k as usize],
+                };
+                t.object = object;
+                t.two_sided = two_sided;
+                scene.triangles.push(placement.apply(t));
+            }
+        }
+        "triangle" | "quad" => {
+            only(&["vertices", "normals", "uvs"])?;
+            let count = if kind == "triangle" { 3 } else { 4 };
+            let vs = o.vertices.as_ref().ok_or(format!("{where_}: a {kind} needs `vertices`"))?;
+            if vs.len() != count {
+                return Err(format!("{where_}: a {kind} needs {count} vertices, found {}", vs.len()));
+            }
+            let vs: Vec<Vec3> = vs.iter().map(|v| Vec3::from(*v)).collect();
+            if vs.iter().any(|v| !crate::math::is_finite(*v)) {
+                return Err(format!("{where_}: vertices must be finite numbers"));
+            }
+            let ns: Option<Vec<Vec3>> = match &o.normals {
+                None => None,
+                Some(Normals::PerVertex(ns)) if ns.len() == count => {
+                    let ns: Vec<Vec3> = ns.iter().map(|n| Vec3::from(*n)).collect();
+                    if ns.iter().any(|n| !crate::math::is_finite(*n) || n.length_squared() < 1e-20) {
+                        return Err(format!("{where_}: normals must be finite, non-zero vectors"));
+                    }
+                    Some(ns.into_iter().map(Vec3::normalize).collect())
+                }
+                Some(_) => return Err(format!("{where_}: `normals` of a {kind} must be {count} vectors")),
+            };
+            let uvs: Option<Vec<Vec2>> = match &o.uvs {
+                None => None,
+                Some(uvs) if uvs.len() == count => Some(uvs.iter().map(|u| Vec2::from(*u)).collect()),
+                Some(_) => return Err(format!("{where_}: `uvs` of a {kind} must be {count} pairs")),
+            };
+            let material = match explicit_material {
+                Some(m) => m,
+                None => scene.default_material_index(),
+            };
+            let corners: &[[usize; 3]] = if count == 3 { &[[0, 1, 2]] } else { &[[0, 1, 2], [0, 2, 3]] };
+            for c in corners {
+                let v = [vs[c[0]], vs[c[1]], vs[c[2]]];
+                let geo = (v[1] - v[0]).cross(v[2] - v[0]);
+                if !(geo.length() > 0.0) {
+                    return Err(format!("{where_}: the {kind} has zero area (its vertices are collinear)"));
+                }
+                let geo = geo.normalize();
+                let t = Triangle {
+                    v,
+                    n: ns.as_ref().map(|n| [n[c[0]], n[c[1]], n[c[2]]]).unwrap_or([geo; 3]),
+                    uv: uvs.as_ref().map(|u| [u[c[0]], u[c[1]], u[c[2]]]).unwrap_or([Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0), Vec2::new(if count == 3 { 0.0 } else { 1.0 }, 1.0)]),
+                    material,
+                    object,
+                    two_sided,
+                };
+                scene.triangles.push(placement.apply(t));
+            }
+        }
+        "sphere" => {
+            only(&["center", "radius"])?;
+            let center = finite(o.center, where_, "center")?.ok_or(format!("{where_}: a sphere needs `center`"))?;
+            let radius = o.radius.ok_or(format!("{where_}: a sphere needs `radius`"))?;
+            if !(radius.is_finite() && radius > 0.0) {
+                return Err(format!("{where_}: radius must be a finite number > 0, found {radius}"));
+            }
+            let material = match explicit_material {
+                Some(m) => m,
+                None => scene.default_material_index(),
+            };
+            // A sphere stays analytic, so only uniform scale keeps it a sphere.
+            let (center, radius) = placement.apply_sphere(center, radius).map_err(|e| format!("{where_}: {e}"))?;
+            scene.spheres.push(Sphere { center, radius, material, object });
+        }
+        other => return Err(format!("{where_}: unknown object type \"{other}\" (expected mesh, triangle, quad or sphere)")),
+    }
+    let name = match (&o.file, kind) {
+        (Some(f), _) => Path::new(f).file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default(),
+        (None, k) => format!("{k} {}", object + 1),
+    };
+    scene.objects.push(ObjectInfo { name, kind: kind.to_string(), triangles: first..scene.triangles.len() });
+    Ok(())
+}
+
+/// Object placement: scale, then rotate about X, Y, Z, then translate.
+pub struct Placement {
+    matrix: glam::Mat4,
+    normal_matrix: glam::Mat3,
+    uniform_scale: Option<f32>,
+    identity: bool,
+}
+
+impl Placement {
+    pub fn new(translate: Vec3, rotate_deg: Vec3, scale: Vec3) -> Placement {
+        let rot = glam::Quat::from_rotation_z(rotate_deg.z.to_radians())
+            * glam::Quat::from_rotation_y(rotate_deg.y.to_radians())
+            * glam::Quat::from_rotation_x(rotate_deg.x.to_radians());
+        let matrix = glam::Mat4::from_scale_rotation_translation(scale, rot, translate);
+        let normal_matrix = glam::Mat3::from_mat4(matrix).inverse().transpose();
+        let uniform_scale = (scale.x == scale.y && scale.y == scale.z).then_some(scale.x);
+        let identity = translate == Vec3::ZERO && rotate_deg == Vec3::ZERO && scale == Vec3::ONE;
+        Placement { matrix, normal_matrix, uniform_scale, identity }
+    }
+
+    fn apply(&self, mut t: Triangle) -> Triangle {
+        if self.identity {
+            return t;
+        }
+        // A mirroring scale flips the winding; swap two corners to keep fronts in front.
+        let flips = self.matrix.determinant() < 0.0;
+        for k in 0..3 {
+            t.v[k] = self.matrix.transform_point3(t.v[k]);
+            t.n[k] = (self.normal_matrix * t.n[k]).normalize_or_zero();
+        }
+        if flips {
+            t.v.swap(1, 2);
+            t.n.swap(1, 2);
+            t.uv.swap(1, 2);
+        }
+        t
+    }
+
+    fn apply_sphere(&self, center: Vec3, radius: f32) -> Result<(Vec3, f32), String> {
+        match self.uniform_scale {
+            Some(s) => Ok((self.matrix.transform_point3(center), radius * s.abs())),
+            None => Err("a sphere's scale must be one number (non-uniform scale would not keep it a sphere)".into()),
+        }
+    }
+}
+
+fn placement(o: &ObjectDesc, where_: &str) -> Result<Placement, String> {
+    let translate = finite(o.translate, where_, "translate")?.unwrap_or(Vec3::ZERO);
+    let rotate = finite(o.rotate_deg, where_, "rotate_deg")?.unwrap_or(Vec3::ZERO);
+    let scale = match &o.scale {
+        None => Vec3::ONE,
+        Some(ScaleDesc::Uniform(s)) => Vec3::splat(*s),
+        Some(ScaleDesc::PerAxis(s)) => Vec3::from(*s),
+    };
+    if !crate::math::is_finite(scale) || scale.x * scale.y * scale.z == 0.0 {
+        return Err(format!("{where_}: scale must be finite and non-zero"));
+    }
+    Ok(Placement::new(translate, rotate, scale))
+}
+
+fn reject(where_: &str, what: &str, keys: &[(&str, bool)]) -> Result<(), String> {
+    match keys.iter().find(|(_, present)| *present) {
+        Some((key, _)) => Err(format!("{where_}: `{key}` is not a key of a {what}")),
+        None => Ok(()),
+    }
+}
+
+fn finite(v: Option<[f32; 3]>, where_: &str, key: &str) -> Result<Option<Vec3>, String> {
+    match v.map(Vec3::from) {
+        Some(v) if !crate::math::is_finite(v) => Err(format!("{where_}: `{key}` must be finite numbers, found {v}")),
+        other => Ok(other),
+    }
+}
+
+/// A radiance, power or reflectance: finite and not negative.
+fn color(v: Option<[f32; 3]>, default: Vec3, where_: &str, key: &str) -> Result<Vec3, String> {
+    let v = v.map(Vec3::from).unwrap_or(default);
+    if !crate::math::is_finite(v) || v.min_element() < 0.0 {
+        return Err(format!("{where_}: `{key}` must be finite and not negative, found {v}"));
+    }
+    Ok(v)
+}
+
+/// 1-based line of a byte offset.
+fn line_of(text: &str, offset: usize) -> usize {
+    text[..offset.min(text.len())].bytes().filter(|&b| b == b'\n').count() + 1
+}
+
+fn toml_error(origin: &str, text: &str, e: &toml::de::Error) -> String {
+    let msg = e.message().trim().replace('\n', " ");
+    match e.span() {
+        Some(span) => {
+            let line = line_of(text, span.start);
+            let snippet = text.lines().nth(line - 1).unwrap_or("").trim();
+            format!("{origin}:{line}: {msg} (in `{snippet}`)")
+        }
+        None => format!("{origin}: {msg}"),
+    }
+}
+
+/// Loads an 8-bit sRGB image (or a float EXR) into a linear texture.
+pub fn load_texture(path: &Path) -> Result<super::Texture, String> {
+    let bytes = super::builtin::read_asset(path).map_err(|e| format!("cannot read {e}"))?;
+    let img = image::load_from_memory(&bytes).map_err(|e| format!("cannot decode {}: {e}", path.display()))?;
+    let is_float = matches!(img, image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_));
+    let rgb = img.to_rgb32f();
+    let texels = rgb
+        .pixels()
+        .map(|p| {
+            let c = Vec3::new(p[0], p[1], p[2]);
+            if is_float { c } else { Vec3::new(srgb_to_linear(c.x), srgb_to_linear(c.y), srgb_to_linear(c.z)) }
+        })
+        .collect();
+    Ok(super::Texture { width: rgb.width(), height: rgb.height(), texels })
+}
+
+fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+}
+
+/// Where a scene argument points: a built-in name, a `.toml` or a bare `.obj`.
+pub fn load_scene(arg: &str) -> Result<Scene, String> {
+    let path = PathBuf::from(arg);
+    let is_obj = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
+    if is_obj {
+        return obj::frame_bare_obj(&path);
+    }
+    if path.exists() || arg.ends_with(".toml") || arg.contains('/') {
+        return load_scene_file(&path);
+    }
+    super::builtin::load_builtin(arg).ok_or_else(|| {
+        format!(
+            "\"{arg}\" is neither a scene file nor a built-in scene (built-in: {})",
+            super::builtin::names().join(", ")
+        )
+    })?
+}

@@ -1,0 +1,90 @@
+//! Materials: the terms of the scene format's BSDF, plus an optional texture.
+
+use crate::math::{Vec2, Vec3};
+use std::sync::Arc;
+
+pub const DEFAULT_MATERIAL: &str = "default";
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    pub name: String,
+    /// k_L: diffuse albedo; the BSDF term is k_L / pi.
+    pub lambertian: Vec3,
+    /// k_G: normalized Blinn-Phong lobe weight.
+    pub glossy: Vec3,
+    pub sharpness: f32,
+    pub mirror: Vec3,
+    pub transmission: Vec3,
+    pub ior: f32,
+    /// Multiplies `lambertian` when present (linear values, decoded from sRGB).
+    pub texture: Option<Arc<Texture>>,
+}
+
+impl Material {
+    pub fn default_grey() -> Material {
+        Material { name: DEFAULT_MATERIAL.into(), ..Material::black() }.with_lambertian(Vec3::splat(0.8))
+    }
+
+    /// All terms zero: the base that a scene file's entries fill in.
+    pub fn black() -> Material {
+        Material {
+            name: String::new(),
+            lambertian: Vec3::ZERO,
+            glossy: Vec3::ZERO,
+            sharpness: 100.0,
+            mirror: Vec3::ZERO,
+            transmission: Vec3::ZERO,
+            ior: 1.5,
+            texture: None,
+        }
+    }
+
+    fn with_lambertian(mut self, k: Vec3) -> Material {
+        self.lambertian = k;
+        self
+    }
+
+    pub fn has_glossy(&self) -> bool {
+        self.glossy != Vec3::ZERO
+    }
+
+    /// True when shading this material casts secondary rays.
+    pub fn has_secondary(&self) -> bool {
+        self.mirror != Vec3::ZERO || self.transmission != Vec3::ZERO
+    }
+
+    /// Diffuse albedo at a surface point (texture applied).
+    pub fn albedo(&self, uv: Vec2) -> Vec3 {
+        match &self.texture {
+            Some(t) => self.lambertian * t.sample(uv),
+            None => self.lambertian,
+        }
+    }
+}
+
+/// A linear-RGB texture, sampled bilinearly with wrapping.
+#[derive(Debug, PartialEq)]
+pub struct Texture {
+    pub width: u32,
+    pub height: u32,
+    pub texels: Vec<Vec3>,
+}
+
+impl Texture {
+    pub fn sample(&self, uv: Vec2) -> Vec3 {
+        let (w, h) = (self.width as i64, self.height as i64);
+        // v = 0 is the bottom row of the image (OBJ convention).
+        let x = uv.x * w as f32 - 0.5;
+        let y = (1.0 - uv.y) * h as f32 - 0.5;
+        if !(x.is_finite() && y.is_finite()) {
+            return Vec3::ZERO;
+        }
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let texel = |xi: i64, yi: i64| self.texels[(xi.rem_euclid(w) + yi.rem_euclid(h) * w) as usize];
+        let (xi, yi) = (x0 as i64, y0 as i64);
+        let top = texel(xi, yi).lerp(texel(xi + 1, yi), fx);
+        let bottom = texel(xi, yi + 1).lerp(texel(xi + 1, yi + 1), fx);
+        top.lerp(bottom, fy)
+    }
+}

@@ -1,0 +1,216 @@
+//! The scene model every renderer reads: world-space triangles and analytic
+//! spheres, lights, materials and the camera. Scene files are parsed into it
+//! by `file.rs`; meshes come from `obj.rs`; built-in scenes from `builtin.rs`.
+
+pub mod builtin;
+pub mod camera;
+pub mod file;
+pub mod material;
+pub mod obj;
+
+pub use camera::{Camera, CameraView, Fov};
+pub use material::{Material, Texture};
+
+use crate::math::{Ray, Vec2, Vec3};
+
+/// A light source. Point lights follow CGPP 15.4.5: `L_i = power / (4 pi d^2)`.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Light {
+    Point { position: Vec3, power: Vec3 },
+    /// `direction` is the unit direction the light travels.
+    Directional { direction: Vec3, irradiance: Vec3 },
+}
+
+/// One world-space triangle with its shading attributes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Triangle {
+    pub v: [Vec3; 3],
+    /// Unit shading normals per vertex (the geometric normal when the file has none).
+    pub n: [Vec3; 3],
+    pub uv: [Vec2; 3],
+    pub material: u32,
+    pub object: u32,
+    pub two_sided: bool,
+}
+
+impl Triangle {
+    /// `(v1 - v0) x (v2 - v0)`, normalized: the front side (CCW winding).
+    pub fn geometric_normal(&self) -> Vec3 {
+        (self.v[1] - self.v[0]).cross(self.v[2] - self.v[0]).normalize()
+    }
+
+    pub fn area(&self) -> f32 {
+        0.5 * (self.v[1] - self.v[0]).cross(self.v[2] - self.v[0]).length()
+    }
+}
+
+/// An analytic sphere: never tessellated.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sphere {
+    pub center: Vec3,
+    pub radius: f32,
+    pub material: u32,
+    pub object: u32,
+}
+
+/// What kind of primitive a hit or an id refers to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum PrimitiveKind {
+    Triangle,
+    Sphere,
+}
+
+/// One `[[object]]` of the scene file, for id views and the inspector.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ObjectInfo {
+    pub name: String,
+    pub kind: String,
+    /// Range of this object's triangles in `Scene::triangles` (empty for spheres).
+    pub triangles: std::ops::Range<usize>,
+}
+
+/// Image and display settings from `[render]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderDefaults {
+    pub width: u32,
+    pub height: u32,
+    pub background: Vec3,
+    pub ambient: Vec3,
+    pub exposure: f32,
+}
+
+impl Default for RenderDefaults {
+    fn default() -> Self {
+        RenderDefaults {
+            width: 800,
+            height: 500,
+            background: Vec3::new(0.0, 0.0, 0.1),
+            ambient: Vec3::ZERO,
+            exposure: 1.0,
+        }
+    }
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct Scene {
+    /// A name to show and to build file names from (the file stem or built-in name).
+    pub name: String,
+    pub camera: Camera,
+    pub render: RenderDefaults,
+    pub lights: Vec<Light>,
+    pub materials: Vec<Material>,
+    pub triangles: Vec<Triangle>,
+    pub spheres: Vec<Sphere>,
+    pub objects: Vec<ObjectInfo>,
+    /// Things worth telling the user that did not stop the scene loading.
+    pub warnings: Vec<String>,
+}
+
+/// Everything a renderer found about the surface a sample sees. Renderers
+/// answer visibility only; `shade()` turns this into radiance (DESIGN.md
+/// principle 1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfaceHit {
+    pub position: Vec3,
+    /// Unit geometric normal, flipped towards the viewer on two-sided surfaces.
+    pub geometric_normal: Vec3,
+    /// Unit interpolated shading normal, flipped with the geometric one.
+    pub shading_normal: Vec3,
+    pub barycentric: Vec3,
+    pub uv: Vec2,
+    /// Ray parameter of the hit (distance from the ray origin, rays being unit).
+    pub t: f32,
+    pub kind: PrimitiveKind,
+    /// Index into `Scene::triangles` or `Scene::spheres`.
+    pub primitive: u32,
+    pub object: u32,
+    pub material: u32,
+    /// True when the surface was hit from its back (two-sided surfaces only).
+    pub back_face: bool,
+}
+
+impl Scene {
+    pub fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// World-space bounds of all geometry, `None` for an empty scene.
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for t in &self.triangles {
+            for v in t.v {
+                lo = lo.min(v);
+                hi = hi.max(v);
+            }
+        }
+        for s in &self.spheres {
+            lo = lo.min(s.center - Vec3::splat(s.radius));
+            hi = hi.max(s.center + Vec3::splat(s.radius));
+        }
+        (lo.x <= hi.x).then_some((lo, hi))
+    }
+
+    /// The surface record for a ray that hit triangle `index` with barycentric
+    /// weights `b` (of v0, v1, v2) at parameter `t`. Both the ray tracer and the
+    /// rasterizer build their hits here, so identical visibility gives identical
+    /// shading inputs.
+    pub fn triangle_hit(&self, index: u32, b: Vec3, t: f32, ray: &Ray) -> SurfaceHit {
+        let tri = &self.triangles[index as usize];
+        let position = tri.v[0] * b.x + tri.v[1] * b.y + tri.v[2] * b.z;
+        let mut geometric_normal = tri.geometric_normal();
+        let mut shading_normal = (tri.n[0] * b.x + tri.n[1] * b.y + tri.n[2] * b.z).normalize_or(geometric_normal);
+        let back_face = geometric_normal.dot(ray.dir) > 0.0;
+        if back_face {
+            geometric_normal = -geometric_normal;
+            shading_normal = -shading_normal;
+        }
+        SurfaceHit {
+            position,
+            geometric_normal,
+            shading_normal,
+            barycentric: b,
+            uv: tri.uv[0] * b.x + tri.uv[1] * b.y + tri.uv[2] * b.z,
+            t,
+            kind: PrimitiveKind::Triangle,
+            primitive: index,
+            object: tri.object,
+            material: tri.material,
+            back_face,
+        }
+    }
+
+    /// The surface record for a ray that hit sphere `index` at parameter `t`.
+    pub fn sphere_hit(&self, index: u32, t: f32, ray: &Ray) -> SurfaceHit {
+        let s = &self.spheres[index as usize];
+        let position = ray.at(t);
+        let outward = (position - s.center) / s.radius;
+        let back_face = outward.dot(ray.dir) > 0.0;
+        let n = if back_face { -outward } else { outward };
+        // Spherical uv: u around +y, v from the south pole up.
+        let u = 0.5 + outward.z.atan2(outward.x) * -0.5 * std::f32::consts::FRAC_1_PI;
+        let v = 0.5 + outward.y.clamp(-1.0, 1.0).asin() * std::f32::consts::FRAC_1_PI;
+        SurfaceHit {
+            position,
+            geometric_normal: n,
+            shading_normal: n,
+            barycentric: Vec3::ZERO,
+            uv: Vec2::new(u, v),
+            t,
+            kind: PrimitiveKind::Sphere,
+            primitive: index,
+            object: s.object,
+            material: s.material,
+            back_face,
+        }
+    }
+
+    /// A default grey Lambertian material, added on demand.
+    pub fn default_material_index(&mut self) -> u32 {
+        if let Some(i) = self.materials.iter().position(|m| m.name == material::DEFAULT_MATERIAL) {
+            return i as u32;
+        }
+        self.materials.push(Material::default_grey());
+        (self.materials.len() - 1) as u32
+    }
+}

@@ -1,0 +1,185 @@
+//! OBJ/MTL meshes through tobj, checked for bad data, and the automatic
+//! framing of a bare `.obj` given on the command line.
+//!
+//! MTL mapping: `Kd` -> lambertian, `Ks` -> glossy, `Ns` -> sharpness,
+//! `map_Kd` -> texture. Other MTL terms are ignored.
+
+use super::file::NormalMode;
+use super::{Camera, Fov, Light, Material, ObjectInfo, Scene, Triangle};
+use crate::math::{Vec2, Vec3};
+use std::path::Path;
+use std::sync::Arc;
+
+pub struct LoadedMesh {
+    /// `material` is an index into `materials`, or `u32::MAX` for "none given".
+    pub triangles: Vec<Triangle>,
+    pub materials: Vec<Material>,
+    /// Triangles dropped because they have no area.
+    pub degenerate: usize,
+}
+
+pub fn load_obj(path: &Path, mode: NormalMode) -> Result<LoadedMesh, String> {
+    let name = path.display();
+    let bytes = super::builtin::read_asset(path).map_err(|e| format!("cannot read OBJ {e}"))?;
+    let base = path.parent().unwrap_or(Path::new("."));
+    let options = tobj::LoadOptions { triangulate: true, single_index: false, ignore_points: true, ignore_lines: true };
+    let (models, mtl) = tobj::load_obj_buf(&mut std::io::Cursor::new(bytes), &options, |mtl_path| {
+        let data = super::builtin::read_asset(&base.join(mtl_path)).map_err(|_| tobj::LoadError::OpenFileFailed)?;
+        tobj::load_mtl_buf(&mut std::io::Cursor::new(data))
+    })
+    .map_err(|e| format!("{name}: cannot read OBJ: {e}"))?;
+    let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    let materials = match mtl {
+        Ok(ms) => ms
+            .iter()
+            .map(|m| {
+                let mut mat = Material::black();
+                mat.name = format!("{stem}/{}", m.name);
+                mat.lambertian = m.diffuse.map(Vec3::from).unwrap_or(Vec3::splat(0.8));
+                mat.glossy = m.specular.map(Vec3::from).unwrap_or(Vec3::ZERO);
+                mat.sharpness = m.shininess.unwrap_or(100.0);
+                if let Some(tex) = &m.diffuse_texture {
+                    mat.texture = Some(Arc::new(super::file::load_texture(&base.join(tex)).map_err(|e| format!("{name}: MTL {}: {e}", m.name))?));
+                }
+                if !crate::math::is_finite(mat.lambertian) || !crate::math::is_finite(mat.glossy) || !mat.sharpness.is_finite() {
+                    return Err(format!("{name}: MTL material {} has values that are not finite", m.name));
+                }
+                Ok(mat)
+            })
+            .collect::<Result<Vec<_>, String>>()?,
+        // A missing or broken MTL is not fatal: the mesh falls back to the default material.
+        Err(_) => Vec::new(),
+    };
+
+    let mut triangles = Vec::new();
+    let mut degenerate = 0;
+    for model in &models {
+        let m = &model.mesh;
+        let pos: Vec<Vec3> = m.positions.chunks_exact(3).map(|p| Vec3::new(p[0], p[1], p[2])).collect();
+        if let Some(i) = pos.iter().position(|p| !crate::math::is_finite(*p)) {
+            return Err(format!("{name}: vertex {} of \"{}\" is not finite", i + 1, model.name));
+        }
+        let normals: Vec<Vec3> = m.normals.chunks_exact(3).map(|p| Vec3::new(p[0], p[1], p[2])).collect();
+        let uvs: Vec<Vec2> = m.texcoords.chunks_exact(2).map(|p| Vec2::new(p[0], p[1])).collect();
+        let check = |idx: &[u32], len: usize, what: &str| -> Result<(), String> {
+            match idx.iter().find(|&&i| i as usize >= len) {
+                Some(i) => Err(format!("{name}: a face of \"{}\" uses {what} {} but the file has only {len}", model.name, i + 1)),
+                None => Ok(()),
+            }
+        };
+        check(&m.indices, pos.len(), "vertex")?;
+        let has_normals = !m.normal_indices.is_empty() && m.normal_indices.len() == m.indices.len();
+        let has_uvs = !m.texcoord_indices.is_empty() && m.texcoord_indices.len() == m.indices.len();
+        if has_normals {
+            check(&m.normal_indices, normals.len(), "normal")?;
+        }
+        if has_uvs {
+            check(&m.texcoord_indices, uvs.len(), "texture coordinate")?;
+        }
+        let use_file_normals = has_normals && mode == NormalMode::Auto;
+        let smooth = if mode == NormalMode::Smooth || (mode == NormalMode::Auto && !has_normals) {
+            Some(smooth_normals(&pos, &m.indices))
+        } else {
+            None
+        };
+        let material = m.material_id.map(|i| i as u32).filter(|&i| (i as usize) < materials.len()).unwrap_or(u32::MAX);
+        for (f, idx) in m.indices.chunks_exact(3).enumerate() {
+            let v = [pos[idx[0] as usize], pos[idx[1] as usize], pos[idx[2] as usize]];
+            let geo = (v[1] - v[0]).cross(v[2] - v[0]);
+            let len = geo.length();
+            // Skip triangles whose normal cannot be formed; they cover no area.
+            if !(len > 0.0) || !(geo / len).is_finite() {
+                degenerate += 1;
+                continue;
+            }
+            let geo = geo / len;
+            let corner = |k: usize| -> Vec3 {
+                if use_file_normals {
+                    normals[m.normal_indices[3 * f + k] as usize].normalize_or(geo)
+                } else if let Some(s) = &smooth {
+                    s[idx[k] as usize].normalize_or(geo)
+                } else {
+                    geo
+                }
+            };
+            let uv = |k: usize| if has_uvs { uvs[m.texcoord_indices[3 * f + k] as usize] } else { Vec2::ZERO };
+            triangles.push(Triangle {
+                v,
+                n: [corner(0), corner(1), corner(2)],
+                uv: [uv(0), uv(1), uv(2)],
+                material,
+                object: 0,
+                two_sided: false,
+            });
+        }
+    }
+    if triangles.is_empty() {
+        return Err(format!("{name}: the OBJ has no triangles with area"));
+    }
+    Ok(LoadedMesh { triangles, materials, degenerate })
+}
+
+/// Area-weighted vertex normals (the un-normalized face normal is already
+/// area-weighted).
+fn smooth_normals(pos: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
+    let mut acc = vec![Vec3::ZERO; pos.len()];
+    for idx in indices.chunks_exact(3) {
+        let (a, b, c) = (pos[idx[0] as usize], pos[idx[1] as usize], pos[idx[2] as usize]);
+        let n = (b - a).cross(c - a);
+        if n.is_finite() {
+            for &i in idx {
+                acc[i as usize] += n;
+            }
+        }
+    }
+    acc
+}
+
+/// A scene around a bare `.obj`: camera on +z looking at the bounding-box
+/// centre with the whole box in view, one point light above and behind it.
+pub fn frame_bare_obj(path: &Path) -> Result<Scene, String> {
+    let mesh = load_obj(path, NormalMode::Auto)?;
+    let mut scene = Scene {
+        name: path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "mesh".into()),
+        ..Scene::default()
+    };
+    scene.materials = mesh.materials;
+    let fallback = scene.default_material_index();
+    scene.triangles = mesh
+        .triangles
+        .into_iter()
+        .map(|mut t| {
+            if t.material == u32::MAX {
+                t.material = fallback;
+            }
+            t
+        })
+        .collect();
+    scene.objects.push(ObjectInfo { name: scene.name.clone(), kind: "mesh".into(), triangles: 0..scene.triangles.len() });
+    let (lo, hi) = scene.bounds().ok_or("the OBJ has no geometry")?;
+    frame_camera(&mut scene, lo, hi);
+    Ok(scene)
+}
+
+/// Points the camera at a bounding box from +z with the box in view, and adds
+/// a light above and behind the camera, strong enough to light the box.
+pub fn frame_camera(scene: &mut Scene, lo: Vec3, hi: Vec3) {
+    let center = (lo + hi) * 0.5;
+    let radius = ((hi - lo).length() * 0.5).max(1e-6);
+    let fov_y: f32 = 45.0;
+    let aspect = scene.render.width as f32 / scene.render.height as f32;
+    let half = (fov_y.to_radians() * 0.5).tan().min((fov_y.to_radians() * 0.5).tan() * aspect);
+    let distance = radius / half.atan().sin() * 1.05;
+    scene.camera = Camera {
+        eye: center + Vec3::new(0.0, 0.0, distance),
+        target: center,
+        up: Vec3::Y,
+        fov: Fov::Y(fov_y),
+        near: ((distance - radius) * 0.5).max(distance * 1e-3),
+        far: (distance + radius) * 2.0,
+    };
+    let light_pos = center + Vec3::new(0.5 * distance, 1.5 * distance, 1.2 * distance);
+    let d2 = (light_pos - center).length_squared();
+    // About irradiance 3 W/m^2 at the object: a well-exposed grey at exposure 1.
+    scene.lights.push(Light::Point { position: light_pos, power: Vec3::splat(3.0 * 4.0 * std::f32::consts::PI * d2) });
+}
