@@ -1,0 +1,129 @@
+//! Display and export: exposure and sRGB encoding happen here, once; inside
+//! the core everything is linear radiance. Files are written atomically
+//! (a temporary file in the same directory, then a rename).
+
+use crate::math::{Radiance, Vec3};
+use std::path::Path;
+
+/// sRGB transfer function (IEC 61966-2-1) of a linear value in [0, 1].
+pub fn linear_to_srgb(c: f32) -> f32 {
+    if c <= 0.003_130_8 { 12.92 * c } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 }
+}
+
+/// One pixel as displayed: exposure `d` (CGPP's display constant), clamp,
+/// then sRGB encoding (or plain scaling when `gamma` is off), 8 bits.
+pub fn display_pixel(c: Radiance, exposure: f32, gamma: bool) -> [u8; 3] {
+    let encode = |v: f32| {
+        let v = if v.is_finite() { (v * exposure).clamp(0.0, 1.0) } else { 0.0 };
+        let v = if gamma { linear_to_srgb(v) } else { v };
+        (v * 255.0 + 0.5) as u8
+    };
+    [encode(c.x), encode(c.y), encode(c.z)]
+}
+
+/// The whole image as 8-bit RGB, row-major.
+pub fn to_rgb8(pixels: &[Radiance], exposure: f32, gamma: bool) -> Vec<u8> {
+    pixels.iter().flat_map(|&c| display_pixel(c, exposure, gamma)).collect()
+}
+
+/// Writes `pixels` (width x height, linear) by the extension of `path`:
+/// `.png` (sRGB 8-bit with exposure), `.exr` (linear f32), `.ppm` (ASCII, sRGB 8-bit).
+pub fn save_image(path: &Path, width: u32, height: u32, pixels: &[Radiance], exposure: f32) -> Result<(), String> {
+    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).unwrap_or_default();
+    let bytes = match ext.as_str() {
+        "png" => encode_png(width, height, &to_rgb8(pixels, exposure, true))?,
+        "exr" => encode_exr(width, height, pixels)?,
+        "ppm" => encode_ppm(width, height, &to_rgb8(pixels, exposure, true)),
+        _ => return Err(format!("{}: unknown image type (use .png, .exr or .ppm)", path.display())),
+    };
+    write_atomic(path, &bytes)
+}
+
+pub fn encode_png(width: u32, height: u32, rgb8: &[u8]) -> Result<Vec<u8>, String> {
+    let img = image::RgbImage::from_raw(width, height, rgb8.to_vec()).ok_or("image buffer has the wrong size")?;
+    let mut out = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut out, image::ImageFormat::Png).map_err(|e| format!("cannot encode PNG: {e}"))?;
+    Ok(out.into_inner())
+}
+
+fn encode_exr(width: u32, height: u32, pixels: &[Radiance]) -> Result<Vec<u8>, String> {
+    let data: Vec<f32> = pixels.iter().flat_map(|c| [c.x, c.y, c.z]).collect();
+    let img = image::Rgb32FImage::from_raw(width, height, data).ok_or("image buffer has the wrong size")?;
+    let mut out = std::io::Cursor::new(Vec::new());
+    image::DynamicImage::ImageRgb32F(img)
+        .write_to(&mut out, image::ImageFormat::OpenExr)
+        .map_err(|e| format!("cannot encode EXR: {e}"))?;
+    Ok(out.into_inner())
+}
+
+fn encode_ppm(width: u32, height: u32, rgb8: &[u8]) -> Vec<u8> {
+    // Plain (ASCII) PPM, as CGPP listing 15.6 writes it.
+    let mut s = format!("P3\n{width} {height}\n255\n");
+    for row in rgb8.chunks(width as usize * 3) {
+        let line: Vec<String> = row.iter().map(|v| v.to_string()).collect();
+        s.push_str(&line.join(" "));
+        s.push('\n');
+    }
+    s.into_bytes()
+}
+
+/// Writes a file so that readers never see it half-written.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), String> {
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let name = path.file_name().ok_or_else(|| format!("{}: not a file name", path.display()))?;
+    let tmp = dir.join(format!(".{}.{}.tmp", name.to_string_lossy(), std::process::id()));
+    std::fs::write(&tmp, bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    std::fs::rename(&tmp, path).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        format!("cannot write {}: {e}", path.display())
+    })
+}
+
+/// A loaded image in linear radiance, for `compare` and the reference tests.
+pub struct LinearImage {
+    pub width: u32,
+    pub height: u32,
+    pub pixels: Vec<Radiance>,
+}
+
+/// Reads `.exr` as linear values and `.png`/`.ppm` as sRGB-encoded 8-bit (decoded to linear).
+pub fn load_image(path: &Path) -> Result<LinearImage, String> {
+    let img = image::open(path).map_err(|e| format!("cannot read image {}: {e}", path.display()))?;
+    let is_float = matches!(img, image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_));
+    let rgb = img.to_rgb32f();
+    let decode = |v: f32| if is_float { v } else if v <= 0.04045 { v / 12.92 } else { ((v + 0.055) / 1.055).powf(2.4) };
+    let pixels = rgb.pixels().map(|p| Vec3::new(decode(p[0]), decode(p[1]), decode(p[2]))).collect();
+    Ok(LinearImage { width: rgb.width(), height: rgb.height(), pixels })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn srgb_known_values() {
+        assert_eq!(display_pixel(Vec3::ZERO, 1.0, true), [0, 0, 0]);
+        assert_eq!(display_pixel(Vec3::ONE, 1.0, true), [255, 255, 255]);
+        // Linear 0.5 encodes to about 0.7354 -> 188.
+        assert_eq!(display_pixel(Vec3::splat(0.5), 1.0, true), [188, 188, 188]);
+        assert_eq!(display_pixel(Vec3::splat(0.5), 1.0, false), [128, 128, 128]);
+        // Exposure scales before encoding; NaN never reaches a pixel.
+        assert_eq!(display_pixel(Vec3::splat(0.25), 2.0, true), [188, 188, 188]);
+        assert_eq!(display_pixel(Vec3::new(f32::NAN, 2.0, -1.0), 1.0, true), [0, 255, 0]);
+    }
+
+    #[test]
+    fn exr_round_trips_linear_values() {
+        let dir = std::env::temp_dir().join(format!("pinhole-io-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let px = vec![Vec3::new(0.1, 2.5, 100.0), Vec3::new(0.0, 1e-3, 7.0)];
+        let path = dir.join("a.exr");
+        save_image(&path, 2, 1, &px, 1.0).unwrap();
+        let back = load_image(&path).unwrap();
+        assert_eq!(back.pixels, px);
+        let ppm = dir.join("a.ppm");
+        save_image(&ppm, 2, 1, &px, 1.0).unwrap();
+        assert!(std::fs::read_to_string(&ppm).unwrap().starts_with("P3\n2 1\n255\n"));
+        assert!(save_image(&dir.join("a.gif"), 2, 1, &px, 1.0).unwrap_err().contains("unknown image type"));
+    }
+}
