@@ -1,0 +1,71 @@
+//! Image error metrics between a test image and a reference, on linear values.
+
+use crate::math::Radiance;
+
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct ErrorMetrics {
+    /// Root mean squared error over all pixels and channels.
+    pub rmse: f64,
+    /// Mean of (a - b)^2 / (b^2 + 0.01): squared error relative to the reference.
+    pub rel_mse: f64,
+    /// Largest absolute channel difference.
+    pub max_abs: f64,
+    /// Mean radiance of the reference, to state rmse relative to it.
+    pub reference_mean: f64,
+    /// Pixels whose largest channel difference exceeds 1e-4 relative.
+    pub differing_pixels: u64,
+}
+
+/// Compares `test` against `reference` (same size, row-major linear RGB).
+pub fn compare(test: &[Radiance], reference: &[Radiance]) -> Result<ErrorMetrics, String> {
+    if test.len() != reference.len() {
+        return Err(format!("the images differ in size ({} vs {} pixels)", test.len(), reference.len()));
+    }
+    if test.is_empty() {
+        return Err("the images are empty".into());
+    }
+    let (mut se, mut rel, mut max_abs, mut mean) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    let mut differing = 0u64;
+    for (a, b) in test.iter().zip(reference) {
+        let mut differs = false;
+        for k in 0..3 {
+            let (x, y) = (a[k] as f64, b[k] as f64);
+            let d = x - y;
+            se += d * d;
+            rel += d * d / (y * y + 0.01);
+            max_abs = max_abs.max(d.abs());
+            mean += y;
+            if d.abs() > 1e-4 * y.abs().max(x.abs()).max(1e-3) {
+                differs = true;
+            }
+        }
+        differing += differs as u64;
+    }
+    let n = (test.len() * 3) as f64;
+    Ok(ErrorMetrics {
+        rmse: (se / n).sqrt(),
+        rel_mse: rel / n,
+        max_abs,
+        reference_mean: mean / n,
+        differing_pixels: differing,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    #[test]
+    fn by_hand() {
+        let a = vec![Vec3::new(1.0, 1.0, 1.0), Vec3::new(0.0, 0.0, 0.0)];
+        let b = vec![Vec3::new(1.0, 1.0, 1.0), Vec3::new(0.0, 0.0, 0.6)];
+        let m = compare(&a, &b).unwrap();
+        // One channel off by 0.6 of six: mse = 0.36 / 6 = 0.06.
+        assert!((m.rmse - 0.06f64.sqrt()).abs() < 1e-9);
+        assert!((m.max_abs - 0.6).abs() < 1e-6);
+        assert!((m.rel_mse - 0.36 / (0.36 + 0.01) / 6.0).abs() < 1e-6);
+        assert_eq!(m.differing_pixels, 1);
+        assert!(compare(&a, &b[..1]).is_err());
+    }
+}

@@ -3,7 +3,7 @@
 
 use super::{sample_offset, PassJob, PreparedScene, RayCounts, RenderSettings, Renderer};
 use crate::math::Radiance;
-use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, Ordering};
 
 pub struct FrameResult {
     pub width: u32,
@@ -23,6 +23,22 @@ pub fn render_frame(
     cancel: &AtomicBool,
     passes_done: Option<&AtomicU32>,
 ) -> Option<FrameResult> {
+    render_frame_in_bands(renderer, prepared, settings, cancel, passes_done, 1, None)
+}
+
+/// As `render_frame`, with each pass split into `bands` bands of rows so that
+/// `rows_done` can report progress within a pass (long reference renders).
+/// Splitting costs the rasterizers one setup per band, so frames that are
+/// timed use one band.
+pub fn render_frame_in_bands(
+    renderer: &dyn Renderer,
+    prepared: &PreparedScene,
+    settings: &RenderSettings,
+    cancel: &AtomicBool,
+    passes_done: Option<&AtomicU32>,
+    bands: u32,
+    rows_done: Option<&AtomicU64>,
+) -> Option<FrameResult> {
     let view = prepared.scene.camera.view(settings.width, settings.height);
     let n = (settings.width * settings.height) as usize;
     let mut sum = vec![Radiance::ZERO; n];
@@ -30,15 +46,23 @@ pub fn render_frame(
     let mut counts = RayCounts::default();
     let spp = settings.spp.max(1);
     for i in 0..spp {
-        let job = PassJob {
-            prepared,
-            view: &view,
-            settings,
-            offset: sample_offset(i, spp),
-            rows: 0..settings.height,
-            cancel,
-        };
-        counts += renderer.render_pass(&job, &mut pass);
+        let band_rows = settings.height.div_ceil(bands.clamp(1, settings.height.max(1)));
+        let width = settings.width as usize;
+        for (b, out) in pass.chunks_mut(band_rows as usize * width).enumerate() {
+            let y0 = b as u32 * band_rows;
+            let job = PassJob {
+                prepared,
+                view: &view,
+                settings,
+                offset: sample_offset(i, spp),
+                rows: y0..y0 + (out.len() / width) as u32,
+                cancel,
+            };
+            counts += renderer.render_pass(&job, out);
+            if let Some(done) = rows_done {
+                done.fetch_add(job.rows.len() as u64, Ordering::Relaxed);
+            }
+        }
         if cancel.load(Ordering::Relaxed) {
             return None;
         }

@@ -13,7 +13,7 @@ pub mod raytrace;
 pub mod shade;
 pub mod trace;
 
-pub use frame::{render_frame, FrameResult};
+pub use frame::{render_frame, render_frame_in_bands, FrameResult};
 pub use prepared::PreparedScene;
 
 use crate::math::{Radiance, Ray, Vec2};

@@ -1,0 +1,324 @@
+//! The command line (CLI.md): `render`, `bench`, `compare`, `list`, and the
+//! viewer when no subcommand is given. Errors are returned as one sentence;
+//! `main` prints them and exits non-zero.
+
+use crate::render::{self, debug::View, PreparedScene, RayCounts, RenderSettings, ShadowMode};
+use crate::scene::Scene;
+use clap::{Args, Parser, Subcommand};
+use serde_json::json;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::time::Instant;
+
+#[derive(Parser)]
+#[command(name = "pinhole", version, about = "Watch a CPU ray tracer and a CPU rasterizer render the same scene.")]
+#[command(args_conflicts_with_subcommands = true)]
+pub struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+    /// Scene to open in the viewer: a .toml, a .obj or a built-in name.
+    scene: Option<String>,
+    /// Open the window, wait for the full-quality frame, save a screenshot of the window there, exit.
+    #[arg(long, value_name = "OUT.png")]
+    screenshot: Option<PathBuf>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render once without a window.
+    Render {
+        scene: String,
+        /// Output image: .png (sRGB 8-bit), .exr (linear f32) or .ppm.
+        #[arg(short = 'o', long = "output", value_name = "OUT")]
+        output: PathBuf,
+        #[command(flatten)]
+        opts: RenderOpts,
+        /// Write run statistics as JSON (`-` for stdout).
+        #[arg(long, value_name = "FILE")]
+        stats: Option<String>,
+    },
+    /// Render warm frames and print timing statistics as JSON.
+    Bench {
+        scene: String,
+        #[command(flatten)]
+        opts: RenderOpts,
+        /// Number of timed frames (after one warm-up frame).
+        #[arg(long, default_value_t = 5)]
+        frames: u32,
+    },
+    /// Error metrics between two images (.exr or .png).
+    Compare {
+        a: PathBuf,
+        b: PathBuf,
+        #[arg(long)]
+        json: bool,
+    },
+    /// List renderers, views and built-in scenes.
+    List,
+}
+
+#[derive(Args, Clone)]
+struct RenderOpts {
+    /// raytrace | rasterize, or a variant (see `pinhole list`).
+    #[arg(long, default_value = "raytrace")]
+    renderer: String,
+    #[arg(long)]
+    width: Option<u32>,
+    #[arg(long)]
+    height: Option<u32>,
+    /// Samples per pixel (stratified; 1 = the pixel centre).
+    #[arg(long, default_value_t = 1)]
+    spp: u32,
+    /// shaded | barycentric | raydir | depth | normal | id | uv
+    #[arg(long, default_value = "shaded")]
+    view: String,
+    /// ray | map | none
+    #[arg(long, default_value = "ray")]
+    shadows: String,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Shadow-ray start offset along the ray (CGPP's rayBumpEpsilon).
+    #[arg(long, value_name = "EPS")]
+    bump: Option<f32>,
+}
+
+/// Parses the arguments and runs the command.
+pub fn run() -> Result<(), String> {
+    let cli = match Cli::try_parse() {
+        Ok(c) => c,
+        Err(e) => {
+            // Help and version go to stdout with success; usage errors are clap's one-liners.
+            let _ = e.print();
+            std::process::exit(if e.use_stderr() { 2 } else { 0 });
+        }
+    };
+    match cli.command {
+        None => crate::app::run(cli.scene, cli.screenshot),
+        Some(Command::Render { scene, output, opts, stats }) => cmd_render(&scene, &output, &opts, stats.as_deref()),
+        Some(Command::Bench { scene, opts, frames }) => cmd_bench(&scene, &opts, frames),
+        Some(Command::Compare { a, b, json }) => cmd_compare(&a, &b, json),
+        Some(Command::List) => {
+            cmd_list();
+            Ok(())
+        }
+    }
+}
+
+/// A scene loaded and prepared under the requested thread pool, with timings.
+struct Loaded {
+    prepared: PreparedScene,
+    settings: RenderSettings,
+    renderer: Box<dyn render::Renderer>,
+    pool: rayon::ThreadPool,
+    load_ms: f64,
+}
+
+fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
+    let renderer = render::renderer_by_name(&opts.renderer)?;
+    let view = View::parse(&opts.view)?;
+    let shadows = ShadowMode::parse(&opts.shadows)?;
+    if opts.spp == 0 || opts.spp > 65536 {
+        return Err(format!("--spp {} is not between 1 and 65536", opts.spp));
+    }
+    let threads = opts.threads.unwrap_or(0);
+    if opts.threads == Some(0) {
+        return Err("--threads must be at least 1".into());
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| format!("cannot start {threads} worker threads: {e}"))?;
+    let start = Instant::now();
+    let scene: Scene = crate::scene::file::load_scene(scene_arg)?;
+    let load_ms = start.elapsed().as_secs_f64() * 1e3;
+    for w in &scene.warnings {
+        eprintln!("warning: {w}");
+    }
+    let mut settings = RenderSettings::for_scene(&scene);
+    for (flag, v) in [("--width", opts.width), ("--height", opts.height)] {
+        if let Some(v) = v {
+            if !(1..=16384).contains(&v) {
+                return Err(format!("{flag} {v} is not between 1 and 16384"));
+            }
+        }
+    }
+    settings.width = opts.width.unwrap_or(settings.width);
+    settings.height = opts.height.unwrap_or(settings.height);
+    settings.spp = opts.spp;
+    settings.view = view;
+    settings.shadows = shadows;
+    if let Some(b) = opts.bump {
+        if !(b.is_finite() && b >= 0.0) {
+            return Err(format!("--bump {b} must be a finite number >= 0"));
+        }
+        settings.shadow_bump = b;
+    }
+    let prepared = pool.install(|| PreparedScene::new(scene));
+    Ok(Loaded { prepared, settings, renderer, pool, load_ms })
+}
+
+fn stats_json(l: &Loaded, render_ms: f64, counts: &RayCounts, spp: u32) -> serde_json::Value {
+    let per_frame = |v: u64| v / spp.max(1) as u64 * spp.max(1) as u64;
+    json!({
+        "renderer": l.renderer.name(),
+        "scene": l.prepared.scene.name,
+        "width": l.settings.width,
+        "height": l.settings.height,
+        "spp": spp,
+        "threads": l.pool.current_num_threads(),
+        "triangles": l.prepared.scene.triangles.len(),
+        "spheres": l.prepared.scene.spheres.len(),
+        "load_ms": l.load_ms,
+        "build_ms": l.prepared.build_ms,
+        "render_ms": render_ms,
+        "primary_rays": per_frame(counts.primary),
+        "shadow_rays": counts.shadow,
+        "secondary_rays": counts.secondary,
+        "bvh_nodes_visited": counts.nodes,
+        "primitive_tests": counts.tests,
+        "samples_tested": counts.samples_tested,
+        "samples_covered": counts.samples_covered,
+        "fragments_shaded": counts.fragments_shaded,
+        "depth_test_failures": counts.depth_fails,
+        "shadows": l.settings.shadows.name(),
+        "view": l.settings.view.name(),
+    })
+}
+
+fn cmd_render(scene_arg: &str, output: &Path, opts: &RenderOpts, stats: Option<&str>) -> Result<(), String> {
+    let ext = output.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).unwrap_or_default();
+    if !["png", "exr", "ppm"].contains(&ext.as_str()) {
+        return Err(format!("{}: unknown image type (use .png, .exr or .ppm)", output.display()));
+    }
+    let l = load(scene_arg, opts)?;
+    let cancel = AtomicBool::new(false);
+    let rows_done = AtomicU64::new(0);
+    let total_rows = l.settings.height as u64 * l.settings.spp as u64;
+    let show_progress = std::io::stderr().is_terminal();
+    let start = Instant::now();
+    let done = AtomicBool::new(false);
+    let result = std::thread::scope(|s| {
+        if show_progress {
+            s.spawn(|| progress_loop(&rows_done, total_rows, &done));
+        }
+        let bands = if show_progress { 32 } else { 1 };
+        let r = l.pool.install(|| {
+            render::render_frame_in_bands(l.renderer.as_ref(), &l.prepared, &l.settings, &cancel, None, bands, Some(&rows_done))
+        });
+        done.store(true, Ordering::Relaxed);
+        r
+    });
+    let render_ms = start.elapsed().as_secs_f64() * 1e3;
+    let frame = result.ok_or("the render was cancelled")?;
+    crate::image_io::save_image(output, frame.width, frame.height, &frame.pixels, l.prepared.scene.render.exposure)?;
+    if let Some(dest) = stats {
+        let j = stats_json(&l, render_ms, &frame.counts, l.settings.spp);
+        write_json(dest, &j)?;
+    }
+    Ok(())
+}
+
+/// Prints a progress line on stderr until `done`.
+fn progress_loop(rows_done: &AtomicU64, total: u64, done: &AtomicBool) {
+    let start = Instant::now();
+    let mut shown = false;
+    while !done.load(Ordering::Relaxed) {
+        std::thread::sleep(std::time::Duration::from_millis(200));
+        let d = rows_done.load(Ordering::Relaxed);
+        let secs = start.elapsed().as_secs_f64();
+        if secs > 0.5 && d > 0 {
+            let eta = secs * (total as f64 / d as f64 - 1.0);
+            eprint!("\rrendering {:5.1}%  {:.1} s elapsed, about {:.0} s left   ", 100.0 * d as f64 / total as f64, secs, eta);
+            shown = true;
+        }
+    }
+    if shown {
+        eprintln!("\rrendered in {:.1} s{:40}", start.elapsed().as_secs_f64(), "");
+    }
+}
+
+fn write_json(dest: &str, j: &serde_json::Value) -> Result<(), String> {
+    let text = serde_json::to_string_pretty(j).map_err(|e| e.to_string())? + "\n";
+    if dest == "-" {
+        print!("{text}");
+        Ok(())
+    } else {
+        crate::image_io::write_atomic(Path::new(dest), text.as_bytes())
+    }
+}
+
+fn cmd_bench(scene_arg: &str, opts: &RenderOpts, frames: u32) -> Result<(), String> {
+    if frames == 0 {
+        return Err("--frames must be at least 1".into());
+    }
+    let l = load(scene_arg, opts)?;
+    let cancel = AtomicBool::new(false);
+    let mut times = Vec::new();
+    let mut counts = RayCounts::default();
+    for i in 0..=frames {
+        let start = Instant::now();
+        let frame = l
+            .pool
+            .install(|| render::render_frame(l.renderer.as_ref(), &l.prepared, &l.settings, &cancel, None))
+            .ok_or("the render was cancelled")?;
+        let ms = start.elapsed().as_secs_f64() * 1e3;
+        if i > 0 {
+            times.push(ms);
+            counts = frame.counts;
+        }
+    }
+    times.sort_by(f64::total_cmp);
+    let median = times[times.len() / 2];
+    let mut j = stats_json(&l, median, &counts, l.settings.spp);
+    j["render_ms_min"] = json!(times[0]);
+    j["frames"] = json!(frames);
+    j["primary_rays_per_s"] = json!(counts.primary as f64 / (median / 1e3));
+    j["rays_per_s"] = json!((counts.primary + counts.shadow + counts.secondary) as f64 / (median / 1e3));
+    write_json("-", &j)
+}
+
+fn cmd_compare(a: &Path, b: &Path, as_json: bool) -> Result<(), String> {
+    let ia = crate::image_io::load_image(a)?;
+    let ib = crate::image_io::load_image(b)?;
+    if (ia.width, ia.height) != (ib.width, ib.height) {
+        return Err(format!(
+            "{} is {}x{} but {} is {}x{}; compare needs images of the same size",
+            a.display(),
+            ia.width,
+            ia.height,
+            b.display(),
+            ib.width,
+            ib.height
+        ));
+    }
+    let m = crate::metrics::compare(&ia.pixels, &ib.pixels)?;
+    if as_json {
+        write_json("-", &serde_json::to_value(m).map_err(|e| e.to_string())?)
+    } else {
+        println!("rmse      {:.6}  ({:.3}% of the mean {:.6} of {})", m.rmse, 100.0 * m.rmse / m.reference_mean.max(1e-12), m.reference_mean, b.display());
+        println!("rel_mse   {:.6}", m.rel_mse);
+        println!("max_abs   {:.6}", m.max_abs);
+        println!("differing {} of {} pixels", m.differing_pixels, ia.pixels.len());
+        Ok(())
+    }
+}
+
+fn cmd_list() {
+    println!("renderers:");
+    for r in render::renderers() {
+        println!("  {:24} {}", r.name(), r.description());
+    }
+    println!("  {:24} = {}", "raytrace", render::DEFAULT_RAYTRACE);
+    println!("  {:24} = {}", "rasterize", render::raster::DEFAULT_RASTERIZE);
+    println!("views:");
+    for v in View::ALL {
+        println!("  {}", v.name());
+    }
+    println!("shadows:\n  none\n  ray\n  map");
+    println!("built-in scenes:");
+    for s in crate::scene::builtin::names() {
+        println!("  {s}");
+    }
+}

@@ -1,0 +1,89 @@
+//! The command line as scripts use it (CLI.md): outputs, JSON fields, and
+//! errors that are one sentence with a non-zero exit, never a panic.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn pinhole(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_pinhole")).args(args).output().expect("run pinhole")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("pinhole-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d.join(name)
+}
+
+fn assert_clean_error(out: &Output, needle: &str) {
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "expected failure, stderr: {err}");
+    assert!(!err.contains("panicked") && !err.contains("internal error"), "panic: {err}");
+    assert_eq!(err.trim().lines().count(), 1, "one line expected: {err}");
+    assert!(err.contains(needle), "{err:?} should mention {needle:?}");
+}
+
+#[test]
+fn render_png_exr_ppm_with_stats() {
+    let png = tmp("t.png");
+    let stats = tmp("t.json");
+    let out = pinhole(&["render", "one-triangle", "-o", png.to_str().unwrap(), "--width", "80", "--height", "50", "--stats", stats.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let img = image::open(&png).unwrap();
+    assert_eq!((img.width(), img.height()), (80, 50));
+    let j: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+    for key in ["renderer", "width", "height", "spp", "threads", "triangles", "load_ms", "build_ms", "render_ms", "primary_rays", "shadow_rays", "secondary_rays"] {
+        assert!(j.get(key).is_some(), "stats lack {key}: {j}");
+    }
+    assert_eq!(j["primary_rays"], 4000);
+    assert_eq!(j["renderer"], "raytrace:bvh");
+
+    let exr = tmp("t.exr");
+    assert!(pinhole(&["render", "one-triangle", "-o", exr.to_str().unwrap(), "--width", "80", "--height", "50"]).status.success());
+    let ppm = tmp("t.ppm");
+    assert!(pinhole(&["render", "one-triangle", "-o", ppm.to_str().unwrap(), "--width", "8", "--height", "5"]).status.success());
+    assert!(std::fs::read_to_string(&ppm).unwrap().starts_with("P3\n8 5\n255\n"));
+
+    // compare: an image against itself has zero error; JSON has the contract's fields.
+    let out = pinhole(&["compare", exr.to_str().unwrap(), exr.to_str().unwrap(), "--json"]);
+    assert!(out.status.success());
+    let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(j["rmse"], 0.0);
+    assert!(j.get("rel_mse").is_some() && j.get("max_abs").is_some());
+}
+
+#[test]
+fn bench_prints_json() {
+    let out = pinhole(&["bench", "spheres", "--frames", "2", "--width", "64", "--height", "40", "--threads", "1"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(j["threads"], 1);
+    assert_eq!(j["primary_rays"], 64 * 40);
+    assert!(j["render_ms_min"].as_f64().unwrap() <= j["render_ms"].as_f64().unwrap());
+}
+
+#[test]
+fn list_names_everything() {
+    let out = pinhole(&["list"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    for name in ["raytrace:brute", "raytrace:bvh", "one-triangle", "triangle-ground", "teapot", "spheres", "bunny", "barycentric"] {
+        assert!(text.contains(name), "list lacks {name}");
+    }
+}
+
+#[test]
+fn errors_are_one_sentence() {
+    let png = tmp("e.png");
+    let p = png.to_str().unwrap();
+    assert_clean_error(&pinhole(&["render", "nope", "-o", p]), "built-in");
+    assert_clean_error(&pinhole(&["render", "/nonexistent.toml", "-o", p]), "/nonexistent.toml");
+    assert_clean_error(&pinhole(&["render", "one-triangle", "-o", p, "--renderer", "magic"]), "magic");
+    assert_clean_error(&pinhole(&["render", "one-triangle", "-o", p, "--view", "xray"]), "xray");
+    assert_clean_error(&pinhole(&["render", "one-triangle", "-o", p, "--spp", "0"]), "--spp");
+    assert_clean_error(&pinhole(&["render", "one-triangle", "-o", p, "--threads", "0"]), "--threads");
+    assert_clean_error(&pinhole(&["render", "one-triangle", "-o", "/tmp/x.gif"]), "unknown image type");
+    assert_clean_error(&pinhole(&["render", "one-triangle", "-o", "/nonexistent-dir/x.png", "--width", "8", "--height", "5"]), "cannot write");
+    let bad = tmp("bad.toml");
+    std::fs::write(&bad, "[render]\nwidht = 3\n").unwrap();
+    assert_clean_error(&pinhole(&["render", bad.to_str().unwrap(), "-o", p]), "bad.toml:2");
+    assert_clean_error(&pinhole(&["compare", "/nonexistent.exr", p]), "/nonexistent.exr");
+}
