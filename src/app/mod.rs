@@ -1,9 +1,216 @@
-//! The egui viewer (issue 4). Placeholder until the viewer lands.
+//! The egui viewer (issue 4): a live framebuffer of the selected renderer
+//! with camera, light, material and shading panels, navigation and export.
+//! Rendering runs on `worker`; `state` holds what the user edits; `panels`
+//! and `viewport` draw it.
+
+use eframe::egui;
+pub mod camera_control;
+pub mod export;
+pub mod open_dialog;
+pub mod panels;
+pub mod settings_store;
+pub mod state;
+pub mod viewport;
+pub mod worker;
+
+pub use state::PinholeApp;
+
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+/// `--screenshot`: wait for the full-quality frame, capture the window, exit.
+pub struct ScreenshotState {
+    pub path: PathBuf,
+    /// UI frames drawn since the complete image reached the texture.
+    pub frames_shown: u32,
+    pub requested: bool,
+    pub started: Instant,
+    pub result: Arc<Mutex<Option<Result<(), String>>>>,
+}
+
+/// Frame-pacing measurement (`PINHOLE_BENCH_UI=SECONDS`): orbits the camera
+/// every frame like a drag would, then prints UI frames per second.
+pub struct UiBench {
+    pub started: Instant,
+    pub seconds: f32,
+    pub frames: u32,
+    pub worst_ms: f32,
+    last: Option<Instant>,
+    pub done: bool,
+}
+
+impl UiBench {
+    pub fn new(seconds: f32) -> UiBench {
+        UiBench { started: Instant::now(), seconds, frames: 0, worst_ms: 0.0, last: None, done: false }
+    }
+
+    fn frame(&mut self, camera: &mut crate::scene::Camera) {
+        let now = Instant::now();
+        if let Some(l) = self.last {
+            self.worst_ms = self.worst_ms.max((now - l).as_secs_f32() * 1e3);
+        }
+        self.last = Some(now);
+        self.frames += 1;
+        camera_control::orbit(camera, 3.0, 0.0);
+        if !self.done && self.started.elapsed().as_secs_f32() >= self.seconds {
+            self.done = true;
+            let secs = self.started.elapsed().as_secs_f32();
+            println!(
+                "ui-bench: {} frames in {:.2} s = {:.1} fps, worst frame gap {:.1} ms",
+                self.frames,
+                secs,
+                self.frames as f32 / secs,
+                self.worst_ms
+            );
+        }
+    }
+}
+
+/// Called at the end of every frame: drives `--screenshot` and the UI bench.
+fn screenshot_frame(app: &mut PinholeApp, ctx: &egui::Context) {
+    if app.bench.as_ref().is_some_and(|b| b.done) && app.screenshot.is_none() {
+        ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+    }
+    if app.screenshot.is_none() {
+        return;
+    }
+    let generation = app.generation;
+    let shown = app.shown_version;
+    let ready = !app.loading()
+        && app.with_output(|o| o.idle && o.complete && o.generation == generation && o.version == shown)
+        && !app.bench.as_ref().is_some_and(|b| !b.done);
+    let viewport_rect = app.viewport_rect;
+    let Some(shot) = app.screenshot.as_mut() else { return };
+    ctx.request_repaint_after(Duration::from_millis(30));
+    if shot.result.lock().unwrap().is_some() {
+        ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+        return;
+    }
+    if shot.requested {
+        return;
+    }
+    if shot.started.elapsed() > Duration::from_secs(600) {
+        *shot.result.lock().unwrap() = Some(Err("--screenshot: the frame did not finish within 10 minutes".into()));
+        return;
+    }
+    if !ready {
+        shot.frames_shown = 0;
+        return;
+    }
+    shot.frames_shown += 1;
+    if shot.frames_shown < 3 {
+        return;
+    }
+    shot.requested = true;
+    if let Some(r) = viewport_rect {
+        let ppp = ctx.pixels_per_point();
+        println!(
+            "viewport={},{},{},{}",
+            (r.min.x * ppp).round(),
+            (r.min.y * ppp).round(),
+            (r.width() * ppp).round(),
+            (r.height() * ppp).round()
+        );
+    }
+    let path = shot.path.clone();
+    let result = shot.result.clone();
+    let ctx2 = ctx.clone();
+    ctx.request_screenshot(move |image| {
+        let rgb: Vec<u8> = image.pixels.iter().flat_map(|c| [c.r(), c.g(), c.b()]).collect();
+        let r = crate::image_io::encode_png(image.size[0] as u32, image.size[1] as u32, &rgb)
+            .and_then(|bytes| crate::image_io::write_atomic(&path, &bytes));
+        *result.lock().unwrap() = Some(r);
+        ctx2.request_repaint();
+    });
+}
+
+/// The eframe wrapper: storage, and the root `ui`.
+struct EframeApp(PinholeApp);
+
+impl eframe::App for EframeApp {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        self.0.ui(ui);
+    }
+
+    fn save(&mut self, storage: &mut dyn eframe::Storage) {
+        if self.0.persist {
+            self.0.persisted().save(storage);
+        }
+    }
+}
 
 /// Opens the viewer on `scene` (a built-in name, `.toml` or `.obj`; `None`:
-/// the default scene). With `screenshot`, waits for the full-quality frame,
-/// saves a screenshot of the whole window there and exits.
-pub fn run(scene: Option<String>, screenshot: Option<std::path::PathBuf>) -> Result<(), String> {
-    let _ = (scene, screenshot);
-    Err("the viewer is not built yet".into())
+/// the scene of the last run, else the default scene). With `screenshot`,
+/// waits for the full-quality frame, saves a screenshot of the whole window
+/// there and exits.
+pub fn run(scene: Option<String>, screenshot: Option<PathBuf>) -> Result<(), String> {
+    use crate::scene::{builtin, file};
+    // An explicit scene that does not load is an error before any window opens.
+    let explicit = match &scene {
+        Some(arg) => Some((file::load_scene(arg)?, arg.clone())),
+        None => None,
+    };
+    let shot_result = Arc::new(Mutex::new(None));
+    let bench = std::env::var("PINHOLE_BENCH_UI").ok().and_then(|s| s.parse::<f32>().ok());
+    let batch = screenshot.is_some() || bench.is_some();
+
+    // In --screenshot mode the window fits the image 1:1 beside the side panel.
+    let size = match &explicit {
+        Some((s, _)) if batch => [(s.render.width as f32 + 330.0).max(900.0), s.render.height as f32 + 110.0],
+        _ => [1280.0, 800.0],
+    };
+    let options = eframe::NativeOptions {
+        viewport: egui::ViewportBuilder::default()
+            .with_title("pinhole")
+            .with_inner_size(size)
+            .with_drag_and_drop(true),
+        persist_window: !batch,
+        ..Default::default()
+    };
+    let shot_state = screenshot.map(|path| ScreenshotState {
+        path,
+        frames_shown: 0,
+        requested: false,
+        started: Instant::now(),
+        result: shot_result.clone(),
+    });
+    let wanted_shot = shot_state.is_some();
+    eframe::run_native(
+        "pinhole",
+        options,
+        Box::new(move |cc| {
+            let persisted = if batch { None } else { settings_store::Persisted::load(cc.storage) };
+            let (scene, arg) = match explicit {
+                Some(x) => x,
+                None => {
+                    let remembered = persisted.as_ref().and_then(|p| p.scene.clone());
+                    match remembered.and_then(|a| file::load_scene(&a).ok().map(|s| (s, a))) {
+                        Some(x) => x,
+                        None => {
+                            let name = builtin::DEFAULT_SCENE.to_string();
+                            match file::load_scene(&name) {
+                                Ok(s) => (s, name),
+                                Err(e) => return Err(e.into()),
+                            }
+                        }
+                    }
+                }
+            };
+            let mut app = PinholeApp::new(scene, arg, persisted.as_ref());
+            app.persist = !batch;
+            if batch {
+                app.res_scale = 1.0;
+            }
+            app.screenshot = shot_state;
+            app.bench = bench.map(UiBench::new);
+            Ok(Box::new(EframeApp(app)))
+        }),
+    )
+    .map_err(|e| format!("cannot open the viewer window: {e}"))?;
+    match shot_result.lock().unwrap().take() {
+        Some(r) => r,
+        None if wanted_shot => Err("--screenshot: the window closed before the screenshot was taken".into()),
+        None => Ok(()),
+    }
 }

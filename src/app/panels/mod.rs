@@ -1,0 +1,57 @@
+//! The viewer's panels: the menu bar, the status bar and the side-panel
+//! sections (camera, lights, materials, shading), one file each.
+
+use eframe::egui;
+pub mod camera;
+pub mod lights;
+pub mod materials;
+pub mod menu;
+pub mod shading;
+pub mod status;
+
+use crate::math::Vec3;
+
+/// Three labelled drag values for a vector; true when one changed.
+pub fn vec3_edit(ui: &mut egui::Ui, label: &str, v: &mut Vec3, speed: f32) -> bool {
+    let mut changed = false;
+    ui.horizontal(|ui| {
+        let l = ui.label(label);
+        for (i, axis) in ["x", "y", "z"].iter().enumerate() {
+            changed |= ui
+                .add(egui::DragValue::new(&mut v[i]).speed(speed).prefix(format!("{axis} ")).max_decimals(4))
+                .labelled_by(l.id)
+                .changed();
+        }
+    });
+    changed
+}
+
+/// A linear colour: picker plus R, G, B drag values (exact numbers matter).
+pub fn color_edit(ui: &mut egui::Ui, label: &str, c: &mut Vec3, max: f32) -> bool {
+    let mut changed = false;
+    ui.horizontal(|ui| {
+        let l = ui.label(label);
+        let mut rgb = c.to_array();
+        if max <= 1.0 {
+            if ui.color_edit_button_rgb(&mut rgb).labelled_by(l.id).changed() {
+                *c = Vec3::from_array(rgb);
+                changed = true;
+            }
+        }
+        for (i, ch) in ["R", "G", "B"].iter().enumerate() {
+            changed |= ui
+                .add(egui::DragValue::new(&mut c[i]).speed(0.005 * max).range(0.0..=max).prefix(format!("{ch} ")).max_decimals(3))
+                .on_hover_text(format!("{label} {ch}"))
+                .changed();
+        }
+    });
+    changed
+}
+
+/// A collapsing section whose open state lives in `open` (so it persists).
+pub fn section(ui: &mut egui::Ui, title: &str, open: &mut bool, body: impl FnOnce(&mut egui::Ui)) {
+    let r = egui::CollapsingHeader::new(egui::RichText::new(title).strong()).open(Some(*open)).show(ui, body);
+    if r.header_response.clicked() {
+        *open = !*open;
+    }
+}

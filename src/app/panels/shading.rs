@@ -1,0 +1,52 @@
+//! Shading section: debug view, shadows (none / ray / map) and the ray bump,
+//! samples per pixel, secondary depth, ambient, background, exposure and
+//! gamma on/off.
+
+use eframe::egui;
+use super::{color_edit, section};
+use crate::app::PinholeApp;
+use crate::render::debug::View;
+use crate::render::ShadowMode;
+
+pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
+    let mut open = app.panels.shading;
+    section(ui, "Shading", &mut open, |ui| {
+        let s = &mut app.settings;
+        ui.horizontal(|ui| {
+            ui.label("view");
+            egui::ComboBox::from_id_salt("debug-view").selected_text(s.view.name()).show_ui(ui, |ui| {
+                for v in View::ALL {
+                    ui.selectable_value(&mut s.view, v, v.name());
+                }
+            });
+        });
+        ui.horizontal(|ui| {
+            ui.label("shadows");
+            for m in ShadowMode::ALL {
+                ui.radio_value(&mut s.shadows, m, m.name());
+            }
+        });
+        ui.horizontal(|ui| {
+            let l = ui.label("ray bump ε");
+            ui.add(egui::Slider::new(&mut s.shadow_bump, 1e-7..=1e-1).logarithmic(true)).labelled_by(l.id);
+        });
+        ui.horizontal(|ui| {
+            let l = ui.label("samples per pixel");
+            ui.add(egui::Slider::new(&mut s.spp, 1..=256).logarithmic(true)).labelled_by(l.id);
+        });
+        ui.horizontal(|ui| {
+            let l = ui.label("max depth");
+            ui.add(egui::Slider::new(&mut s.max_depth, 0..=16)).labelled_by(l.id);
+        });
+        let r = &mut app.params.render;
+        color_edit(ui, "ambient", &mut r.ambient, 1.0);
+        color_edit(ui, "background", &mut r.background, 1.0);
+        ui.horizontal(|ui| {
+            let l = ui.label("exposure");
+            ui.add(egui::Slider::new(&mut r.exposure, 0.01..=100.0).logarithmic(true)).labelled_by(l.id);
+        });
+        ui.checkbox(&mut app.gamma, "gamma (sRGB encode)");
+        ui.label(egui::RichText::new("interpolation (flat / gouraud / phong): not in the render core yet").small().weak());
+    });
+    app.panels.shading = open;
+}

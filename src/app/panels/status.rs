@@ -1,0 +1,74 @@
+//! The status bar: renderer, resolution, samples so far, time per frame,
+//! rays or fragments per second, triangles, and UI frames per second.
+
+use eframe::egui;
+use crate::app::PinholeApp;
+
+pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
+    let text = status_text(app);
+    let fps = app.ui_fps();
+    egui::Panel::bottom("status-bar").show(ui, |ui| {
+        ui.horizontal(|ui| {
+            ui.label(text);
+            ui.separator();
+            ui.label(format!("UI {fps:.0} fps"));
+            if let Some(m) = &app.message {
+                ui.separator();
+                ui.label(m);
+            }
+        });
+    });
+}
+
+/// The status line as plain text (tests read it).
+pub fn status_text(app: &PinholeApp) -> String {
+    let renderer = app.renderer.clone();
+    let triangles = app.scene.triangles.len();
+    let spheres = app.scene.spheres.len();
+    app.with_output(|o| {
+        let s = &o.stats;
+        let c = &s.counts;
+        let rays = c.primary + c.shadow + c.secondary;
+        let rate = if s.pass_ms > 0.0 {
+            if c.primary > 0 || c.fragments_shaded == 0 {
+                format!("{} rays/s", si(rays as f64 / (s.pass_ms / 1e3)))
+            } else {
+                format!("{} fragments/s", si(c.fragments_shaded as f64 / (s.pass_ms / 1e3)))
+            }
+        } else {
+            "–".into()
+        };
+        let state = if let Some(e) = &o.error {
+            format!("error: {e}")
+        } else if o.complete {
+            format!("done in {:.0} ms", s.frame_ms)
+        } else if o.preview {
+            "preview".into()
+        } else {
+            "rendering".into()
+        };
+        format!(
+            "{renderer} | {}x{} | {}/{} spp | {:.1} ms/pass | {rate} | {triangles} triangles{} | first image {:.0} ms | {state}",
+            o.width,
+            o.height,
+            o.passes,
+            o.spp,
+            s.pass_ms,
+            if spheres > 0 { format!(", {spheres} spheres") } else { String::new() },
+            s.first_image_ms,
+        )
+    })
+}
+
+/// 1234567 -> "1.23 M".
+pub fn si(v: f64) -> String {
+    if v >= 1e9 {
+        format!("{:.2} G", v / 1e9)
+    } else if v >= 1e6 {
+        format!("{:.2} M", v / 1e6)
+    } else if v >= 1e3 {
+        format!("{:.1} k", v / 1e3)
+    } else {
+        format!("{v:.0}")
+    }
+}

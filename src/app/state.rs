@@ -1,0 +1,437 @@
+//! The viewer's state and its frame: what is loaded, what is edited, what
+//! was last asked of the worker. Panels and the viewport read and change
+//! this struct; at the end of each frame a change becomes a render request.
+
+use eframe::egui;
+use super::export::ExportDialog;
+use super::open_dialog::OpenDialog;
+use super::settings_store::{Panels, Persisted};
+use super::worker::{Output, Request, SceneParams, Worker};
+use crate::render::{self, RenderSettings};
+use crate::scene::{builtin, Camera, Scene};
+use std::path::PathBuf;
+use std::sync::mpsc::{channel, Receiver};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant, SystemTime};
+
+/// The whole viewer. `ui()` draws one frame into any `egui::Ui`, so the
+/// window and the egui_kittest harness run the same code.
+pub struct PinholeApp {
+    /// The scene as loaded (its geometry is what the worker renders).
+    pub scene: Arc<Scene>,
+    /// How to load it again (built-in name or path).
+    pub scene_arg: String,
+    pub scene_id: u64,
+    /// Camera, lights, materials and `[render]` values as edited.
+    pub params: SceneParams,
+    /// The camera the scene file gave, for "reset".
+    pub initial_camera: Camera,
+    /// Render settings at resolution scale 1 (the scene's size).
+    pub settings: RenderSettings,
+    pub res_scale: f32,
+    pub renderer: String,
+    pub renderer_names: Vec<&'static str>,
+    pub gamma: bool,
+    pub panels: Panels,
+    pub worker: Worker,
+    /// The last request sent (generation counts every request).
+    pub generation: u64,
+    last_sent: Option<Request>,
+    /// The camera moved this frame (orbit, pan, fly...): ask for a preview.
+    pub camera_moving: bool,
+    pub texture: Option<egui::TextureHandle>,
+    pub shown_version: u64,
+    /// A problem to show in the red bar (the previous scene stays).
+    pub error_bar: Option<String>,
+    /// A passing note in the status bar (e.g. "saved x.png").
+    pub message: Option<String>,
+    loader: Option<Receiver<(String, Result<Scene, String>)>>,
+    watch: Option<(PathBuf, Option<SystemTime>)>,
+    last_watch_check: Instant,
+    pub open_dialog: OpenDialog,
+    pub export: ExportDialog,
+    pub screenshot: Option<super::ScreenshotState>,
+    /// Where the image was drawn last frame, in points, and its size in pixels.
+    pub viewport_rect: Option<egui::Rect>,
+    /// Index of the light being dragged in the viewport.
+    pub dragging_light: Option<usize>,
+    pub viewport_focused: bool,
+    /// Timestamps of recent UI frames, for the fps read-out.
+    frame_times: std::collections::VecDeque<Instant>,
+    repaint_ctx: Arc<Mutex<Option<egui::Context>>>,
+    /// Whether `save()` writes eframe storage (off for tests and screenshots).
+    pub persist: bool,
+    /// `PINHOLE_BENCH_UI`: orbit continuously for this long, print fps, quit.
+    pub bench: Option<super::UiBench>,
+}
+
+impl PinholeApp {
+    /// A viewer on `scene`, with no window (tests build it this way; `run`
+    /// wraps it in eframe).
+    pub fn new(scene: Scene, scene_arg: String, persisted: Option<&Persisted>) -> PinholeApp {
+        let repaint_ctx: Arc<Mutex<Option<egui::Context>>> = Arc::new(Mutex::new(None));
+        let rc = repaint_ctx.clone();
+        let worker = Worker::start(Arc::new(move || {
+            if let Some(ctx) = rc.lock().unwrap().as_ref() {
+                ctx.request_repaint();
+            }
+        }));
+        let renderer_names = render::renderer_names();
+        let p = persisted.cloned().unwrap_or_default();
+        let renderer = p
+            .renderer
+            .clone()
+            .filter(|r| renderer_names.contains(&r.as_str()))
+            .unwrap_or_else(|| render::DEFAULT_RAYTRACE.to_string());
+        let mut settings = RenderSettings::for_scene(&scene);
+        p.apply_to(&mut settings);
+        let mut app = PinholeApp {
+            params: SceneParams::of(&scene),
+            initial_camera: scene.camera.clone(),
+            scene: Arc::new(Scene::default()),
+            scene_arg: String::new(),
+            scene_id: 0,
+            settings,
+            res_scale: p.res_scale.clamp(0.1, 2.0),
+            renderer,
+            renderer_names,
+            gamma: p.gamma,
+            panels: p.panels,
+            worker,
+            generation: 0,
+            last_sent: None,
+            camera_moving: false,
+            texture: None,
+            shown_version: 0,
+            error_bar: None,
+            message: None,
+            loader: None,
+            watch: None,
+            last_watch_check: Instant::now(),
+            open_dialog: OpenDialog::new(),
+            export: ExportDialog::default(),
+            screenshot: None,
+            viewport_rect: None,
+            dragging_light: None,
+            viewport_focused: false,
+            frame_times: Default::default(),
+            repaint_ctx,
+            persist: false,
+            bench: None,
+        };
+        app.install_scene(scene, scene_arg);
+        app
+    }
+
+    /// A viewer for tests: no storage, default settings.
+    pub fn new_for_test(scene: Scene) -> PinholeApp {
+        let name = scene.name.clone();
+        PinholeApp::new(scene, name, None)
+    }
+
+    /// Makes `scene` the one on show; the worker builds its BVH.
+    pub fn install_scene(&mut self, scene: Scene, arg: String) {
+        self.scene_id += 1;
+        self.params = SceneParams::of(&scene);
+        self.initial_camera = scene.camera.clone();
+        let keep = self.settings.clone();
+        self.settings = RenderSettings::for_scene(&scene);
+        self.settings.spp = keep.spp;
+        self.settings.shadows = keep.shadows;
+        self.settings.shadow_bump = keep.shadow_bump;
+        self.settings.max_depth = keep.max_depth;
+        self.settings.view = keep.view;
+        self.message = (!scene.warnings.is_empty()).then(|| scene.warnings.join("; "));
+        let path = PathBuf::from(&arg);
+        self.watch = (builtin::source(&arg).is_none() && path.exists()).then(|| {
+            let mtime = std::fs::metadata(&path).and_then(|m| m.modified()).ok();
+            (path, mtime)
+        });
+        self.scene_arg = arg;
+        self.scene = Arc::new(scene);
+        self.worker.set_scene(self.scene_id, self.scene.clone());
+        self.error_bar = None;
+        self.last_sent = None;
+    }
+
+    /// Loads a scene in the background; it replaces the current one only if it loads.
+    pub fn open(&mut self, arg: String) {
+        let (tx, rx) = channel();
+        let ctx = self.repaint_ctx.lock().unwrap().clone();
+        std::thread::spawn(move || {
+            let result = crate::scene::file::load_scene(&arg);
+            let _ = tx.send((arg, result));
+            if let Some(ctx) = ctx {
+                ctx.request_repaint();
+            }
+        });
+        self.loader = Some(rx);
+        self.message = Some("loading…".into());
+    }
+
+    /// True while a scene is loading in the background.
+    pub fn loading(&self) -> bool {
+        self.loader.is_some()
+    }
+
+    /// Blocks until a background load finished and was applied (tests only).
+    pub fn wait_loaded(&mut self, timeout: Duration) -> bool {
+        let Some(rx) = self.loader.take() else { return true };
+        match rx.recv_timeout(timeout) {
+            Ok(r) => {
+                self.apply_loaded(r);
+                true
+            }
+            Err(_) => false,
+        }
+    }
+
+    fn apply_loaded(&mut self, (arg, result): (String, Result<Scene, String>)) {
+        self.message = None;
+        match result {
+            Ok(scene) => self.install_scene(scene, arg),
+            Err(e) => self.error_bar = Some(e),
+        }
+    }
+
+    fn poll_loader(&mut self) {
+        if let Some(rx) = &self.loader {
+            match rx.try_recv() {
+                Ok(r) => {
+                    self.loader = None;
+                    self.apply_loaded(r);
+                }
+                Err(std::sync::mpsc::TryRecvError::Empty) => {}
+                Err(std::sync::mpsc::TryRecvError::Disconnected) => self.loader = None,
+            }
+        }
+    }
+
+    /// Reloads the scene file when it changed on disk (checked twice a second).
+    fn poll_watch(&mut self, ctx: &egui::Context) {
+        if self.watch.is_none() || self.loader.is_some() {
+            return;
+        }
+        ctx.request_repaint_after(Duration::from_millis(500));
+        if self.last_watch_check.elapsed() < Duration::from_millis(450) {
+            return;
+        }
+        self.last_watch_check = Instant::now();
+        let Some((path, mtime)) = self.watch.as_mut() else { return };
+        let now = std::fs::metadata(&*path).and_then(|m| m.modified()).ok();
+        if now != *mtime {
+            *mtime = now;
+            let arg = self.scene_arg.clone();
+            self.open(arg);
+        }
+    }
+
+    /// The settings the worker renders with (resolution scaled).
+    pub fn effective_settings(&self) -> RenderSettings {
+        let mut s = self.settings.clone();
+        s.width = ((s.width as f32 * self.res_scale).round() as u32).max(1);
+        s.height = ((s.height as f32 * self.res_scale).round() as u32).max(1);
+        s
+    }
+
+    /// Sends a request when anything that affects the image changed.
+    pub fn sync_worker(&mut self) {
+        let settings = self.effective_settings();
+        if let Some(last) = &self.last_sent {
+            if last.scene_id == self.scene_id
+                && last.renderer == self.renderer
+                && last.settings == settings
+                && last.gamma == self.gamma
+                && last.params.same_as(&self.params)
+            {
+                return;
+            }
+        }
+        if self.params.camera.validate().is_err() {
+            return; // half-typed camera values: keep the last image
+        }
+        self.generation += 1;
+        let req = Request {
+            generation: self.generation,
+            scene_id: self.scene_id,
+            params: self.params.clone(),
+            settings,
+            renderer: self.renderer.clone(),
+            gamma: self.gamma,
+            interactive: self.camera_moving,
+        };
+        self.worker.request(req.clone());
+        self.last_sent = Some(req);
+    }
+
+    /// Blocks until the worker has finished everything asked so far (tests and
+    /// `--screenshot` only). False on timeout.
+    pub fn wait_idle(&mut self, timeout: Duration) -> bool {
+        let deadline = Instant::now() + timeout;
+        if !self.wait_loaded(timeout) {
+            return false;
+        }
+        self.sync_worker();
+        self.worker.wait_idle(self.generation, deadline.saturating_duration_since(Instant::now()))
+    }
+
+    /// Runs `f` on the worker's latest output under its lock.
+    pub fn with_output<T>(&self, f: impl FnOnce(&Output) -> T) -> T {
+        f(&self.worker.shared.output.lock().unwrap())
+    }
+
+    /// The renderer by index (number keys 1..9).
+    pub fn select_renderer(&mut self, index: usize) {
+        if let Some(n) = self.renderer_names.get(index) {
+            self.renderer = n.to_string();
+        }
+    }
+
+    pub fn reset_camera(&mut self) {
+        self.params.camera = self.initial_camera.clone();
+        self.camera_moving = true;
+    }
+
+    pub fn frame_all(&mut self) {
+        if let Some(b) = self.scene.bounds() {
+            let s = self.effective_settings();
+            super::camera_control::frame_all(&mut self.params.camera, b, s.width, s.height);
+            self.camera_moving = true;
+        }
+    }
+
+    pub fn persisted(&self) -> Persisted {
+        Persisted {
+            scene: Some(self.scene_arg.clone()),
+            renderer: Some(self.renderer.clone()),
+            spp: self.settings.spp,
+            shadows: self.settings.shadows,
+            shadow_bump: self.settings.shadow_bump,
+            max_depth: self.settings.max_depth,
+            view: self.settings.view,
+            res_scale: self.res_scale,
+            gamma: self.gamma,
+            panels: self.panels,
+        }
+    }
+
+    /// UI frames per second over the last second.
+    pub fn ui_fps(&self) -> f32 {
+        match (self.frame_times.front(), self.frame_times.back()) {
+            (Some(a), Some(b)) if self.frame_times.len() > 1 && b > a => {
+                (self.frame_times.len() - 1) as f32 / (*b - *a).as_secs_f32()
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// Copies a newly published image into the texture.
+    fn update_texture(&mut self, ctx: &egui::Context) {
+        let out = self.worker.shared.output.lock().unwrap();
+        if out.version == self.shown_version || out.width == 0 {
+            return;
+        }
+        let image = egui::ColorImage::from_rgb([out.width as usize, out.height as usize], &out.rgb8);
+        self.shown_version = out.version;
+        drop(out);
+        match &mut self.texture {
+            Some(t) => t.set(image, egui::TextureOptions::NEAREST),
+            None => self.texture = Some(ctx.load_texture("pinhole-frame", image, egui::TextureOptions::NEAREST)),
+        }
+    }
+
+    /// Keyboard shortcuts that work anywhere (not while typing).
+    fn shortcuts(&mut self, ctx: &egui::Context) {
+        use egui::{Key, KeyboardShortcut, Modifiers};
+        if ctx.input_mut(|i| i.consume_shortcut(&KeyboardShortcut::new(Modifiers::COMMAND, Key::S))) {
+            self.export.open_with(&self.scene.name, &self.renderer);
+        }
+        if ctx.input_mut(|i| i.consume_shortcut(&KeyboardShortcut::new(Modifiers::COMMAND, Key::O))) {
+            self.open_dialog.open = true;
+        }
+        if ctx.egui_wants_keyboard_input() {
+            return;
+        }
+        let keys = [Key::Num1, Key::Num2, Key::Num3, Key::Num4, Key::Num5, Key::Num6, Key::Num7, Key::Num8, Key::Num9];
+        for (i, k) in keys.iter().enumerate() {
+            if ctx.input(|inp| inp.key_pressed(*k) && inp.modifiers.is_none()) {
+                self.select_renderer(i);
+            }
+        }
+        if ctx.input(|i| i.key_pressed(Key::F) && i.modifiers.is_none()) {
+            self.frame_all();
+        }
+        if ctx.input(|i| i.key_pressed(Key::Home)) {
+            self.reset_camera();
+        }
+    }
+
+    fn dropped_files(&mut self, ctx: &egui::Context) {
+        let dropped: Vec<PathBuf> = ctx.input(|i| i.raw.dropped_files.iter().map(|f| f.path().to_path_buf()).collect());
+        if let Some(p) = dropped.into_iter().next() {
+            self.open(p.to_string_lossy().into_owned());
+        }
+    }
+
+    /// One frame of the whole viewer.
+    pub fn ui(&mut self, ui: &mut egui::Ui) {
+        let ctx = ui.ctx().clone();
+        {
+            let mut rc = self.repaint_ctx.lock().unwrap();
+            if rc.is_none() {
+                *rc = Some(ctx.clone());
+            }
+        }
+        let now = Instant::now();
+        self.frame_times.push_back(now);
+        while self.frame_times.front().is_some_and(|t| now.duration_since(*t) > Duration::from_secs(1)) {
+            self.frame_times.pop_front();
+        }
+        self.camera_moving = false;
+        self.poll_loader();
+        self.poll_watch(&ctx);
+        self.dropped_files(&ctx);
+        self.shortcuts(&ctx);
+        if let Some(b) = &mut self.bench {
+            b.frame(&mut self.params.camera);
+            self.camera_moving = true;
+            ctx.request_repaint();
+        }
+        self.update_texture(&ctx);
+
+        super::panels::menu::show(self, ui);
+        if let Some(err) = self.error_bar.clone() {
+            egui::Panel::top("error-bar")
+                .frame(egui::Frame::new().fill(egui::Color32::from_rgb(110, 20, 20)).inner_margin(6.0))
+                .show(ui, |ui| {
+                    ui.horizontal(|ui| {
+                        ui.colored_label(egui::Color32::WHITE, format!("⚠ {err}"));
+                        if ui.button("Dismiss").clicked() {
+                            self.error_bar = None;
+                        }
+                    });
+                });
+        }
+        super::panels::status::show(self, ui);
+        if self.panels.side {
+            egui::Panel::left("side-panel").default_size(300.0).resizable(true).show(ui, |ui| {
+                egui::ScrollArea::vertical().show(ui, |ui| {
+                    super::panels::camera::show(self, ui);
+                    super::panels::lights::show(self, ui);
+                    super::panels::materials::show(self, ui);
+                    super::panels::shading::show(self, ui);
+                });
+            });
+        }
+        egui::CentralPanel::default().frame(egui::Frame::new().fill(egui::Color32::from_gray(24))).show(ui, |ui| {
+            super::viewport::show(self, ui);
+        });
+        if let Some(path) = self.open_dialog.show(&ctx) {
+            self.open(path);
+        }
+        super::export::show_dialog(self, &ctx);
+
+        self.sync_worker();
+        super::screenshot_frame(self, &ctx);
+    }
+}

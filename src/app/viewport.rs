@@ -1,0 +1,142 @@
+//! The central viewport: the rendered image (1:1 in pixels when it fits),
+//! light markers drawn over it, and mouse/keyboard navigation.
+
+use eframe::egui;
+use super::camera_control as cc;
+use super::PinholeApp;
+use crate::math::{Vec2, Vec3};
+use crate::scene::Light;
+use egui::{Color32, Pos2, Rect, Sense, Stroke};
+
+pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
+    let avail = ui.available_rect_before_wrap();
+    let response = ui.allocate_rect(avail, Sense::click_and_drag());
+    let ppp = ui.ctx().pixels_per_point();
+    let settings = app.effective_settings();
+    let (iw, ih) = (settings.width as f32, settings.height as f32);
+    // 1 image pixel = 1 screen pixel when it fits; otherwise scaled to fit.
+    let mut size = egui::vec2(iw / ppp, ih / ppp);
+    let fit = (avail.width() / size.x).min(avail.height() / size.y);
+    if fit < 1.0 {
+        size *= fit;
+    }
+    let min = avail.center() - size * 0.5;
+    let min = Pos2::new((min.x * ppp).round() / ppp, (min.y * ppp).round() / ppp);
+    let rect = Rect::from_min_size(min, size);
+    app.viewport_rect = Some(rect);
+    let painter = ui.painter_at(avail);
+    if let Some(t) = &app.texture {
+        painter.image(t.id(), rect, Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0)), Color32::WHITE);
+    }
+
+    // Image pixel of a screen point and back.
+    let to_px = |p: Pos2| Vec2::new((p.x - rect.min.x) / rect.width() * iw, (p.y - rect.min.y) / rect.height() * ih);
+    let to_screen = |v: Vec2| Pos2::new(rect.min.x + v.x / iw * rect.width(), rect.min.y + v.y / ih * rect.height());
+    let px_per_point = iw / rect.width().max(1.0);
+
+    let view = app.params.camera.view(settings.width, settings.height);
+    let markers: Vec<(usize, Option<Pos2>)> = app
+        .params
+        .lights
+        .iter()
+        .enumerate()
+        .map(|(i, l)| match l {
+            Light::Point { position, .. } => (i, view.project(*position).map(|(p, _)| to_screen(p))),
+            Light::Directional { .. } => (i, None),
+        })
+        .collect();
+
+    // Focus: clicking the viewport gives it the keyboard (WASD/QE fly).
+    if response.clicked() || response.drag_started() {
+        app.viewport_focused = true;
+        ui.ctx().memory_mut(|m| m.surrender_focus(m.focused().unwrap_or(egui::Id::NULL)));
+    } else if ui.input(|i| i.pointer.any_pressed()) && !response.hovered() {
+        app.viewport_focused = false;
+    }
+
+    // Dragging a point-light marker moves the light in the view plane.
+    if response.drag_started_by(egui::PointerButton::Primary) {
+        if let Some(p) = response.interact_pointer_pos() {
+            app.dragging_light = markers
+                .iter()
+                .filter_map(|(i, m)| m.map(|m| (*i, m.distance(p))))
+                .filter(|(_, d)| *d < 10.0)
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+                .map(|(i, _)| i);
+        }
+    }
+    if response.drag_stopped() {
+        app.dragging_light = None;
+    }
+    let delta = response.drag_delta() * px_per_point;
+    let shift = ui.input(|i| i.modifiers.shift);
+    if let Some(i) = app.dragging_light {
+        if let (Some(p), Some(Light::Point { position, .. })) = (response.interact_pointer_pos(), app.params.lights.get_mut(i)) {
+            let depth = view.view_depth(*position);
+            if depth > view.near {
+                let q = to_px(p);
+                *position = view.eye + view.camera_to_world * (view.camera_dir(q.x, q.y) * depth);
+            }
+        }
+    } else if delta != egui::Vec2::ZERO {
+        let cam = &mut app.params.camera;
+        if response.dragged_by(egui::PointerButton::Middle) || (response.dragged_by(egui::PointerButton::Primary) && shift) {
+            cc::pan(cam, delta.x, delta.y, settings.width, settings.height);
+            app.camera_moving = true;
+        } else if response.dragged_by(egui::PointerButton::Primary) {
+            cc::orbit(cam, delta.x, delta.y);
+            app.camera_moving = true;
+        }
+    }
+    if response.hovered() {
+        let scroll = ui.input(|i| i.smooth_scroll_delta.y);
+        if scroll != 0.0 {
+            cc::dolly(&mut app.params.camera, scroll / 50.0);
+            app.camera_moving = true;
+        }
+    }
+    if app.viewport_focused && !ui.ctx().egui_wants_keyboard_input() {
+        fly_keys(app, ui);
+    }
+
+    // Light markers.
+    for (i, m) in &markers {
+        if let Some(p) = m {
+            let hot = app.dragging_light == Some(*i);
+            painter.circle(*p, if hot { 7.0 } else { 5.0 }, Color32::from_rgb(255, 220, 80), Stroke::new(1.5, Color32::BLACK));
+            painter.text(*p + egui::vec2(8.0, -8.0), egui::Align2::LEFT_BOTTOM, format!("L{i}"), egui::FontId::monospace(12.0), Color32::YELLOW);
+        }
+    }
+    // Directional lights: an arrow in the corner along the projected direction.
+    let mut corner = rect.left_top() + egui::vec2(28.0, 28.0);
+    for (i, l) in app.params.lights.iter().enumerate() {
+        if let Light::Directional { direction, .. } = l {
+            let d = view.world_to_camera * direction.normalize_or(Vec3::NEG_Y);
+            let v = egui::vec2(d.x, -d.y);
+            let v = if v.length() > 1e-3 { v.normalized() * 18.0 } else { egui::Vec2::ZERO };
+            painter.circle_stroke(corner, 20.0, Stroke::new(1.0, Color32::from_gray(160)));
+            painter.arrow(corner - v, v * 2.0, Stroke::new(2.0, Color32::from_rgb(255, 220, 80)));
+            painter.text(corner + egui::vec2(22.0, -18.0), egui::Align2::LEFT_TOP, format!("L{i}"), egui::FontId::monospace(12.0), Color32::YELLOW);
+            corner.y += 48.0;
+        }
+    }
+    if app.viewport_focused {
+        painter.rect_stroke(avail.shrink(1.0), 0.0, Stroke::new(1.0, Color32::from_rgb(80, 120, 200)), egui::StrokeKind::Inside);
+    }
+}
+
+/// WASD/QE fly at a speed proportional to the scene's size.
+fn fly_keys(app: &mut PinholeApp, ui: &egui::Ui) {
+    use egui::Key;
+    let (dir, dt, fast) = ui.input(|i| {
+        let k = |key: Key| if i.key_down(key) { 1.0 } else { 0.0 };
+        let dir = Vec3::new(k(Key::D) - k(Key::A), k(Key::E) - k(Key::Q), k(Key::W) - k(Key::S));
+        (dir, i.stable_dt.min(0.1), i.modifiers.shift)
+    });
+    if dir != Vec3::ZERO {
+        let speed = cc::scene_scale(app.scene.bounds()) * if fast { 1.0 } else { 0.3 };
+        cc::fly(&mut app.params.camera, dir, speed * dt.max(1.0 / 60.0));
+        app.camera_moving = true;
+        ui.ctx().request_repaint();
+    }
+}
