@@ -47,6 +47,17 @@ enum Command {
         #[arg(long, default_value_t = 5)]
         frames: u32,
     },
+    /// The debug record of one pixel, replayed exactly as the renderer computed it.
+    Pixel {
+        scene: String,
+        x: u32,
+        y: u32,
+        #[command(flatten)]
+        opts: RenderOpts,
+        /// Print JSON instead of text.
+        #[arg(long)]
+        json: bool,
+    },
     /// Error metrics between two images (.exr or .png).
     Compare {
         a: PathBuf,
@@ -99,6 +110,7 @@ pub fn run() -> Result<(), String> {
         Some(Command::Render { scene, output, opts, stats }) => cmd_render(&scene, &output, &opts, stats.as_deref()),
         Some(Command::Bench { scene, opts, frames }) => cmd_bench(&scene, &opts, frames),
         Some(Command::Compare { a, b, json }) => cmd_compare(&a, &b, json),
+        Some(Command::Pixel { scene, x, y, opts, json }) => cmd_pixel(&scene, x, y, &opts, json),
         Some(Command::List) => {
             cmd_list();
             Ok(())
@@ -277,6 +289,18 @@ fn cmd_bench(scene_arg: &str, opts: &RenderOpts, frames: u32) -> Result<(), Stri
     j["primary_rays_per_s"] = json!(counts.primary as f64 / (median / 1e3));
     j["rays_per_s"] = json!((counts.primary + counts.shadow + counts.secondary) as f64 / (median / 1e3));
     write_json("-", &j)
+}
+
+fn cmd_pixel(scene_arg: &str, x: u32, y: u32, opts: &RenderOpts, as_json: bool) -> Result<(), String> {
+    let l = load(scene_arg, opts)?;
+    let replay = render::replay_pixel(l.renderer.as_ref(), &l.prepared, &l.settings, x, y)?;
+    let scene = &l.prepared.scene;
+    if as_json {
+        write_json("-", &crate::pixel_report::to_json(l.renderer.name(), scene, x, y, &replay))
+    } else {
+        print!("{}", crate::pixel_report::to_text(l.renderer.name(), scene, x, y, &replay));
+        Ok(())
+    }
 }
 
 fn cmd_compare(a: &Path, b: &Path, as_json: bool) -> Result<(), String> {

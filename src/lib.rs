@@ -7,6 +7,7 @@ pub mod cli;
 pub mod image_io;
 pub mod math;
 pub mod metrics;
+pub mod pixel_report;
 pub mod render;
 pub mod scene;
 pub mod app;

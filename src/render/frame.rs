@@ -79,3 +79,33 @@ pub fn render_frame_in_bands(
     }
     Some(FrameResult { width: settings.width, height: settings.height, pixels: sum, counts })
 }
+
+/// A pixel replayed sample by sample: the records, and the final value, which
+/// is averaged exactly as `render_frame` averages it.
+pub struct PixelReplay {
+    pub samples: Vec<(crate::math::Vec2, super::trace::PixelTrace, Radiance)>,
+    pub radiance: Radiance,
+}
+
+/// Replays pixel `(x, y)` of the frame `render_frame` would render.
+pub fn replay_pixel(renderer: &dyn Renderer, prepared: &PreparedScene, settings: &RenderSettings, x: u32, y: u32) -> Result<PixelReplay, String> {
+    if x >= settings.width || y >= settings.height {
+        return Err(format!("pixel ({x}, {y}) is outside the {}x{} image", settings.width, settings.height));
+    }
+    let view = prepared.scene.camera.view(settings.width, settings.height);
+    let cancel = AtomicBool::new(false);
+    let spp = settings.spp.max(1);
+    let mut sum = Radiance::ZERO;
+    let mut samples = Vec::new();
+    for i in 0..spp {
+        let offset = sample_offset(i, spp);
+        let job = PassJob { prepared, view: &view, settings, offset, rows: y..y + 1, cancel: &cancel };
+        let mut rec = super::trace::PixelTrace::new();
+        let value = renderer
+            .trace_pixel(&job, x, y, &mut rec)
+            .ok_or_else(|| format!("{} cannot replay pixels yet", renderer.name()))?;
+        sum += value;
+        samples.push((offset, rec, value));
+    }
+    Ok(PixelReplay { samples, radiance: sum * (1.0 / spp as f32) })
+}

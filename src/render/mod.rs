@@ -13,7 +13,7 @@ pub mod raytrace;
 pub mod shade;
 pub mod trace;
 
-pub use frame::{render_frame, render_frame_in_bands, FrameResult};
+pub use frame::{render_frame, render_frame_in_bands, replay_pixel, FrameResult, PixelReplay};
 pub use prepared::PreparedScene;
 
 use crate::math::{Radiance, Ray, Vec2};
@@ -152,6 +152,13 @@ pub trait Renderer: Sync + Send {
     /// parallel, and returns what it counted. Result must not depend on the
     /// number of threads.
     fn render_pass(&self, job: &PassJob, out: &mut [Radiance]) -> RayCounts;
+
+    /// Replays pixel `(x, y)` of this pass through the same code path with a
+    /// recorder, returning the very value `render_pass` stores there; `None`
+    /// when this renderer cannot replay pixels.
+    fn trace_pixel(&self, _job: &PassJob, _x: u32, _y: u32, _rec: &mut trace::PixelTrace) -> Option<Radiance> {
+        None
+    }
 }
 
 /// Every registered renderer, reference first.
@@ -193,12 +200,17 @@ pub fn resolve_sample<Q: SceneQuery, R: Recorder>(
     rec: &mut R,
 ) -> Radiance {
     let scene = &job.prepared.scene;
-    match job.settings.view {
-        debug::View::Shaded => match hit {
-            Some(h) => shade::shade(scene, query, job.settings, h, -ray.dir, 0, counts, rec),
-            None => scene.render.background,
-        },
-        view => debug::view_color(view, job.view, ray, hit),
+    match (job.settings.view, hit) {
+        (debug::View::Shaded, Some(h)) => shade::shade(scene, query, job.settings, h, -ray.dir, 0, counts, rec),
+        (debug::View::Shaded, None) => {
+            rec.shaded(0, scene.render.background);
+            scene.render.background
+        }
+        (view, hit) => {
+            let c = debug::view_color(view, job.view, ray, hit);
+            rec.shaded(0, c);
+            c
+        }
     }
 }
 

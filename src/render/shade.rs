@@ -145,7 +145,10 @@ pub fn trace<Q: SceneQuery, R: Recorder>(
     rec.closest(hit.as_ref());
     match hit {
         Some(h) => shade(scene, query, settings, &h, -ray.dir, depth, counts, rec),
-        None => scene.render.background,
+        None => {
+            rec.shaded(depth, scene.render.background);
+            scene.render.background
+        }
     }
 }
 

@@ -57,3 +57,129 @@ pub struct NoRecord;
 impl Recorder for NoRecord {
     const ENABLED: bool = false;
 }
+
+/// Most primitive tests kept per ray: brute force tests every triangle, and a
+/// record of 70 000 misses helps nobody. The count of the rest is kept.
+pub const MAX_TESTS_PER_RAY: usize = 4096;
+
+/// A recorded ray with everything that happened along it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RayRecord {
+    pub ray: Ray,
+    pub t_max: f32,
+    /// 0 = eye ray, 1 = shadow or first secondary ray, ...
+    pub depth: u32,
+    pub shadow: bool,
+    pub nodes_visited: Vec<u32>,
+    pub tests: Vec<PrimitiveTest>,
+    /// Tests made but not kept (beyond `MAX_TESTS_PER_RAY`).
+    pub tests_omitted: usize,
+    pub closest: Option<SurfaceHit>,
+}
+
+/// One fragment of a rasterizer's pixel history, in draw order (RenderDoc style).
+#[derive(Clone, Debug, PartialEq)]
+pub struct FragmentRecord {
+    pub kind: PrimitiveKind,
+    pub primitive: u32,
+    /// Screen-space (affine) barycentric weights, when the method has them.
+    pub screen_barycentric: Option<Vec3>,
+    /// Perspective-correct barycentric weights.
+    pub barycentric: Vec3,
+    /// Interpolated view depth of the fragment.
+    pub depth: f32,
+    /// The depth stored in the buffer before this fragment.
+    pub stored_depth: f32,
+    pub passed_depth_test: bool,
+    /// Radiance when the fragment was shaded (forward shading), else `None`.
+    pub shaded: Option<Radiance>,
+}
+
+/// Everything one sample of one pixel did, in order. Built by passing a
+/// `PixelTrace` through the renderer's real code path.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PixelTrace {
+    pub rays: Vec<RayRecord>,
+    pub lights: Vec<LightSample>,
+    pub fragments: Vec<FragmentRecord>,
+    /// Radiance returned at each shading depth, innermost first.
+    pub shaded: Vec<(u32, Radiance)>,
+    shadow_active: bool,
+    /// Index of the ray that events go to (shadow rays interleave with the parent's).
+    current: Option<usize>,
+    parent: Vec<usize>,
+}
+
+impl PixelTrace {
+    pub fn new() -> PixelTrace {
+        PixelTrace::default()
+    }
+
+    /// Rasterizers report their fragments here.
+    pub fn fragment(&mut self, f: FragmentRecord) {
+        self.fragments.push(f);
+    }
+
+    fn current_ray(&mut self) -> Option<&mut RayRecord> {
+        self.current.and_then(|i| self.rays.get_mut(i))
+    }
+}
+
+impl Recorder for PixelTrace {
+    fn ray(&mut self, ray: &Ray, t_max: f32, depth: u32) {
+        if let Some(c) = self.current {
+            self.parent.push(c);
+        }
+        self.rays.push(RayRecord {
+            ray: *ray,
+            t_max,
+            depth,
+            shadow: self.shadow_active,
+            nodes_visited: Vec::new(),
+            tests: Vec::new(),
+            tests_omitted: 0,
+            closest: None,
+        });
+        self.current = Some(self.rays.len() - 1);
+    }
+
+    fn node_visit(&mut self, node: u32) {
+        if let Some(r) = self.current_ray() {
+            r.nodes_visited.push(node);
+        }
+    }
+
+    fn primitive_test(&mut self, test: PrimitiveTest) {
+        if let Some(r) = self.current_ray() {
+            if r.tests.len() < MAX_TESTS_PER_RAY {
+                r.tests.push(test);
+            } else {
+                r.tests_omitted += 1;
+            }
+        }
+    }
+
+    fn closest(&mut self, hit: Option<&SurfaceHit>) {
+        if let Some(r) = self.current_ray() {
+            r.closest = hit.copied();
+        }
+    }
+
+    fn light(&mut self, sample: LightSample) {
+        self.lights.push(sample);
+    }
+
+    fn shaded(&mut self, depth: u32, radiance: Radiance) {
+        self.shaded.push((depth, radiance));
+        // Shading of this ray's hit is over: later events belong to its parent.
+        self.current = self.parent.pop();
+    }
+
+    fn in_shadow_ray(&mut self, active: bool) {
+        self.shadow_active = active;
+        if !active {
+            // The shadow ray is done; return to the ray being shaded.
+            self.current = self.parent.pop();
+        }
+    }
+}

@@ -3,9 +3,9 @@
 //! the thing every faster method is checked against.
 
 use super::intersect::{intersect_sphere, intersect_triangle};
-use super::cast_pass;
+use super::{cast_pass, cast_pixel};
 use crate::math::{Radiance, Ray};
-use crate::render::trace::{PrimitiveTest, Recorder};
+use crate::render::trace::{PixelTrace, PrimitiveTest, Recorder};
 use crate::render::{PassJob, PreparedScene, RayCounts, Renderer, SceneQuery};
 use crate::scene::{PrimitiveKind, SurfaceHit};
 
@@ -22,6 +22,10 @@ impl Renderer for BruteForce {
 
     fn render_pass(&self, job: &PassJob, out: &mut [Radiance]) -> RayCounts {
         cast_pass(job, &BruteQuery(job.prepared), out)
+    }
+
+    fn trace_pixel(&self, job: &PassJob, x: u32, y: u32, rec: &mut PixelTrace) -> Option<Radiance> {
+        Some(cast_pixel(job, &BruteQuery(job.prepared), x, y, &mut RayCounts::default(), rec))
     }
 }
 

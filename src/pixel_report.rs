@@ -1,0 +1,198 @@
+//! `pinhole pixel`: a replayed pixel as JSON and as readable text. The
+//! record comes from `render::replay_pixel`, which runs the renderer's own
+//! code path with a recorder.
+
+use crate::math::Vec3;
+use crate::render::raytrace::intersect::Miss;
+use crate::render::trace::{FragmentRecord, LightSample, PixelTrace, RayRecord};
+use crate::render::PixelReplay;
+use crate::scene::{PrimitiveKind, Scene, SurfaceHit};
+use serde_json::{json, Value};
+use std::fmt::Write;
+
+fn v3(v: Vec3) -> Value {
+    json!([v.x, v.y, v.z])
+}
+
+fn kind(k: PrimitiveKind) -> &'static str {
+    match k {
+        PrimitiveKind::Triangle => "triangle",
+        PrimitiveKind::Sphere => "sphere",
+    }
+}
+
+pub fn miss_reason(m: Miss) -> &'static str {
+    match m {
+        Miss::Parallel => "parallel",
+        Miss::BackFace => "back face",
+        Miss::Outside => "outside",
+        Miss::Behind => "behind",
+        Miss::Farther => "farther",
+    }
+}
+
+fn hit_json(scene: &Scene, h: &SurfaceHit) -> Value {
+    json!({
+        "kind": kind(h.kind), "primitive": h.primitive, "object": h.object,
+        "object_name": scene.objects.get(h.object as usize).map(|o| o.name.clone()),
+        "material": scene.materials.get(h.material as usize).map(|m| m.name.clone()),
+        "t": h.t, "position": v3(h.position), "barycentric": v3(h.barycentric),
+        "geometric_normal": v3(h.geometric_normal), "shading_normal": v3(h.shading_normal),
+        "uv": [h.uv.x, h.uv.y], "back_face": h.back_face,
+    })
+}
+
+fn ray_json(scene: &Scene, r: &RayRecord) -> Value {
+    let tests: Vec<Value> = r
+        .tests
+        .iter()
+        .map(|t| match t.outcome {
+            Ok((tt, b1, b2)) => json!({"kind": kind(t.kind), "index": t.index, "result": "hit", "t": tt, "b1": b1, "b2": b2}),
+            Err(m) => json!({"kind": kind(t.kind), "index": t.index, "result": miss_reason(m)}),
+        })
+        .collect();
+    json!({
+        "origin": v3(r.ray.origin), "direction": v3(r.ray.dir), "t_max": finite_or_null(r.t_max),
+        "depth": r.depth, "shadow": r.shadow, "nodes_visited": r.nodes_visited, "tests": tests,
+        "tests_omitted": r.tests_omitted, "closest": r.closest.as_ref().map(|h| hit_json(scene, h)),
+    })
+}
+
+fn finite_or_null(v: f32) -> Value {
+    if v.is_finite() { json!(v) } else { Value::Null }
+}
+
+fn light_json(l: &LightSample) -> Value {
+    json!({
+        "light": l.light, "w_i": v3(l.w_i), "distance": finite_or_null(l.distance), "incident": v3(l.incident),
+        "cos_theta": l.cos_theta, "shadow_ray": l.shadow_ray.map(|(r, t)| json!({"origin": v3(r.origin), "direction": v3(r.dir), "t_max": t})),
+        "blocked_by": l.blocker.map(|(k, i, t)| json!({"kind": kind(k), "index": i, "t": t})),
+        "bsdf": v3(l.bsdf), "contribution": v3(l.contribution),
+    })
+}
+
+fn fragment_json(f: &FragmentRecord) -> Value {
+    json!({
+        "kind": kind(f.kind), "primitive": f.primitive, "screen_barycentric": f.screen_barycentric.map(v3),
+        "barycentric": v3(f.barycentric), "depth": f.depth, "stored_depth": finite_or_null(f.stored_depth),
+        "depth_test": if f.passed_depth_test { "passed" } else { "failed" }, "shaded": f.shaded.map(v3),
+    })
+}
+
+fn sample_json(scene: &Scene, t: &PixelTrace) -> Value {
+    json!({
+        "rays": t.rays.iter().map(|r| ray_json(scene, r)).collect::<Vec<_>>(),
+        "lights": t.lights.iter().map(light_json).collect::<Vec<_>>(),
+        "fragments": t.fragments.iter().map(fragment_json).collect::<Vec<_>>(),
+    })
+}
+
+/// The JSON record: `renderer`, `x`, `y`, `radiance` (the frame's value) and the samples.
+pub fn to_json(renderer: &str, scene: &Scene, x: u32, y: u32, replay: &PixelReplay) -> Value {
+    let display = crate::image_io::display_pixel(replay.radiance, scene.render.exposure, true);
+    json!({
+        "renderer": renderer, "x": x, "y": y, "radiance": v3(replay.radiance), "display_srgb8": display,
+        "exposure": scene.render.exposure, "spp": replay.samples.len(),
+        "samples": replay.samples.iter().map(|(o, t, v)| {
+            let mut s = sample_json(scene, t);
+            s["offset"] = json!([o.x, o.y]);
+            s["radiance"] = v3(*v);
+            s
+        }).collect::<Vec<_>>(),
+    })
+}
+
+fn fmt3(v: Vec3) -> String {
+    format!("({:.5}, {:.5}, {:.5})", v.x, v.y, v.z)
+}
+
+/// A readable account of the first sample, then the final value.
+pub fn to_text(renderer: &str, scene: &Scene, x: u32, y: u32, replay: &PixelReplay) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "pixel ({x}, {y}) of {} by {renderer}, {} sample(s)", scene.name, replay.samples.len());
+    if let Some((offset, t, value)) = replay.samples.first() {
+        let _ = writeln!(s, "sample 1 at sub-pixel ({:.3}, {:.3})", offset.x, offset.y);
+        for r in &t.rays {
+            let what = if r.shadow { "shadow ray" } else if r.depth == 0 { "eye ray" } else { "secondary ray" };
+            let indent = "  ".repeat(r.depth as usize + 1);
+            let _ = writeln!(s, "{indent}{what}: origin {} direction {} t_max {:.5}", fmt3(r.ray.origin), fmt3(r.ray.dir), r.t_max);
+            if !r.nodes_visited.is_empty() {
+                let _ = writeln!(s, "{indent}  BVH nodes visited: {}", r.nodes_visited.len());
+            }
+            let hits = r.tests.iter().filter(|t| t.outcome.is_ok()).count();
+            let mut reasons: std::collections::BTreeMap<&str, usize> = Default::default();
+            for t in &r.tests {
+                if let Err(m) = t.outcome {
+                    *reasons.entry(miss_reason(m)).or_default() += 1;
+                }
+            }
+            let _ = writeln!(
+                s,
+                "{indent}  primitives tested: {} ({hits} hit{}{}){}",
+                r.tests.len() + r.tests_omitted,
+                if hits == 1 { "" } else { "s" },
+                reasons.iter().map(|(k, v)| format!(", {v} {k}")).collect::<String>(),
+                if r.tests_omitted > 0 { format!(", {} not kept", r.tests_omitted) } else { String::new() }
+            );
+            for t in r.tests.iter().filter(|t| t.outcome.is_ok()) {
+                if let Ok((tt, b1, b2)) = t.outcome {
+                    let _ = writeln!(s, "{indent}    {} {} hit at t = {tt:.6}, b = ({:.4}, {b1:.4}, {b2:.4})", kind(t.kind), t.index, 1.0 - b1 - b2);
+                }
+            }
+            match &r.closest {
+                Some(h) => {
+                    let mat = scene.materials.get(h.material as usize).map(|m| m.name.as_str()).unwrap_or("?");
+                    let _ = writeln!(
+                        s,
+                        "{indent}  closest: {} {} (object {}, material {mat}) at t = {:.6}\n{indent}    P = {}  n = {}  b = {}",
+                        kind(h.kind),
+                        h.primitive,
+                        h.object,
+                        h.t,
+                        fmt3(h.position),
+                        fmt3(h.shading_normal),
+                        fmt3(h.barycentric)
+                    );
+                }
+                None if r.shadow => {}
+                None => {
+                    let _ = writeln!(s, "{indent}  closest: nothing (background)");
+                }
+            }
+        }
+        for f in &t.fragments {
+            let _ = writeln!(
+                s,
+                "  fragment: {} {} depth {:.6} vs stored {:.6}: {}  b = {}",
+                kind(f.kind),
+                f.primitive,
+                f.depth,
+                f.stored_depth,
+                if f.passed_depth_test { "passed" } else { "failed" },
+                fmt3(f.barycentric)
+            );
+        }
+        for l in &t.lights {
+            let blocked = match l.blocker {
+                Some((k, i, bt)) => format!("blocked by {} {i} at t = {bt:.5}", kind(k)),
+                None if l.shadow_ray.is_some() => "visible".into(),
+                None => "no shadow ray".into(),
+            };
+            let _ = writeln!(
+                s,
+                "  light {}: w_i {} d = {:.4}, L_i {} cos {:.4}, {blocked}, f {} -> {}",
+                l.light,
+                fmt3(l.w_i),
+                l.distance,
+                fmt3(l.incident),
+                l.cos_theta,
+                fmt3(l.bsdf),
+                fmt3(l.contribution)
+            );
+        }
+        let _ = writeln!(s, "  sample radiance {}", fmt3(*value));
+    }
+    let d = crate::image_io::display_pixel(replay.radiance, scene.render.exposure, true);
+    let _ = writeln!(s, "final radiance {} -> displayed sRGB {:?}", fmt3(replay.radiance), d);
+    s
+}
