@@ -317,13 +317,14 @@ fn cmd_compare(a: &Path, b: &Path, as_json: bool) -> Result<(), String> {
             ib.height
         ));
     }
-    let m = crate::metrics::compare(&ia.pixels, &ib.pixels)?;
+    let m = crate::metrics::compare_images(&ia.pixels, &ib.pixels, ia.width as usize, ia.height as usize)?;
     if as_json {
         write_json("-", &serde_json::to_value(m).map_err(|e| e.to_string())?)
     } else {
         println!("rmse      {:.6}  ({:.3}% of the mean {:.6} of {})", m.rmse, 100.0 * m.rmse / m.reference_mean.max(1e-12), m.reference_mean, b.display());
         println!("rel_mse   {:.6}", m.rel_mse);
         println!("max_abs   {:.6}", m.max_abs);
+        println!("flip      {:.6}", m.flip.unwrap_or(0.0));
         println!("differing {} of {} pixels", m.differing_pixels, ia.pixels.len());
         Ok(())
     }

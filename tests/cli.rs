@@ -49,6 +49,7 @@ fn render_png_exr_ppm_with_stats() {
     let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(j["rmse"], 0.0);
     assert!(j.get("rel_mse").is_some() && j.get("max_abs").is_some());
+    assert_eq!(j["flip"], 0.0);
 }
 
 #[test]

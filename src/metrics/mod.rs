@@ -1,5 +1,7 @@
 //! Image error metrics between a test image and a reference, on linear values.
 
+pub mod flip;
+
 use crate::math::Radiance;
 
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
@@ -14,6 +16,21 @@ pub struct ErrorMetrics {
     pub reference_mean: f64,
     /// Pixels whose largest channel difference exceeds 1e-4 relative.
     pub differing_pixels: u64,
+    /// Mean LDR FLIP error of the sRGB-encoded images (exposure 1); computed by `compare_images`.
+    pub flip: Option<f64>,
+}
+
+/// All metrics, FLIP included, for two images of `width` x `height`.
+pub fn compare_images(test: &[Radiance], reference: &[Radiance], width: usize, height: usize) -> Result<ErrorMetrics, String> {
+    let mut m = compare(test, reference)?;
+    let encode = |img: &[Radiance]| -> Vec<glam::Vec3> {
+        img.iter().map(|&c| {
+            let p = crate::image_io::display_pixel(c, 1.0, true);
+            glam::Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32) / 255.0
+        }).collect()
+    };
+    m.flip = Some(flip::mean_flip(&encode(test), &encode(reference), width, height));
+    Ok(m)
 }
 
 /// Compares `test` against `reference` (same size, row-major linear RGB).
@@ -48,6 +65,7 @@ pub fn compare(test: &[Radiance], reference: &[Radiance]) -> Result<ErrorMetrics
         max_abs,
         reference_mean: mean / n,
         differing_pixels: differing,
+        flip: None,
     })
 }
 
@@ -62,7 +80,7 @@ mod tests {
         let b = vec![Vec3::new(1.0, 1.0, 1.0), Vec3::new(0.0, 0.0, 0.6)];
         let m = compare(&a, &b).unwrap();
         // One channel off by 0.6 of six: mse = 0.36 / 6 = 0.06.
-        assert!((m.rmse - 0.06f64.sqrt()).abs() < 1e-9);
+        assert!((m.rmse - 0.06f64.sqrt()).abs() < 1e-6);
         assert!((m.max_abs - 0.6).abs() < 1e-6);
         assert!((m.rel_mse - 0.36 / (0.36 + 0.01) / 6.0).abs() < 1e-6);
         assert_eq!(m.differing_pixels, 1);
