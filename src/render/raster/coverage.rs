@@ -1,0 +1,44 @@
+//! Coverage counts: how many times each variant's coverage loop visits each
+//! sample, without depth test or shading. Used by the watertightness tests (a
+//! mesh must cover every interior sample exactly once) and suited to a crack
+//! debug view.
+
+use super::fixed::{self, snap_all, snap_offset};
+use super::setup::{PixelRect, ScreenTri};
+use super::tiled::{self, TileGrid};
+use super::{barycentric, incremental, scanline, Method};
+use crate::math::Vec2;
+
+/// Runs the coverage loop of `method` over 2D triangles given in image
+/// coordinates (either winding), samples at `offset` inside each pixel, and
+/// returns per pixel (row-major) how many triangles covered its sample.
+/// `None` for the methods whose coverage is a 3D ray test (naive, bbox).
+pub fn coverage_counts(method: Method, width: u32, height: u32, offset: Vec2, tris: &[[Vec2; 3]]) -> Option<Vec<u32>> {
+    let sts: Vec<ScreenTri> = tris.iter().enumerate().filter_map(|(i, p)| ScreenTri::flat(i as u32, *p, offset, width, height)).collect();
+    let full = PixelRect::new(0, 0, width, height);
+    let mut counts = vec![0u32; (width * height) as usize];
+    let mut tested = 0;
+    let mut hit = |x: u32, y: u32| counts[(x + y * width) as usize] += 1;
+    match method {
+        Method::Incremental => sts.iter().for_each(|st| incremental::raster(st, full, offset, &mut tested, |x, y, _| hit(x, y))),
+        Method::Barycentric => sts.iter().for_each(|st| barycentric::raster(st, full, offset, &mut tested, |x, y, _| hit(x, y))),
+        Method::Scanline => sts.iter().for_each(|st| scanline::raster(st, full, offset, &mut tested, |x, y, _| hit(x, y))),
+        Method::Fixed => {
+            let off = snap_offset(offset);
+            for ft in snap_all(&sts, off, width, height) {
+                fixed::raster(&ft, full, off, &mut tested, |x, y, _| hit(x, y));
+            }
+        }
+        Method::Tiled => {
+            let off = snap_offset(offset);
+            let fts = snap_all(&sts, off, width, height);
+            let grid = TileGrid::new(width, 0, height);
+            let bins = tiled::bin(&fts, &grid, off);
+            for (t, bin) in bins.iter().enumerate() {
+                tiled::tile_fragments(&fts, bin, grid.rect(t), off, &mut tested, |_, x, y, _| hit(x, y));
+            }
+        }
+        Method::Naive | Method::BBox => return None,
+    }
+    Some(counts)
+}

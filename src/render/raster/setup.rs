@@ -1,0 +1,286 @@
+//! Triangle setup, shared by every rasterizer variant: world to camera space,
+//! back-face culling, near-plane clipping, projection to the image and the
+//! pixel bounding box. The result is a list of screen-space triangles in scene
+//! order, each remembering which scene triangle it came from.
+
+use super::clip::{clip_near, triangle_vertices};
+use crate::math::{Vec2, Vec3};
+use crate::render::PassJob;
+use crate::scene::{CameraView, Triangle};
+use rayon::prelude::*;
+
+/// A half-open rectangle of pixels `[x0, x1) x [y0, y1)`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct PixelRect {
+    pub x0: u32,
+    pub y0: u32,
+    pub x1: u32,
+    pub y1: u32,
+}
+
+impl PixelRect {
+    pub fn new(x0: u32, y0: u32, x1: u32, y1: u32) -> PixelRect {
+        PixelRect { x0, y0, x1, y1 }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.x0 >= self.x1 || self.y0 >= self.y1
+    }
+
+    pub fn intersect(&self, o: &PixelRect) -> PixelRect {
+        PixelRect { x0: self.x0.max(o.x0), y0: self.y0.max(o.y0), x1: self.x1.min(o.x1), y1: self.y1.min(o.y1) }
+    }
+
+    pub fn width(&self) -> u32 {
+        self.x1.saturating_sub(self.x0)
+    }
+
+    pub fn height(&self) -> u32 {
+        self.y1.saturating_sub(self.y0)
+    }
+
+    pub fn area(&self) -> u64 {
+        self.width() as u64 * self.height() as u64
+    }
+
+    /// Grown by `m` pixels on every side, clamped to `[0, w) x [0, h)`.
+    pub fn grown(&self, m: u32, w: u32, h: u32) -> PixelRect {
+        PixelRect { x0: self.x0.saturating_sub(m), y0: self.y0.saturating_sub(m), x1: (self.x1 + m).min(w), y1: (self.y1 + m).min(h) }
+    }
+}
+
+/// The pixels `i` in `[0, n)` whose sample `i + off` lies in `[lo, hi]`.
+pub fn sample_span(lo: f32, hi: f32, off: f32, n: u32) -> (u32, u32) {
+    if !(lo <= hi) {
+        return (0, 0);
+    }
+    let a = (lo - off).ceil().clamp(0.0, n as f32);
+    let b = ((hi - off).floor() + 1.0).clamp(0.0, n as f32);
+    (a as u32, b as u32)
+}
+
+/// Twice the signed area of the 2D triangle `a, b, p`: the edge function of edge
+/// `a -> b` at `p`. In image coordinates (y down) it is positive on the inner
+/// side of every edge of a triangle with positive area.
+#[inline(always)]
+pub fn edge_function(a: Vec2, b: Vec2, p: Vec2) -> f32 {
+    (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x)
+}
+
+/// A projected (clipped) triangle ready to rasterize.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ScreenTri {
+    /// Index of the scene triangle this piece belongs to.
+    pub tri: u32,
+    /// Image positions (pixels), ordered so the signed area is positive.
+    pub p: [Vec2; 3],
+    /// 1 / view depth at each vertex: affine in image space.
+    pub inv_z: [f32; 3],
+    /// Barycentrics in the original triangle divided by view depth, per vertex:
+    /// affine in image space, so perspective-correct weights are `sum / inv_z`.
+    pub bz: [Vec3; 3],
+    /// Pixels whose sample position may be covered, clamped to the image.
+    pub bbox: PixelRect,
+}
+
+impl ScreenTri {
+    /// A screen triangle from projected vertices; `None` when it has no area or
+    /// no sample of the image can fall inside it. Vertices 1 and 2 are swapped
+    /// when needed to make the area positive.
+    pub fn new(tri: u32, mut p: [Vec2; 3], mut inv_z: [f32; 3], mut bz: [Vec3; 3], off: Vec2, width: u32, height: u32) -> Option<ScreenTri> {
+        let area = edge_function(p[0], p[1], p[2]);
+        if !area.is_finite() || area == 0.0 {
+            return None;
+        }
+        if area < 0.0 {
+            p.swap(1, 2);
+            inv_z.swap(1, 2);
+            bz.swap(1, 2);
+        }
+        let lo = p[0].min(p[1]).min(p[2]);
+        let hi = p[0].max(p[1]).max(p[2]);
+        let (x0, x1) = sample_span(lo.x, hi.x, off.x, width);
+        let (y0, y1) = sample_span(lo.y, hi.y, off.y, height);
+        let bbox = PixelRect { x0, y0, x1, y1 };
+        (!bbox.is_empty()).then_some(ScreenTri { tri, p, inv_z, bz, bbox })
+    }
+
+    /// A triangle given directly in image space at depth 1 (tests, coverage counts).
+    pub fn flat(tri: u32, p: [Vec2; 3], off: Vec2, width: u32, height: u32) -> Option<ScreenTri> {
+        ScreenTri::new(tri, p, [1.0; 3], [Vec3::X, Vec3::Y, Vec3::Z], off, width, height)
+    }
+
+    /// Interpolated 1 / view depth for screen-space weights `l`.
+    #[inline(always)]
+    pub fn inv_z_at(&self, l: [f32; 3]) -> f32 {
+        l[0] * self.inv_z[0] + l[1] * self.inv_z[1] + l[2] * self.inv_z[2]
+    }
+
+    /// Perspective-correct barycentrics (b1, b2) in the original triangle for
+    /// screen-space weights `l`, given `inv_z = inv_z_at(l)`.
+    #[inline(always)]
+    pub fn bary_at(&self, l: [f32; 3], inv_z: f32) -> [f32; 2] {
+        let b = (self.bz[0] * l[0] + self.bz[1] * l[1] + self.bz[2] * l[2]) / inv_z;
+        [b.y, b.z]
+    }
+
+    /// Screen-space (affine, NOT perspective-correct) weights of the pixel sample `q`.
+    pub fn screen_weights(&self, q: Vec2) -> [f32; 3] {
+        let area = edge_function(self.p[0], self.p[1], self.p[2]);
+        [
+            edge_function(self.p[1], self.p[2], q) / area,
+            edge_function(self.p[2], self.p[0], q) / area,
+            edge_function(self.p[0], self.p[1], q) / area,
+        ]
+    }
+}
+
+/// True when the single-sided test of the ray tracer would reject every eye
+/// ray hitting this triangle: its geometric normal faces away from the eye.
+#[inline]
+pub fn is_back_face(view: &CameraView, t: &Triangle) -> bool {
+    if t.two_sided {
+        return false;
+    }
+    let n = (t.v[1] - t.v[0]).cross(t.v[2] - t.v[0]);
+    (view.eye - t.v[0]).dot(n) <= 0.0
+}
+
+/// Culls, clips and projects one scene triangle, appending 0, 1 or 2 pieces.
+pub fn setup_triangle(view: &CameraView, t: &Triangle, index: u32, off: Vec2, out: &mut Vec<ScreenTri>) {
+    if is_back_face(view, t) {
+        return;
+    }
+    let c = t.v.map(|v| view.to_camera(v));
+    if c.iter().all(|c| -c.z >= view.far) {
+        return;
+    }
+    for piece in clip_near(triangle_vertices(c), view.near).as_slice() {
+        let p = piece.map(|v| view.project_camera(v.pos));
+        let inv_z = piece.map(|v| 1.0 / -v.pos.z);
+        let bz = [piece[0].bary * inv_z[0], piece[1].bary * inv_z[1], piece[2].bary * inv_z[2]];
+        if let Some(st) = ScreenTri::new(index, p, inv_z, bz, off, view.width, view.height) {
+            out.push(st);
+        }
+    }
+}
+
+/// Every triangle of the scene set up for this pass, in scene order (setup in parallel).
+pub fn setup_pass(job: &PassJob) -> Vec<ScreenTri> {
+    const CHUNK: usize = 4096;
+    let view = job.view;
+    let rows = PixelRect::new(0, job.rows.start, view.width, job.rows.end);
+    let pieces: Vec<Vec<ScreenTri>> = job
+        .prepared
+        .scene
+        .triangles
+        .par_chunks(CHUNK)
+        .enumerate()
+        .map(|(ci, chunk)| {
+            let mut out = Vec::with_capacity(chunk.len());
+            for (j, t) in chunk.iter().enumerate() {
+                setup_triangle(view, t, (ci * CHUNK + j) as u32, job.offset, &mut out);
+            }
+            // Drop pieces outside the rows of this job.
+            out.retain(|st| !st.bbox.intersect(&rows).is_empty());
+            out
+        })
+        .collect();
+    pieces.concat()
+}
+
+/// For consecutive bands of `band` rows starting at `rows_start`, the indices
+/// of the rectangles that overlap each band, in order.
+pub fn bin_rows(rects: impl Iterator<Item = PixelRect>, rows_start: u32, rows_end: u32, band: u32) -> Vec<Vec<u32>> {
+    let n = (rows_end.saturating_sub(rows_start)).div_ceil(band) as usize;
+    let mut bins = vec![Vec::new(); n];
+    for (i, r) in rects.enumerate() {
+        let y0 = r.y0.max(rows_start);
+        let y1 = r.y1.min(rows_end);
+        if y0 >= y1 || r.x0 >= r.x1 {
+            continue;
+        }
+        for b in (y0 - rows_start) / band..=(y1 - 1 - rows_start) / band {
+            bins[b as usize].push(i as u32);
+        }
+    }
+    bins
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Camera, Fov};
+
+    #[test]
+    fn sample_span_by_hand() {
+        // Samples at x + 0.5: 2.5, 3.5 and 4.5 lie in [2.2, 4.5].
+        assert_eq!(sample_span(2.2, 4.5, 0.5, 10), (2, 5));
+        assert_eq!(sample_span(-3.0, 0.4, 0.5, 10), (0, 0));
+        assert_eq!(sample_span(8.0, 100.0, 0.5, 10), (8, 10));
+        assert_eq!(sample_span(f32::NAN, 1.0, 0.5, 10), (0, 0));
+    }
+
+    #[test]
+    fn orientation_is_normalised() {
+        let p = [Vec2::new(1.0, 1.0), Vec2::new(5.0, 1.0), Vec2::new(1.0, 5.0)];
+        let a = ScreenTri::flat(0, p, Vec2::splat(0.5), 10, 10).unwrap();
+        let b = ScreenTri::flat(0, [p[0], p[2], p[1]], Vec2::splat(0.5), 10, 10).unwrap();
+        // Same positions; the attributes follow their vertices.
+        assert_eq!((a.p, a.bbox), (b.p, b.bbox));
+        assert_eq!(b.bz, [Vec3::X, Vec3::Z, Vec3::Y]);
+        assert!(edge_function(a.p[0], a.p[1], a.p[2]) > 0.0);
+        assert_eq!(a.bbox, PixelRect::new(1, 1, 5, 5));
+        // The weights of vertex 0 at the vertex itself.
+        let w = a.screen_weights(a.p[0]);
+        assert_eq!(w, [1.0, 0.0, 0.0]);
+        assert!(ScreenTri::flat(0, [p[0], p[0], p[1]], Vec2::splat(0.5), 10, 10).is_none());
+    }
+
+    #[test]
+    fn back_faces_match_the_ray_tracer() {
+        // The book's triangle faces +z (towards the eye at the origin): front.
+        let cam = Camera { fov: Fov::X(90.0), ..Camera::default() };
+        let view = cam.view(80, 50);
+        let mut t = Triangle {
+            v: [Vec3::new(0.0, 1.0, -2.0), Vec3::new(-1.9, -1.0, -2.0), Vec3::new(1.6, -0.5, -2.0)],
+            n: [Vec3::Z; 3],
+            uv: [Vec2::ZERO; 3],
+            material: 0,
+            object: 0,
+            two_sided: false,
+        };
+        assert!(!is_back_face(&view, &t));
+        t.v.swap(1, 2);
+        assert!(is_back_face(&view, &t));
+        t.two_sided = true;
+        assert!(!is_back_face(&view, &t));
+    }
+
+    #[test]
+    fn crossing_triangle_projects_only_its_front_part() {
+        // A long triangle on the floor, from in front of the camera to behind it:
+        // it must come out clipped (never wrapped behind the eye).
+        let cam = Camera { fov: Fov::Y(90.0), near: 0.5, ..Camera::default() };
+        let view = cam.view(100, 100);
+        let t = Triangle {
+            v: [Vec3::new(-1.0, -1.0, -5.0), Vec3::new(1.0, -1.0, -5.0), Vec3::new(0.0, -1.0, 5.0)],
+            n: [Vec3::Y; 3],
+            uv: [Vec2::ZERO; 3],
+            material: 0,
+            object: 0,
+            two_sided: true,
+        };
+        let mut out = Vec::new();
+        setup_triangle(&view, &t, 7, Vec2::splat(0.5), &mut out);
+        assert_eq!(out.len(), 2);
+        for st in &out {
+            assert_eq!(st.tri, 7);
+            for k in 0..3 {
+                // Every piece lies below the horizon (y > 50) and at depth >= near.
+                assert!(st.p[k].y > 50.0, "{st:?}");
+                assert!(st.inv_z[k] <= 1.0 / 0.5 + 1e-6);
+            }
+        }
+    }
+}
