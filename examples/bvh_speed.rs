@@ -1,0 +1,99 @@
+//! Times the BVH: build and primary rays on benchmark scenes, the figures
+//! DESIGN.md compares with Embree 3 (`tools/peers/embree_primary.py`).
+//!
+//!     cargo run --release --example bvh_speed -- ../shared/bench/stanford-bunny.toml ...
+//!
+//! Prints, per scene: best-of-N build ms, and Mrays/s for bare closest-hit
+//! queries (eye ray + traversal, like Embree's rtcIntersect1 loop), the depth
+//! view (`render_pass`, primary rays only) and the shaded frame with shadow rays.
+
+use pinhole::render::raytrace::bvh::{Bvh, BvhQuery, BvhRayTracer};
+use pinhole::render::trace::NoRecord;
+use pinhole::render::{debug::View, PassJob, PreparedScene, RayCounts, RenderSettings, Renderer, SceneQuery, ShadowMode};
+use pinhole::math::{Radiance, Vec2};
+use rayon::prelude::*;
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+
+fn best_of<F: FnMut()>(n: usize, mut f: F) -> f64 {
+    (0..n)
+        .map(|_| {
+            let t = Instant::now();
+            f();
+            t.elapsed().as_secs_f64()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+fn main() {
+    let mut args: Vec<String> = std::env::args().skip(1).collect();
+    if args.is_empty() {
+        args = vec!["/work/shared/bench/stanford-bunny.toml".into(), "/work/shared/bench/teapot.toml".into()];
+    }
+    let reps = 7;
+    for path in args {
+        let scene = pinhole::scene::file::load_scene_file(Path::new(&path)).expect("scene");
+        let prepared = PreparedScene::new(scene);
+        let build = best_of(reps, || {
+            std::hint::black_box(Bvh::build(&prepared.scene, &prepared.edges));
+        });
+        let (w, h) = (prepared.scene.render.width, prepared.scene.render.height);
+        let view = prepared.scene.camera.view(w, h);
+        let rays = (w * h) as f64;
+
+        // Bare closest-hit queries, rows in parallel.
+        let query = BvhQuery::new(&prepared);
+        let mut hits = 0u64;
+        let bare = best_of(reps, || {
+            hits = (0..h)
+                .into_par_iter()
+                .map(|y| {
+                    let mut counts = RayCounts::default();
+                    let mut n = 0u64;
+                    for x in 0..w {
+                        let (px, py) = (x as f32 + 0.5, y as f32 + 0.5);
+                        let ray = view.eye_ray(px, py);
+                        n += query.closest(&ray, view.far_t(px, py), false, &mut counts, &mut NoRecord).is_some() as u64;
+                    }
+                    n
+                })
+                .sum();
+        });
+
+        let cancel = AtomicBool::new(false);
+        let mut out = vec![Radiance::ZERO; (w * h) as usize];
+        let mut pass = |view_kind: View, shadows: ShadowMode| {
+            let settings = RenderSettings { view: view_kind, shadows, ..RenderSettings::for_scene(&prepared.scene) };
+            let mut counts = RayCounts::default();
+            let t = best_of(reps, || {
+                let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: Vec2::splat(0.5), rows: 0..h, cancel: &cancel };
+                counts = BvhRayTracer.render_pass(&job, &mut out);
+            });
+            (t, counts)
+        };
+        let (depth, dc) = pass(View::Depth, ShadowMode::None);
+        let (shaded, sc) = pass(View::Shaded, ShadowMode::Ray);
+        println!(
+            "pinhole {} tris={} {}x{} threads={} nodes={} depth={} build_ms={:.1} bare_ms={:.1} bare_mrays_per_s={:.2} hits={} \
+             depth_view_ms={:.1} depth_view_mrays_per_s={:.2} nodes_per_ray={:.1} tests_per_ray={:.1} shaded_ms={:.1} shaded_mrays_per_s={:.2} (primary+shadow)",
+            Path::new(&path).file_stem().unwrap().to_string_lossy(),
+            prepared.edges.len(),
+            w,
+            h,
+            rayon::current_num_threads(),
+            prepared.bvh.node_count(),
+            prepared.bvh.depth(),
+            build * 1e3,
+            bare * 1e3,
+            rays / bare / 1e6,
+            hits,
+            depth * 1e3,
+            rays / depth / 1e6,
+            dc.nodes as f64 / rays,
+            dc.tests as f64 / rays,
+            shaded * 1e3,
+            (sc.primary + sc.shadow) as f64 / shaded / 1e6,
+        );
+    }
+}
