@@ -14,18 +14,26 @@ pub enum View {
     Barycentric,
     /// Eye-ray direction as (d + 1) / 2 (Figure 15.4).
     Raydir,
-    /// View-axis depth, near = white, far = black (linear in 1/z).
+    /// Distance from the eye along the eye ray, on a log scale from near (black) to far (white).
     Depth,
+    /// What a depth buffer stores: 1/z, mapped so near = 1 (white) and far = 0 (black).
+    Zbuffer,
     /// Shading normal as (n + 1) / 2.
     Normal,
     /// Object ids as distinct colours.
     Id,
     /// A checker in texture coordinates.
     Uv,
+    /// Work per pixel as a heat map: BVH nodes visited plus primitives tested by
+    /// the eye ray (ray tracers); triangles tested, fragments shaded (rasterizers).
+    Cost,
 }
 
+/// The cost that maps to the hot end of the cost view's colour scale.
+pub const COST_SCALE: f32 = 1024.0;
+
 impl View {
-    pub const ALL: [View; 7] = [View::Shaded, View::Barycentric, View::Raydir, View::Depth, View::Normal, View::Id, View::Uv];
+    pub const ALL: [View; 9] = [View::Shaded, View::Barycentric, View::Raydir, View::Depth, View::Zbuffer, View::Normal, View::Id, View::Uv, View::Cost];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -36,6 +44,8 @@ impl View {
             View::Normal => "normal",
             View::Id => "id",
             View::Uv => "uv",
+            View::Zbuffer => "zbuffer",
+            View::Cost => "cost",
         }
     }
 
@@ -55,13 +65,15 @@ pub fn view_color(view: View, camera: &CameraView, ray: &Ray, hit: Option<&Surfa
     }
     let Some(h) = hit else { return Vec3::ZERO };
     match view {
-        View::Shaded | View::Raydir => unreachable!("handled above"),
+        // Shaded is resolved by shade(); cost by the renderer, which counted the work.
+        View::Shaded | View::Raydir | View::Cost => Vec3::ZERO,
         View::Barycentric => h.barycentric,
-        View::Depth => {
-            // 1/z maps near to 1 and far to 0; it is what a depth buffer stores.
+        View::Depth => Vec3::splat(depth_value(camera, (h.position - camera.eye).length())),
+        View::Zbuffer => {
+            // 1/z maps near to 1 and far to 0, linear in screen space as rasterizers store it.
             let z = camera.view_depth(h.position).max(camera.near);
             let inv = (1.0 / z - 1.0 / camera.far) / (1.0 / camera.near - 1.0 / camera.far);
-            Vec3::splat(inv.clamp(0.0, 1.0).powf(0.25))
+            Vec3::splat(inv.clamp(0.0, 1.0))
         }
         View::Normal => (h.shading_normal + Vec3::ONE) * 0.5,
         View::Id => id_color(h.object),
@@ -80,4 +92,26 @@ pub fn id_color(id: u32) -> Vec3 {
         1.0 - (k.min(4.0 - k).clamp(0.0, 1.0))
     };
     Vec3::new(k(5.0), k(3.0), k(1.0)) * 0.8 + Vec3::splat(0.1)
+}
+
+/// The depth view's grey level for a distance from the eye: log scale, near = 0, far = 1.
+pub fn depth_value(camera: &CameraView, distance: f32) -> f32 {
+    ((distance.max(camera.near) / camera.near).ln() / (camera.far / camera.near).ln()).clamp(0.0, 1.0)
+}
+
+/// Heat-map colour of a cost: black, blue, magenta, orange, yellow, white on a
+/// log scale up to `COST_SCALE`.
+pub fn cost_color(cost: f32) -> Vec3 {
+    let t = ((1.0 + cost.max(0.0)).log2() / (1.0 + COST_SCALE).log2()).clamp(0.0, 1.0);
+    const STOPS: [Vec3; 6] = [
+        Vec3::new(0.0, 0.0, 0.0),
+        Vec3::new(0.05, 0.05, 0.6),
+        Vec3::new(0.6, 0.05, 0.6),
+        Vec3::new(0.95, 0.4, 0.05),
+        Vec3::new(1.0, 0.9, 0.1),
+        Vec3::new(1.0, 1.0, 1.0),
+    ];
+    let x = t * (STOPS.len() - 1) as f32;
+    let i = (x.floor() as usize).min(STOPS.len() - 2);
+    STOPS[i].lerp(STOPS[i + 1], x - i as f32)
 }

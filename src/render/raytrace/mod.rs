@@ -8,6 +8,7 @@ pub mod intersect;
 
 use super::trace::{NoRecord, Recorder};
 use super::{resolve_sample, PassJob, RayCounts, SceneQuery};
+use super::debug::{cost_color, View};
 use crate::math::Radiance;
 use rayon::prelude::*;
 
@@ -42,7 +43,13 @@ pub fn cast_pixel<Q: SceneQuery, R: Recorder>(job: &PassJob, query: &Q, x: u32, 
     let t_max = job.view.far_t(p.x, p.y);
     counts.primary += 1;
     rec.ray(&ray, t_max, 0);
+    let work_before = counts.nodes + counts.tests;
     let hit = query.closest(&ray, t_max, false, counts, rec);
     rec.closest(hit.as_ref());
+    if job.settings.view == View::Cost {
+        let c = cost_color((counts.nodes + counts.tests - work_before) as f32);
+        rec.shaded(0, c);
+        return c;
+    }
     resolve_sample(job, query, &ray, hit.as_ref(), counts, rec)
 }

@@ -1,0 +1,113 @@
+//! Debug views show their expected patterns on the book's one-triangle scene
+//! (CGPP 15.4.1.2 and figure 15.6), in every renderer.
+
+mod common;
+use common::*;
+use pinhole::math::{Radiance, Vec3};
+use pinhole::render::debug::View;
+use pinhole::render::{renderer_names, PreparedScene, RenderSettings};
+
+const W: u32 = 200;
+const H: u32 = 125;
+
+fn render_view(renderer: &str, scene_name: &str, view: View) -> Vec<Radiance> {
+    let scene = builtin(scene_name);
+    let mut settings = RenderSettings::for_scene(&scene);
+    settings.width = W;
+    settings.height = H;
+    settings.view = view;
+    render(renderer, &PreparedScene::new(scene), &settings)
+}
+
+fn at(img: &[Radiance], x: u32, y: u32) -> Vec3 {
+    img[(x + y * W) as usize]
+}
+
+/// Pixel nearest to a world point of the one-triangle scene, moved `inset`
+/// pixels towards the triangle's centroid so it lies inside.
+fn vertex_pixel(v: Vec3, inset: f32) -> (u32, u32) {
+    let scene = builtin("one-triangle");
+    let view = scene.camera.view(W, H);
+    let centroid = scene.triangles[0].v.iter().copied().sum::<Vec3>() / 3.0;
+    let (p, _) = view.project(v).unwrap();
+    let (c, _) = view.project(centroid).unwrap();
+    let q = p + (c - p).normalize() * inset;
+    (q.x as u32, q.y as u32)
+}
+
+#[test]
+fn raydir_red_grows_rightwards_and_green_upwards() {
+    for r in renderer_names() {
+        let img = render_view(r, "one-triangle", View::Raydir);
+        for x in 1..W {
+            assert!(at(&img, x, 60).x > at(&img, x - 1, 60).x, "{r}: red must grow left to right");
+        }
+        for y in 1..H {
+            assert!(at(&img, 100, y).y < at(&img, 100, y - 1).y, "{r}: green must grow bottom to top");
+        }
+        // Looking down -z: blue = (d.z + 1) / 2 stays below one half.
+        assert!(img.iter().all(|c| c.z < 0.5));
+    }
+}
+
+#[test]
+fn barycentric_vertices_are_pure_channels() {
+    let scene = builtin("one-triangle");
+    let v = scene.triangles[0].v;
+    for r in renderer_names() {
+        let img = render_view(r, "one-triangle", View::Barycentric);
+        for (k, vertex) in v.iter().enumerate() {
+            let (x, y) = vertex_pixel(*vertex, 3.0);
+            let c = at(&img, x, y);
+            assert!(c[k] > 0.9, "{r}: near vertex {k} at ({x}, {y}) the colour is {c}");
+            assert!((c.x + c.y + c.z - 1.0).abs() < 1e-4, "{r}: weights sum to one: {c}");
+        }
+        // Outside the triangle: black.
+        assert_eq!(at(&img, 2, 2), Vec3::ZERO);
+    }
+}
+
+#[test]
+fn depth_increases_with_distance() {
+    // The triangle lies in the plane z = -2: its distance from the eye grows
+    // away from the image centre, so the corner near v1 is deeper than the centre.
+    let scene = builtin("one-triangle");
+    let v1 = scene.triangles[0].v[1];
+    for r in renderer_names() {
+        let img = render_view(r, "one-triangle", View::Depth);
+        let (x, y) = vertex_pixel(v1, 3.0);
+        let centre = at(&img, W / 2, H / 2).x;
+        let corner = at(&img, x, y).x;
+        assert!(corner > centre && centre > 0.0, "{r}: corner {corner} vs centre {centre}");
+        let z = render_view(r, "one-triangle", View::Zbuffer);
+        // 1/z is constant on a plane of constant z.
+        assert!((at(&z, x, y).x - at(&z, W / 2, H / 2).x).abs() < 1e-5, "{r}");
+    }
+    // Across objects: on triangle-ground the far ground is deeper than the near ground.
+    let img = render_view("raytrace:brute", "triangle-ground", View::Depth);
+    assert!(at(&img, 5, H - 1).x < at(&img, 5, 75).x);
+}
+
+#[test]
+fn normal_and_id_views() {
+    let scene = builtin("one-triangle");
+    let n0 = scene.triangles[0].n[0];
+    for r in renderer_names() {
+        let img = render_view(r, "one-triangle", View::Normal);
+        let (x, y) = vertex_pixel(scene.triangles[0].v[0], 2.0);
+        let c = at(&img, x, y) * 2.0 - Vec3::ONE;
+        assert!(c.dot(n0) > 0.98, "{r}: normal near v0 is {c}, expected {n0}");
+        let ids = render_view(r, "triangle-ground", View::Id);
+        // The triangle (object 0) and the ground (objects 2, 3) differ in colour.
+        assert_ne!(at(&ids, W / 2, 40), at(&ids, 5, H - 2), "{r}");
+    }
+}
+
+#[test]
+fn cost_view_shows_more_work_for_brute_force() {
+    // Brute force tests every triangle of the teapot for each ray; the BVH tests few.
+    let brute = render_view("raytrace:brute", "teapot", View::Cost);
+    let bvh = render_view("raytrace:bvh", "teapot", View::Cost);
+    let heat = |img: &[Radiance]| img.iter().map(|c| c.x + c.y + c.z).sum::<f32>() / img.len() as f32;
+    assert!(heat(&brute) > 1.5 * heat(&bvh), "brute {} vs bvh {}", heat(&brute), heat(&bvh));
+}
