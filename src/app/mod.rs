@@ -157,7 +157,7 @@ pub fn run(scene: Option<String>, screenshot: Option<PathBuf>) -> Result<(), Str
 
     // In --screenshot mode the window fits the image 1:1 beside the side panel.
     let size = match &explicit {
-        Some((s, _)) if batch => [(s.render.width as f32 + 330.0).max(900.0), s.render.height as f32 + 110.0],
+        Some((s, _)) if batch => [s.render.width as f32 + 420.0, s.render.height as f32 + 120.0],
         _ => [1280.0, 800.0],
     };
     let options = eframe::NativeOptions {

@@ -38,7 +38,7 @@ impl OpenDialog {
                 }
             });
             ui.horizontal(|ui| {
-                if ui.button("⬆ up").clicked() {
+                if ui.button("Up").clicked() {
                     if let Some(parent) = self.dir.parent() {
                         self.dir = parent.to_path_buf();
                     }
@@ -50,7 +50,7 @@ impl OpenDialog {
                 Ok(entries) => {
                     for (path, is_dir) in entries {
                         let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-                        let label = if is_dir { format!("📁 {name}/") } else { name };
+                        let label = if is_dir { format!("{name}/") } else { name };
                         let r = ui.selectable_label(self.path == path.to_string_lossy(), label);
                         if r.clicked() {
                             self.path = path.to_string_lossy().into_owned();

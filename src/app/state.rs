@@ -405,7 +405,7 @@ impl PinholeApp {
                 .frame(egui::Frame::new().fill(egui::Color32::from_rgb(110, 20, 20)).inner_margin(6.0))
                 .show(ui, |ui| {
                     ui.horizontal(|ui| {
-                        ui.colored_label(egui::Color32::WHITE, format!("⚠ {err}"));
+                        ui.colored_label(egui::Color32::WHITE, format!("Error: {err}"));
                         if ui.button("Dismiss").clicked() {
                             self.error_bar = None;
                         }

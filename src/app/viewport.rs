@@ -56,7 +56,7 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
 
     // Dragging a point-light marker moves the light in the view plane.
     if response.drag_started_by(egui::PointerButton::Primary) {
-        if let Some(p) = response.interact_pointer_pos() {
+        if let Some(p) = ui.input(|i| i.pointer.press_origin()) {
             app.dragging_light = markers
                 .iter()
                 .filter_map(|(i, m)| m.map(|m| (*i, m.distance(p))))

@@ -15,11 +15,11 @@ use crate::math::Vec3;
 pub fn vec3_edit(ui: &mut egui::Ui, label: &str, v: &mut Vec3, speed: f32) -> bool {
     let mut changed = false;
     ui.horizontal(|ui| {
-        let l = ui.label(label);
+        ui.label(label);
         for (i, axis) in ["x", "y", "z"].iter().enumerate() {
             changed |= ui
                 .add(egui::DragValue::new(&mut v[i]).speed(speed).prefix(format!("{axis} ")).max_decimals(4))
-                .labelled_by(l.id)
+                .accessible_name(format!("{label} {axis}"))
                 .changed();
         }
     });
@@ -30,10 +30,10 @@ pub fn vec3_edit(ui: &mut egui::Ui, label: &str, v: &mut Vec3, speed: f32) -> bo
 pub fn color_edit(ui: &mut egui::Ui, label: &str, c: &mut Vec3, max: f32) -> bool {
     let mut changed = false;
     ui.horizontal(|ui| {
-        let l = ui.label(label);
+        ui.label(label);
         let mut rgb = c.to_array();
         if max <= 1.0 {
-            if ui.color_edit_button_rgb(&mut rgb).labelled_by(l.id).changed() {
+            if ui.color_edit_button_rgb(&mut rgb).accessible_name(label).changed() {
                 *c = Vec3::from_array(rgb);
                 changed = true;
             }
@@ -41,7 +41,7 @@ pub fn color_edit(ui: &mut egui::Ui, label: &str, c: &mut Vec3, max: f32) -> boo
         for (i, ch) in ["R", "G", "B"].iter().enumerate() {
             changed |= ui
                 .add(egui::DragValue::new(&mut c[i]).speed(0.005 * max).range(0.0..=max).prefix(format!("{ch} ")).max_decimals(3))
-                .on_hover_text(format!("{label} {ch}"))
+                .accessible_name(format!("{label} {ch}"))
                 .changed();
         }
     });

@@ -12,13 +12,10 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
     let mut open = app.panels.shading;
     section(ui, "Shading", &mut open, |ui| {
         let s = &mut app.settings;
-        ui.horizontal(|ui| {
-            ui.label("view");
-            egui::ComboBox::from_id_salt("debug-view").selected_text(s.view.name()).show_ui(ui, |ui| {
-                for v in View::ALL {
-                    ui.selectable_value(&mut s.view, v, v.name());
-                }
-            });
+        egui::ComboBox::from_label("debug view").selected_text(s.view.name()).show_ui(ui, |ui| {
+            for v in View::ALL {
+                ui.selectable_value(&mut s.view, v, v.name());
+            }
         });
         ui.horizontal(|ui| {
             ui.label("shadows");

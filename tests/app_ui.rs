@@ -1,0 +1,348 @@
+//! The viewer driven like a user with egui_kittest: pick a renderer, edit a
+//! material colour, move a light, export; each test checks the app state and
+//! the rendered pixels (against `render_frame` of the same scene) or the file.
+
+use eframe::egui;
+use egui_kittest::kittest::Queryable;
+use egui_kittest::Harness;
+use pinhole::app::PinholeApp;
+use pinhole::math::{Radiance, Vec3};
+use pinhole::render::{self, PreparedScene};
+use pinhole::scene::{Light, Scene};
+use std::sync::atomic::AtomicBool;
+use std::time::Duration;
+
+const WAIT: Duration = Duration::from_secs(120);
+
+fn small_scene(name: &str) -> Scene {
+    let mut scene = pinhole::scene::file::load_scene(name).unwrap();
+    scene.render.width = 160;
+    scene.render.height = 100;
+    scene
+}
+
+fn harness(scene: Scene) -> Harness<'static, PinholeApp> {
+    let app = PinholeApp::new_for_test(scene);
+    let mut h = Harness::builder()
+        .with_size([1280.0, 800.0])
+        .build_ui_state(|ui: &mut egui::Ui, app: &mut PinholeApp| app.ui(ui), app);
+    settle(&mut h);
+    h
+}
+
+/// Runs frames until the worker finished what the UI asked, and one more
+/// frame so the texture shows it.
+fn settle(h: &mut Harness<'static, PinholeApp>) {
+    h.step();
+    assert!(h.state_mut().wait_idle(WAIT), "the worker did not finish");
+    h.step();
+    h.step();
+}
+
+/// What `pinhole render` computes for the app's current scene, settings and renderer.
+fn reference(app: &PinholeApp) -> Vec<Radiance> {
+    let mut scene = (*app.scene).clone();
+    app.params.apply(&mut scene);
+    let prepared = PreparedScene::new(scene);
+    let renderer = render::renderer_by_name(&app.renderer).unwrap();
+    let settings = app.effective_settings();
+    render::render_frame(renderer.as_ref(), &prepared, &settings, &AtomicBool::new(false), None)
+        .unwrap()
+        .pixels
+}
+
+fn shown(app: &PinholeApp) -> Vec<Radiance> {
+    app.with_output(|o| {
+        assert!(o.complete && o.error.is_none(), "frame not complete: {:?}", o.error);
+        o.linear.clone()
+    })
+}
+
+fn pixel(app: &PinholeApp, x: u32, y: u32) -> Radiance {
+    app.with_output(|o| o.linear[(x + y * o.width) as usize])
+}
+
+#[test]
+fn first_frame_matches_the_reference_renderer() {
+    let h = harness(small_scene("one-triangle"));
+    let app = h.state();
+    assert_eq!(app.with_output(|o| (o.width, o.height)), (160, 100));
+    assert_eq!(shown(app), reference(app));
+    let status = pinhole::app::panels::status::status_text(app);
+    assert!(status.contains("160x100") && status.contains("1/1 spp") && status.contains("1 triangles"), "{status}");
+}
+
+#[test]
+fn renderer_combo_and_number_keys_switch_renderer_in_place() {
+    let mut h = harness(small_scene("one-triangle"));
+    let names = h.state().renderer_names.clone();
+    let target = *names.iter().find(|n| **n != h.state().renderer).expect("at least two renderers");
+    let camera = h.state().params.camera.clone();
+    h.get_by_label("Renderer").click();
+    h.step();
+    h.step();
+    h.get_by_label(target).click();
+    settle(&mut h);
+    let app = h.state();
+    assert_eq!(app.renderer, target);
+    assert_eq!(app.params.camera, camera, "the camera stays when the renderer changes");
+    assert_eq!(shown(app), reference(app), "{target} image differs from render_frame");
+    assert!(pinhole::app::panels::status::status_text(app).starts_with(target));
+
+    // Key 1 picks the first renderer.
+    h.key_press(egui::Key::Num1);
+    settle(&mut h);
+    assert_eq!(h.state().renderer, names[0]);
+}
+
+#[test]
+fn editing_a_material_colour_rerenders_with_it() {
+    let mut h = harness(small_scene("one-triangle"));
+    let centre = pixel(h.state(), 80, 60);
+    assert!(centre.x < 1e-6, "the green triangle has (almost) no red: {centre}");
+    h.get_by_label("Materials").click();
+    h.step();
+    h.step();
+    h.get_by_label("green k_L R").set_value_accesskit(0.8);
+    settle(&mut h);
+    let app = h.state();
+    let green = app.params.materials.iter().find(|m| m.name == "green").unwrap();
+    assert_eq!(green.lambertian, Vec3::new(0.8, 0.8, 0.0));
+    let after = pixel(app, 80, 60);
+    assert!(after.x > 1e-4 && after.x > 0.5 * after.y, "red appears where the triangle is lit: {after}");
+    assert_eq!(shown(app), reference(app));
+}
+
+#[test]
+fn moving_a_light_in_the_panel_and_by_its_marker() {
+    let mut h = harness(small_scene("one-triangle"));
+    let before = shown(h.state());
+    // Bring the light in front of the camera with the panel's drag values.
+    h.get_by_label("L0 position z").set_value_accesskit(-1.0);
+    settle(&mut h);
+    h.get_by_label("L0 position y").set_value_accesskit(0.0);
+    settle(&mut h);
+    let app = h.state();
+    assert_eq!(app.params.lights[0], Light::Point { position: Vec3::new(1.0, 0.0, -1.0), power: Vec3::splat(10.0) });
+    let after = shown(app);
+    assert_ne!(before, after);
+    assert_eq!(after, reference(app));
+
+    // Drag its marker 30 points left: the light moves left in the view plane at its depth.
+    let settings = app.effective_settings();
+    let view = app.params.camera.view(settings.width, settings.height);
+    let rect = app.viewport_rect.unwrap();
+    let (p, depth) = view.project(Vec3::new(1.0, 0.0, -1.0)).unwrap();
+    let scale = rect.width() / settings.width as f32;
+    let start = rect.min + egui::vec2(p.x, p.y) * scale;
+    h.drag_at(start);
+    h.step();
+    h.hover_at(start + egui::vec2(-10.0, 0.0));
+    h.step();
+    h.hover_at(start + egui::vec2(-30.0, 0.0));
+    h.step();
+    h.drop_at(start + egui::vec2(-30.0, 0.0));
+    settle(&mut h);
+    let app = h.state();
+    let Light::Point { position, .. } = app.params.lights[0] else { panic!("not a point light") };
+    assert!(position.x < 1.0 - 1e-3, "light did not move left: {position}");
+    assert!((view.view_depth(position) - depth).abs() < 1e-3, "depth kept");
+    assert_eq!(shown(app), reference(app));
+}
+
+#[test]
+fn adding_and_removing_lights() {
+    let mut h = harness(small_scene("one-triangle"));
+    h.get_by_label("+ directional").click();
+    settle(&mut h);
+    assert!(matches!(h.state().params.lights[1], Light::Directional { .. }));
+    assert_eq!(shown(h.state()), reference(h.state()));
+    h.get_all_by_label("remove").next().unwrap().click();
+    settle(&mut h);
+    assert_eq!(h.state().params.lights.len(), 1);
+    assert!(matches!(h.state().params.lights[0], Light::Directional { .. }));
+}
+
+#[test]
+fn ctrl_s_exports_png_as_displayed_and_linear_exr() {
+    let mut h = harness(small_scene("one-triangle"));
+    let dir = std::env::temp_dir().join(format!("pinhole-app-export-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // A debug view is exported as displayed, too.
+    h.state_mut().settings.view = render::debug::View::Barycentric;
+    settle(&mut h);
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::S);
+    h.step();
+    h.step();
+    let suggested = h.state().export.path.clone();
+    assert!(suggested.contains("one-triangle-raytrace_"), "{suggested}");
+    let base = dir.join("shot");
+    h.get_by_label("file").set_text_value_accesskit(&base.with_extension("png").to_string_lossy());
+    h.step();
+    h.get_by_label("Save PNG (as displayed)").click();
+    h.step();
+    h.step();
+    let png = image::open(base.with_extension("png")).unwrap().to_rgb8();
+    let displayed = h.state().with_output(|o| o.rgb8.clone());
+    assert_eq!(png.as_raw(), &displayed);
+    assert!(h.state().message.as_deref().unwrap_or("").contains("saved"));
+
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::S);
+    h.step();
+    h.step();
+    h.get_by_label("file").set_text_value_accesskit(&base.with_extension("png").to_string_lossy());
+    h.step();
+    h.get_by_label("Save EXR (linear)").click();
+    h.step();
+    let exr = pinhole::image_io::load_image(&base.with_extension("exr")).unwrap();
+    assert_eq!(exr.pixels, shown(h.state()));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_broken_file_shows_its_error_and_the_scene_stays_then_reloads_on_change() {
+    let mut h = harness(small_scene("one-triangle"));
+    let dir = std::env::temp_dir().join(format!("pinhole-app-reload-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("mine.toml");
+    let good = "[render]\nwidth = 64\nheight = 40\nbackground = [0.5, 0.0, 0.0]\n\n[[light]]\ntype = \"point\"\nposition = [0.0, 2.0, 0.0]\npower = [10.0, 10.0, 10.0]\n\n[[object]]\ntype = \"sphere\"\ncenter = [0.0, 0.0, -3.0]\nradius = 1.0\n";
+    std::fs::write(&path, "[camera]\neye = [0.0, 0.0]\n").unwrap();
+
+    // Open through the dialog: type the path, press Open.
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::O);
+    h.step();
+    h.step();
+    assert!(h.state().open_dialog.open);
+    h.get_by_label("path").set_text_value_accesskit(&path.to_string_lossy());
+    h.step();
+    h.get_by_label("Open").click();
+    h.step();
+    assert!(h.state_mut().wait_loaded(WAIT));
+    h.step();
+    let err = h.state().error_bar.clone().expect("an error bar");
+    assert!(err.contains("mine.toml"), "{err}");
+    assert_eq!(h.state().scene.name, "one-triangle", "the previous scene stays");
+    assert!(h.query_by_label_contains("mine.toml").is_some(), "the error is on screen");
+
+    // Fix the file: the viewer notices and reloads it.
+    std::fs::write(&path, good).unwrap();
+    h.state_mut().open(path.to_string_lossy().into_owned());
+    assert!(h.state_mut().wait_loaded(WAIT));
+    settle(&mut h);
+    assert!(h.state().error_bar.is_none());
+    assert_eq!(h.state().scene.name, "mine");
+    assert_eq!(pixel(h.state(), 0, 0), Vec3::new(0.5, 0.0, 0.0));
+    std::thread::sleep(Duration::from_millis(1100));
+    std::fs::write(&path, good.replace("[0.5, 0.0, 0.0]", "[0.0, 0.25, 0.0]")).unwrap();
+    let start = std::time::Instant::now();
+    while h.state().params.render.background.y != 0.25 && start.elapsed() < Duration::from_secs(10) {
+        std::thread::sleep(Duration::from_millis(100));
+        h.step();
+        h.state_mut().wait_loaded(WAIT);
+    }
+    settle(&mut h);
+    assert_eq!(pixel(h.state(), 0, 0), Vec3::new(0.0, 0.25, 0.0), "reloaded after the file changed");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn orbit_drag_moves_the_eye_around_the_target() {
+    let mut h = harness(small_scene("teapot"));
+    let before = h.state().params.camera.clone();
+    let c = h.state().viewport_rect.unwrap().center();
+    h.drag_at(c);
+    h.step();
+    h.hover_at(c + egui::vec2(40.0, 10.0));
+    h.step();
+    h.drop_at(c + egui::vec2(40.0, 10.0));
+    settle(&mut h);
+    let cam = &h.state().params.camera;
+    assert_eq!(cam.target, before.target);
+    assert!((cam.eye - before.eye).length() > 1e-3);
+    assert!(((cam.eye - cam.target).length() - (before.eye - before.target).length()).abs() < 1e-3);
+    assert_eq!(shown(h.state()), reference(h.state()));
+    // F frames everything; Home resets.
+    h.key_press(egui::Key::Home);
+    settle(&mut h);
+    assert_eq!(h.state().params.camera, before);
+}
+
+#[test]
+fn samples_accumulate_and_exposure_is_display_only() {
+    let mut h = harness(small_scene("one-triangle"));
+    h.state_mut().settings.spp = 4;
+    settle(&mut h);
+    let app = h.state();
+    assert_eq!(app.with_output(|o| (o.passes, o.spp)), (4, 4));
+    assert_eq!(shown(app).len(), reference(app).len());
+    let lin = shown(app);
+    let refr = reference(app);
+    let max = lin.iter().zip(&refr).map(|(a, b)| (*a - *b).abs().max_element()).fold(0.0, f32::max);
+    assert!(max < 1e-5, "4 spp differs from render_frame by {max}");
+    let rgb_before = app.with_output(|o| o.rgb8.clone());
+    h.state_mut().params.render.exposure = 4.0;
+    settle(&mut h);
+    assert_eq!(shown(h.state()), lin, "exposure does not re-render");
+    assert_ne!(h.state().with_output(|o| o.rgb8.clone()), rgb_before);
+}
+
+#[test]
+fn shadow_map_mode_never_crashes_the_viewer() {
+    let mut h = harness(small_scene("triangle-ground"));
+    h.get_by_label("map").click();
+    settle(&mut h);
+    assert_eq!(h.state().settings.shadows, render::ShadowMode::Map);
+    let status = pinhole::app::panels::status::status_text(h.state());
+    assert!(status.contains("done") || status.contains("error"), "{status}");
+    // And back to ray shadows renders normally.
+    h.get_by_label("ray").click();
+    settle(&mut h);
+    assert_eq!(shown(h.state()), reference(h.state()));
+}
+
+#[test]
+fn settings_persist_between_runs() {
+    #[derive(Default)]
+    struct Mem(std::collections::HashMap<String, String>);
+    impl eframe::Storage for Mem {
+        fn get_string(&self, key: &str) -> Option<String> {
+            self.0.get(key).cloned()
+        }
+        fn set_string(&mut self, key: &str, value: String) {
+            self.0.insert(key.into(), value);
+        }
+        fn remove_string(&mut self, key: &str) {
+            self.0.remove(key);
+        }
+        fn flush(&mut self) {}
+    }
+    let mut app = PinholeApp::new_for_test(small_scene("one-triangle"));
+    app.renderer = "raytrace:brute".into();
+    app.settings.spp = 9;
+    app.gamma = false;
+    app.panels.materials = true;
+    let mut mem = Mem::default();
+    app.persisted().save(&mut mem);
+    let p = pinhole::app::settings_store::Persisted::load(Some(&mem)).unwrap();
+    let again = PinholeApp::new(small_scene("spheres"), "spheres".into(), Some(&p));
+    assert_eq!(p.scene.as_deref(), Some("one-triangle"));
+    assert_eq!(again.renderer, "raytrace:brute");
+    assert_eq!(again.settings.spp, 9);
+    assert!(!again.gamma && again.panels.materials);
+}
+
+#[test]
+fn open_dialog_lists_scenes_and_folders() {
+    let dir = std::env::temp_dir().join(format!("pinhole-app-list-{}", std::process::id()));
+    std::fs::create_dir_all(dir.join("sub")).unwrap();
+    for f in ["b.toml", "a.obj", "c.txt", ".hidden.toml"] {
+        std::fs::write(dir.join(f), "").unwrap();
+    }
+    let names: Vec<String> = pinhole::app::open_dialog::list_dir(&dir)
+        .unwrap()
+        .into_iter()
+        .map(|(p, _)| p.file_name().unwrap().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(names, ["sub", "a.obj", "b.toml"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
