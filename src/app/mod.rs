@@ -29,41 +29,67 @@ pub struct ScreenshotState {
     pub result: Arc<Mutex<Option<Result<(), String>>>>,
 }
 
-/// Frame-pacing measurement (`PINHOLE_BENCH_UI=SECONDS`): orbits the camera
-/// every frame like a drag would, then prints UI frames per second.
+/// Frame-pacing measurement, `PINHOLE_BENCH_UI=SECONDS[:still][:SPP]`:
+/// repaints continuously (orbiting the camera a little each frame like a
+/// drag, unless `still`), then prints UI frames per second and frame gaps.
 pub struct UiBench {
     pub started: Instant,
     pub seconds: f32,
-    pub frames: u32,
-    pub worst_ms: f32,
+    pub orbit: bool,
+    pub spp: Option<u32>,
+    gaps_ms: Vec<f32>,
     last: Option<Instant>,
     pub done: bool,
+    pub reported: bool,
 }
 
 impl UiBench {
-    pub fn new(seconds: f32) -> UiBench {
-        UiBench { started: Instant::now(), seconds, frames: 0, worst_ms: 0.0, last: None, done: false }
+    pub fn parse(spec: &str) -> Option<UiBench> {
+        let mut parts = spec.split(':');
+        let seconds = parts.next()?.parse::<f32>().ok()?;
+        let mut bench = UiBench { started: Instant::now(), seconds, orbit: true, spp: None, gaps_ms: Vec::new(), last: None, done: false, reported: false };
+        for p in parts {
+            if p == "still" {
+                bench.orbit = false;
+            } else if let Ok(n) = p.parse() {
+                bench.spp = Some(n);
+            }
+        }
+        Some(bench)
     }
 
-    fn frame(&mut self, camera: &mut crate::scene::Camera) {
+    fn frame(&mut self, camera: &mut crate::scene::Camera) -> bool {
         let now = Instant::now();
+        // The first second is window start-up, not pacing.
+        if self.started.elapsed().as_secs_f32() < 1.0 {
+            self.last = Some(now);
+            return false;
+        }
         if let Some(l) = self.last {
-            self.worst_ms = self.worst_ms.max((now - l).as_secs_f32() * 1e3);
+            self.gaps_ms.push((now - l).as_secs_f32() * 1e3);
         }
         self.last = Some(now);
-        self.frames += 1;
-        camera_control::orbit(camera, 3.0, 0.0);
-        if !self.done && self.started.elapsed().as_secs_f32() >= self.seconds {
+        if self.orbit {
+            camera_control::orbit(camera, 3.0, 0.0);
+        }
+        if !self.done && self.started.elapsed().as_secs_f32() >= self.seconds + 1.0 {
             self.done = true;
-            let secs = self.started.elapsed().as_secs_f32();
+            let mut g = self.gaps_ms.clone();
+            g.sort_by(f32::total_cmp);
+            let total: f32 = g.iter().sum();
+            let pct = |q: f32| g.get(((g.len() as f32 - 1.0) * q) as usize).copied().unwrap_or(0.0);
             println!(
-                "ui-bench: {} frames in {:.2} s = {:.1} fps, worst frame gap {:.1} ms",
-                self.frames,
-                secs,
-                self.frames as f32 / secs,
-                self.worst_ms
+                "ui-bench ({}): {} frames in {:.2} s = {:.1} fps; frame gap median {:.1} ms, p95 {:.1} ms, max {:.1} ms",
+                if self.orbit { "orbiting" } else { "still" },
+                g.len(),
+                total / 1e3,
+                g.len() as f32 / (total / 1e3),
+                pct(0.5),
+                pct(0.95),
+                pct(1.0)
             );
         }
+        self.orbit
     }
 }
 
@@ -152,7 +178,7 @@ pub fn run(scene: Option<String>, screenshot: Option<PathBuf>) -> Result<(), Str
         None => None,
     };
     let shot_result = Arc::new(Mutex::new(None));
-    let bench = std::env::var("PINHOLE_BENCH_UI").ok().and_then(|s| s.parse::<f32>().ok());
+    let bench = std::env::var("PINHOLE_BENCH_UI").ok().and_then(|s| UiBench::parse(&s));
     let batch = screenshot.is_some() || bench.is_some();
 
     // In --screenshot mode the window fits the image 1:1 beside the side panel.
@@ -203,7 +229,10 @@ pub fn run(scene: Option<String>, screenshot: Option<PathBuf>) -> Result<(), Str
                 app.res_scale = 1.0;
             }
             app.screenshot = shot_state;
-            app.bench = bench.map(UiBench::new);
+            app.bench = bench;
+            if let Some(n) = app.bench.as_ref().and_then(|b| b.spp) {
+                app.settings.spp = n;
+            }
             Ok(Box::new(EframeApp(app)))
         }),
     )

@@ -393,8 +393,12 @@ impl PinholeApp {
         self.dropped_files(&ctx);
         self.shortcuts(&ctx);
         if let Some(b) = &mut self.bench {
-            b.frame(&mut self.params.camera);
-            self.camera_moving = true;
+            self.camera_moving |= b.frame(&mut self.params.camera);
+            let report = b.done && !b.reported;
+            b.reported |= b.done;
+            if report {
+                println!("ui-bench: {}", super::panels::status::status_text(self));
+            }
             ctx.request_repaint();
         }
         self.update_texture(&ctx);
