@@ -7,12 +7,13 @@
 use super::setup::{PixelRect, ScreenTri};
 use crate::math::Vec2;
 
-/// Signed distance of `q` from the line through `a` and `b`.
+/// Signed distance of `q` from the line through `a` and `b`: the line's normal
+/// dotted with `q - a` (equal to `n.q + d` with `d = -n.a`, without the
+/// cancellation between two large terms that form suffers far from the origin).
 #[inline(always)]
 pub fn line_distance(a: Vec2, b: Vec2, q: Vec2) -> f32 {
     let n = Vec2::new(a.y - b.y, b.x - a.x);
-    let d = a.x * b.y - b.x * a.y;
-    (n.dot(q) + d) / n.length()
+    n.dot(q - a) / n.length()
 }
 
 /// The barycentric weight of vertex `a` at `q` in the 2D triangle `a, b, c`.

@@ -25,13 +25,13 @@ pub fn coverage_counts(method: Method, width: u32, height: u32, offset: Vec2, tr
         Method::Scanline => sts.iter().for_each(|st| scanline::raster(st, full, offset, &mut tested, |x, y, _| hit(x, y))),
         Method::Fixed => {
             let off = snap_offset(offset);
-            for ft in snap_all(&sts, off, width, height) {
+            for ft in snap_all(&sts, offset, width, height) {
                 fixed::raster(&ft, full, off, &mut tested, |x, y, _| hit(x, y));
             }
         }
         Method::Tiled => {
             let off = snap_offset(offset);
-            let fts = snap_all(&sts, off, width, height);
+            let fts = snap_all(&sts, offset, width, height);
             let grid = TileGrid::new(width, 0, height);
             let bins = tiled::bin(&fts, &grid, off);
             for (t, bin) in bins.iter().enumerate() {

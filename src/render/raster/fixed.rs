@@ -64,7 +64,8 @@ pub struct FixedTri {
     /// 0 on top and left edges (samples exactly on them are inside), 1 otherwise:
     /// a sample is covered when E_k >= bias_k for all k.
     pub bias: [i64; 3],
-    pub inv_area: f32,
+    /// The pass's (unsnapped) sample offset: interpolation happens at the true sample.
+    pub sample_off: Vec2,
     pub bbox: PixelRect,
     /// Needs i128 evaluation.
     pub wide: bool,
@@ -78,22 +79,19 @@ fn first_at_or_after(v: i64, off: i64) -> i64 {
 
 impl FixedTri {
     /// `None` when the snapped triangle has no area or covers no sample of the image.
-    pub fn new(st: &ScreenTri, off: [i64; 2], width: u32, height: u32) -> Option<FixedTri> {
+    pub fn new(st: &ScreenTri, off: [i64; 2], sample_off: Vec2, width: u32, height: u32) -> Option<FixedTri> {
         let mut st = *st;
         let mut v = st.p.map(|p| [snap(p.x), snap(p.y)]);
         let area = |v: &[[i64; 2]; 3]| -> i128 {
             (v[1][0] - v[0][0]) as i128 * (v[2][1] - v[0][1]) as i128 - (v[1][1] - v[0][1]) as i128 * (v[2][0] - v[0][0]) as i128
         };
-        let mut a2 = area(&v);
+        let a2 = area(&v);
         if a2 == 0 {
             return None;
         }
         if a2 < 0 {
             v.swap(1, 2);
-            st.p.swap(1, 2);
-            st.inv_z.swap(1, 2);
-            st.bz.swap(1, 2);
-            a2 = -a2;
+            st.swap_12();
         }
         let ends = [(1, 2), (2, 0), (0, 1)];
         let a = ends.map(|(s, e)| v[s][1] - v[e][1]);
@@ -113,7 +111,7 @@ impl FixedTri {
         if bbox.is_empty() {
             return None;
         }
-        Some(FixedTri { st, v, a, b, bias, inv_area: 1.0 / a2 as f32, bbox, wide })
+        Some(FixedTri { st, v, a, b, bias, sample_off, bbox, wide })
     }
 
     /// Exact edge function k at the snapped sample point `(sx, sy)`.
@@ -136,17 +134,21 @@ impl FixedTri {
         e[0] >= T::from(self.bias[0]) && e[1] >= T::from(self.bias[1]) && e[2] >= T::from(self.bias[2])
     }
 
-    /// Screen-space weights from exact edge values: the same bits whichever loop produced them.
+    /// Screen-space weights at the sample of pixel `(x, y)`, from the unsnapped
+    /// float vertices (snapping decides coverage only, so shading stays as
+    /// accurate as the float variants'). Evaluated directly, not stepped: the
+    /// same bits whichever loop asks.
     #[inline(always)]
-    pub fn weights<T: EdgeInt>(&self, e: &[T; 3]) -> [f32; 3] {
-        [e[0].to_f32() * self.inv_area, e[1].to_f32() * self.inv_area, e[2].to_f32() * self.inv_area]
+    pub fn weights(&self, x: u32, y: u32) -> [f32; 3] {
+        self.st.screen_weights(Vec2::new(x as f32 + self.sample_off.x, y as f32 + self.sample_off.y))
     }
 }
 
 /// Every triangle of the pass snapped (in order; dropped when degenerate after snapping).
-pub fn snap_all(tris: &[ScreenTri], off: [i64; 2], width: u32, height: u32) -> Vec<FixedTri> {
+pub fn snap_all(tris: &[ScreenTri], sample_off: Vec2, width: u32, height: u32) -> Vec<FixedTri> {
     use rayon::prelude::*;
-    tris.par_iter().filter_map(|st| FixedTri::new(st, off, width, height)).collect()
+    let off = snap_offset(sample_off);
+    tris.par_iter().filter_map(|st| FixedTri::new(st, off, sample_off, width, height)).collect()
 }
 
 /// Visits the covered samples of `ft` inside `rect`, stepping the integer edge
@@ -175,7 +177,7 @@ fn raster_in<T: EdgeInt, F: FnMut(u32, u32, [f32; 3])>(ft: &FixedTri, rect: Pixe
         let mut e = row;
         for x in r.x0..r.x1 {
             if e[0] >= bias[0] && e[1] >= bias[1] && e[2] >= bias[2] {
-                emit(x, y, ft.weights(&e));
+                emit(x, y, ft.weights(x, y));
             }
             e[0] = e[0] + step_x[0];
             e[1] = e[1] + step_x[1];
@@ -194,7 +196,7 @@ mod tests {
     fn cover(p: [Vec2; 3], w: u32, h: u32) -> Vec<(u32, u32)> {
         let st = ScreenTri::flat(0, p, Vec2::splat(0.5), w, h).unwrap();
         let off = snap_offset(Vec2::splat(0.5));
-        let ft = FixedTri::new(&st, off, w, h).unwrap();
+        let ft = FixedTri::new(&st, off, Vec2::splat(0.5), w, h).unwrap();
         let mut out = Vec::new();
         let mut tested = 0;
         raster(&ft, PixelRect::new(0, 0, w, h), off, &mut tested, |x, y, _| out.push((x, y)));
@@ -229,11 +231,10 @@ mod tests {
         // (1,1)->(5,1): 2 px^2 each. Screen weights 12/16, 2/16, 2/16.
         let st = ScreenTri::flat(0, [Vec2::new(1.0, 1.0), Vec2::new(5.0, 1.0), Vec2::new(1.0, 5.0)], Vec2::splat(0.5), 8, 8).unwrap();
         let off = snap_offset(Vec2::splat(0.5));
-        let ft = FixedTri::new(&st, off, 8, 8).unwrap();
-        assert_eq!(ft.inv_area, 1.0 / (16.0 * 65536.0));
+        let ft = FixedTri::new(&st, off, Vec2::splat(0.5), 8, 8).unwrap();
         let e: [i64; 3] = ft.edges_at_pixel(1, 1, off);
         assert_eq!(e, [12 * 65536, 2 * 65536, 2 * 65536]);
-        assert_eq!(ft.weights(&e), [0.75, 0.125, 0.125]);
+        assert_eq!(ft.weights(1, 1), [0.75, 0.125, 0.125]);
         // Left edge x = 1 and top edge y = 1 are top-left; the hypotenuse is not.
         assert_eq!(ft.bias, [1, 0, 0]);
         assert_eq!(ft.bbox, PixelRect::new(1, 1, 5, 5));
@@ -246,7 +247,7 @@ mod tests {
         let big = [Vec2::new(-1.0e7, -1.0e7), Vec2::new(3.0e7, -1.0e7), Vec2::new(-1.0e7, 3.0e7)];
         let st = ScreenTri::flat(0, big, Vec2::splat(0.5), 16, 16).unwrap();
         let off = snap_offset(Vec2::splat(0.5));
-        let ft = FixedTri::new(&st, off, 16, 16).unwrap();
+        let ft = FixedTri::new(&st, off, Vec2::splat(0.5), 16, 16).unwrap();
         assert!(ft.wide);
         let mut n = 0;
         let mut tested = 0;

@@ -11,16 +11,15 @@ use super::tiled::{self, TileGrid};
 use super::vis_buffer::{DepthKey, VisBuffer};
 use super::{barycentric, incremental, scanline, Method, RasterOptions};
 use crate::math::Radiance;
-use crate::render::raytrace::brute::BruteQuery;
+use crate::render::raytrace::bvh::BvhQuery;
 use crate::render::{PassJob, PreparedScene, RayCounts};
 use rayon::prelude::*;
 
 /// The scene query for shadow and secondary rays of rasterized frames.
-// TODO: switch to `raytrace::bvh::BvhQuery` once the BVH lands.
-pub type Query<'a> = BruteQuery<'a>;
+pub type Query<'a> = BvhQuery<'a>;
 
 pub fn query(prepared: &PreparedScene) -> Query<'_> {
-    BruteQuery(prepared)
+    BvhQuery::new(prepared)
 }
 
 /// Rows per band of the band-parallel variants.
@@ -67,7 +66,7 @@ pub fn render_bands(method: Method, options: RasterOptions, job: &PassJob, out: 
     match method {
         Method::Fixed => {
             let off = snap_offset(off);
-            let fts = snap_all(&tris, off, job.view.width, job.view.height);
+            let fts = snap_all(&tris, job.offset, job.view.width, job.view.height);
             let bins = bin_rows(fts.iter().map(|f| f.bbox), rows0, rows1, BAND_ROWS);
             bands(job, &query, key, forward, out, |vb, b| {
                 let (rect, mut tested) = (vb.rect, 0);
@@ -106,7 +105,7 @@ pub fn render_tiled(options: RasterOptions, job: &PassJob, out: &mut [Radiance])
     }
     let query = query(job.prepared);
     let off = snap_offset(job.offset);
-    let fts = snap_all(&setup_pass(job), off, width, job.view.height);
+    let fts = snap_all(&setup_pass(job), job.offset, width, job.view.height);
     let grid = TileGrid::new(width, job.rows.start, job.rows.end);
     let bins = tiled::bin(&fts, &grid, off);
     let spheres = all_sphere_bounds(job.view, &job.prepared.scene.spheres, job.offset);

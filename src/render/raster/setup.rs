@@ -81,6 +81,8 @@ pub struct ScreenTri {
     pub bz: [Vec3; 3],
     /// Pixels whose sample position may be covered, clamped to the image.
     pub bbox: PixelRect,
+    /// 1 / (twice the signed area) for the vertex order in `p`.
+    pub inv_area: f32,
 }
 
 impl ScreenTri {
@@ -102,7 +104,8 @@ impl ScreenTri {
         let (x0, x1) = sample_span(lo.x, hi.x, off.x, width);
         let (y0, y1) = sample_span(lo.y, hi.y, off.y, height);
         let bbox = PixelRect { x0, y0, x1, y1 };
-        (!bbox.is_empty()).then_some(ScreenTri { tri, p, inv_z, bz, bbox })
+        let inv_area = 1.0 / area.abs();
+        (!bbox.is_empty()).then_some(ScreenTri { tri, p, inv_z, bz, bbox, inv_area })
     }
 
     /// A triangle given directly in image space at depth 1 (tests, coverage counts).
@@ -124,14 +127,24 @@ impl ScreenTri {
         [b.y, b.z]
     }
 
-    /// Screen-space (affine, NOT perspective-correct) weights of the pixel sample `q`.
+    /// Screen-space (affine, NOT perspective-correct) weights of the sample `q`,
+    /// each edge function evaluated directly, relative to the edge's start vertex.
+    #[inline(always)]
     pub fn screen_weights(&self, q: Vec2) -> [f32; 3] {
-        let area = edge_function(self.p[0], self.p[1], self.p[2]);
+        let p = &self.p;
         [
-            edge_function(self.p[1], self.p[2], q) / area,
-            edge_function(self.p[2], self.p[0], q) / area,
-            edge_function(self.p[0], self.p[1], q) / area,
+            edge_function(p[1], p[2], q) * self.inv_area,
+            edge_function(p[2], p[0], q) * self.inv_area,
+            edge_function(p[0], p[1], q) * self.inv_area,
         ]
+    }
+
+    /// Swaps vertices 1 and 2 with their attributes (the area changes sign).
+    pub fn swap_12(&mut self) {
+        self.p.swap(1, 2);
+        self.inv_z.swap(1, 2);
+        self.bz.swap(1, 2);
+        self.inv_area = -self.inv_area;
     }
 }
 

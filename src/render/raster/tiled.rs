@@ -141,7 +141,7 @@ pub fn tile_fragments<F: FnMut(&FixedTri, u32, u32, [f32; 3])>(
                     for y in br.y0..br.y1 {
                         let mut e = row;
                         for x in br.x0..br.x1 {
-                            emit(ft, x, y, ft.weights(&e));
+                            emit(ft, x, y, ft.weights(x, y));
                             for k in 0..3 {
                                 e[k] += step_x[k];
                             }
@@ -154,14 +154,11 @@ pub fn tile_fragments<F: FnMut(&FixedTri, u32, u32, [f32; 3])>(
                 }
                 // Partial block: a coverage mask (bit = dx + 8 dy), then the covered samples.
                 let mut mask = 0u64;
-                let mut vals = [[0i64; 3]; 64];
                 for dy in 0..br.height() {
                     let mut e = row;
                     for dx in 0..br.width() {
                         if ft.covered(&e) {
-                            let bit = dx + BLOCK * dy;
-                            mask |= 1 << bit;
-                            vals[bit as usize] = e;
+                            mask |= 1 << (dx + BLOCK * dy);
                         }
                         for k in 0..3 {
                             e[k] += step_x[k];
@@ -174,7 +171,8 @@ pub fn tile_fragments<F: FnMut(&FixedTri, u32, u32, [f32; 3])>(
                 while mask != 0 {
                     let bit = mask.trailing_zeros();
                     mask &= mask - 1;
-                    emit(ft, br.x0 + bit % BLOCK, br.y0 + bit / BLOCK, ft.weights(&vals[bit as usize]));
+                    let (x, y) = (br.x0 + bit % BLOCK, br.y0 + bit / BLOCK);
+                    emit(ft, x, y, ft.weights(x, y));
                 }
             }
         }
@@ -192,7 +190,7 @@ mod tests {
         // Triangle (0,0), (64,0), (0,64) in a 64x64 image, samples at +0.5.
         let st = ScreenTri::flat(0, [Vec2::new(0.0, 0.0), Vec2::new(64.0, 0.0), Vec2::new(0.0, 64.0)], Vec2::splat(0.5), 64, 64).unwrap();
         let off = fixed::snap_offset(Vec2::splat(0.5));
-        let ft = FixedTri::new(&st, off, 64, 64).unwrap();
+        let ft = FixedTri::new(&st, off, Vec2::splat(0.5), 64, 64).unwrap();
         assert_eq!(classify(&ft, PixelRect::new(0, 0, 8, 8), off), Class::Accept);
         assert_eq!(classify(&ft, PixelRect::new(56, 56, 64, 64), off), Class::Reject);
         assert_eq!(classify(&ft, PixelRect::new(28, 28, 36, 36), off), Class::Partial);
