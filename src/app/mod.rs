@@ -151,6 +151,32 @@ fn screenshot_frame(app: &mut PinholeApp, ctx: &egui::Context) {
     });
 }
 
+/// For scripts (screenshots, benchmarks): `PINHOLE_RENDERER=NAME` picks the
+/// renderer, `PINHOLE_VIEW=NAME` the debug view, `PINHOLE_PANELS=camera,lights,
+/// materials,shading` (or `none`) which side-panel sections are open.
+fn apply_env_overrides(app: &mut PinholeApp) {
+    if let Ok(name) = std::env::var("PINHOLE_RENDERER") {
+        match crate::render::renderer_by_name(&name) {
+            Ok(r) => app.renderer = r.name().to_string(),
+            Err(e) => eprintln!("pinhole: PINHOLE_RENDERER: {e}"),
+        }
+    }
+    if let Ok(v) = std::env::var("PINHOLE_VIEW") {
+        match crate::render::debug::View::parse(&v) {
+            Ok(v) => app.settings.view = v,
+            Err(e) => eprintln!("pinhole: PINHOLE_VIEW: {e}"),
+        }
+    }
+    if let Ok(list) = std::env::var("PINHOLE_PANELS") {
+        let has = |n: &str| list.split(',').any(|p| p.trim() == n);
+        app.panels.side = list.trim() != "none";
+        app.panels.camera = has("camera");
+        app.panels.lights = has("lights");
+        app.panels.materials = has("materials");
+        app.panels.shading = has("shading");
+    }
+}
+
 /// The eframe wrapper: storage, and the root `ui`.
 struct EframeApp(PinholeApp);
 
@@ -183,7 +209,7 @@ pub fn run(scene: Option<String>, screenshot: Option<PathBuf>) -> Result<(), Str
 
     // In --screenshot mode the window fits the image 1:1 beside the side panel.
     let size = match &explicit {
-        Some((s, _)) if batch => [s.render.width as f32 + 420.0, s.render.height as f32 + 120.0],
+        Some((s, _)) if batch => [s.render.width as f32 + 460.0, s.render.height as f32 + 120.0],
         _ => [1280.0, 800.0],
     };
     let options = eframe::NativeOptions {
@@ -228,6 +254,7 @@ pub fn run(scene: Option<String>, screenshot: Option<PathBuf>) -> Result<(), Str
             if batch {
                 app.res_scale = 1.0;
             }
+            apply_env_overrides(&mut app);
             app.screenshot = shot_state;
             app.bench = bench;
             if let Some(n) = app.bench.as_ref().and_then(|b| b.spp) {

@@ -29,14 +29,19 @@ pub fn status_text(app: &PinholeApp) -> String {
         let s = &o.stats;
         let c = &s.counts;
         let rays = c.primary + c.shadow + c.secondary;
-        let rate = if s.pass_ms > 0.0 {
-            if c.primary > 0 || c.fragments_shaded == 0 {
-                format!("{} rays/s", si(rays as f64 / (s.pass_ms / 1e3)))
+        let per_s = |n: u64| si(n as f64 / (s.pass_ms / 1e3));
+        let rate = if s.pass_ms <= 0.0 {
+            "–".to_string()
+        } else if c.fragments_shaded > 0 {
+            // A rasterizer: fragments shaded, plus the shadow/secondary rays it cast.
+            let rays = c.shadow + c.secondary;
+            if rays > 0 {
+                format!("{} fragments/s, {} rays/s", per_s(c.fragments_shaded), per_s(rays))
             } else {
-                format!("{} fragments/s", si(c.fragments_shaded as f64 / (s.pass_ms / 1e3)))
+                format!("{} fragments/s", per_s(c.fragments_shaded))
             }
         } else {
-            "–".into()
+            format!("{} rays/s", per_s(rays))
         };
         let state = if let Some(e) = &o.error {
             format!("error: {e}")

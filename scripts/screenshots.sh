@@ -1,0 +1,31 @@
+#!/bin/sh
+# Regenerates screenshots/*.png: the viewer (`pinhole --screenshot`) in a real
+# window under Xvfb with Mesa's software OpenGL, on each built-in scene, with
+# each renderer family, and with the panels open.
+# Needs: xvfb-run (apt-get install xvfb libgl1-mesa-dri).
+set -eu
+cd "$(dirname "$0")/.."
+cargo build --release --quiet
+bin=target/release/pinhole
+out=screenshots
+mkdir -p "$out"
+
+shot() { # NAME SCENE [VAR=VALUE...]
+    name=$1; scene=$2; shift 2
+    env LIBGL_ALWAYS_SOFTWARE=1 "$@" xvfb-run -a -s "-screen 0 1280x800x24" \
+        "$bin" --screenshot "$out/$name.png" "$scene" >/dev/null
+    echo "$out/$name.png"
+}
+
+# Each built-in scene with the default renderer and panels.
+for scene in $("$bin" list | sed -n '/^built-in scenes:/,$p' | tail -n +2); do
+    shot "scene-$scene" "$scene"
+done
+# Each renderer family on the same scene.
+shot renderer-raytrace teapot PINHOLE_RENDERER=raytrace PINHOLE_PANELS=shading
+shot renderer-rasterize teapot PINHOLE_RENDERER=rasterize PINHOLE_PANELS=shading
+shot renderer-raytrace-brute one-triangle PINHOLE_RENDERER=raytrace:brute PINHOLE_PANELS=shading
+# Panels open: camera and materials; a debug view.
+shot panel-camera-materials spheres PINHOLE_PANELS=camera,materials
+shot view-barycentric one-triangle PINHOLE_VIEW=barycentric PINHOLE_PANELS=shading
+shot view-normal bunny PINHOLE_VIEW=normal PINHOLE_PANELS=lights
