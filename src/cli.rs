@@ -65,6 +65,25 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Speed-versus-accuracy chart: error against frame time as spp grows (+ OUT.csv beside it).
+    Chart {
+        scene: String,
+        #[arg(short = 'o', long = "output", value_name = "OUT.png")]
+        output: PathBuf,
+        /// Renderers to compare (comma-separated).
+        #[arg(long, default_value = "raytrace,rasterize")]
+        renderers: String,
+        /// Samples per pixel to sweep (comma-separated).
+        #[arg(long = "spp-list", default_value = "1,4,16,64")]
+        spp_list: String,
+        /// Reference image (linear .exr); default: raytrace:bvh at --reference-spp.
+        #[arg(long)]
+        reference: Option<PathBuf>,
+        #[arg(long = "reference-spp", default_value_t = 256)]
+        reference_spp: u32,
+        #[command(flatten)]
+        opts: RenderOpts,
+    },
     /// List renderers, views and built-in scenes.
     List,
 }
@@ -111,6 +130,9 @@ pub fn run() -> Result<(), String> {
         Some(Command::Bench { scene, opts, frames }) => cmd_bench(&scene, &opts, frames),
         Some(Command::Compare { a, b, json }) => cmd_compare(&a, &b, json),
         Some(Command::Pixel { scene, x, y, opts, json }) => cmd_pixel(&scene, x, y, &opts, json),
+        Some(Command::Chart { scene, output, renderers, spp_list, reference, reference_spp, opts }) => {
+            cmd_chart(&scene, &output, &renderers, &spp_list, reference.as_deref(), reference_spp, &opts)
+        }
         Some(Command::List) => {
             cmd_list();
             Ok(())
@@ -301,6 +323,50 @@ fn cmd_pixel(scene_arg: &str, x: u32, y: u32, opts: &RenderOpts, as_json: bool) 
         print!("{}", crate::pixel_report::to_text(l.renderer.name(), scene, x, y, &replay));
         Ok(())
     }
+}
+
+fn cmd_chart(scene_arg: &str, output: &Path, renderers: &str, spp_list: &str, reference: Option<&Path>, reference_spp: u32, opts: &RenderOpts) -> Result<(), String> {
+    if output.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() != Some("png") {
+        return Err(format!("{}: the chart is written as .png", output.display()));
+    }
+    let spps: Vec<u32> = spp_list
+        .split(',')
+        .map(|s| s.trim().parse::<u32>().ok().filter(|&n| (1..=65536).contains(&n)).ok_or(format!("--spp-list: \"{s}\" is not a sample count")))
+        .collect::<Result<_, _>>()?;
+    let names: Vec<&str> = renderers.split(',').map(str::trim).collect();
+    for n in &names {
+        render::renderer_by_name(n)?;
+    }
+    let l = load(scene_arg, opts)?;
+    let (w, h) = (l.settings.width, l.settings.height);
+    let reference_pixels = match reference {
+        Some(path) => {
+            let img = crate::image_io::load_image(path)?;
+            if (img.width, img.height) != (w, h) {
+                return Err(format!("{} is {}x{} but the render is {w}x{h}", path.display(), img.width, img.height));
+            }
+            img.pixels
+        }
+        None => {
+            eprintln!("rendering the reference: raytrace:bvh at {reference_spp} spp");
+            let r = render::renderer_by_name(render::DEFAULT_RAYTRACE)?;
+            let settings = RenderSettings { spp: reference_spp, ..l.settings.clone() };
+            l.pool
+                .install(|| render::render_frame(r.as_ref(), &l.prepared, &settings, &AtomicBool::new(false), None))
+                .ok_or("cancelled")?
+                .pixels
+        }
+    };
+    let points = l.pool.install(|| {
+        crate::chart::sweep(&l.prepared, &l.settings, &names, &spps, &reference_pixels, 3, |r, spp| eprintln!("measuring {r} at {spp} spp"))
+    })?;
+    let title = format!("{}: error against time, {w}x{h}, {} threads", l.prepared.scene.name, l.pool.current_num_threads());
+    let png = crate::chart::draw_png(&points, &title, 900, 600)?;
+    crate::image_io::write_atomic(output, &png)?;
+    let csv_path = output.with_extension("csv");
+    crate::image_io::write_atomic(&csv_path, crate::chart::to_csv(&points).as_bytes())?;
+    eprintln!("wrote {} and {}", output.display(), csv_path.display());
+    Ok(())
 }
 
 fn cmd_compare(a: &Path, b: &Path, as_json: bool) -> Result<(), String> {

@@ -3,6 +3,7 @@
 //!
 //! The core (everything but `app`) has no GUI types.
 
+pub mod chart;
 pub mod cli;
 pub mod image_io;
 pub mod math;

@@ -88,3 +88,21 @@ fn errors_are_one_sentence() {
     assert_clean_error(&pinhole(&["render", bad.to_str().unwrap(), "-o", p]), "bad.toml:2");
     assert_clean_error(&pinhole(&["compare", "/nonexistent.exr", p]), "/nonexistent.exr");
 }
+
+#[test]
+fn chart_writes_png_and_csv() {
+    let png = tmp("chart.png");
+    let out = pinhole(&[
+        "chart", "spheres", "-o", png.to_str().unwrap(), "--width", "40", "--height", "25", "--spp-list", "1,4", "--reference-spp", "16",
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(image::open(&png).is_ok());
+    let csv = std::fs::read_to_string(png.with_extension("csv")).unwrap();
+    let rows: Vec<&str> = csv.lines().collect();
+    assert_eq!(rows[0], "renderer,spp,ms,rel_rmse,flip");
+    assert_eq!(rows.len(), 5, "two renderers x two spp: {csv}");
+    // More samples, less error (against a 16-spp reference with the same sample pattern family).
+    let err = |row: &str| row.split(',').nth(3).unwrap().parse::<f64>().unwrap();
+    assert!(err(rows[2]) < err(rows[1]), "{csv}");
+    assert_clean_error(&pinhole(&["chart", "spheres", "-o", png.to_str().unwrap(), "--spp-list", "1,x"]), "--spp-list");
+}
