@@ -296,4 +296,40 @@ mod tests {
             }
         }
     }
+
+    #[test]
+    fn perspective_correct_matches_the_ray_cast_and_affine_does_not() {
+        use crate::render::raytrace::intersect::{intersect_triangle, TriangleEdges};
+        // A triangle slanted in depth: v0 near (depth 1), v1 and v2 far (depth 5).
+        let cam = Camera { fov: Fov::Y(90.0), near: 0.1, ..Camera::default() };
+        let view = cam.view(100, 100);
+        let t = Triangle {
+            v: [Vec3::new(-0.8, -0.8, -1.0), Vec3::new(4.0, -4.0, -5.0), Vec3::new(0.0, 4.0, -5.0)],
+            n: [Vec3::Z; 3],
+            uv: [Vec2::ZERO; 3],
+            material: 0,
+            object: 0,
+            two_sided: true,
+        };
+        let mut out = Vec::new();
+        setup_triangle(&view, &t, 0, Vec2::splat(0.5), &mut out);
+        assert_eq!(out.len(), 1);
+        let st = out[0];
+        // Pixel (40, 55): its sample is inside the projection.
+        let q = Vec2::new(40.5, 55.5);
+        let l = st.screen_weights(q);
+        assert!(l.iter().all(|&w| w > 0.0), "{l:?}");
+        let inv_z = st.inv_z_at(l);
+        let [b1, b2] = st.bary_at(l, inv_z);
+        let ray = view.eye_ray(q.x, q.y);
+        let (_, r1, r2) = intersect_triangle(&ray, &TriangleEdges::new(&t), f32::INFINITY).unwrap();
+        assert!((b1 - r1).abs() < 1e-5 && (b2 - r2).abs() < 1e-5, "perspective-correct ({b1}, {b2}) vs ray ({r1}, {r2})");
+        // The screen-space (affine) weights are those of the projection, not of the surface point.
+        // Map them back to the original vertex order (the setup may have swapped 1 and 2).
+        let affine = st.bz[0] / st.inv_z[0] * l[0] + st.bz[1] / st.inv_z[1] * l[1] + st.bz[2] / st.inv_z[2] * l[2];
+        assert!((affine.y - r1).abs() > 0.05 || (affine.z - r2).abs() > 0.05, "affine {affine:?} vs ray ({r1}, {r2})");
+        // By hand: 1/z is affine in the image; at the vertices it is 1 and 1/5.
+        assert!(st.inv_z.contains(&1.0) && st.inv_z.contains(&0.2));
+        assert!(inv_z > 0.2 && inv_z < 1.0);
+    }
 }
