@@ -106,6 +106,9 @@ struct RenderOpts {
     /// ray | map | none
     #[arg(long, default_value = "ray")]
     shadows: String,
+    /// flat | gouraud | phong: how shading varies across a triangle.
+    #[arg(long, default_value = "phong")]
+    interpolation: String,
     /// Worker threads (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
@@ -153,6 +156,7 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
     let renderer = render::renderer_by_name(&opts.renderer)?;
     let view = View::parse(&opts.view)?;
     let shadows = ShadowMode::parse(&opts.shadows)?;
+    let interpolation = render::Interpolation::parse(&opts.interpolation)?;
     if opts.spp == 0 || opts.spp > 65536 {
         return Err(format!("--spp {} is not between 1 and 65536", opts.spp));
     }
@@ -183,6 +187,7 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
     settings.spp = opts.spp;
     settings.view = view;
     settings.shadows = shadows;
+    settings.interpolation = interpolation;
     if let Some(b) = opts.bump {
         if !(b.is_finite() && b >= 0.0) {
             return Err(format!("--bump {b} must be a finite number >= 0"));
@@ -218,6 +223,7 @@ fn stats_json(l: &Loaded, render_ms: f64, counts: &RayCounts, spp: u32) -> serde
         "depth_test_failures": counts.depth_fails,
         "shadows": l.settings.shadows.name(),
         "view": l.settings.view.name(),
+        "interpolation": l.settings.interpolation.name(),
     })
 }
 

@@ -50,6 +50,38 @@ impl ShadowMode {
     }
 }
 
+/// How shading varies across a triangle (Computer Graphics from Scratch, ch. 13).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Interpolation {
+    /// One normal per face: the geometric normal everywhere.
+    Flat,
+    /// Lighting computed at the three vertices, the radiance interpolated.
+    Gouraud,
+    /// Normals interpolated and lighting computed per sample.
+    #[default]
+    Phong,
+}
+
+impl Interpolation {
+    pub const ALL: [Interpolation; 3] = [Interpolation::Flat, Interpolation::Gouraud, Interpolation::Phong];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Interpolation::Flat => "flat",
+            Interpolation::Gouraud => "gouraud",
+            Interpolation::Phong => "phong",
+        }
+    }
+
+    pub fn parse(s: &str) -> Result<Interpolation, String> {
+        Self::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| format!("unknown interpolation \"{s}\" (expected flat, gouraud or phong)"))
+    }
+}
+
 /// Per-render knobs. Scene-level values (background, ambient, exposure) stay
 /// in `Scene::render`.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -64,6 +96,8 @@ pub struct RenderSettings {
     /// Maximum depth of mirror and refraction rays.
     pub max_depth: u32,
     pub view: debug::View,
+    #[serde(default)]
+    pub interpolation: Interpolation,
 }
 
 impl RenderSettings {
@@ -76,6 +110,7 @@ impl RenderSettings {
             shadow_bump: 1e-4,
             max_depth: 4,
             view: debug::View::Shaded,
+            interpolation: Interpolation::Phong,
         }
     }
 }
@@ -201,7 +236,14 @@ pub fn resolve_sample<Q: SceneQuery, R: Recorder>(
 ) -> Radiance {
     let scene = &job.prepared.scene;
     match (job.settings.view, hit) {
-        (debug::View::Shaded, Some(h)) => shade::shade(scene, query, job.settings, h, -ray.dir, 0, counts, rec),
+        (debug::View::Shaded, Some(h)) => match job.settings.interpolation {
+            Interpolation::Phong => shade::shade(scene, query, job.settings, h, -ray.dir, 0, counts, rec),
+            Interpolation::Flat => {
+                let flat = SurfaceHit { shading_normal: h.geometric_normal, ..*h };
+                shade::shade(scene, query, job.settings, &flat, -ray.dir, 0, counts, rec)
+            }
+            Interpolation::Gouraud => shade::shade_gouraud(scene, query, job.settings, h, job.view.eye, counts, rec),
+        },
         (debug::View::Shaded, None) => {
             rec.shaded(0, scene.render.background);
             scene.render.background

@@ -87,6 +87,42 @@ pub fn shade<Q: SceneQuery, R: Recorder>(
     l_o
 }
 
+/// Gouraud shading: `shade()` at the triangle's three vertices (each seen
+/// from the eye), the results blended with the hit's barycentric weights.
+/// Spheres have no vertices and are shaded per sample.
+#[allow(clippy::too_many_arguments)]
+pub fn shade_gouraud<Q: SceneQuery, R: Recorder>(
+    scene: &Scene,
+    query: &Q,
+    settings: &RenderSettings,
+    hit: &SurfaceHit,
+    eye: Vec3,
+    counts: &mut RayCounts,
+    rec: &mut R,
+) -> Radiance {
+    if hit.kind != crate::scene::PrimitiveKind::Triangle {
+        let w_o = (eye - hit.position).normalize_or_zero();
+        return shade(scene, query, settings, hit, w_o, 0, counts, rec);
+    }
+    let tri = &scene.triangles[hit.primitive as usize];
+    let side = if hit.back_face { -1.0 } else { 1.0 };
+    let mut l_o = Vec3::ZERO;
+    for k in 0..3 {
+        let mut b = Vec3::ZERO;
+        b[k] = 1.0;
+        let vertex = SurfaceHit {
+            position: tri.v[k],
+            shading_normal: tri.n[k] * side,
+            barycentric: b,
+            uv: tri.uv[k],
+            ..*hit
+        };
+        let w_o = (eye - tri.v[k]).normalize_or_zero();
+        l_o += hit.barycentric[k] * shade(scene, query, settings, &vertex, w_o, 0, counts, rec);
+    }
+    l_o
+}
+
 /// Perfect mirror reflection and Fresnel-weighted refraction.
 fn secondary<Q: SceneQuery, R: Recorder>(
     scene: &Scene,
