@@ -245,10 +245,17 @@ struct WorkerLoop {
     last_req: Option<Request>,
     /// Milliseconds per row of the last full-resolution pass, for band sizing.
     ms_per_row: f64,
+    /// The preview renders at 1/`preview_div` of the resolution, adapted so
+    /// it takes about one display frame (4 to 32).
+    preview_div: u32,
+    /// Renderer and scene the timings above were measured with.
+    timed: (String, u64),
 }
 
 /// Aim for a band to take about this long, so the texture updates often.
 const BAND_MS: f64 = 30.0;
+/// Aim for a coarse preview to take about this long.
+const PREVIEW_MS: f64 = 20.0;
 
 impl WorkerLoop {
     fn new(rx: Receiver<Msg>, cancel: Arc<AtomicBool>, shared: Arc<Shared>, repaint: Arc<dyn Fn() + Send + Sync>) -> Self {
@@ -256,7 +263,7 @@ impl WorkerLoop {
             .thread_name(|i| format!("pinhole-render-{i}"))
             .build()
             .expect("cannot start the render thread pool");
-        WorkerLoop { rx, cancel, shared, repaint, pool, prepared: None, frame: None, last_req: None, ms_per_row: -1.0 }
+        WorkerLoop { rx, cancel, shared, repaint, pool, prepared: None, frame: None, last_req: None, ms_per_row: -1.0, preview_div: 16, timed: (String::new(), 0) }
     }
 
     fn run(mut self) {
@@ -360,6 +367,12 @@ impl WorkerLoop {
         };
         let (width, height) = (req.settings.width.max(1), req.settings.height.max(1));
         let n = (width * height) as usize;
+        if self.timed != (req.renderer.clone(), req.scene_id) {
+            // Another renderer or scene: old timings mean nothing.
+            self.timed = (req.renderer.clone(), req.scene_id);
+            self.ms_per_row = -1.0;
+            self.preview_div = 16;
+        }
         let slow = self.ms_per_row < 0.0 || self.ms_per_row * height as f64 > 2.0 * BAND_MS;
         let now = Instant::now();
         self.frame = Some(Frame {
@@ -406,19 +419,21 @@ impl WorkerLoop {
         let cancel: &AtomicBool = &self.cancel;
         if f.preview_pending {
             f.preview_pending = false;
-            let (pw, ph) = ((f.width / 4).max(1), (f.height / 4).max(1));
+            let div = self.preview_div;
+            let (pw, ph) = ((f.width / div).max(1), (f.height / div).max(1));
             let view = prepared.scene.camera.view(pw, ph);
             let mut settings = f.req.settings.clone();
             settings.width = pw;
             settings.height = ph;
             settings.spp = 1;
             let mut small = vec![Radiance::ZERO; (pw * ph) as usize];
-            let job = PassJob { prepared, view: &view, settings: &settings, offset: render::sample_offset(0, 1), rows: 0..ph, cancel };
+            // The preview is not cancelled: it is cheap by construction (its
+            // size adapts), and while the camera moves every frame cancels the
+            // one before, so a cancellable preview would never be seen.
+            let keep_going = AtomicBool::new(false);
+            let job = PassJob { prepared, view: &view, settings: &settings, offset: render::sample_offset(0, 1), rows: 0..ph, cancel: &keep_going };
             let renderer = &f.renderer;
             let result = self.pool.install(|| guarded(|| renderer.render_pass(&job, &mut small)));
-            if cancel.load(Ordering::Relaxed) {
-                return;
-            }
             if let Err(e) = result {
                 let req = f.req.clone();
                 self.fail(&req, e);
@@ -435,6 +450,9 @@ impl WorkerLoop {
                 }
             }
             let first_ms = f.started.elapsed().as_secs_f64() * 1e3;
+            // Aim the next preview at ~20 ms: its cost scales with 1/div^2.
+            let full_ms = first_ms * (div * div) as f64;
+            self.preview_div = ((full_ms / PREVIEW_MS).sqrt().ceil() as u32).clamp(4, 32);
             f.first_image = true;
             let req = f.req.clone();
             let mut out = self.shared.output.lock().unwrap();
@@ -505,7 +523,7 @@ impl WorkerLoop {
             pass_done = true;
             let pass_ms = f.pass_started.elapsed().as_secs_f64() * 1e3;
             self.ms_per_row = pass_ms / f.height as f64;
-        } else if self.ms_per_row < 0.0 {
+        } else {
             self.ms_per_row = band_ms / rows.len() as f64;
         }
         let complete = f.pass >= spp;
