@@ -12,9 +12,10 @@
 //!   rounding difference between the box test and the primitive test can
 //!   never cull a primitive the reference hits.
 //!
-//! Layout: 32-byte nodes; the two children of an interior node sit next to
-//! each other in one 64-byte pair (one cache line), so traversal tests both
-//! children's boxes from one line. Node 0 is the root, node 1 unused padding.
+//! Layout: the binary SAH tree is collapsed into a 4-wide one (as Embree
+//! does): each 128-byte node holds the boxes of up to four children in
+//! structure-of-arrays form, so one SIMD slab test checks all four, and a
+//! child word that is either a node index or a leaf (first primitive, count).
 
 use super::brute::make_hit;
 use super::cast_pass;
@@ -23,7 +24,7 @@ use crate::math::{Radiance, Ray};
 use crate::render::trace::{PrimitiveTest, Recorder};
 use crate::render::{PassJob, PreparedScene, RayCounts, Renderer, SceneQuery};
 use crate::scene::{PrimitiveKind, Scene, SurfaceHit};
-use glam::{Vec3, Vec3A};
+use glam::{Vec3, Vec3A, Vec4};
 
 /// Primitive ids: triangle index, or sphere index with this bit set. Ordering
 /// the ids as integers orders primitives as brute force scans them.
@@ -37,9 +38,13 @@ const COST_INTERSECT: f32 = 1.0;
 /// Subtrees with more primitives than this are built in parallel.
 const PARALLEL_MIN: usize = 4096;
 /// Below this depth the build splits by SAH; deeper it splits at the median,
-/// which bounds the depth (and the traversal stack) at MEDIAN_DEPTH + 32.
+/// which bounds the depth at MEDIAN_DEPTH + 32.
 const MEDIAN_DEPTH: u32 = 32;
+/// Traversal stack entries kept on the machine stack; deeper trees (which
+/// need more than 3 per level) use a heap stack instead.
 const STACK: usize = 64;
+/// Child words with this bit set are leaves: first primitive << 3 | count - 1.
+const LEAF_BIT: u32 = 1 << 31;
 /// The slab test's far distance is stretched by this factor (and the near
 /// one shrunk) to absorb its rounding and that of the primitive tests.
 const SLAB_WIDEN: f32 = 1.0e-5;
@@ -64,37 +69,13 @@ impl Aabb {
 }
 
 /// What a node holds, for the viewer and the debugger.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub enum NodeContent {
-    Interior { left: u32, right: u32 },
+    /// Two to four children, by node id.
+    Interior { children: Vec<u32> },
     /// `count` primitives starting at `first` in the BVH's primitive order
     /// (see `Bvh::primitive`).
     Leaf { first: u32, count: u32 },
-}
-
-/// A node: bounds and either two children (`count == 0`, children at
-/// `first`, `first + 1`) or `count` primitives starting at `first`.
-#[derive(Clone, Copy, Debug, Default)]
-#[repr(C)]
-struct Node {
-    min: [f32; 3],
-    first: u32,
-    max: [f32; 3],
-    count: u32,
-}
-
-#[derive(Clone, Copy, Debug, Default)]
-#[repr(C, align(64))]
-struct NodePair([Node; 2]);
-
-/// The hierarchy, flattened, with the primitives in leaf order.
-pub struct Bvh {
-    pairs: Vec<NodePair>,
-    /// Per primitive slot: the triangle's edges (unused for spheres).
-    tris: Vec<TriangleEdges>,
-    /// Per primitive slot: triangle index, or sphere index | SPHERE_BIT.
-    ids: Vec<u32>,
-    depth: u32,
 }
 
 /// Bounds and centroid of one primitive during the build.
@@ -187,10 +168,12 @@ fn build_rec(refs: &mut [PrimRef], first: u32, depth: u32, max_depth: &mut u32) 
     let mut mid = 0;
     if depth < MEDIAN_DEPTH && extent.max_element() > 0.0 {
         // Binned SAH over all three axes in one pass.
+        // Fewer bins for small nodes: their sweeps would cost more than the binning.
+        let nb = if n <= 32 { 8 } else if n <= 512 { 16 } else { BINS };
         let mut bins = [[Bin { b: Bounds::EMPTY, n: 0 }; BINS]; 3];
-        let scale = Vec3A::select(extent.cmpgt(Vec3A::ZERO), Vec3A::splat(BINS as f32 * 0.99999) / extent, Vec3A::ZERO);
+        let scale = Vec3A::select(extent.cmpgt(Vec3A::ZERO), Vec3A::splat(nb as f32 * 0.99999) / extent, Vec3A::ZERO);
         for r in refs.iter() {
-            let k = ((r.centroid() - cb.min) * scale).as_uvec3().min(glam::UVec3::splat(BINS as u32 - 1));
+            let k = ((r.centroid() - cb.min) * scale).as_uvec3().min(glam::UVec3::splat(nb as u32 - 1));
             for a in 0..3 {
                 let bin = &mut bins[a][k[a] as usize];
                 bin.b.grow(r.min, r.max);
@@ -206,14 +189,14 @@ fn build_rec(refs: &mut [PrimRef], first: u32, depth: u32, max_depth: &mut u32) 
             let mut right_cost = [0.0f32; BINS];
             let mut acc = Bounds::EMPTY;
             let mut cnt = 0u32;
-            for i in (1..BINS).rev() {
+            for i in (1..nb).rev() {
                 acc = Bounds::union(acc, bins[i].b);
                 cnt += bins[i].n;
                 right_cost[i] = if cnt > 0 { acc.half_area() * cnt as f32 } else { 0.0 };
             }
             let mut acc = Bounds::EMPTY;
             let mut cnt = 0u32;
-            for i in 0..BINS - 1 {
+            for i in 0..nb - 1 {
                 acc = Bounds::union(acc, bins[i].b);
                 cnt += bins[i].n;
                 if cnt == 0 || cnt as usize == n {
@@ -233,7 +216,7 @@ fn build_rec(refs: &mut [PrimRef], first: u32, depth: u32, max_depth: &mut u32) 
             }
             let (_, axis, plane) = best;
             let (lo, s) = (cb.min[axis], scale[axis]);
-            let in_left = |r: &PrimRef| (((r.centroid()[axis] - lo) * s) as u32).min(BINS as u32 - 1) < plane as u32;
+            let in_left = |r: &PrimRef| (((r.centroid()[axis] - lo) * s) as u32).min(nb as u32 - 1) < plane as u32;
             // In-place partition.
             let (mut i, mut j) = (0usize, n);
             while i < j {
@@ -269,21 +252,97 @@ fn build_rec(refs: &mut [PrimRef], first: u32, depth: u32, max_depth: &mut u32) 
     Tmp::Inner { b: Bounds::union(l.bounds(), r.bounds()), kids: Box::new([l, r]) }
 }
 
-fn to_node(b: Bounds, first: u32, count: u32) -> Node {
-    Node { min: b.min.to_array(), first, max: b.max.to_array(), count }
+/// A 4-wide node: the children's boxes as planes (min x, max x, min y, max
+/// y, min z, max z), one lane per child, and the children's words.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+struct Node4 {
+    planes: [Vec4; 6],
+    child: [u32; 4],
+    /// Bit i set when child slot i is used.
+    valid: u32,
+    _pad: [u32; 3],
 }
 
-/// Writes `t` into node slot `slot` and its subtree after it, depth first.
-fn flatten(t: &Tmp, slot: usize, pairs: &mut Vec<NodePair>) {
-    match t {
-        Tmp::Leaf { b, first, count } => pairs[slot / 2].0[slot % 2] = to_node(*b, *first, *count),
-        Tmp::Inner { b, kids } => {
-            let child = pairs.len() * 2;
-            pairs.push(NodePair::default());
-            pairs[slot / 2].0[slot % 2] = to_node(*b, child as u32, 0);
-            flatten(&kids[0], child, pairs);
-            flatten(&kids[1], child + 1, pairs);
+/// The hierarchy: 4-wide nodes, with the primitives in leaf order.
+pub struct Bvh {
+    nodes: Vec<Node4>,
+    /// The root's word: node 0, or a leaf when the scene is tiny.
+    root: u32,
+    root_bounds: Aabb,
+    /// Per primitive slot: the triangle's edges (unused for spheres) and the
+    /// primitive id (triangle index, or sphere index | SPHERE_BIT).
+    prims: Vec<(TriangleEdges, u32)>,
+    /// For the debugger: each node's own bounds, and each leaf's (by first slot).
+    node_bounds: Vec<Aabb>,
+    leaf_bounds: Vec<(u32, Aabb)>,
+    depth: u32,
+    /// True when a traversal may need more than `STACK` entries.
+    deep: bool,
+}
+
+fn aabb(b: Bounds) -> Aabb {
+    Aabb { min: Vec3::from(b.min), max: Vec3::from(b.max) }
+}
+
+#[inline(always)]
+fn leaf_word(first: u32, count: u32) -> u32 {
+    debug_assert!(count >= 1 && count as usize <= MAX_LEAF && first < 1 << 28);
+    LEAF_BIT | first << 3 | (count - 1)
+}
+
+#[inline(always)]
+fn leaf_range(word: u32) -> (usize, usize) {
+    let first = ((word & !LEAF_BIT) >> 3) as usize;
+    (first, first + (word & 7) as usize + 1)
+}
+
+struct Collapse {
+    nodes: Vec<Node4>,
+    node_bounds: Vec<Aabb>,
+    leaf_bounds: Vec<(u32, Aabb)>,
+    depth: u32,
+}
+
+impl Collapse {
+    /// The word for binary subtree `t` at 4-wide level `level`: a leaf, or a
+    /// node whose children are `t`'s grandchildren (the larger ones opened first).
+    fn word(&mut self, t: &Tmp, level: u32) -> u32 {
+        self.depth = self.depth.max(level);
+        let (b, kids) = match t {
+            Tmp::Leaf { b, first, count } => {
+                self.leaf_bounds.push((*first, aabb(*b)));
+                return leaf_word(*first, *count);
+            }
+            Tmp::Inner { b, kids } => (*b, kids),
+        };
+        let mut children: Vec<&Tmp> = vec![&kids[0], &kids[1]];
+        while children.len() < 4 {
+            let open = children
+                .iter()
+                .enumerate()
+                .filter(|(_, c)| matches!(c, Tmp::Inner { .. }))
+                .max_by(|(_, a), (_, c)| a.bounds().half_area().total_cmp(&c.bounds().half_area()))
+                .map(|(i, _)| i);
+            let Some(i) = open else { break };
+            let Tmp::Inner { kids, .. } = children[i] else { unreachable!() };
+            children.splice(i..=i, [&kids[0], &kids[1]]);
         }
+        let index = self.nodes.len();
+        self.nodes.push(Node4 { planes: [Vec4::ZERO; 6], child: [0; 4], valid: 0, _pad: [0; 3] });
+        self.node_bounds.push(aabb(b));
+        let mut node = self.nodes[index];
+        for (i, c) in children.into_iter().enumerate() {
+            let cb = c.bounds();
+            for axis in 0..3 {
+                node.planes[axis * 2][i] = cb.min[axis];
+                node.planes[axis * 2 + 1][i] = cb.max[axis];
+            }
+            node.child[i] = self.word(c, level + 1);
+            node.valid |= 1 << i;
+        }
+        self.nodes[index] = node;
+        index as u32
     }
 }
 
@@ -302,21 +361,47 @@ impl Bvh {
             let (min, max) = padded(c - r, c + r);
             refs.push(PrimRef { min, max, id: i as u32 | SPHERE_BIT });
         }
-        let mut depth = 0;
-        let tree = build_rec(&mut refs, 0, 0, &mut depth);
-        let mut pairs = Vec::with_capacity(refs.len() / 2 + 1);
-        pairs.push(NodePair::default());
-        flatten(&tree, 0, &mut pairs);
-        drop(tree);
         let dummy = TriangleEdges { v0: Vec3::ZERO, e1: Vec3::ZERO, e2: Vec3::ZERO, two_sided: false };
-        let ids: Vec<u32> = refs.iter().map(|r| r.id).collect();
-        let tris = ids.iter().map(|&id| if id & SPHERE_BIT == 0 { edges[id as usize] } else { dummy }).collect();
-        Bvh { pairs, tris, ids, depth }
+        if refs.is_empty() {
+            return Bvh {
+                nodes: Vec::new(),
+                root: leaf_word(0, 1),
+                root_bounds: Aabb::EMPTY,
+                prims: Vec::new(),
+                node_bounds: Vec::new(),
+                leaf_bounds: Vec::new(),
+                depth: 0,
+                deep: false,
+            };
+        }
+        let mut binary_depth = 0;
+        let tree = build_rec(&mut refs, 0, 0, &mut binary_depth);
+        let mut c = Collapse {
+            nodes: Vec::with_capacity(refs.len() / 4 + 1),
+            node_bounds: Vec::with_capacity(refs.len() / 4 + 1),
+            leaf_bounds: Vec::with_capacity(refs.len() / 2 + 1),
+            depth: 0,
+        };
+        let root = c.word(&tree, 0);
+        let root_bounds = aabb(tree.bounds());
+        drop(tree);
+        c.leaf_bounds.sort_unstable_by_key(|(first, _)| *first);
+        let prims = refs.iter().map(|r| (if r.id & SPHERE_BIT == 0 { edges[r.id as usize] } else { dummy }, r.id)).collect();
+        Bvh {
+            nodes: c.nodes,
+            root,
+            root_bounds,
+            prims,
+            node_bounds: c.node_bounds,
+            leaf_bounds: c.leaf_bounds,
+            depth: c.depth,
+            deep: (c.depth as usize + 1) * 3 >= STACK,
+        }
     }
 
-    /// Number of nodes (interior and leaves).
+    /// Number of nodes: interior nodes plus leaves.
     pub fn node_count(&self) -> usize {
-        self.pairs.len() * 2 - 1
+        self.nodes.len() + self.leaf_bounds.len()
     }
 
     /// Levels below the root of the deepest leaf (0 when the root is a leaf).
@@ -326,40 +411,46 @@ impl Bvh {
 
     /// Bounds of the root: every primitive, slightly padded.
     pub fn bounds(&self) -> Aabb {
-        self.node_bounds(0)
+        self.root_bounds
     }
 
-    /// Index of the root node.
-    pub const ROOT: u32 = 0;
-
-    /// Bounds of node `index` (the root is 0; children come from `node_content`).
-    pub fn node_bounds(&self, index: u32) -> Aabb {
-        let n = self.node(index);
-        Aabb { min: Vec3::from(n.min), max: Vec3::from(n.max) }
+    /// Id of the root node (what `node_visit` reports and `node_content` takes).
+    pub fn root(&self) -> u32 {
+        self.root
     }
 
-    pub fn node_content(&self, index: u32) -> NodeContent {
-        let n = self.node(index);
-        if n.count == 0 && !self.ids.is_empty() {
-            NodeContent::Interior { left: n.first, right: n.first + 1 }
+    /// Bounds of node `id`.
+    pub fn node_bounds(&self, id: u32) -> Aabb {
+        if id & LEAF_BIT == 0 {
+            self.node_bounds[id as usize]
         } else {
-            NodeContent::Leaf { first: n.first, count: n.count }
+            let first = leaf_range(id).0 as u32;
+            match self.leaf_bounds.binary_search_by_key(&first, |(f, _)| *f) {
+                Ok(i) => self.leaf_bounds[i].1,
+                Err(_) => Aabb::EMPTY,
+            }
+        }
+    }
+
+    pub fn node_content(&self, id: u32) -> NodeContent {
+        if id & LEAF_BIT == 0 {
+            let n = &self.nodes[id as usize];
+            NodeContent::Interior { children: (0..4).filter(|i| n.valid & 1 << i != 0).map(|i| n.child[i]).collect() }
+        } else {
+            let (first, end) = leaf_range(id);
+            let count = if self.prims.is_empty() { 0 } else { (end - first) as u32 };
+            NodeContent::Leaf { first: first as u32, count }
         }
     }
 
     /// Number of primitive slots (triangles plus spheres).
     pub fn primitive_count(&self) -> usize {
-        self.ids.len()
+        self.prims.len()
     }
 
     /// The primitive in slot `slot` of the leaf order.
     pub fn primitive(&self, slot: u32) -> (PrimitiveKind, u32) {
-        decode(self.ids[slot as usize])
-    }
-
-    #[inline(always)]
-    fn node(&self, index: u32) -> &Node {
-        &self.pairs[(index >> 1) as usize].0[(index & 1) as usize]
+        decode(self.prims[slot as usize].1)
     }
 }
 
@@ -368,10 +459,10 @@ fn decode(id: u32) -> (PrimitiveKind, u32) {
     if id & SPHERE_BIT == 0 { (PrimitiveKind::Triangle, id) } else { (PrimitiveKind::Sphere, id & !SPHERE_BIT) }
 }
 
-/// The ray, prepared for slab tests.
+/// The ray, prepared for 4-wide slab tests.
 struct RayPre {
-    origin: Vec3A,
-    inv: Vec3A,
+    origin: [Vec4; 3],
+    inv: [Vec4; 3],
 }
 
 impl RayPre {
@@ -383,17 +474,70 @@ impl RayPre {
             let inv = 1.0 / d;
             if inv.is_finite() { inv } else { f32::MAX.copysign(d) }
         };
-        RayPre { origin: Vec3A::from(ray.origin), inv: Vec3A::new(fix(ray.dir.x), fix(ray.dir.y), fix(ray.dir.z)) }
+        let inv = [fix(ray.dir.x), fix(ray.dir.y), fix(ray.dir.z)];
+        RayPre { origin: [Vec4::splat(ray.origin.x), Vec4::splat(ray.origin.y), Vec4::splat(ray.origin.z)], inv: inv.map(Vec4::splat) }
     }
 
-    /// Whether the ray meets the node's box within [0, t_far], and where it enters.
+    /// Which of the node's children the ray meets within [0, t_far] (a bit
+    /// mask), and where it enters each.
     #[inline(always)]
-    fn slab(&self, n: &Node, t_far: f32) -> (bool, f32) {
-        let t1 = (Vec3A::from(n.min) - self.origin) * self.inv;
-        let t2 = (Vec3A::from(n.max) - self.origin) * self.inv;
-        let tn = t1.min(t2).max_element() * (1.0 - SLAB_WIDEN);
-        let tf = t1.max(t2).min_element() * (1.0 + SLAB_WIDEN);
-        (tn.max(0.0) <= tf.min(t_far), tn)
+    fn slab4(&self, n: &Node4, t_far: f32) -> (u32, Vec4) {
+        let p = &n.planes;
+        let (x0, x1) = ((p[0] - self.origin[0]) * self.inv[0], (p[1] - self.origin[0]) * self.inv[0]);
+        let (y0, y1) = ((p[2] - self.origin[1]) * self.inv[1], (p[3] - self.origin[1]) * self.inv[1]);
+        let (z0, z1) = ((p[4] - self.origin[2]) * self.inv[2], (p[5] - self.origin[2]) * self.inv[2]);
+        let tn = x0.min(x1).max(y0.min(y1)).max(z0.min(z1)).max(Vec4::ZERO) * (1.0 - SLAB_WIDEN);
+        let tf = (x0.max(x1).min(y0.max(y1)).min(z0.max(z1)) * (1.0 + SLAB_WIDEN)).min(Vec4::splat(t_far));
+        (tn.cmple(tf).bitmask() & n.valid, tn)
+    }
+
+    /// The same test for one box (the root's).
+    fn slab1(&self, b: &Aabb, t_far: f32) -> bool {
+        let mut t = (0.0f32, t_far);
+        for axis in 0..3 {
+            let o = self.origin[axis].x;
+            let inv = self.inv[axis].x;
+            let (a, b) = ((b.min[axis] - o) * inv, (b.max[axis] - o) * inv);
+            t.0 = t.0.max(a.min(b) * (1.0 - SLAB_WIDEN));
+            t.1 = t.1.min(a.max(b) * (1.0 + SLAB_WIDEN));
+        }
+        t.0 <= t.1
+    }
+}
+
+/// The traversal stack: on the machine stack for ordinary trees.
+trait Stack {
+    fn push(&mut self, word: u32, t: f32);
+    fn pop(&mut self) -> Option<(u32, f32)>;
+}
+
+struct ArrayStack {
+    items: [(u32, f32); STACK],
+    len: usize,
+}
+
+impl Stack for ArrayStack {
+    #[inline(always)]
+    fn push(&mut self, word: u32, t: f32) {
+        self.items[self.len] = (word, t);
+        self.len += 1;
+    }
+    #[inline(always)]
+    fn pop(&mut self) -> Option<(u32, f32)> {
+        if self.len == 0 {
+            return None;
+        }
+        self.len -= 1;
+        Some(self.items[self.len])
+    }
+}
+
+impl Stack for Vec<(u32, f32)> {
+    fn push(&mut self, word: u32, t: f32) {
+        Vec::push(self, (word, t));
+    }
+    fn pop(&mut self) -> Option<(u32, f32)> {
+        Vec::pop(self)
     }
 }
 
@@ -408,8 +552,6 @@ impl<'a> BvhQuery<'a> {
         BvhQuery { prepared }
     }
 
-    /// The traversal shared by both queries. `ANY` stops at the first hit.
-    /// Returns (id, t, b1, b2) of the winning primitive.
     #[inline(always)]
     fn traverse<const ANY: bool, R: Recorder>(
         &self,
@@ -420,59 +562,94 @@ impl<'a> BvhQuery<'a> {
         rec: &mut R,
     ) -> Option<(u32, f32, f32, f32)> {
         let bvh = &self.prepared.bvh;
-        if bvh.ids.is_empty() {
+        if bvh.prims.is_empty() {
             return None;
         }
+        if bvh.deep {
+            self.traverse_with::<ANY, R, _>(ray, t_max, inside, counts, rec, &mut Vec::new())
+        } else {
+            let mut stack = ArrayStack { items: [(0, 0.0); STACK], len: 0 };
+            self.traverse_with::<ANY, R, _>(ray, t_max, inside, counts, rec, &mut stack)
+        }
+    }
+
+    /// The traversal shared by both queries. `ANY` stops at the first hit.
+    /// Returns (id, t, b1, b2) of the winning primitive.
+    #[inline(always)]
+    fn traverse_with<const ANY: bool, R: Recorder, S: Stack>(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        inside: bool,
+        counts: &mut RayCounts,
+        rec: &mut R,
+        stack: &mut S,
+    ) -> Option<(u32, f32, f32, f32)> {
+        let bvh = &self.prepared.bvh;
         let spheres = &self.prepared.scene.spheres;
         let r = RayPre::new(ray);
+        if !r.slab1(&bvh.root_bounds, t_max) {
+            return None;
+        }
         let mut best_t = t_max;
         let mut best_id = u32::MAX;
         let (mut best_b1, mut best_b2) = (0.0f32, 0.0f32);
         // Primitive tests accept t < limit: t_max, then just above best_t so
         // an equal-t hit on an earlier primitive can still win the tie.
         let mut limit = t_max;
-        let mut stack = [(0u32, 0.0f32); STACK];
-        let mut sp = 0usize;
-        if !r.slab(bvh.node(0), t_max).0 {
-            return None;
-        }
-        let mut index = 0u32;
+        let mut word = bvh.root;
+        let (mut visits, mut tests) = (0u64, 0u64);
         'walk: loop {
-            let node = bvh.node(index);
-            counts.nodes += 1;
+            visits += 1;
             if R::ENABLED {
-                rec.node_visit(index);
+                rec.node_visit(word);
             }
-            if node.count == 0 {
-                let (a, b) = (bvh.node(node.first), bvh.node(node.first + 1));
-                let (hit_a, ta) = r.slab(a, best_t);
-                let (hit_b, tb) = r.slab(b, best_t);
-                match (hit_a, hit_b) {
-                    (true, true) => {
-                        let (near, far, t_far) = if ta <= tb { (node.first, node.first + 1, tb) } else { (node.first + 1, node.first, ta) };
-                        stack[sp] = (far, t_far);
-                        sp += 1;
-                        index = near;
+            if word & LEAF_BIT == 0 {
+                let node = &bvh.nodes[word as usize];
+                let (mask, tn) = r.slab4(node, best_t);
+                if mask != 0 {
+                    if mask & (mask - 1) == 0 {
+                        word = node.child[mask.trailing_zeros() as usize];
                         continue 'walk;
                     }
-                    (true, false) => {
-                        index = node.first;
+                    let tn = tn.to_array();
+                    if mask.count_ones() == 2 {
+                        let (i, j) = (mask.trailing_zeros() as usize, 31 - mask.leading_zeros() as usize);
+                        let (near, far) = if tn[i] <= tn[j] { (i, j) } else { (j, i) };
+                        stack.push(node.child[far], tn[far]);
+                        word = node.child[near];
                         continue 'walk;
                     }
-                    (false, true) => {
-                        index = node.first + 1;
-                        continue 'walk;
+                    // More: continue with the nearest, push the rest farthest first.
+                    let mut items = [(0u32, 0.0f32); 4];
+                    let mut k = 0;
+                    let mut m = mask;
+                    while m != 0 {
+                        let i = m.trailing_zeros() as usize;
+                        m &= m - 1;
+                        let item = (node.child[i], tn[i]);
+                        // Insertion sort, descending t.
+                        let mut j = k;
+                        while j > 0 && items[j - 1].1 < item.1 {
+                            items[j] = items[j - 1];
+                            j -= 1;
+                        }
+                        items[j] = item;
+                        k += 1;
                     }
-                    (false, false) => {}
+                    for &(w, t) in &items[..k - 1] {
+                        stack.push(w, t);
+                    }
+                    word = items[k - 1].0;
+                    continue 'walk;
                 }
             } else {
-                let start = node.first as usize;
-                let end = start + node.count as usize;
-                for k in start..end {
-                    let id = bvh.ids[k];
-                    counts.tests += 1;
+                let (start, end) = leaf_range(word);
+                for (tri, id) in &bvh.prims[start..end] {
+                    let id = *id;
+                    tests += 1;
                     let found = if id & SPHERE_BIT == 0 {
-                        let outcome = intersect_triangle(ray, &bvh.tris[k], limit);
+                        let outcome = intersect_triangle(ray, tri, limit);
                         if R::ENABLED {
                             rec.primitive_test(PrimitiveTest { kind: PrimitiveKind::Triangle, index: id, outcome });
                         }
@@ -490,6 +667,8 @@ impl<'a> BvhQuery<'a> {
                     };
                     if let Some((t, b1, b2)) = found {
                         if ANY {
+                            counts.nodes += visits;
+                            counts.tests += tests;
                             return Some((id, t, b1, b2));
                         }
                         // t <= best_t here; on a tie the lower id (scene order) wins.
@@ -504,18 +683,16 @@ impl<'a> BvhQuery<'a> {
                 }
             }
             // Pop the next node that may still hold something nearer.
-            loop {
-                if sp == 0 {
-                    break 'walk;
-                }
-                sp -= 1;
-                let (next, t_enter) = stack[sp];
+            while let Some((next, t_enter)) = stack.pop() {
                 if t_enter <= best_t {
-                    index = next;
+                    word = next;
                     continue 'walk;
                 }
             }
+            break;
         }
+        counts.nodes += visits;
+        counts.tests += tests;
         (best_id != u32::MAX).then_some((best_id, best_t, best_b1, best_b2))
     }
 }
@@ -724,7 +901,7 @@ mod tests {
         let total = scene.triangles.len() + scene.spheres.len();
         assert_eq!(bvh.primitive_count(), total);
         let mut seen = vec![0u32; total];
-        let mut stack = vec![(Bvh::ROOT, 0u32)];
+        let mut stack = vec![(bvh.root(), 0u32)];
         let mut nodes = 0;
         let mut max_depth = 0;
         while let Some((i, depth)) = stack.pop() {
@@ -732,8 +909,9 @@ mod tests {
             max_depth = max_depth.max(depth);
             let b = bvh.node_bounds(i);
             match bvh.node_content(i) {
-                NodeContent::Interior { left, right } => {
-                    for c in [left, right] {
+                NodeContent::Interior { children } => {
+                    assert!((2..=4).contains(&children.len()), "node {i} has {} children", children.len());
+                    for c in children {
                         assert!(b.contains(&bvh.node_bounds(c)), "node {i} does not contain child {c}");
                         stack.push((c, depth + 1));
                     }
@@ -781,15 +959,13 @@ mod tests {
         let prepared = load("bunny");
         let bvh = &prepared.bvh;
         let n = prepared.edges.len();
-        assert!(bvh.depth() < 40, "depth {}", bvh.depth());
-        assert!(bvh.node_count() < 2 * n, "{} nodes for {n} triangles", bvh.node_count());
-        // Interior nodes' children are adjacent pairs.
-        if let NodeContent::Interior { left, right } = bvh.node_content(Bvh::ROOT) {
-            assert_eq!(right, left + 1);
-            assert_eq!(left % 2, 0);
-        } else {
-            panic!("the bunny's root is a leaf");
-        }
+        assert!(bvh.depth() < 16, "depth {}", bvh.depth());
+        assert!(bvh.node_count() < n, "{} nodes for {n} triangles", bvh.node_count());
+        // Nodes are mostly full (4 children).
+        let interior = bvh.nodes.len();
+        let children: u32 = bvh.nodes.iter().map(|n| n.valid.count_ones()).sum();
+        assert!(children as f32 > 2.5 * interior as f32, "{children} children in {interior} nodes");
+        assert!(matches!(bvh.node_content(bvh.root()), NodeContent::Interior { .. }));
     }
 
     #[test]
