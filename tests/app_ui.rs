@@ -346,3 +346,34 @@ fn open_dialog_lists_scenes_and_folders() {
     assert_eq!(names, ["sub", "a.obj", "b.toml"]);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[derive(Debug)]
+struct Dropped(std::path::PathBuf);
+
+impl egui::DroppedFile for Dropped {
+    fn path(&self) -> &std::path::Path {
+        &self.0
+    }
+    fn bytes(&self) -> Result<Vec<u8>, String> {
+        std::fs::read(&self.0).map_err(|e| e.to_string())
+    }
+}
+
+#[test]
+fn dropping_an_obj_on_the_window_opens_it_framed() {
+    let mut h = harness(small_scene("one-triangle"));
+    let dir = std::env::temp_dir().join(format!("pinhole-app-drop-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let obj = dir.join("tri.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    h.input_mut().dropped_files.push(std::sync::Arc::new(Dropped(obj.clone())));
+    h.step();
+    assert!(h.state_mut().wait_loaded(WAIT));
+    settle(&mut h);
+    let app = h.state();
+    assert_eq!(app.scene.name, "tri");
+    assert_eq!(app.scene.triangles.len(), 1);
+    assert!(app.error_bar.is_none());
+    assert_eq!(shown(app), reference(app));
+    let _ = std::fs::remove_dir_all(&dir);
+}
