@@ -153,7 +153,8 @@ fn screenshot_frame(app: &mut PinholeApp, ctx: &egui::Context) {
 
 /// For scripts (screenshots, benchmarks): `PINHOLE_RENDERER=NAME` picks the
 /// renderer, `PINHOLE_VIEW=NAME` the debug view, `PINHOLE_PANELS=camera,lights,
-/// materials,shading` (or `none`) which side-panel sections are open.
+/// materials,shading` (or `none`) which side-panel sections are open,
+/// `PINHOLE_GAMMA=off` turns the sRGB encoding off.
 fn apply_env_overrides(app: &mut PinholeApp) {
     if let Ok(name) = std::env::var("PINHOLE_RENDERER") {
         match crate::render::renderer_by_name(&name) {
@@ -166,6 +167,9 @@ fn apply_env_overrides(app: &mut PinholeApp) {
             Ok(v) => app.settings.view = v,
             Err(e) => eprintln!("pinhole: PINHOLE_VIEW: {e}"),
         }
+    }
+    if let Ok(g) = std::env::var("PINHOLE_GAMMA") {
+        app.gamma = !matches!(g.as_str(), "0" | "off" | "false");
     }
     if let Ok(list) = std::env::var("PINHOLE_PANELS") {
         let has = |n: &str| list.split(',').any(|p| p.trim() == n);

@@ -13,6 +13,7 @@ const SCENES: &[(&str, &str)] = &[
     ("teapot", include_str!("../../assets/scenes/teapot.toml")),
     ("spheres", include_str!("../../assets/scenes/spheres.toml")),
     ("bunny", include_str!("../../assets/scenes/bunny.toml")),
+    ("test-pattern", include_str!("../../assets/scenes/test-pattern.toml")),
 ];
 
 const FILES: &[(&str, &[u8])] = &[
@@ -20,6 +21,7 @@ const FILES: &[(&str, &[u8])] = &[
     ("models/stanford-bunny.obj", include_bytes!("../../assets/models/stanford-bunny.obj")),
     ("models/suzanne.obj", include_bytes!("../../assets/models/suzanne.obj")),
     ("models/spot.obj", include_bytes!("../../assets/models/spot.obj")),
+    ("textures/test-pattern.exr", include_bytes!("../../assets/textures/test-pattern.exr")),
 ];
 
 /// The scene the viewer opens when given none.
