@@ -16,6 +16,7 @@ pub struct Persisted {
     pub shadow_bump: f32,
     pub max_depth: u32,
     pub view: crate::render::debug::View,
+    pub interpolation: crate::render::Interpolation,
     pub res_scale: f32,
     pub gamma: bool,
     pub panels: Panels,
@@ -48,6 +49,7 @@ impl Default for Persisted {
             shadow_bump: 1e-4,
             max_depth: 4,
             view: crate::render::debug::View::Shaded,
+            interpolation: crate::render::Interpolation::Phong,
             res_scale: 1.0,
             gamma: true,
             panels: Panels::default(),
@@ -63,6 +65,7 @@ impl Persisted {
         s.shadow_bump = self.shadow_bump;
         s.max_depth = self.max_depth;
         s.view = self.view;
+        s.interpolation = self.interpolation;
     }
 
     pub fn load(storage: Option<&dyn eframe::Storage>) -> Option<Persisted> {

@@ -141,6 +141,7 @@ impl PinholeApp {
         self.settings.shadow_bump = keep.shadow_bump;
         self.settings.max_depth = keep.max_depth;
         self.settings.view = keep.view;
+        self.settings.interpolation = keep.interpolation;
         self.message = (!scene.warnings.is_empty()).then(|| scene.warnings.join("; "));
         let path = PathBuf::from(&arg);
         self.watch = (builtin::source(&arg).is_none() && path.exists()).then(|| {
@@ -309,6 +310,7 @@ impl PinholeApp {
             shadow_bump: self.settings.shadow_bump,
             max_depth: self.settings.max_depth,
             view: self.settings.view,
+            interpolation: self.settings.interpolation,
             res_scale: self.res_scale,
             gamma: self.gamma,
             panels: self.panels,

@@ -6,7 +6,7 @@ use eframe::egui;
 use super::{color_edit, section};
 use crate::app::PinholeApp;
 use crate::render::debug::View;
-use crate::render::ShadowMode;
+use crate::render::{Interpolation, ShadowMode};
 
 pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
     let mut open = app.panels.shading;
@@ -43,7 +43,12 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
             ui.add(egui::Slider::new(&mut r.exposure, 0.01..=100.0).logarithmic(true)).labelled_by(l.id);
         });
         ui.checkbox(&mut app.gamma, "gamma (sRGB encode)");
-        ui.label(egui::RichText::new("interpolation (flat / gouraud / phong): not in the render core yet").small().weak());
+        ui.horizontal(|ui| {
+            ui.label("interpolation");
+            for m in Interpolation::ALL {
+                ui.radio_value(&mut app.settings.interpolation, m, m.name());
+            }
+        });
     });
     app.panels.shading = open;
 }
