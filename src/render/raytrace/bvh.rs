@@ -18,10 +18,10 @@
 //! child word that is either a node index or a leaf (first primitive, count).
 
 use super::brute::make_hit;
-use super::cast_pass;
+use super::{cast_pass, cast_pixel};
 use super::intersect::{intersect_sphere, intersect_triangle, TriangleEdges};
 use crate::math::{Radiance, Ray};
-use crate::render::trace::{PrimitiveTest, Recorder};
+use crate::render::trace::{PixelTrace, PrimitiveTest, Recorder};
 use crate::render::{PassJob, PreparedScene, RayCounts, Renderer, SceneQuery};
 use crate::scene::{PrimitiveKind, Scene, SurfaceHit};
 use glam::{Vec3, Vec3A, Vec4};
@@ -361,7 +361,7 @@ impl Bvh {
             let (min, max) = padded(c - r, c + r);
             refs.push(PrimRef { min, max, id: i as u32 | SPHERE_BIT });
         }
-        let dummy = TriangleEdges { v0: Vec3::ZERO, e1: Vec3::ZERO, e2: Vec3::ZERO, two_sided: false };
+        let dummy = TriangleEdges { v0: Vec3::ZERO, e1: Vec3::ZERO, e2: Vec3::ZERO, det_epsilon: 0.0, two_sided: false };
         if refs.is_empty() {
             return Bvh {
                 nodes: Vec::new(),
@@ -724,6 +724,10 @@ impl Renderer for BvhRayTracer {
 
     fn render_pass(&self, job: &PassJob, out: &mut [Radiance]) -> RayCounts {
         cast_pass(job, &BvhQuery::new(job.prepared), out)
+    }
+
+    fn trace_pixel(&self, job: &PassJob, x: u32, y: u32, rec: &mut PixelTrace) -> Option<Radiance> {
+        Some(cast_pixel(job, &BvhQuery::new(job.prepared), x, y, &mut RayCounts::default(), rec))
     }
 }
 
