@@ -30,7 +30,9 @@ use crate::math::Radiance;
 pub use coverage::coverage_counts;
 
 /// The renderer `--renderer rasterize` names.
-pub const DEFAULT_RASTERIZE: &str = "rasterize:tiled";
+/// `fixed`: watertight, and measured a little faster than `tiled` at 1280x720
+/// on the bench scenes (per-pixel resolve dominates both; tiling adds bookkeeping).
+pub const DEFAULT_RASTERIZE: &str = "rasterize:fixed";
 
 /// The rasterization methods, from the book's first version to the fastest.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

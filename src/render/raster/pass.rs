@@ -109,32 +109,31 @@ pub fn render_tiled(options: RasterOptions, job: &PassJob, out: &mut [Radiance])
     let grid = TileGrid::new(width, job.rows.start, job.rows.end);
     let bins = tiled::bin(&fts, &grid, off);
     let spheres = all_sphere_bounds(job.view, &job.prepared.scene.spheres, job.offset);
-    let tiles: Vec<(Vec<Radiance>, RayCounts)> = (0..grid.count())
-        .into_par_iter()
-        .map(|t| {
-            let rect = grid.rect(t);
-            let mut colors = vec![Radiance::ZERO; rect.area() as usize];
-            if job.cancelled() {
-                return (colors, RayCounts::default());
+    // Rows of tiles in parallel; the tiles of a row one after the other, each
+    // resolved straight into the output through one reused buffer.
+    out.par_chunks_mut(width as usize * tiled::TILE as usize)
+        .enumerate()
+        .map(|(ty, chunk)| {
+            let mut counts = RayCounts::default();
+            let first = grid.rect(ty * grid.nx as usize);
+            let mut vb = VisBuffer::new(job, &query, first, DepthKey::NegInvZ, !options.early_depth);
+            for tx in 0..grid.nx as usize {
+                if job.cancelled() {
+                    break;
+                }
+                let t = ty * grid.nx as usize + tx;
+                let rect = grid.rect(t);
+                vb.reset(rect);
+                let mut tested = 0;
+                tiled::tile_fragments(&fts, &bins[t], rect, off, &mut tested, |ft, x, y, l| vb.triangle_fragment(&ft.st, x, y, l));
+                vb.counts.samples_tested += tested;
+                raster_spheres(&mut vb, &spheres);
+                counts += vb.finish_into(chunk, width as usize, rect.x0 as usize);
             }
-            let mut vb = VisBuffer::new(job, &query, rect, DepthKey::NegInvZ, !options.early_depth);
-            let mut tested = 0;
-            tiled::tile_fragments(&fts, &bins[t], rect, off, &mut tested, |ft, x, y, l| vb.triangle_fragment(&ft.st, x, y, l));
-            vb.counts.samples_tested += tested;
-            raster_spheres(&mut vb, &spheres);
-            let counts = vb.finish(&mut colors);
-            (colors, counts)
+            counts
         })
-        .collect();
-    let mut counts = RayCounts::default();
-    for (t, (colors, c)) in tiles.into_iter().enumerate() {
-        counts += c;
-        let rect = grid.rect(t);
-        let w = rect.width() as usize;
-        for (j, row) in colors.chunks_exact(w).enumerate() {
-            let start = ((rect.y0 - job.rows.start) as usize + j) * width as usize + rect.x0 as usize;
-            out[start..start + w].copy_from_slice(row);
-        }
-    }
-    counts
+        .reduce(RayCounts::default, |mut a, b| {
+            a += b;
+            a
+        })
 }

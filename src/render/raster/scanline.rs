@@ -2,7 +2,7 @@
 //! triangles", "Shaded triangles", "Depth buffering"): sort the vertices by y,
 //! walk the long edge and the two short edges row by row, and fill the span
 //! between them, interpolating attributes along the edges and then across the
-//! span. The interpolated attribute here is the vector of screen-space weights,
+//! span (each sample evaluated from the span's ends). The interpolated attribute here is the vector of screen-space weights,
 //! which the shared fragment code turns into 1/z and perspective-correct
 //! barycentrics (the book's 1/z interpolation). It runs on the same clipped
 //! triangles as every other variant and samples at the pass's sample positions.
@@ -42,12 +42,14 @@ pub fn raster<F: FnMut(u32, u32, [f32; 3])>(st: &ScreenTri, rect: PixelRect, off
             continue;
         }
         *tested += (x1 - x0) as u64;
+        // Across the span: each sample's weights from the span's ends (a running
+        // sum `w += step` drifts enough over a long span to move texture lookups).
         let width = right.0 - left.0;
-        let step = if width > 0.0 { (right.1 - left.1) / width } else { Vec3::ZERO };
-        let mut w = left.1 + step * (x0 as f32 + off.x - left.0);
+        let inv_width = if width > 0.0 { 1.0 / width } else { 0.0 };
         for x in x0..x1 {
+            let s = (x as f32 + off.x - left.0) * inv_width;
+            let w = left.1 + (right.1 - left.1) * s;
             emit(x, y, [w.x, w.y, w.z]);
-            w += step;
         }
     }
 }

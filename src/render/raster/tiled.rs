@@ -131,7 +131,12 @@ pub fn tile_fragments<F: FnMut(&FixedTri, u32, u32, [f32; 3])>(
         for by in (by0..r.y1).step_by(BLOCK as usize) {
             for bx in (bx0..r.x1).step_by(BLOCK as usize) {
                 let br = PixelRect::new(bx, by, bx + BLOCK, by + BLOCK).intersect(&r);
-                let c = if class == Class::Accept { Class::Accept } else { classify(ft, br, off) };
+                // Small rectangles (most of a fine mesh) are cheaper to test sample by sample.
+                let c = match class {
+                    Class::Accept => Class::Accept,
+                    _ if br.area() <= 16 => Class::Partial,
+                    _ => classify(ft, br, off),
+                };
                 if c == Class::Reject {
                     continue;
                 }

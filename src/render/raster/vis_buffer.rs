@@ -10,7 +10,7 @@
 //! the brute-force caster.
 
 use super::setup::{PixelRect, ScreenTri};
-use crate::math::{Radiance, Ray, Vec3};
+use crate::math::{Radiance, Vec3};
 use crate::render::trace::NoRecord;
 use crate::render::{resolve_sample, PassJob, RayCounts, SceneQuery};
 
@@ -95,7 +95,7 @@ impl<'j, 'a, Q: SceneQuery> VisBuffer<'j, 'a, Q> {
             self.id[i] = st.tri;
             self.payload[i] = st.bary_at(l, inv_z);
             if self.forward {
-                self.shade_now(i);
+                self.shade_now(i, x, y);
             }
         } else {
             self.counts.depth_fails += 1;
@@ -117,7 +117,7 @@ impl<'j, 'a, Q: SceneQuery> VisBuffer<'j, 'a, Q> {
         self.id[i] = tri;
         self.payload[i] = [b1, b2];
         if self.forward {
-            self.shade_now(i);
+            self.shade_now(i, x, y);
         }
     }
 
@@ -148,31 +148,22 @@ impl<'j, 'a, Q: SceneQuery> VisBuffer<'j, 'a, Q> {
             self.id[i] = s | SPHERE_BIT;
             self.payload[i] = [t, 0.0];
             if self.forward {
-                self.shade_now(i);
+                self.shade_now(i, x, y);
             }
         } else {
             self.counts.depth_fails += 1;
         }
     }
 
-    fn pixel(&self, i: usize) -> (u32, u32) {
-        (self.rect.x0 + (i % self.stride) as u32, self.rect.y0 + (i / self.stride) as u32)
-    }
-
-    fn eye_ray(&self, i: usize) -> Ray {
-        let (x, y) = self.pixel(i);
-        let p = self.job.sample_position(x, y);
-        self.job.view.eye_ray(p.x, p.y)
-    }
-
-    fn shade_now(&mut self, i: usize) {
+    fn shade_now(&mut self, i: usize, x: u32, y: u32) {
         self.counts.fragments_shaded += 1;
-        self.color[i] = self.shade(i);
+        self.color[i] = self.shade(i, x, y);
     }
 
     /// Builds the `SurfaceHit` of what pixel `i` sees and hands it to the shared shading.
-    fn shade(&mut self, i: usize) -> Radiance {
-        let ray = self.eye_ray(i);
+    fn shade(&mut self, i: usize, x: u32, y: u32) -> Radiance {
+        let p = self.job.sample_position(x, y);
+        let ray = self.job.view.eye_ray(p.x, p.y);
         let id = self.id[i];
         let scene = &self.job.prepared.scene;
         let hit = if id == EMPTY {
@@ -199,18 +190,47 @@ impl<'j, 'a, Q: SceneQuery> VisBuffer<'j, 'a, Q> {
     /// width): early-depth mode shades each visible surface once here; forward
     /// mode already shaded it. Counts one primary sample per pixel.
     pub fn finish(mut self, out: &mut [Radiance]) -> RayCounts {
-        debug_assert_eq!(out.len(), self.id.len());
-        for i in 0..out.len() {
-            self.counts.primary += 1;
-            out[i] = if self.forward && self.id[i] != EMPTY {
-                self.color[i]
-            } else {
-                if self.id[i] != EMPTY {
-                    self.counts.fragments_shaded += 1;
-                }
-                self.shade(i)
-            };
+        let stride = self.stride;
+        self.finish_into(out, stride, 0)
+    }
+
+    /// As `finish`, into rows of `out_stride` pixels starting at column `x_offset`.
+    pub fn finish_into(&mut self, out: &mut [Radiance], out_stride: usize, x_offset: usize) -> RayCounts {
+        let r = self.rect;
+        let mut i = 0;
+        for (row, y) in (r.y0..r.y1).enumerate() {
+            let line = &mut out[row * out_stride + x_offset..row * out_stride + x_offset + self.stride];
+            for (px, x) in line.iter_mut().zip(r.x0..r.x1) {
+                self.counts.primary += 1;
+                *px = if self.forward && self.id[i] != EMPTY {
+                    self.color[i]
+                } else {
+                    if self.id[i] != EMPTY {
+                        self.counts.fragments_shaded += 1;
+                    }
+                    self.shade(i, x, y)
+                };
+                i += 1;
+            }
         }
-        self.counts
+        std::mem::take(&mut self.counts)
+    }
+
+    /// Empties the buffers for another region of at most the same size (the tiles of a row).
+    pub fn reset(&mut self, rect: PixelRect) {
+        let n = rect.area() as usize;
+        assert!(self.key == DepthKey::NegInvZ && n <= self.id.capacity());
+        self.rect = rect;
+        self.stride = rect.width() as usize;
+        self.depth.clear();
+        self.depth.resize(n, -1.0 / self.job.view.far);
+        self.id.clear();
+        self.id.resize(n, EMPTY);
+        self.payload.clear();
+        self.payload.resize(n, [0.0; 2]);
+        if self.forward {
+            self.color.clear();
+            self.color.resize(n, Radiance::ZERO);
+        }
     }
 }
