@@ -63,7 +63,7 @@ pub fn shade<Q: SceneQuery, R: Recorder>(
         if settings.shadows == ShadowMode::Ray {
             // CGPP listing 15.20: start a little along the ray so it does not re-hit P.
             let eps = settings.shadow_bump;
-            let ray = Ray::new(p + w_i * eps, w_i);
+            let ray = Ray::new(shadow_origin(scene, hit) + w_i * eps, w_i);
             let t_max = distance - eps;
             counts.shadow += 1;
             rec.in_shadow_ray(true);
@@ -85,6 +85,30 @@ pub fn shade<Q: SceneQuery, R: Recorder>(
     }
     rec.shaded(depth, l_o);
     l_o
+}
+
+/// Where shadow rays leave a surface point. On a triangle with smooth vertex
+/// normals the flat facet lies below the smooth surface those normals
+/// describe, so near the shadow terminator a shadow ray from the facet hits
+/// the neighbouring facets and leaves black speckles. Following Hanika
+/// ("Hacking the shadow terminator", Ray Tracing Gems II, ch. 4), the origin
+/// is lifted onto the curved surface the vertex normals imply. On flat
+/// triangles and spheres it is the hit point itself.
+pub fn shadow_origin(scene: &Scene, hit: &SurfaceHit) -> Vec3 {
+    if hit.kind != crate::scene::PrimitiveKind::Triangle {
+        return hit.position;
+    }
+    let tri = &scene.triangles[hit.primitive as usize];
+    let side = if hit.back_face { -1.0 } else { 1.0 };
+    let mut lifted = Vec3::ZERO;
+    for k in 0..3 {
+        let n = tri.n[k] * side;
+        let d = hit.position - tri.v[k];
+        // Keep only the part of P - v_k above the vertex's tangent plane.
+        let below = d.dot(n).min(0.0);
+        lifted += hit.barycentric[k] * (tri.v[k] + d - below * n);
+    }
+    if lifted.is_finite() { lifted } else { hit.position }
 }
 
 /// Gouraud shading: `shade()` at the triangle's three vertices (each seen
