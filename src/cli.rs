@@ -100,7 +100,7 @@ struct RenderOpts {
     /// Samples per pixel (stratified; 1 = the pixel centre).
     #[arg(long, default_value_t = 1)]
     spp: u32,
-    /// shaded | barycentric | raydir | depth | normal | id | uv
+    /// shaded | barycentric | raydir | depth | zbuffer | normal | id | uv | cost | diff (see `pinhole list`)
     #[arg(long, default_value = "shaded")]
     view: String,
     /// ray | map | none
@@ -252,6 +252,9 @@ fn cmd_render(scene_arg: &str, output: &Path, opts: &RenderOpts, stats: Option<&
     });
     let render_ms = start.elapsed().as_secs_f64() * 1e3;
     let frame = result.ok_or("the render was cancelled")?;
+    if let Some(n) = frame.differing_pixels {
+        eprintln!("{n} of {} pixels differ from raytrace:brute", frame.pixels.len());
+    }
     crate::image_io::save_image(output, frame.width, frame.height, &frame.pixels, l.prepared.scene.render.exposure)?;
     if let Some(dest) = stats {
         let j = stats_json(&l, render_ms, &frame.counts, l.settings.spp);

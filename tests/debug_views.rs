@@ -111,3 +111,28 @@ fn cost_view_shows_more_work_for_brute_force() {
     let heat = |img: &[Radiance]| img.iter().map(|c| c.x + c.y + c.z).sum::<f32>() / img.len() as f32;
     assert!(heat(&brute) > 1.5 * heat(&bvh), "brute {} vs bvh {}", heat(&brute), heat(&bvh));
 }
+
+#[test]
+fn diff_view_counts_differences_from_the_reference() {
+    use pinhole::render::{render_frame, renderer_by_name};
+    use std::sync::atomic::AtomicBool;
+    let scene = builtin("teapot");
+    let mut settings = RenderSettings::for_scene(&scene);
+    settings.width = W;
+    settings.height = H;
+    settings.view = View::Diff;
+    let prepared = PreparedScene::new(scene);
+    let diff = |name: &str| render_frame(renderer_by_name(name).unwrap().as_ref(), &prepared, &settings, &AtomicBool::new(false), None).unwrap();
+    let bvh = diff("raytrace:bvh");
+    assert_eq!(bvh.differing_pixels, Some(0), "the BVH gives the reference's pixels");
+    let raster = diff("rasterize");
+    let n = raster.differing_pixels.unwrap();
+    assert!(n > 0 && n < (W * H / 100) as u64, "edge pixels only: {n}");
+    // Differing pixels are marked red or blue, at least half bright; the rest is dim.
+    let marked = raster.pixels.iter().filter(|c| c.x >= 0.5 || c.z >= 0.5).count() as u64;
+    assert_eq!(marked, n);
+    // A real error is counted: a scene with a brighter light differs everywhere it is lit.
+    let (img, count) = pinhole::render::debug::diff_image(&bvh.pixels.iter().map(|c| *c * 1.01 + Vec3::splat(1e-3)).collect::<Vec<_>>(), &bvh.pixels);
+    assert_eq!(count, (W * H) as u64);
+    assert!(img.iter().all(|c| c.x >= 0.5));
+}

@@ -27,13 +27,16 @@ pub enum View {
     /// Work per pixel as a heat map: BVH nodes visited plus primitives tested by
     /// the eye ray (ray tracers); triangles tested, fragments shaded (rasterizers).
     Cost,
+    /// This renderer's shaded image minus the reference `raytrace:brute`'s:
+    /// red where brighter, blue where darker (amplified), the rest dimmed.
+    Diff,
 }
 
 /// The cost that maps to the hot end of the cost view's colour scale.
 pub const COST_SCALE: f32 = 1024.0;
 
 impl View {
-    pub const ALL: [View; 9] = [View::Shaded, View::Barycentric, View::Raydir, View::Depth, View::Zbuffer, View::Normal, View::Id, View::Uv, View::Cost];
+    pub const ALL: [View; 10] = [View::Shaded, View::Barycentric, View::Raydir, View::Depth, View::Zbuffer, View::Normal, View::Id, View::Uv, View::Cost, View::Diff];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -46,6 +49,7 @@ impl View {
             View::Uv => "uv",
             View::Zbuffer => "zbuffer",
             View::Cost => "cost",
+            View::Diff => "diff",
         }
     }
 
@@ -66,7 +70,9 @@ pub fn view_color(view: View, camera: &CameraView, ray: &Ray, hit: Option<&Surfa
     let Some(h) = hit else { return Vec3::ZERO };
     match view {
         // Shaded is resolved by shade(); cost by the renderer, which counted the work.
-        View::Shaded | View::Raydir | View::Cost => Vec3::ZERO,
+        // Cost is coloured by the renderer, which counted the work; diff is a
+        // whole-frame comparison (`diff_image`).
+        View::Shaded | View::Raydir | View::Cost | View::Diff => Vec3::ZERO,
         View::Barycentric => h.barycentric,
         View::Depth => Vec3::splat(depth_value(camera, (h.position - camera.eye).length())),
         View::Zbuffer => {
@@ -114,4 +120,36 @@ pub fn cost_color(cost: f32) -> Vec3 {
     let x = t * (STOPS.len() - 1) as f32;
     let i = (x.floor() as usize).min(STOPS.len() - 2);
     STOPS[i].lerp(STOPS[i + 1], x - i as f32)
+}
+
+/// Whether two radiances differ by more than 1e-4 relative in any channel
+/// (the agreement tests' criterion).
+pub fn differs(a: Vec3, b: Vec3) -> bool {
+    let d = (a - b).abs();
+    let m = a.abs().max(b.abs());
+    d.x > 1e-4 * m.x + 1e-7 || d.y > 1e-4 * m.y + 1e-7 || d.z > 1e-4 * m.z + 1e-7
+}
+
+/// The diff view of `test` against `reference`: where the luminance is higher
+/// red, lower blue, amplified so a difference of 10% of the reference's mean
+/// is full scale, and never dimmer than a clearly visible 0.5 where the pixels
+/// differ at all; equal pixels show the reference dimmed to grey. Returns the
+/// image and the number of differing pixels.
+pub fn diff_image(test: &[Radiance], reference: &[Radiance]) -> (Vec<Radiance>, u64) {
+    let mean = reference.iter().map(|c| crate::math::luminance(*c)).sum::<f32>() / reference.len().max(1) as f32;
+    let gain = 10.0 / mean.max(1e-6);
+    let mut count = 0;
+    let image = test
+        .iter()
+        .zip(reference)
+        .map(|(&a, &b)| {
+            if !differs(a, b) {
+                return Vec3::splat((crate::math::luminance(b) / mean.max(1e-6) * 0.01).min(0.02));
+            }
+            count += 1;
+            let d = (crate::math::luminance(a) - crate::math::luminance(b)) * gain;
+            if d >= 0.0 { Vec3::new(d.clamp(0.5, 1.0), 0.0, 0.0) } else { Vec3::new(0.0, 0.0, (-d).clamp(0.5, 1.0)) }
+        })
+        .collect();
+    (image, count)
 }

@@ -11,6 +11,8 @@ pub struct FrameResult {
     /// Linear radiance, row-major, averaged over the samples.
     pub pixels: Vec<Radiance>,
     pub counts: RayCounts,
+    /// The diff view: how many pixels differ from the reference.
+    pub differing_pixels: Option<u64>,
 }
 
 /// Renders a whole frame of `settings.spp` samples. Returns `None` when
@@ -39,6 +41,15 @@ pub fn render_frame_in_bands(
     bands: u32,
     rows_done: Option<&AtomicU64>,
 ) -> Option<FrameResult> {
+    if settings.view == super::debug::View::Diff {
+        // Both images shaded; the reference is the brute-force caster.
+        let shaded = RenderSettings { view: super::debug::View::Shaded, ..settings.clone() };
+        let mine = render_frame_in_bands(renderer, prepared, &shaded, cancel, passes_done, bands, rows_done)?;
+        let reference = super::raytrace::brute::BruteForce;
+        let theirs = render_frame_in_bands(&reference, prepared, &shaded, cancel, None, bands, None)?;
+        let (pixels, count) = super::debug::diff_image(&mine.pixels, &theirs.pixels);
+        return Some(FrameResult { pixels, differing_pixels: Some(count), ..mine });
+    }
     let view = prepared.scene.camera.view(settings.width, settings.height);
     let n = (settings.width * settings.height) as usize;
     let mut sum = vec![Radiance::ZERO; n];
@@ -77,7 +88,7 @@ pub fn render_frame_in_bands(
     for s in &mut sum {
         *s *= inv;
     }
-    Some(FrameResult { width: settings.width, height: settings.height, pixels: sum, counts })
+    Some(FrameResult { width: settings.width, height: settings.height, pixels: sum, counts, differing_pixels: None })
 }
 
 /// A pixel replayed sample by sample: the records, and the final value, which
