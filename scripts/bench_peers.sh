@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Measures pinhole against its peers (../shared/COMPARE.md) in ONE run, on the
+# benchmark scenes, and prints the figures and ratios. Only same-run ratios
+# mean anything on these shared machines.
+#
+#   bash scripts/bench_peers.sh [SCENE.toml ...]     (default: ../shared/bench/*.toml)
+#
+# Needs the peers set up as COMPARE.md says (/tmp/peers venv, libembree-dev, Mesa).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+shared=$(cd ../shared && pwd)
+py=${PEERS_PYTHON:-/tmp/peers/bin/python}
+bin=target/release/pinhole
+cargo build --release --quiet
+scenes=("$@")
+[ ${#scenes[@]} -gt 0 ] || scenes=("$shared"/bench/*.toml)
+field() { python3 -c "import json,sys; print(json.load(sys.stdin)['$1'])"; }
+for scene in "${scenes[@]}"; do
+    name=$(basename "$scene" .toml)
+    echo "== $name"
+    ( cd "$shared/bench" && "$py" ../tools/peers/embree_primary.py "$(basename "$scene")" 2 ) 2>&1 | sed 's/^/embree:   /'
+    "$bin" bench "$scene" --renderer raytrace --view depth --shadows none --frames 10 > /tmp/pinhole-primary.json
+    echo "pinhole:  primary rays $(field primary_rays_per_s < /tmp/pinhole-primary.json | awk '{printf "%.2f Mrays/s", $1/1e6}'), build $(field build_ms < /tmp/pinhole-primary.json | awk '{printf "%.1f ms", $1}') (depth view: eye rays + hit record, no shading)"
+    ( cd "$shared/bench" && "$py" ../tools/peers/mitsuba_direct.py "$(basename "$scene")" ) 2>&1 | sed 's/^/mitsuba:  /'
+    "$bin" bench "$scene" --renderer raytrace --frames 10 > /tmp/pinhole-frame.json
+    echo "pinhole:  ray-cast frame (primary + shadow + Blinn-Phong) $(field render_ms < /tmp/pinhole-frame.json | awk '{printf "%.1f ms", $1}')"
+    ( cd "$shared/bench" && "$py" ../tools/peers/llvmpipe_raster.py "$(basename "$scene")" ) 2>&1 | sed 's/^/llvmpipe: /'
+    "$bin" bench "$scene" --renderer rasterize --shadows none --frames 10 > /tmp/pinhole-raster.json
+    echo "pinhole:  rasterized frame (depth test + per-pixel Blinn-Phong, no shadows) $(field render_ms < /tmp/pinhole-raster.json | awk '{printf "%.1f ms", $1}')"
+done
