@@ -6,7 +6,7 @@
 //! shading == early depth, and any row range renders the same rows.
 
 use pinhole::math::{Radiance, Vec2, Vec3};
-use pinhole::render::raster::{Method, RasterOptions, Rasterizer};
+use pinhole::render::raster::{Method, Rasterizer};
 use pinhole::render::raytrace::intersect::intersect_sphere;
 use pinhole::render::{render_frame, sample_offset, PassJob, PreparedScene, RenderSettings, Renderer};
 use pinhole::scene::{CameraView, Scene};
@@ -36,7 +36,7 @@ fn brute() -> Box<dyn Renderer> {
 }
 
 fn raster(m: Method) -> Rasterizer {
-    Rasterizer::new(m, RasterOptions::default())
+    Rasterizer::new(m)
 }
 
 /// Equal within 1e-4 relative, per channel.
@@ -245,7 +245,7 @@ fn forward_shading_gives_the_early_depth_image_with_more_shading() {
         let settings = settings(&scene);
         let prepared = PreparedScene::new(scene);
         for m in [Method::Incremental, Method::Tiled, Method::BBox] {
-            let r = |early_depth| render_frame(&Rasterizer::new(m, RasterOptions { early_depth }), &prepared, &settings, &AtomicBool::new(false), None).unwrap();
+            let r = |early_depth| render_frame(&Rasterizer::new(m), &prepared, &RenderSettings { early_depth, ..settings.clone() }, &AtomicBool::new(false), None).unwrap();
             let (early, forward) = (r(true), r(false));
             assert!(early.pixels == forward.pixels, "{} on {name}", m.name());
             let (ce, cf) = (early.counts, forward.counts);

@@ -98,6 +98,24 @@ pub struct RenderSettings {
     pub view: debug::View,
     #[serde(default)]
     pub interpolation: Interpolation,
+    /// Rasterizers: resolve visibility first, then shade once per pixel
+    /// (CGPP 15.8.3); false = forward shading of every fragment that passes
+    /// the depth test when it arrives. Ray casters ignore it.
+    #[serde(default = "default_true")]
+    pub early_depth: bool,
+    /// Rasterizers: coverage samples per pixel (1 = off; 2, 4 or 8 at the
+    /// D3D standard positions), one shade per pixel per primitive. Ray
+    /// casters ignore it (they antialias with `spp`).
+    #[serde(default = "default_one")]
+    pub msaa: u32,
+}
+
+fn default_true() -> bool {
+    true
+}
+
+fn default_one() -> u32 {
+    1
 }
 
 impl RenderSettings {
@@ -111,6 +129,8 @@ impl RenderSettings {
             max_depth: 4,
             view: debug::View::Shaded,
             interpolation: Interpolation::Phong,
+            early_depth: true,
+            msaa: 1,
         }
     }
 }

@@ -93,6 +93,9 @@ pub struct FragmentRecord {
     pub passed_depth_test: bool,
     /// Radiance when the fragment was shaded (forward shading), else `None`.
     pub shaded: Option<Radiance>,
+    /// The MSAA coverage sample it was tested at; `None` for the pass's own
+    /// sample (without MSAA, or MSAA's pixel-centre shading layer).
+    pub sample: Option<u32>,
 }
 
 /// Everything one sample of one pixel did, in order. Built by passing a

@@ -4,7 +4,7 @@
 //! when all weights are >= 0; the weights then interpolate 1/z and the
 //! attributes over z (perspective-correct, CGPP 15.6.4.2).
 
-use super::setup::{PixelRect, ScreenTri};
+use super::setup::{PixelRect, ScreenTri, Tested};
 use crate::math::Vec2;
 
 /// Signed distance of `q` from the line through `a` and `b`: the line's normal
@@ -24,12 +24,12 @@ pub fn bary2d(a: Vec2, b: Vec2, c: Vec2, q: Vec2) -> f32 {
 
 /// Visits the covered samples of `st` inside `rect` with their screen-space weights.
 #[inline]
-pub fn raster<F: FnMut(u32, u32, [f32; 3])>(st: &ScreenTri, rect: PixelRect, off: Vec2, tested: &mut u64, mut emit: F) {
+pub fn raster<F: FnMut(u32, u32, [f32; 3])>(st: &ScreenTri, rect: PixelRect, off: Vec2, tested: &mut impl Tested, mut emit: F) {
     let r = st.bbox.intersect(&rect);
     if r.is_empty() {
         return;
     }
-    *tested += r.area();
+    tested.add(r);
     let [p0, p1, p2] = st.p;
     for y in r.y0..r.y1 {
         for x in r.x0..r.x1 {

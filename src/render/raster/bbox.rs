@@ -2,15 +2,10 @@
 //! (CGPP listings 15.23 and 15.24): the same 3D ray test, far fewer samples
 //! tested. The box is that of the triangle's near-clipped projection, grown by
 //! one pixel so that rounding can never lose a sample the ray test would hit;
-//! the images equal the naive rasterizer's.
+//! the images equal the naive rasterizer's. The pass is in `pass.rs`.
 
-use super::naive::{ray_test_rect, region_rays};
-use super::pass::bands;
-use super::setup::{bin_rows, setup_pass, PixelRect};
-use super::vis_buffer::DepthKey;
-use super::RasterOptions;
-use crate::math::Radiance;
-use crate::render::{PassJob, RayCounts};
+use super::setup::{setup_pass, PixelRect};
+use crate::render::PassJob;
 
 /// Per scene triangle with any visible piece: its index and the box of all its pieces.
 pub fn triangle_boxes(job: &PassJob) -> Vec<(u32, PixelRect)> {
@@ -26,20 +21,4 @@ pub fn triangle_boxes(job: &PassJob) -> Vec<(u32, PixelRect)> {
         }
     }
     boxes
-}
-
-pub fn render(job: &PassJob, options: RasterOptions, out: &mut [Radiance]) -> RayCounts {
-    let query = super::pass::query(job.prepared);
-    let boxes = triangle_boxes(job);
-    let bins = bin_rows(boxes.iter().map(|b| b.1), job.rows.start, job.rows.end, super::pass::BAND_ROWS);
-    bands(job, &query, DepthKey::RayT, !options.early_depth, out, |vb, band| {
-        let rays = region_rays(vb);
-        for &i in &bins[band] {
-            let (tri, b) = boxes[i as usize];
-            let r = b.intersect(&vb.rect);
-            if !r.is_empty() {
-                ray_test_rect(vb, &rays, tri, r);
-            }
-        }
-    })
 }

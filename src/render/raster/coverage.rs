@@ -17,7 +17,7 @@ pub fn coverage_counts(method: Method, width: u32, height: u32, offset: Vec2, tr
     let sts: Vec<ScreenTri> = tris.iter().enumerate().filter_map(|(i, p)| ScreenTri::flat(i as u32, *p, offset, width, height)).collect();
     let full = PixelRect::new(0, 0, width, height);
     let mut counts = vec![0u32; (width * height) as usize];
-    let mut tested = 0;
+    let mut tested = 0u64;
     let mut hit = |x: u32, y: u32| counts[(x + y * width) as usize] += 1;
     match method {
         Method::Incremental => sts.iter().for_each(|st| incremental::raster(st, full, offset, &mut tested, |x, y, _| hit(x, y))),

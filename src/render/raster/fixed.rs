@@ -7,7 +7,7 @@
 //! top-left rule gives a sample lying exactly on the edge to exactly one of them:
 //! no cracks and no double hits, whatever the mesh.
 
-use super::setup::{PixelRect, ScreenTri};
+use super::setup::{PixelRect, ScreenTri, Tested};
 use crate::math::Vec2;
 use std::ops::{Add, Mul, Sub};
 
@@ -154,21 +154,21 @@ pub fn snap_all(tris: &[ScreenTri], sample_off: Vec2, width: u32, height: u32) -
 /// Visits the covered samples of `ft` inside `rect`, stepping the integer edge
 /// functions by additions, with their screen-space weights.
 #[inline]
-pub fn raster<F: FnMut(u32, u32, [f32; 3])>(ft: &FixedTri, rect: PixelRect, off: [i64; 2], tested: &mut u64, emit: F) {
+pub fn raster<C: Tested, F: FnMut(u32, u32, [f32; 3])>(ft: &FixedTri, rect: PixelRect, off: [i64; 2], tested: &mut C, emit: F) {
     if ft.wide {
-        raster_in::<i128, F>(ft, rect, off, tested, emit)
+        raster_in::<i128, C, F>(ft, rect, off, tested, emit)
     } else {
-        raster_in::<i64, F>(ft, rect, off, tested, emit)
+        raster_in::<i64, C, F>(ft, rect, off, tested, emit)
     }
 }
 
 #[inline(always)]
-fn raster_in<T: EdgeInt, F: FnMut(u32, u32, [f32; 3])>(ft: &FixedTri, rect: PixelRect, off: [i64; 2], tested: &mut u64, mut emit: F) {
+fn raster_in<T: EdgeInt, C: Tested, F: FnMut(u32, u32, [f32; 3])>(ft: &FixedTri, rect: PixelRect, off: [i64; 2], tested: &mut C, mut emit: F) {
     let r = ft.bbox.intersect(&rect);
     if r.is_empty() {
         return;
     }
-    *tested += r.area();
+    tested.add(r);
     let step_x = [0, 1, 2].map(|k| T::from(ft.a[k]) * T::from(ONE));
     let step_y = [0, 1, 2].map(|k| T::from(ft.b[k]) * T::from(ONE));
     let bias = ft.bias.map(T::from);
@@ -198,7 +198,7 @@ mod tests {
         let off = snap_offset(Vec2::splat(0.5));
         let ft = FixedTri::new(&st, off, Vec2::splat(0.5), w, h).unwrap();
         let mut out = Vec::new();
-        let mut tested = 0;
+        let mut tested = 0u64;
         raster(&ft, PixelRect::new(0, 0, w, h), off, &mut tested, |x, y, _| out.push((x, y)));
         out.sort();
         out
@@ -250,7 +250,7 @@ mod tests {
         let ft = FixedTri::new(&st, off, Vec2::splat(0.5), 16, 16).unwrap();
         assert!(ft.wide);
         let mut n = 0;
-        let mut tested = 0;
+        let mut tested = 0u64;
         raster(&ft, PixelRect::new(0, 0, 16, 16), off, &mut tested, |_, _, _| n += 1);
         assert_eq!(n, 256);
     }

@@ -6,18 +6,18 @@
 //! the earlier one; rounding in the stepped sums can leave rare holes, which
 //! the `fixed` variant removes).
 
-use super::setup::{edge_function, PixelRect, ScreenTri};
+use super::setup::{edge_function, PixelRect, ScreenTri, Tested};
 use crate::math::Vec2;
 
 /// Visits the covered samples of `st` inside `rect` with their screen-space
 /// weights; adds the samples tested to `tested`.
 #[inline]
-pub fn raster<F: FnMut(u32, u32, [f32; 3])>(st: &ScreenTri, rect: PixelRect, off: Vec2, tested: &mut u64, mut emit: F) {
+pub fn raster<F: FnMut(u32, u32, [f32; 3])>(st: &ScreenTri, rect: PixelRect, off: Vec2, tested: &mut impl Tested, mut emit: F) {
     let r = st.bbox.intersect(&rect);
     if r.is_empty() {
         return;
     }
-    *tested += r.area();
+    tested.add(r);
     let p = st.p;
     let inv_area = st.inv_area;
     // Edge k is the one opposite vertex k: E_k(q) = a_k q.x + b_k q.y + c_k.

@@ -6,7 +6,9 @@
 //! - `setup`: camera space, back-face culling, near clipping (`clip`), projection;
 //! - coverage loops, one per file: `naive` and `bbox` (the 3D ray test),
 //!   `barycentric`, `incremental`, `scanline`, `fixed`, `tiled`;
-//! - `vis_buffer`: depth test, visibility buffer, forward or early-depth shading;
+//! - `vis_buffer`: depth test, visibility buffer, forward or early-depth shading,
+//!   the pixel-history recorder and the cost view's counts;
+//! - `msaa`: coverage sample patterns and the one-shade-per-primitive resolve;
 //! - `sphere`: analytic spheres through the ray tracer's sphere test;
 //! - `pass`: the parallel regions of a pass; `coverage`: coverage counts for tests.
 
@@ -16,6 +18,7 @@ pub mod clip;
 pub mod coverage;
 pub mod fixed;
 pub mod incremental;
+pub mod msaa;
 pub mod naive;
 pub mod pass;
 pub mod scanline;
@@ -24,6 +27,7 @@ pub mod sphere;
 pub mod tiled;
 pub mod vis_buffer;
 
+use super::trace::PixelTrace;
 use super::{PassJob, RayCounts, Renderer};
 use crate::math::Radiance;
 
@@ -78,31 +82,15 @@ impl Method {
     }
 }
 
-/// Knobs shared by every rasterizer variant.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct RasterOptions {
-    /// true: resolve visibility first (a visibility buffer of primitive and
-    /// barycentrics per pixel), then shade once per pixel. false: forward
-    /// shading, every fragment that passes the depth test when it arrives is shaded.
-    pub early_depth: bool,
-}
-
-impl Default for RasterOptions {
-    fn default() -> Self {
-        RasterOptions { early_depth: true }
-    }
-}
-
-/// One rasterizer variant with its options.
+/// One rasterizer variant. Its knobs (early depth, MSAA) are in `RenderSettings`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Rasterizer {
     pub method: Method,
-    pub options: RasterOptions,
 }
 
 impl Rasterizer {
-    pub fn new(method: Method, options: RasterOptions) -> Rasterizer {
-        Rasterizer { method, options }
+    pub fn new(method: Method) -> Rasterizer {
+        Rasterizer { method }
     }
 }
 
@@ -116,21 +104,15 @@ impl Renderer for Rasterizer {
     }
 
     fn render_pass(&self, job: &PassJob, out: &mut [Radiance]) -> RayCounts {
-        match self.method {
-            Method::Naive => naive::render(job, self.options, out),
-            Method::BBox => bbox::render(job, self.options, out),
-            Method::Tiled => pass::render_tiled(self.options, job, out),
-            m => pass::render_bands(m, self.options, job, out),
-        }
+        pass::render(self.method, job, out)
+    }
+
+    fn trace_pixel(&self, job: &PassJob, x: u32, y: u32, rec: &mut PixelTrace) -> Option<Radiance> {
+        Some(pass::trace(self.method, job, x, y, rec))
     }
 }
 
-/// Every variant with the given options.
-pub fn renderers_with(options: RasterOptions) -> Vec<Box<dyn Renderer>> {
-    Method::ALL.into_iter().map(|m| Box::new(Rasterizer::new(m, options)) as Box<dyn Renderer>).collect()
-}
-
-/// Every variant with the default options (early depth).
+/// Every variant.
 pub fn renderers() -> Vec<Box<dyn Renderer>> {
-    renderers_with(RasterOptions::default())
+    Method::ALL.into_iter().map(|m| Box::new(Rasterizer::new(m)) as Box<dyn Renderer>).collect()
 }

@@ -3,17 +3,30 @@
 //! parallel into its own visibility buffer (triangles in scene order, then the
 //! spheres), and resolve it into the output. Regions never share pixels, so
 //! the result does not depend on the number of threads.
+//!
+//! A pass rasterizes one or more *layers*: one sample position each, with its
+//! own setup and visibility buffer. Without MSAA there is one layer at the
+//! pass's sample; with MSAA N there are N + 1: the pixel-centre layer that
+//! shading reads and the N coverage samples (`msaa.rs`).
+//!
+//! `trace` replays one pixel through this very code: the same setup and
+//! coverage loops over the region holding the pixel (its row, or its tile),
+//! with a recording `VisBuffer` that keeps that pixel's fragment history.
 
-use super::fixed::{self, snap_all, snap_offset};
-use super::setup::{bin_rows, setup_pass, PixelRect};
+use super::fixed::{self, snap_all, snap_offset, FixedTri};
+use super::msaa;
+use super::naive::{ray_test_rect, region_rays};
+use super::setup::{bin_rows, setup_pass, PixelRect, ScreenTri};
 use super::sphere::{all_sphere_bounds, raster_spheres};
-use super::tiled::{self, TileGrid};
-use super::vis_buffer::{DepthKey, VisBuffer};
-use super::{barycentric, incremental, scanline, Method, RasterOptions};
-use crate::math::Radiance;
+use super::tiled::{self, Class, TileGrid};
+use super::vis_buffer::{DepthKey, FragmentRecorder, VisBuffer};
+use super::{barycentric, bbox, incremental, scanline, Method};
+use crate::math::{Radiance, Vec2};
 use crate::render::raytrace::bvh::BvhQuery;
-use crate::render::{PassJob, PreparedScene, RayCounts};
+use crate::render::trace::PixelTrace;
+use crate::render::{PassJob, PreparedScene, RayCounts, SceneQuery};
 use rayon::prelude::*;
+use std::ops::Range;
 
 /// The scene query for shadow and secondary rays of rasterized frames.
 pub type Query<'a> = BvhQuery<'a>;
@@ -25,18 +38,205 @@ pub fn query(prepared: &PreparedScene) -> Query<'_> {
 /// Rows per band of the band-parallel variants.
 pub const BAND_ROWS: u32 = 16;
 
-/// Runs `raster_band(buffer, band index)` for every band of `BAND_ROWS` rows of
-/// the job in parallel, then the spheres, then resolves each band into `out`.
-pub fn bands<'a, F>(job: &PassJob, query: &Query<'a>, key: DepthKey, forward: bool, out: &mut [Radiance], raster_band: F) -> RayCounts
-where
-    F: Fn(&mut VisBuffer<Query<'a>>, usize) + Sync,
-{
-    let width = job.view.width as usize;
+/// What a variant's coverage loop reads, set up once per layer.
+enum Geometry {
+    /// naive: every triangle against every sample of the region.
+    All,
+    /// bbox: each scene triangle's grown box, binned by band.
+    Boxes { boxes: Vec<(u32, PixelRect)>, bins: Vec<Vec<u32>> },
+    /// barycentric, incremental, scanline: screen triangles binned by band.
+    Float { tris: Vec<ScreenTri>, bins: Vec<Vec<u32>> },
+    /// fixed: snapped triangles binned by band.
+    Fixed { fts: Vec<FixedTri>, off: [i64; 2], bins: Vec<Vec<u32>> },
+    /// tiled: snapped triangles binned by tile, with their whole-tile class.
+    Tiled { fts: Vec<FixedTri>, off: [i64; 2], bins: Vec<Vec<(u32, Class)>> },
+}
+
+/// One sample position of a pass, set up.
+pub struct Layer<'a> {
+    pub job: PassJob<'a>,
+    method: Method,
+    geo: Geometry,
+    spheres: Vec<Option<crate::render::raster::setup::PixelRect>>,
+    /// MSAA coverage sample index; `None` for the pass's own sample.
+    pub sample: Option<u32>,
+}
+
+fn job_at<'a>(job: &PassJob<'a>, offset: Vec2, rows: Range<u32>) -> PassJob<'a> {
+    PassJob { prepared: job.prepared, view: job.view, settings: job.settings, offset, rows, cancel: job.cancel }
+}
+
+impl<'a> Layer<'a> {
+    /// Sets up the rows of `job` at sample `offset`; tiles are those of `grid`.
+    fn new(method: Method, job: &PassJob<'a>, offset: Vec2, sample: Option<u32>, grid: &TileGrid) -> Layer<'a> {
+        let job = job_at(job, offset, job.rows.clone());
+        let (r0, r1) = (job.rows.start, job.rows.end);
+        let (w, h) = (job.view.width, job.view.height);
+        let geo = match method {
+            Method::Naive => Geometry::All,
+            Method::BBox => {
+                let boxes = bbox::triangle_boxes(&job);
+                let bins = bin_rows(boxes.iter().map(|b| b.1), r0, r1, BAND_ROWS);
+                Geometry::Boxes { boxes, bins }
+            }
+            Method::Barycentric | Method::Incremental | Method::Scanline => {
+                let tris = setup_pass(&job);
+                let bins = bin_rows(tris.iter().map(|t| t.bbox), r0, r1, BAND_ROWS);
+                Geometry::Float { tris, bins }
+            }
+            Method::Fixed => {
+                let fts = snap_all(&setup_pass(&job), offset, w, h);
+                let bins = bin_rows(fts.iter().map(|f| f.bbox), r0, r1, BAND_ROWS);
+                Geometry::Fixed { fts, off: snap_offset(offset), bins }
+            }
+            Method::Tiled => {
+                let off = snap_offset(offset);
+                let fts = snap_all(&setup_pass(&job), offset, w, h);
+                let bins = tiled::bin(&fts, grid, off);
+                Geometry::Tiled { fts, off, bins }
+            }
+        };
+        let spheres = all_sphere_bounds(job.view, &job.prepared.scene.spheres, offset);
+        Layer { job, method, geo, spheres, sample }
+    }
+
+    /// Rasterizes this layer's triangles of region `region` (band or tile
+    /// index), then the spheres, into `vb` (whose rect lies in that region).
+    pub fn raster<Q: SceneQuery, R: FragmentRecorder>(&self, vb: &mut VisBuffer<Q, R>, region: usize) {
+        let rect = vb.rect;
+        match &self.geo {
+            Geometry::All => {
+                let rays = region_rays(vb);
+                for tri in 0..self.job.prepared.edges.len() as u32 {
+                    if self.job.cancelled() {
+                        return;
+                    }
+                    ray_test_rect(vb, &rays, tri, rect);
+                }
+            }
+            Geometry::Boxes { boxes, bins } => {
+                let rays = region_rays(vb);
+                for &i in &bins[region] {
+                    let (tri, b) = boxes[i as usize];
+                    let r = b.intersect(&rect);
+                    if !r.is_empty() {
+                        ray_test_rect(vb, &rays, tri, r);
+                    }
+                }
+            }
+            Geometry::Float { tris, bins } => {
+                let off = self.job.offset;
+                let mut tested = vb.begin_tests();
+                for &i in &bins[region] {
+                    let st = &tris[i as usize];
+                    let emit = |x, y, l| vb.triangle_fragment(st, x, y, l);
+                    match self.method {
+                        Method::Incremental => incremental::raster(st, rect, off, &mut tested, emit),
+                        Method::Barycentric => barycentric::raster(st, rect, off, &mut tested, emit),
+                        _ => scanline::raster(st, rect, off, &mut tested, emit),
+                    }
+                }
+                vb.end_tests(tested);
+            }
+            Geometry::Fixed { fts, off, bins } => {
+                let mut tested = vb.begin_tests();
+                for &i in &bins[region] {
+                    let ft = &fts[i as usize];
+                    fixed::raster(ft, rect, *off, &mut tested, |x, y, l| vb.triangle_fragment(&ft.st, x, y, l));
+                }
+                vb.end_tests(tested);
+            }
+            Geometry::Tiled { fts, off, bins } => {
+                let mut tested = vb.begin_tests();
+                tiled::tile_fragments(fts, &bins[region], rect, *off, &mut tested, |ft, x, y, l| vb.triangle_fragment(&ft.st, x, y, l));
+                vb.end_tests(tested);
+            }
+        }
+        raster_spheres(vb, &self.spheres);
+    }
+}
+
+fn depth_key(method: Method) -> DepthKey {
+    match method {
+        Method::Naive | Method::BBox => DepthKey::RayT,
+        _ => DepthKey::NegInvZ,
+    }
+}
+
+/// The layers of a pass: the pass's sample, plus the MSAA coverage samples.
+fn layers<'a>(method: Method, job: &PassJob<'a>, grid: &TileGrid) -> Vec<Layer<'a>> {
+    let mut out = vec![Layer::new(method, job, job.offset, None, grid)];
+    for (k, off) in msaa::sample_offsets(job.settings.msaa, job.offset, job.settings.spp).into_iter().enumerate() {
+        out.push(Layer::new(method, job, off, Some(k as u32), grid));
+    }
+    out
+}
+
+/// Resolves the region of `vbs` (one buffer per layer) into `out`.
+fn resolve<Q: SceneQuery, R: FragmentRecorder>(vbs: &mut [VisBuffer<Q, R>], out: &mut [Radiance], stride: usize, x_offset: usize) -> RayCounts {
+    if vbs.len() == 1 {
+        vbs[0].finish_into(out, stride, x_offset)
+    } else {
+        msaa::finish_into(vbs, out, stride, x_offset)
+    }
+}
+
+fn buffers<'j, 'a, Q: SceneQuery>(layers: &'j [Layer<'a>], query: &'j Q, rect: PixelRect, key: DepthKey, forward: bool) -> Vec<VisBuffer<'j, 'a, Q>> {
+    layers
+        .iter()
+        .map(|l| {
+            let mut vb = VisBuffer::new(&l.job, query, rect, key, forward);
+            vb.sample = l.sample;
+            vb
+        })
+        .collect()
+}
+
+/// Forward shading applies without MSAA only (MSAA shades once per pixel per primitive).
+fn forward(job: &PassJob) -> bool {
+    !job.settings.early_depth && job.settings.msaa <= 1
+}
+
+/// Renders `job.rows` of one pass of `method` into `out`.
+pub fn render(method: Method, job: &PassJob, out: &mut [Radiance]) -> RayCounts {
+    let width = job.view.width;
     if width == 0 || job.rows.is_empty() {
         return RayCounts::default();
     }
-    let spheres = all_sphere_bounds(job.view, &job.prepared.scene.spheres, job.offset);
-    out.par_chunks_mut(width * BAND_ROWS as usize)
+    let query = query(job.prepared);
+    let grid = TileGrid::new(width, job.rows.start, job.rows.end);
+    let layers = layers(method, job, &grid);
+    let (key, forward) = (depth_key(method), forward(job));
+    let sum = |mut a: RayCounts, b: RayCounts| {
+        a += b;
+        a
+    };
+    if method == Method::Tiled {
+        // Rows of tiles in parallel; the tiles of a row one after the other,
+        // each resolved straight into the output through reused buffers.
+        return out
+            .par_chunks_mut(width as usize * tiled::TILE as usize)
+            .enumerate()
+            .map(|(ty, chunk)| {
+                let mut counts = RayCounts::default();
+                let mut vbs = buffers(&layers, &query, grid.rect(ty * grid.nx as usize), key, forward);
+                for tx in 0..grid.nx as usize {
+                    if job.cancelled() {
+                        break;
+                    }
+                    let t = ty * grid.nx as usize + tx;
+                    let rect = grid.rect(t);
+                    for (l, vb) in layers.iter().zip(&mut vbs) {
+                        vb.reset(rect);
+                        l.raster(vb, t);
+                    }
+                    counts += resolve(&mut vbs, chunk, width as usize, rect.x0 as usize);
+                }
+                counts
+            })
+            .reduce(RayCounts::default, sum);
+    }
+    out.par_chunks_mut(width as usize * BAND_ROWS as usize)
         .enumerate()
         .map(|(b, chunk)| {
             if job.cancelled() {
@@ -44,96 +244,54 @@ where
             }
             let y0 = job.rows.start + b as u32 * BAND_ROWS;
             let y1 = (y0 + BAND_ROWS).min(job.rows.end);
-            let mut vb = VisBuffer::new(job, query, PixelRect::new(0, y0, job.view.width, y1), key, forward);
-            raster_band(&mut vb, b);
-            raster_spheres(&mut vb, &spheres);
-            vb.finish(chunk)
-        })
-        .reduce(RayCounts::default, |mut a, b| {
-            a += b;
-            a
-        })
-}
-
-/// The variants that rasterize projected triangles band by band.
-pub fn render_bands(method: Method, options: RasterOptions, job: &PassJob, out: &mut [Radiance]) -> RayCounts {
-    let query = query(job.prepared);
-    let tris = setup_pass(job);
-    let forward = !options.early_depth;
-    let key = DepthKey::NegInvZ;
-    let (rows0, rows1) = (job.rows.start, job.rows.end);
-    let off = job.offset;
-    match method {
-        Method::Fixed => {
-            let off = snap_offset(off);
-            let fts = snap_all(&tris, job.offset, job.view.width, job.view.height);
-            let bins = bin_rows(fts.iter().map(|f| f.bbox), rows0, rows1, BAND_ROWS);
-            bands(job, &query, key, forward, out, |vb, b| {
-                let (rect, mut tested) = (vb.rect, 0);
-                for &i in &bins[b] {
-                    let ft = &fts[i as usize];
-                    fixed::raster(ft, rect, off, &mut tested, |x, y, l| vb.triangle_fragment(&ft.st, x, y, l));
-                }
-                vb.counts.samples_tested += tested;
-            })
-        }
-        Method::Incremental | Method::Barycentric | Method::Scanline => {
-            let bins = bin_rows(tris.iter().map(|t| t.bbox), rows0, rows1, BAND_ROWS);
-            bands(job, &query, key, forward, out, |vb, b| {
-                let (rect, mut tested) = (vb.rect, 0);
-                for &i in &bins[b] {
-                    let st = &tris[i as usize];
-                    let emit = |x, y, l| vb.triangle_fragment(st, x, y, l);
-                    match method {
-                        Method::Incremental => incremental::raster(st, rect, off, &mut tested, emit),
-                        Method::Barycentric => barycentric::raster(st, rect, off, &mut tested, emit),
-                        _ => scanline::raster(st, rect, off, &mut tested, emit),
-                    }
-                }
-                vb.counts.samples_tested += tested;
-            })
-        }
-        Method::Naive | Method::BBox | Method::Tiled => unreachable!("not a band variant"),
-    }
-}
-
-/// The tiled variant: bin, then rasterize and resolve the tiles in parallel.
-pub fn render_tiled(options: RasterOptions, job: &PassJob, out: &mut [Radiance]) -> RayCounts {
-    let width = job.view.width;
-    if width == 0 || job.rows.is_empty() {
-        return RayCounts::default();
-    }
-    let query = query(job.prepared);
-    let off = snap_offset(job.offset);
-    let fts = snap_all(&setup_pass(job), job.offset, width, job.view.height);
-    let grid = TileGrid::new(width, job.rows.start, job.rows.end);
-    let bins = tiled::bin(&fts, &grid, off);
-    let spheres = all_sphere_bounds(job.view, &job.prepared.scene.spheres, job.offset);
-    // Rows of tiles in parallel; the tiles of a row one after the other, each
-    // resolved straight into the output through one reused buffer.
-    out.par_chunks_mut(width as usize * tiled::TILE as usize)
-        .enumerate()
-        .map(|(ty, chunk)| {
-            let mut counts = RayCounts::default();
-            let first = grid.rect(ty * grid.nx as usize);
-            let mut vb = VisBuffer::new(job, &query, first, DepthKey::NegInvZ, !options.early_depth);
-            for tx in 0..grid.nx as usize {
-                if job.cancelled() {
-                    break;
-                }
-                let t = ty * grid.nx as usize + tx;
-                let rect = grid.rect(t);
-                vb.reset(rect);
-                let mut tested = 0;
-                tiled::tile_fragments(&fts, &bins[t], rect, off, &mut tested, |ft, x, y, l| vb.triangle_fragment(&ft.st, x, y, l));
-                vb.counts.samples_tested += tested;
-                raster_spheres(&mut vb, &spheres);
-                counts += vb.finish_into(chunk, width as usize, rect.x0 as usize);
+            let mut vbs = buffers(&layers, &query, PixelRect::new(0, y0, width, y1), key, forward);
+            for (l, vb) in layers.iter().zip(&mut vbs) {
+                l.raster(vb, b);
             }
-            counts
+            resolve(&mut vbs, chunk, width as usize, 0)
         })
-        .reduce(RayCounts::default, |mut a, b| {
-            a += b;
-            a
+        .reduce(RayCounts::default, sum)
+}
+
+/// Replays pixel `(x, y)` of the pass `render` draws for `job` (whose rows
+/// hold `y`; frames render all rows in one job), recording its fragment
+/// history and shading into `rec`. Returns the value `render` stores there.
+pub fn trace(method: Method, job: &PassJob, x: u32, y: u32, rec: &mut PixelTrace) -> Radiance {
+    let (width, height) = (job.view.width, job.view.height);
+    let query = query(job.prepared);
+    // Only the triangles reaching row y are set up. Band variants rasterize
+    // that row (a pixel's coverage and values do not depend on its band);
+    // tiled rasterizes the pixel's tile of the frame's grid, as the frame does.
+    let row = job_at(job, job.offset, y..y + 1);
+    let grid = TileGrid::new(width, 0, height);
+    let layers = layers(method, &row, &grid);
+    let (rect, region) = if method == Method::Tiled {
+        let t = (y / tiled::TILE * grid.nx + x / tiled::TILE) as usize;
+        (grid.rect(t), t)
+    } else {
+        (PixelRect::new(0, y, width, y + 1), 0)
+    };
+    let (key, forward) = (depth_key(method), forward(job));
+    let mut vbs: Vec<_> = layers
+        .iter()
+        .map(|l| {
+            let mut vb = VisBuffer::with_recorder(&l.job, &query, rect, key, forward, PixelTrace::new(), (x, y));
+            vb.sample = l.sample;
+            vb
         })
+        .collect();
+    for (l, vb) in layers.iter().zip(&mut vbs) {
+        l.raster(vb, region);
+    }
+    let i = vbs[0].index(x, y);
+    let value = if vbs.len() == 1 { vbs[0].resolve(i, x, y) } else { msaa::resolve(&mut vbs, i, x, y) };
+    // The layers' records in layer order: the pass's sample, then the coverage samples.
+    for vb in vbs {
+        let t = vb.rec;
+        rec.fragments.extend(t.fragments);
+        rec.rays.extend(t.rays);
+        rec.lights.extend(t.lights);
+        rec.shaded.extend(t.shaded);
+    }
+    value
 }

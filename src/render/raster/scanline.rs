@@ -7,7 +7,7 @@
 //! barycentrics (the book's 1/z interpolation). It runs on the same clipped
 //! triangles as every other variant and samples at the pass's sample positions.
 
-use super::setup::{PixelRect, ScreenTri};
+use super::setup::{PixelRect, ScreenTri, Tested};
 use crate::math::{Vec2, Vec3};
 
 /// Position and interpolated weights where the edge `a -> b` crosses row `ys`.
@@ -20,7 +20,7 @@ fn along(a: (Vec2, Vec3), b: (Vec2, Vec3), ys: f32) -> (f32, Vec3) {
 
 /// Visits the covered samples of `st` inside `rect`; the samples tested are the spans.
 #[inline]
-pub fn raster<F: FnMut(u32, u32, [f32; 3])>(st: &ScreenTri, rect: PixelRect, off: Vec2, tested: &mut u64, mut emit: F) {
+pub fn raster<F: FnMut(u32, u32, [f32; 3])>(st: &ScreenTri, rect: PixelRect, off: Vec2, tested: &mut impl Tested, mut emit: F) {
     let r = st.bbox.intersect(&rect);
     if r.is_empty() {
         return;
@@ -41,7 +41,7 @@ pub fn raster<F: FnMut(u32, u32, [f32; 3])>(st: &ScreenTri, rect: PixelRect, off
         if x0 >= x1 {
             continue;
         }
-        *tested += (x1 - x0) as u64;
+        tested.add(PixelRect::new(x0, y, x1, y + 1));
         // Across the span: each sample's weights from the span's ends (a running
         // sum `w += step` drifts enough over a long span to move texture lookups).
         let width = right.0 - left.0;

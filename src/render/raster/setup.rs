@@ -49,6 +49,20 @@ impl PixelRect {
     }
 }
 
+/// Where the coverage loops count the samples they test: a plain total
+/// (`u64`), or a total plus a per-pixel map for the cost view
+/// (`vis_buffer::TestCount`). Called once per rectangle (or span) tested.
+pub trait Tested {
+    fn add(&mut self, r: PixelRect);
+}
+
+impl Tested for u64 {
+    #[inline(always)]
+    fn add(&mut self, r: PixelRect) {
+        *self += r.area();
+    }
+}
+
 /// The pixels `i` in `[0, n)` whose sample `i + off` lies in `[lo, hi]`.
 pub fn sample_span(lo: f32, hi: f32, off: f32, n: u32) -> (u32, u32) {
     if !(lo <= hi) {

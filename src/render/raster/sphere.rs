@@ -4,7 +4,7 @@
 //! depth-tested against the triangles already drawn.
 
 use super::setup::{sample_span, PixelRect};
-use super::vis_buffer::{DepthKey, VisBuffer};
+use super::vis_buffer::{DepthKey, FragmentRecorder, VisBuffer};
 use crate::math::{Vec2, Vec3};
 use crate::render::raytrace::intersect::intersect_sphere;
 use crate::render::SceneQuery;
@@ -51,7 +51,7 @@ pub fn all_sphere_bounds(view: &CameraView, spheres: &[Sphere], off: Vec2) -> Ve
 
 /// Draws every sphere (in scene order, after the triangles, as the ray caster
 /// tests them) into the region of `vb`.
-pub fn raster_spheres<Q: SceneQuery>(vb: &mut VisBuffer<Q>, bounds: &[Option<PixelRect>]) {
+pub fn raster_spheres<Q: SceneQuery, R: FragmentRecorder>(vb: &mut VisBuffer<Q, R>, bounds: &[Option<PixelRect>]) {
     let job = vb.job;
     let view = job.view;
     for (si, (s, b)) in job.prepared.scene.spheres.iter().zip(bounds).enumerate() {
@@ -60,7 +60,7 @@ pub fn raster_spheres<Q: SceneQuery>(vb: &mut VisBuffer<Q>, bounds: &[Option<Pix
         if r.is_empty() {
             continue;
         }
-        vb.counts.samples_tested += r.area();
+        vb.add_tested(r);
         for y in r.y0..r.y1 {
             for x in r.x0..r.x1 {
                 let p = job.sample_position(x, y);

@@ -8,7 +8,7 @@
 //! same samples with the same weights: identical images, bit for bit.
 
 use super::fixed::{self, FixedTri, ONE};
-use super::setup::PixelRect;
+use super::setup::{PixelRect, Tested};
 
 /// Tile edge length in pixels.
 pub const TILE: u32 = 32;
@@ -111,7 +111,7 @@ pub fn tile_fragments<F: FnMut(&FixedTri, u32, u32, [f32; 3])>(
     bin: &[(u32, Class)],
     tile: PixelRect,
     off: [i64; 2],
-    tested: &mut u64,
+    tested: &mut impl Tested,
     mut emit: F,
 ) {
     for &(i, class) in bin {
@@ -140,7 +140,7 @@ pub fn tile_fragments<F: FnMut(&FixedTri, u32, u32, [f32; 3])>(
                 if c == Class::Reject {
                     continue;
                 }
-                *tested += br.area();
+                tested.add(br);
                 let mut row: [i64; 3] = ft.edges_at_pixel(br.x0, br.y0, off);
                 if c == Class::Accept {
                     for y in br.y0..br.y1 {

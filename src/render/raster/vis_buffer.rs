@@ -9,10 +9,12 @@
 //! fragment (strict `<`), so the earlier triangle in scene order wins, as in
 //! the brute-force caster.
 
-use super::setup::{PixelRect, ScreenTri};
-use crate::math::{Radiance, Vec3};
-use crate::render::trace::NoRecord;
+use super::setup::{PixelRect, ScreenTri, Tested};
+use crate::math::{Radiance, Ray, Vec3};
+use crate::render::debug::{cost_color, View};
+use crate::render::trace::{FragmentRecord, NoRecord, PixelTrace, Recorder};
 use crate::render::{resolve_sample, PassJob, RayCounts, SceneQuery};
+use crate::scene::{PrimitiveKind, SurfaceHit};
 
 /// No primitive covers the sample.
 pub const EMPTY: u32 = u32::MAX;
@@ -28,7 +30,44 @@ pub enum DepthKey {
     NegInvZ,
 }
 
-pub struct VisBuffer<'j, 'a, Q: SceneQuery> {
+/// A `Recorder` that also takes the rasterizer's fragments (pixel history).
+/// `NoRecord` ignores them, so frames pay nothing.
+pub trait FragmentRecorder: Recorder {
+    fn fragment(&mut self, _f: FragmentRecord) {}
+}
+
+impl FragmentRecorder for NoRecord {}
+
+impl FragmentRecorder for PixelTrace {
+    fn fragment(&mut self, f: FragmentRecord) {
+        self.fragments.push(f);
+    }
+}
+
+/// Samples tested by a coverage loop, with a per-pixel map for the cost view.
+pub struct TestCount {
+    pub total: u64,
+    rect: PixelRect,
+    per_pixel: Vec<u32>,
+}
+
+impl Tested for TestCount {
+    #[inline]
+    fn add(&mut self, r: PixelRect) {
+        self.total += r.area();
+        if !self.per_pixel.is_empty() {
+            let stride = self.rect.width() as usize;
+            for y in r.y0..r.y1 {
+                let row = (y - self.rect.y0) as usize * stride;
+                for x in r.x0..r.x1 {
+                    self.per_pixel[row + (x - self.rect.x0) as usize] += 1;
+                }
+            }
+        }
+    }
+}
+
+pub struct VisBuffer<'j, 'a, Q: SceneQuery, R: FragmentRecorder = NoRecord> {
     pub job: &'j PassJob<'a>,
     pub query: &'j Q,
     pub rect: PixelRect,
@@ -42,11 +81,27 @@ pub struct VisBuffer<'j, 'a, Q: SceneQuery> {
     /// Triangles: perspective-correct (b1, b2) in the scene triangle. Spheres: (t, 0).
     pub payload: Vec<[f32; 2]>,
     color: Vec<Radiance>,
+    /// Cost view only (else empty): per pixel, fragments depth-tested plus fragments shaded...
+    work: Vec<u32>,
+    /// ... and samples tested by the coverage loops.
+    tests: Vec<u32>,
     pub counts: RayCounts,
+    /// The recorder, and the one pixel whose history it takes (replay only).
+    pub rec: R,
+    focus: (u32, u32),
+    /// MSAA coverage sample of this buffer (recorded with its fragments).
+    pub sample: Option<u32>,
 }
 
-impl<'j, 'a, Q: SceneQuery> VisBuffer<'j, 'a, Q> {
+impl<'j, 'a, Q: SceneQuery> VisBuffer<'j, 'a, Q, NoRecord> {
     pub fn new(job: &'j PassJob<'a>, query: &'j Q, rect: PixelRect, key: DepthKey, forward: bool) -> Self {
+        VisBuffer::with_recorder(job, query, rect, key, forward, NoRecord, (u32::MAX, u32::MAX))
+    }
+}
+
+impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
+    /// A buffer whose recorder `rec` takes the history of pixel `focus`.
+    pub fn with_recorder(job: &'j PassJob<'a>, query: &'j Q, rect: PixelRect, key: DepthKey, forward: bool, rec: R, focus: (u32, u32)) -> Self {
         let n = rect.area() as usize;
         let depth = match key {
             DepthKey::NegInvZ => vec![-1.0 / job.view.far; n],
@@ -61,6 +116,7 @@ impl<'j, 'a, Q: SceneQuery> VisBuffer<'j, 'a, Q> {
                 d
             }
         };
+        let cost = job.settings.view == View::Cost;
         VisBuffer {
             job,
             query,
@@ -72,7 +128,12 @@ impl<'j, 'a, Q: SceneQuery> VisBuffer<'j, 'a, Q> {
             id: vec![EMPTY; n],
             payload: vec![[0.0; 2]; n],
             color: if forward { vec![Radiance::ZERO; n] } else { Vec::new() },
+            work: if cost { vec![0; n] } else { Vec::new() },
+            tests: if cost { vec![0; n] } else { Vec::new() },
             counts: RayCounts::default(),
+            rec,
+            focus,
+            sample: None,
         }
     }
 
@@ -82,15 +143,66 @@ impl<'j, 'a, Q: SceneQuery> VisBuffer<'j, 'a, Q> {
         (x - self.rect.x0) as usize + (y - self.rect.y0) as usize * self.stride
     }
 
+    #[inline(always)]
+    fn is_focus(&self, x: u32, y: u32) -> bool {
+        R::ENABLED && (x, y) == self.focus
+    }
+
+    /// Counts the samples of `r` as tested (loops that test through the buffer).
+    #[inline]
+    pub fn add_tested(&mut self, r: PixelRect) {
+        let mut t = self.begin_tests();
+        t.add(r);
+        self.end_tests(t);
+    }
+
+    /// A counter for a coverage loop that cannot borrow the buffer while it runs.
+    #[inline]
+    pub fn begin_tests(&mut self) -> TestCount {
+        TestCount { total: 0, rect: self.rect, per_pixel: std::mem::take(&mut self.tests) }
+    }
+
+    #[inline]
+    pub fn end_tests(&mut self, t: TestCount) {
+        self.counts.samples_tested += t.total;
+        self.tests = t.per_pixel;
+    }
+
+    /// The cost view's work at pixel index `i` (see `View::Cost`).
+    pub fn work_at(&self, i: usize) -> u32 {
+        self.work.get(i).copied().unwrap_or(0) + self.tests.get(i).copied().unwrap_or(0)
+    }
+
+    #[inline(always)]
+    fn count_work(&mut self, i: usize) {
+        if !self.work.is_empty() {
+            self.work[i] += 1;
+        }
+    }
+
+    /// The view depth of a depth key at pixel `(x, y)` (for the record).
+    fn key_depth(&self, key: f32, x: u32, y: u32) -> f32 {
+        match self.key {
+            DepthKey::NegInvZ => -1.0 / key,
+            DepthKey::RayT => {
+                let p = self.job.sample_position(x, y);
+                self.job.view.near + key / self.job.view.camera_dir(p.x, p.y).length()
+            }
+        }
+    }
+
     /// A covered sample of screen triangle `st` with screen-space weights `l`:
     /// depth test on -1/z, then perspective-correct barycentrics on a pass.
     #[inline(always)]
     pub fn triangle_fragment(&mut self, st: &ScreenTri, x: u32, y: u32, l: [f32; 3]) {
         self.counts.samples_covered += 1;
         let i = self.index(x, y);
+        self.count_work(i);
         let inv_z = st.inv_z_at(l);
         let key = -inv_z;
-        if key < self.depth[i] {
+        let stored = self.depth[i];
+        let passed = key < stored;
+        if passed {
             self.depth[i] = key;
             self.id[i] = st.tri;
             self.payload[i] = st.bary_at(l, inv_z);
@@ -100,6 +212,29 @@ impl<'j, 'a, Q: SceneQuery> VisBuffer<'j, 'a, Q> {
         } else {
             self.counts.depth_fails += 1;
         }
+        if self.is_focus(x, y) {
+            // The 2D weights as weights of the scene triangle's vertices (affine
+            // interpolation of the piece's vertex barycentrics).
+            let screen = (0..3).map(|k| st.bz[k] / st.inv_z[k] * l[k]).sum::<Vec3>();
+            let [b1, b2] = st.bary_at(l, inv_z);
+            self.record(PrimitiveKind::Triangle, st.tri, Some(screen), Vec3::new(1.0 - b1 - b2, b1, b2), key, stored, passed, i, x, y);
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn record(&mut self, kind: PrimitiveKind, primitive: u32, screen: Option<Vec3>, b: Vec3, key: f32, stored: f32, passed: bool, i: usize, x: u32, y: u32) {
+        let f = FragmentRecord {
+            kind,
+            primitive,
+            screen_barycentric: screen,
+            barycentric: b,
+            depth: self.key_depth(key, x, y),
+            stored_depth: self.key_depth(stored, x, y),
+            passed_depth_test: passed,
+            shaded: (passed && self.forward).then(|| self.color[i]),
+            sample: self.sample,
+        };
+        self.rec.fragment(f);
     }
 
     /// The current depth bound of pixel `(x, y)` (the ray casters' `t_max`).
@@ -113,19 +248,34 @@ impl<'j, 'a, Q: SceneQuery> VisBuffer<'j, 'a, Q> {
     pub fn ray_fragment(&mut self, x: u32, y: u32, tri: u32, t: f32, b1: f32, b2: f32) {
         self.counts.samples_covered += 1;
         let i = self.index(x, y);
+        self.count_work(i);
+        let stored = self.depth[i];
         self.depth[i] = t;
         self.id[i] = tri;
         self.payload[i] = [b1, b2];
         if self.forward {
             self.shade_now(i, x, y);
         }
+        if self.is_focus(x, y) {
+            self.record(PrimitiveKind::Triangle, tri, None, Vec3::new(1.0 - b1 - b2, b1, b2), t, stored, true, i, x, y);
+        }
     }
 
-    /// A covered sample of a ray-triangle test that lost the depth test.
+    /// A covered sample of a ray-triangle test that lost the depth test; the
+    /// replay re-tests the ray without a bound to record where it hit.
     #[inline(always)]
-    pub fn ray_depth_fail(&mut self) {
+    pub fn ray_depth_fail(&mut self, x: u32, y: u32, tri: u32, ray: &Ray) {
         self.counts.samples_covered += 1;
         self.counts.depth_fails += 1;
+        let i = self.index(x, y);
+        self.count_work(i);
+        if self.is_focus(x, y) {
+            let edges = &self.job.prepared.edges[tri as usize];
+            if let Ok((t, b1, b2)) = crate::render::raytrace::intersect::intersect_triangle(ray, edges, f32::INFINITY) {
+                let stored = self.depth[i];
+                self.record(PrimitiveKind::Triangle, tri, None, Vec3::new(1.0 - b1 - b2, b1, b2), t, stored, false, i, x, y);
+            }
+        }
     }
 
     /// The eye ray hits sphere `s` at `t`. Against another sphere the two ray
@@ -135,7 +285,9 @@ impl<'j, 'a, Q: SceneQuery> VisBuffer<'j, 'a, Q> {
     pub fn sphere_fragment(&mut self, x: u32, y: u32, s: u32, t: f32, key: f32) {
         self.counts.samples_covered += 1;
         let i = self.index(x, y);
+        self.count_work(i);
         let cur = self.id[i];
+        let stored = self.depth[i];
         let nearer = if cur == EMPTY {
             true
         } else if cur & SPHERE_BIT != 0 {
@@ -153,15 +305,20 @@ impl<'j, 'a, Q: SceneQuery> VisBuffer<'j, 'a, Q> {
         } else {
             self.counts.depth_fails += 1;
         }
+        if self.is_focus(x, y) {
+            self.record(PrimitiveKind::Sphere, s, None, Vec3::ZERO, key, stored, nearer, i, x, y);
+        }
     }
 
     fn shade_now(&mut self, i: usize, x: u32, y: u32) {
         self.counts.fragments_shaded += 1;
+        self.count_work(i);
         self.color[i] = self.shade(i, x, y);
     }
 
-    /// Builds the `SurfaceHit` of what pixel `i` sees and hands it to the shared shading.
-    fn shade(&mut self, i: usize, x: u32, y: u32) -> Radiance {
+    /// The eye ray of pixel `(x, y)`'s sample, its far bound, and the
+    /// `SurfaceHit` of what the buffer says it sees.
+    fn eye_hit(&self, i: usize, x: u32, y: u32) -> (Ray, f32, Option<SurfaceHit>) {
         let p = self.job.sample_position(x, y);
         let ray = self.job.view.eye_ray(p.x, p.y);
         let id = self.id[i];
@@ -183,7 +340,55 @@ impl<'j, 'a, Q: SceneQuery> VisBuffer<'j, 'a, Q> {
             };
             Some(scene.triangle_hit(id, b, t, &ray))
         };
+        (ray, self.job.view.far_t(p.x, p.y), hit)
+    }
+
+    /// Hands what pixel index `i` sees to the shared shading (recorded for the focus pixel).
+    pub fn shade(&mut self, i: usize, x: u32, y: u32) -> Radiance {
+        let (ray, t_max, hit) = self.eye_hit(i, x, y);
+        if self.is_focus(x, y) {
+            self.rec.ray(&ray, t_max, 0);
+            self.rec.closest(hit.as_ref());
+            return resolve_sample(self.job, self.query, &ray, hit.as_ref(), &mut self.counts, &mut self.rec);
+        }
         resolve_sample(self.job, self.query, &ray, hit.as_ref(), &mut self.counts, &mut NoRecord)
+    }
+
+    /// True when the frame shows the cost view instead of shading.
+    pub fn cost_view(&self) -> bool {
+        self.job.settings.view == View::Cost
+    }
+
+    /// The final value of pixel `(x, y)` (index `i`): early-depth mode shades
+    /// the visible surface here, forward mode already did; the cost view shows
+    /// the work counted at the pixel. Counts one primary sample.
+    #[inline]
+    pub fn resolve(&mut self, i: usize, x: u32, y: u32) -> Radiance {
+        self.counts.primary += 1;
+        let id = self.id[i];
+        if self.cost_view() {
+            if id != EMPTY && !self.forward {
+                // The shade early depth would do, counted but not computed.
+                self.counts.fragments_shaded += 1;
+                self.count_work(i);
+            }
+            let c = cost_color(self.work_at(i) as f32);
+            if self.is_focus(x, y) {
+                let (ray, t_max, hit) = self.eye_hit(i, x, y);
+                self.rec.ray(&ray, t_max, 0);
+                self.rec.closest(hit.as_ref());
+                self.rec.shaded(0, c);
+            }
+            return c;
+        }
+        if self.forward && id != EMPTY {
+            self.color[i]
+        } else {
+            if id != EMPTY {
+                self.counts.fragments_shaded += 1;
+            }
+            self.shade(i, x, y)
+        }
     }
 
     /// Resolves every pixel of the region into `out` (row-major, the region's
@@ -201,15 +406,7 @@ impl<'j, 'a, Q: SceneQuery> VisBuffer<'j, 'a, Q> {
         for (row, y) in (r.y0..r.y1).enumerate() {
             let line = &mut out[row * out_stride + x_offset..row * out_stride + x_offset + self.stride];
             for (px, x) in line.iter_mut().zip(r.x0..r.x1) {
-                self.counts.primary += 1;
-                *px = if self.forward && self.id[i] != EMPTY {
-                    self.color[i]
-                } else {
-                    if self.id[i] != EMPTY {
-                        self.counts.fragments_shaded += 1;
-                    }
-                    self.shade(i, x, y)
-                };
+                *px = self.resolve(i, x, y);
                 i += 1;
             }
         }
@@ -231,6 +428,12 @@ impl<'j, 'a, Q: SceneQuery> VisBuffer<'j, 'a, Q> {
         if self.forward {
             self.color.clear();
             self.color.resize(n, Radiance::ZERO);
+        }
+        if self.cost_view() {
+            for v in [&mut self.work, &mut self.tests] {
+                v.clear();
+                v.resize(n, 0);
+            }
         }
     }
 }
