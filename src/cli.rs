@@ -100,7 +100,7 @@ struct RenderOpts {
     /// Samples per pixel (stratified; 1 = the pixel centre).
     #[arg(long, default_value_t = 1)]
     spp: u32,
-    /// shaded | barycentric | raydir | depth | zbuffer | normal | id | uv | cost | diff (see `pinhole list`)
+    /// shaded | barycentric | raydir | depth | zbuffer | normal | id | uv | cost | diff | shadowmap (see `pinhole list`)
     #[arg(long, default_value = "shaded")]
     view: String,
     /// ray | map | none
@@ -115,6 +115,12 @@ struct RenderOpts {
     /// Shadow-ray start offset along the ray (CGPP's rayBumpEpsilon).
     #[arg(long, value_name = "EPS")]
     bump: Option<f32>,
+    /// --shadows map: texels per side of each shadow map (per cube face for point lights).
+    #[arg(long = "shadow-map-size", value_name = "N")]
+    shadow_map_size: Option<u32>,
+    /// --shadows map: depth bias in texels, slope-scaled (too small: acne; too large: peter-panning).
+    #[arg(long = "shadow-bias", value_name = "B")]
+    shadow_bias: Option<f32>,
 }
 
 /// Parses the arguments and runs the command.
@@ -194,6 +200,18 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
         }
         settings.shadow_bump = b;
     }
+    if let Some(n) = opts.shadow_map_size {
+        if !(1..=render::shadow_map::MAX_SIZE).contains(&n) {
+            return Err(format!("--shadow-map-size {n} is not between 1 and {}", render::shadow_map::MAX_SIZE));
+        }
+        settings.shadow_map_size = n;
+    }
+    if let Some(b) = opts.shadow_bias {
+        if !(b.is_finite() && b >= 0.0) {
+            return Err(format!("--shadow-bias {b} must be a finite number of texels >= 0"));
+        }
+        settings.shadow_map_bias = b;
+    }
     let prepared = pool.install(|| PreparedScene::new(scene));
     Ok(Loaded { prepared, settings, renderer, pool, load_ms })
 }
@@ -224,6 +242,9 @@ fn stats_json(l: &Loaded, render_ms: f64, counts: &RayCounts, spp: u32) -> serde
         "shadows": l.settings.shadows.name(),
         "view": l.settings.view.name(),
         "interpolation": l.settings.interpolation.name(),
+        "shadow_map_size": l.settings.shadow_map_size,
+        "shadow_map_bias": l.settings.shadow_map_bias,
+        "shadow_map_ms": (l.settings.shadows == ShadowMode::Map).then(|| l.prepared.shadow_maps(l.settings.shadow_map_size).build_ms),
     })
 }
 

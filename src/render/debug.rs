@@ -30,13 +30,16 @@ pub enum View {
     /// This renderer's shaded image minus the reference `raytrace:brute`'s:
     /// red where brighter, blue where darker (amplified), the rest dimmed.
     Diff,
+    /// The lights' shadow maps (CGPP Figure 15.14): depth from the light in
+    /// grey, black near, white far; a point light's six faces in a 3 x 2 grid.
+    Shadowmap,
 }
 
 /// The cost that maps to the hot end of the cost view's colour scale.
 pub const COST_SCALE: f32 = 1024.0;
 
 impl View {
-    pub const ALL: [View; 10] = [View::Shaded, View::Barycentric, View::Raydir, View::Depth, View::Zbuffer, View::Normal, View::Id, View::Uv, View::Cost, View::Diff];
+    pub const ALL: [View; 11] = [View::Shaded, View::Barycentric, View::Raydir, View::Depth, View::Zbuffer, View::Normal, View::Id, View::Uv, View::Cost, View::Diff, View::Shadowmap];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -50,6 +53,7 @@ impl View {
             View::Zbuffer => "zbuffer",
             View::Cost => "cost",
             View::Diff => "diff",
+            View::Shadowmap => "shadowmap",
         }
     }
 
@@ -72,7 +76,8 @@ pub fn view_color(view: View, camera: &CameraView, ray: &Ray, hit: Option<&Surfa
         // Shaded is resolved by shade(); cost by the renderer, which counted the work.
         // Cost is coloured by the renderer, which counted the work; diff is a
         // whole-frame comparison (`diff_image`).
-        View::Shaded | View::Raydir | View::Cost | View::Diff => Vec3::ZERO,
+        // The shadow map view is drawn by `shadow_map::view_sample`.
+        View::Shaded | View::Raydir | View::Cost | View::Diff | View::Shadowmap => Vec3::ZERO,
         View::Barycentric => h.barycentric,
         View::Depth => Vec3::splat(depth_value(camera, (h.position - camera.eye).length())),
         View::Zbuffer => {

@@ -50,6 +50,10 @@ pub fn render_frame_in_bands(
         let (pixels, count) = super::debug::diff_image(&mine.pixels, &theirs.pixels);
         return Some(FrameResult { pixels, differing_pixels: Some(count), ..mine });
     }
+    if settings.shadows == super::ShadowMode::Map || settings.view == super::debug::View::Shadowmap {
+        // Build the shadow maps once, in parallel, before the passes look them up.
+        prepared.shadow_maps(settings.shadow_map_size);
+    }
     let view = prepared.scene.camera.view(settings.width, settings.height);
     let n = (settings.width * settings.height) as usize;
     let mut sum = vec![Radiance::ZERO; n];

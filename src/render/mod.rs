@@ -11,6 +11,7 @@ pub mod prepared;
 pub mod raster;
 pub mod raytrace;
 pub mod shade;
+pub mod shadow_map;
 pub mod trace;
 
 pub use frame::{render_frame, render_frame_in_bands, replay_pixel, FrameResult, PixelReplay};
@@ -93,6 +94,14 @@ pub struct RenderSettings {
     pub shadows: ShadowMode,
     /// CGPP's `rayBumpEpsilon`: how far shadow and secondary rays start off the surface.
     pub shadow_bump: f32,
+    /// `--shadows map`: texels per side of each shadow map (per cube face for a point light).
+    #[serde(default = "shadow_map::default_size")]
+    pub shadow_map_size: u32,
+    /// `--shadows map`: depth bias in texels of the map, slope-scaled: a point is
+    /// shadowed when it lies farther from the light than the stored depth by more
+    /// than `bias * texel size * (1 + tan theta)` (see `shadow_map`).
+    #[serde(default = "shadow_map::default_bias")]
+    pub shadow_map_bias: f32,
     /// Maximum depth of mirror and refraction rays.
     pub max_depth: u32,
     pub view: debug::View,
@@ -126,6 +135,8 @@ impl RenderSettings {
             spp: 1,
             shadows: ShadowMode::Ray,
             shadow_bump: 1e-4,
+            shadow_map_size: shadow_map::DEFAULT_SIZE,
+            shadow_map_bias: shadow_map::DEFAULT_BIAS,
             max_depth: 4,
             view: debug::View::Shaded,
             interpolation: Interpolation::Phong,
@@ -174,6 +185,11 @@ pub trait SceneQuery: Sync {
     /// The first surface found along `ray` with `0 < t < t_max`, as
     /// (kind, index, t); `None` when the segment is clear.
     fn occluder<R: Recorder>(&self, ray: &Ray, t_max: f32, counts: &mut RayCounts, rec: &mut R) -> Option<(PrimitiveKind, u32, f32)>;
+    /// Shadow maps to look light visibility up in (`--shadows map`);
+    /// `resolve_sample` wraps the query in a `shadow_map::MapQuery` that has them.
+    fn shadow_maps(&self) -> Option<&shadow_map::ShadowMaps> {
+        None
+    }
 }
 
 /// One sample pass of a frame: every pixel sampled at the same sub-pixel offset.
@@ -247,6 +263,26 @@ pub fn renderer_by_name(name: &str) -> Result<Box<dyn Renderer>, String> {
 /// shaded view, a debug colour otherwise, the background on a miss.
 #[inline]
 pub fn resolve_sample<Q: SceneQuery, R: Recorder>(
+    job: &PassJob,
+    query: &Q,
+    ray: &Ray,
+    hit: Option<&SurfaceHit>,
+    counts: &mut RayCounts,
+    rec: &mut R,
+) -> Radiance {
+    if job.settings.view == debug::View::Shadowmap {
+        return shadow_map::view_sample(job, ray, rec);
+    }
+    if job.settings.shadows == ShadowMode::Map && job.settings.view == debug::View::Shaded && hit.is_some() {
+        return shadow_map::with_maps(job.prepared, job.settings, |maps| {
+            resolve_with(job, &shadow_map::MapQuery { inner: query, maps }, ray, hit, counts, rec)
+        });
+    }
+    resolve_with(job, query, ray, hit, counts, rec)
+}
+
+#[inline]
+fn resolve_with<Q: SceneQuery, R: Recorder>(
     job: &PassJob,
     query: &Q,
     ray: &Ray,

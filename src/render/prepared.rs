@@ -13,6 +13,9 @@ pub struct PreparedScene {
     pub bvh: Bvh,
     /// Time to build the BVH, milliseconds.
     pub build_ms: f64,
+    /// The last shadow maps built (`--shadows map`), keyed by size and lights;
+    /// see `PreparedScene::shadow_maps`.
+    pub shadow_cache: super::shadow_map::ShadowMapCache,
 }
 
 impl PreparedScene {
@@ -21,7 +24,7 @@ impl PreparedScene {
         let start = Instant::now();
         let bvh = Bvh::build(&scene, &edges);
         let build_ms = start.elapsed().as_secs_f64() * 1e3;
-        PreparedScene { scene, edges, bvh, build_ms }
+        PreparedScene { scene, edges, bvh, build_ms, shadow_cache: Default::default() }
     }
 
     /// Rebuilds after the scene's geometry changed (materials and lights need no rebuild).

@@ -71,6 +71,12 @@ pub fn shade<Q: SceneQuery, R: Recorder>(
             blocker = query.occluder(&ray, t_max, counts, rec);
             rec.in_shadow_ray(false);
             shadow_ray = Some((ray, t_max));
+        } else if settings.shadows == ShadowMode::Map {
+            // CGPP 15.6.5: no ray; the light's depth map says whether something
+            // nearer to the light covers P (blocker t = how far before P it lies).
+            if let Some(maps) = query.shadow_maps() {
+                blocker = maps.occluder(scene, index, hit, w_i, settings.shadow_map_bias);
+            }
         }
         let f = bsdf(material, albedo, n, w_i, w_o);
         let contribution = if blocker.is_some() { Vec3::ZERO } else { incident * f * cos_theta };

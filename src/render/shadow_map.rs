@@ -1,0 +1,647 @@
+//! Shadow maps (CGPP 15.6.5): for every light, a depth image rendered from the
+//! light by rasterization, looked up by `shade()` instead of casting a shadow
+//! ray when `settings.shadows == ShadowMode::Map`.
+//!
+//! - A point light gets six 90-degree perspective faces (a cube map) of
+//!   `shadow_map_size`^2 texels; each texel stores the distance from the light
+//!   to the first surface along the ray through the texel's centre.
+//! - A directional light gets one orthographic map whose rectangle is fitted
+//!   to the scene's shadow casters (see `caster_bounds`); each texel stores the
+//!   depth along the light's direction.
+//!
+//! The maps are rasterized with the rasterizers' own parts: near clipping
+//! (`clip`), the screen triangle (`setup`) and the watertight fixed-point
+//! coverage loop (`fixed`). Coverage decides which texels a triangle owns;
+//! the stored depth comes from the triangle's plane intersected with the
+//! texel's ray, so it is what a ray cast from the light finds, whatever the
+//! projection does to precision. Spheres stay analytic: a conservative box
+//! (`sphere_bounds`) and a ray-sphere test per texel.
+//!
+//! What is stored matches what the ray caster's shadow rays can hit, so a map
+//! with enough resolution gives the ray-cast image: two-sided triangles from
+//! either side; one-sided triangles only when they face away from the light
+//! (a shadow ray travels towards the light and meets only front faces), so
+//! a closed one-sided mesh stores its far side and never shadows its own lit
+//! side. Spheres store the first point the light sees, as a GPU shadow map
+//! would: they, like two-sided surfaces, can shadow themselves and show acne.
+//!
+//! The lookup (`ShadowMaps::occluder`) projects the shaded point into the map,
+//! takes the nearest texel (no filtering) and calls the point shadowed when
+//! it lies farther from the light than the stored depth by more than the
+//! bias. The bias is slope-scaled and measured in texels: the tolerance is
+//! `shadow_map_bias * w * (1 + tan(theta))`, with `w` the world size of one
+//! texel at the point's depth and `theta` the angle between the surface's
+//! geometric normal and the light direction (tan clamped to `MAX_SLOPE`).
+//! A point may lie up to about 0.7 texel from its texel's centre, where the
+//! surface's depth differs by up to 0.7 w tan(theta); a bias below that
+//! shows acne, one far above it detaches shadows from their casters
+//! (peter-panning).
+//!
+//! Maps depend on geometry, lights and `shadow_map_size` only (not on the
+//! camera or the bias), so `PreparedScene` caches the last set built; a frame
+//! builds them once before its passes, and a pass that finds none builds
+//! them on first use.
+
+use super::raster::clip::{clip_near, triangle_vertices};
+use super::raster::fixed::{self, FixedTri};
+use super::raster::setup::{bin_rows, sample_span, PixelRect, ScreenTri};
+use super::raster::sphere::sphere_bounds;
+use super::trace::Recorder;
+use super::{PassJob, PreparedScene, RayCounts, RenderSettings, SceneQuery};
+use crate::math::{Radiance, Ray, Vec2, Vec3};
+use crate::scene::{Camera, CameraView, Fov, Light, PrimitiveKind, Scene, Sphere, SurfaceHit, Triangle};
+use rayon::prelude::*;
+use std::cell::RefCell;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+/// Texels per side of each map (per cube face for point lights).
+pub const DEFAULT_SIZE: u32 = 1024;
+/// Largest accepted `shadow_map_size` (a point light's six faces at 4096 hold
+/// 100 M texels, 800 MB).
+pub const MAX_SIZE: u32 = 4096;
+/// Default slope-scaled bias, in texels (see the module documentation).
+pub const DEFAULT_BIAS: f32 = 1.0;
+/// The slope factor tan(theta) of the bias is clamped here (about 84 degrees).
+pub const MAX_SLOPE: f32 = 10.0;
+
+pub fn default_size() -> u32 {
+    DEFAULT_SIZE
+}
+
+pub fn default_bias() -> f32 {
+    DEFAULT_BIAS
+}
+
+const SPHERE_BIT: u32 = 1 << 31;
+const EMPTY: u32 = u32::MAX;
+/// Rows of a map rasterized together (bands run in parallel).
+const BAND: u32 = 32;
+
+/// One depth image: a cube face or a directional light's map.
+pub struct Face {
+    /// The light's camera: eye at the light (perspective, 90 degrees) or at the
+    /// centre of the fitted rectangle (orthographic, `half_x`/`half_y` are then
+    /// the rectangle's half extents in world units).
+    pub view: CameraView,
+    pub ortho: bool,
+    /// Per texel (row-major): distance from the light (perspective) or depth
+    /// along the light direction from the view's eye (orthographic);
+    /// `f32::INFINITY` where nothing was drawn.
+    pub depth: Vec<f32>,
+    /// Per texel: the primitive stored (triangle index, or sphere index with
+    /// the top bit set), `u32::MAX` when empty.
+    pub id: Vec<u32>,
+}
+
+/// The maps of one light.
+pub struct LightMap {
+    /// Six faces (+x, -x, +y, -y, +z, -z) for a point light, one for a directional light.
+    pub faces: Vec<Face>,
+    /// Range of the finite depths stored, for the visualization.
+    pub depth_range: (f32, f32),
+}
+
+/// The shadow maps of every light of a scene, in scene order.
+pub struct ShadowMaps {
+    pub size: u32,
+    /// The lights they were built for (the cache key with `size`).
+    pub lights: Vec<Light>,
+    pub maps: Vec<LightMap>,
+    /// Time to build them all, milliseconds.
+    pub build_ms: f64,
+}
+
+/// A triangle piece set up for one face: coverage plus the plane its depth comes from.
+struct FaceTri {
+    ft: FixedTri,
+    /// The (unclipped) triangle's plane in the face's camera space: `n . q = k`.
+    n: Vec3,
+    k: f32,
+    /// Range of view depth over the piece: interpolated depths are clamped to it.
+    z_lo: f32,
+    z_hi: f32,
+}
+
+impl ShadowMaps {
+    /// Rasterizes the maps of every light of `scene`. With `parallel`, the
+    /// bands of every face run on the rayon pool; without it everything runs
+    /// on the calling thread (safe to call from inside a parallel pass).
+    pub fn build(scene: &Scene, size: u32, parallel: bool) -> ShadowMaps {
+        let start = Instant::now();
+        let size = size.clamp(1, MAX_SIZE);
+        let mut faces: Vec<(usize, Face)> = Vec::new();
+        for (li, light) in scene.lights.iter().enumerate() {
+            for view in light_views(scene, light, size) {
+                let ortho = matches!(light, Light::Directional { .. });
+                faces.push((li, Face { view, ortho, depth: Vec::new(), id: Vec::new() }));
+            }
+        }
+        let draw = |face: &mut Face| draw_face(scene, face, size, parallel);
+        if parallel {
+            faces.par_iter_mut().for_each(|(_, f)| draw(f));
+        } else {
+            faces.iter_mut().for_each(|(_, f)| draw(f));
+        }
+        let mut maps: Vec<LightMap> = scene.lights.iter().map(|_| LightMap { faces: Vec::new(), depth_range: (0.0, 0.0) }).collect();
+        for (li, face) in faces {
+            maps[li].faces.push(face);
+        }
+        for m in &mut maps {
+            let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+            for d in m.faces.iter().flat_map(|f| f.depth.iter()).filter(|d| d.is_finite()) {
+                lo = lo.min(*d);
+                hi = hi.max(*d);
+            }
+            m.depth_range = if lo <= hi { (lo, hi) } else { (0.0, 0.0) };
+        }
+        ShadowMaps { size, lights: scene.lights.clone(), maps, build_ms: start.elapsed().as_secs_f64() * 1e3 }
+    }
+
+    /// True when these maps were built for `scene`'s lights at `size`.
+    #[inline]
+    pub fn matches(&self, scene: &Scene, size: u32) -> bool {
+        self.size == size.clamp(1, MAX_SIZE) && self.lights == scene.lights
+    }
+
+    /// The map's verdict for light `light` at `hit`: the primitive stored in
+    /// the texel and how far before the point it lies (as a shadow ray's
+    /// blocker: kind, index, distance from the point), or `None` when lit.
+    /// `bias` is in texels, slope-scaled (module documentation).
+    pub fn occluder(&self, scene: &Scene, light: usize, hit: &SurfaceHit, w_i: Vec3, bias: f32) -> Option<(PrimitiveKind, u32, f32)> {
+        let map = self.maps.get(light)?;
+        // The same point a shadow ray would leave from (lifted on smooth triangles).
+        let p = super::shade::shadow_origin(scene, hit);
+        let n = self.size as f32;
+        let (face, dist, texel_w) = match scene.lights[light] {
+            Light::Point { position, .. } => {
+                let face = &map.faces[cube_face(p - position)];
+                let z = face.view.view_depth(p);
+                (face, (p - position).length(), 2.0 * z / n)
+            }
+            Light::Directional { .. } => {
+                let face = &map.faces[0];
+                (face, face.view.view_depth(p), 2.0 * face.view.half_x.max(face.view.half_y) / n)
+            }
+        };
+        let (x, y) = face.texel_of(p)?;
+        let i = (x + y * self.size) as usize;
+        let id = face.id[i];
+        if id == EMPTY {
+            return None;
+        }
+        let cos = hit.geometric_normal.dot(w_i).abs().clamp(1e-6, 1.0);
+        let tan = ((1.0 - cos * cos).max(0.0).sqrt() / cos).min(MAX_SLOPE);
+        let gap = dist - face.depth[i];
+        if gap > bias * texel_w * (1.0 + tan) {
+            let kind = if id & SPHERE_BIT != 0 { PrimitiveKind::Sphere } else { PrimitiveKind::Triangle };
+            Some((kind, id & !SPHERE_BIT, gap))
+        } else {
+            None
+        }
+    }
+
+    /// The `shadowmap` view at image position `pos` of a `width` x `height`
+    /// image: the lights one below the other, each as a grey depth image
+    /// (black = near the light, white = far or empty, CGPP Figure 15.14;
+    /// linear for a directional light, log scale for a point light's
+    /// distances); a point light's faces in a 3 x 2 grid (+x -x +y / -y +z -z).
+    /// Outside the maps: dark blue.
+    pub fn view_color(&self, pos: Vec2, width: u32, height: u32) -> Radiance {
+        const OUTSIDE: Vec3 = Vec3::new(0.0, 0.0, 0.15);
+        let count = self.maps.len();
+        if count == 0 || width == 0 || height == 0 {
+            return OUTSIDE;
+        }
+        let row_h = height as f32 / count as f32;
+        let li = ((pos.y / row_h) as usize).min(count - 1);
+        let map = &self.maps[li];
+        let local = Vec2::new(pos.x, pos.y - li as f32 * row_h);
+        let n = self.size as f32;
+        let (cols, rows) = if map.faces.len() == 6 { (3.0, 2.0) } else { (1.0, 1.0) };
+        let scale = (width as f32 / (cols * n)).min(row_h / (rows * n));
+        let origin = Vec2::new((width as f32 - cols * n * scale) * 0.5, (row_h - rows * n * scale) * 0.5);
+        let t = (local - origin) / scale;
+        if !(t.x >= 0.0 && t.y >= 0.0 && t.x < cols * n && t.y < rows * n) {
+            return OUTSIDE;
+        }
+        let (fx, fy) = ((t.x / n) as usize, (t.y / n) as usize);
+        let Some(face) = map.faces.get(fx + fy * cols as usize) else { return OUTSIDE };
+        let x = ((t.x - fx as f32 * n) as u32).min(self.size - 1);
+        let y = ((t.y - fy as f32 * n) as u32).min(self.size - 1);
+        let d = face.depth[(x + y * self.size) as usize];
+        if !d.is_finite() {
+            return Vec3::ONE;
+        }
+        let (lo, hi) = map.depth_range;
+        let grey = if !(hi > lo) {
+            0.5
+        } else if face.ortho || lo <= 0.0 {
+            (d - lo) / (hi - lo)
+        } else {
+            // Distances from a point light span decades (a ground plane to the
+            // horizon): a log scale, as the depth view uses.
+            (d / lo).ln() / (hi / lo).ln()
+        };
+        Vec3::splat(grey.clamp(0.0, 1.0))
+    }
+}
+
+impl Face {
+    /// The texel whose ray passes nearest `p`; `None` for a point outside an
+    /// orthographic map (no caster there) or behind a perspective face.
+    #[inline]
+    pub fn texel_of(&self, p: Vec3) -> Option<(u32, u32)> {
+        let c = self.view.to_camera(p);
+        let img = if self.ortho {
+            ortho_project(&self.view, c)
+        } else {
+            if !(c.z < 0.0) {
+                return None;
+            }
+            self.view.project_camera(c)
+        };
+        let n = self.view.width as f32;
+        if self.ortho && !(img.x >= 0.0 && img.y >= 0.0 && img.x < n && img.y < n) {
+            return None;
+        }
+        if !(img.x.is_finite() && img.y.is_finite()) {
+            return None;
+        }
+        let clamp = |v: f32| (v.max(0.0) as u32).min(self.view.width - 1);
+        Some((clamp(img.x), clamp(img.y)))
+    }
+}
+
+/// Which cube face (+x, -x, +y, -y, +z, -z) the direction `v` from the light falls in.
+#[inline]
+pub fn cube_face(v: Vec3) -> usize {
+    let a = v.abs();
+    if a.x >= a.y && a.x >= a.z {
+        if v.x >= 0.0 { 0 } else { 1 }
+    } else if a.y >= a.z {
+        if v.y >= 0.0 { 2 } else { 3 }
+    } else if v.z >= 0.0 {
+        4
+    } else {
+        5
+    }
+}
+
+/// Image position (texels) of a camera-space point in an orthographic face.
+#[inline]
+fn ortho_project(view: &CameraView, c: Vec3) -> Vec2 {
+    Vec2::new(
+        (c.x / view.half_x + 1.0) * 0.5 * view.width as f32,
+        (1.0 - c.y / view.half_y) * 0.5 * view.height as f32,
+    )
+}
+
+/// The light's cameras: six cube faces for a point light, one orthographic
+/// view for a directional light.
+fn light_views(scene: &Scene, light: &Light, size: u32) -> Vec<CameraView> {
+    let Some((lo, hi)) = scene.bounds() else { return Vec::new() };
+    match *light {
+        Light::Point { position, .. } => {
+            // Nothing nearer than this to the light is drawn (the near plane).
+            let far_corner = (0..8)
+                .map(|i| Vec3::new(if i & 1 == 0 { lo.x } else { hi.x }, if i & 2 == 0 { lo.y } else { hi.y }, if i & 4 == 0 { lo.z } else { hi.z }))
+                .map(|c| (c - position).length())
+                .fold(0.0f32, f32::max);
+            let near = (far_corner * 1e-6).max(1e-9);
+            let axes = [
+                (Vec3::X, Vec3::Y),
+                (Vec3::NEG_X, Vec3::Y),
+                (Vec3::Y, Vec3::Z),
+                (Vec3::NEG_Y, Vec3::NEG_Z),
+                (Vec3::Z, Vec3::Y),
+                (Vec3::NEG_Z, Vec3::Y),
+            ];
+            axes.iter()
+                .map(|&(forward, up)| {
+                    let cam = Camera { eye: position, target: position + forward, up, fov: Fov::Y(90.0), near, far: f32::MAX };
+                    let mut v = CameraView::new(&cam, size, size);
+                    // Exactly 90 degrees: faces meet edge to edge.
+                    v.half_x = 1.0;
+                    v.half_y = 1.0;
+                    v
+                })
+                .collect()
+        }
+        Light::Directional { direction, .. } => {
+            let forward = direction.normalize_or(Vec3::NEG_Y);
+            let up = if forward.y.abs() < 0.9 { Vec3::Y } else { Vec3::Z };
+            let (clo, chi) = caster_bounds(scene).unwrap_or((lo, hi));
+            let centre = (clo + chi) * 0.5;
+            let cam = Camera { eye: centre, target: centre + forward, up, fov: Fov::Y(90.0), near: 1.0, far: 2.0 };
+            let mut v = CameraView::new(&cam, size, size);
+            // The rectangle: the casters' box projected across the light, plus a
+            // texel of margin so silhouettes on its edge are not cut.
+            let (mut hx, mut hy) = (0.0f32, 0.0f32);
+            for i in 0..8 {
+                let corner = Vec3::new(if i & 1 == 0 { clo.x } else { chi.x }, if i & 2 == 0 { clo.y } else { chi.y }, if i & 4 == 0 { clo.z } else { chi.z });
+                let c = v.to_camera(corner);
+                hx = hx.max(c.x.abs());
+                hy = hy.max(c.y.abs());
+            }
+            let grow = 1.0 + 2.0 / size as f32;
+            v.half_x = (hx * grow).max(1e-6);
+            v.half_y = (hy * grow).max(1e-6);
+            v.near = f32::NEG_INFINITY;
+            v.far = f32::INFINITY;
+            vec![v]
+        }
+    }
+}
+
+/// The box a directional light's map must cover: that of every primitive
+/// except the huge ones (a ground plane or a planet-sized sphere, larger than
+/// half the whole scene), which rarely cast shadows on anything visible and
+/// would spread the map's texels over kilometres. Shadows fall along the
+/// light's direction, so outside the casters' rectangle nothing is shadowed;
+/// a huge primitive still receives shadows inside it. `None` when every
+/// primitive is huge (use the whole scene).
+pub fn caster_bounds(scene: &Scene) -> Option<(Vec3, Vec3)> {
+    let (lo, hi) = scene.bounds()?;
+    let limit = 0.5 * (hi - lo).length();
+    let mut b = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    let mut add = |l: Vec3, h: Vec3| {
+        if (h - l).length() <= limit {
+            b.0 = b.0.min(l);
+            b.1 = b.1.max(h);
+        }
+    };
+    for t in &scene.triangles {
+        add(t.v[0].min(t.v[1]).min(t.v[2]), t.v[0].max(t.v[1]).max(t.v[2]));
+    }
+    for s in &scene.spheres {
+        add(s.center - Vec3::splat(s.radius), s.center + Vec3::splat(s.radius));
+    }
+    (b.0.x <= b.1.x).then_some(b)
+}
+
+/// Rasterizes every triangle (in scene order) and then every sphere into one face.
+fn draw_face(scene: &Scene, face: &mut Face, size: u32, parallel: bool) {
+    let n = size as usize;
+    face.depth = vec![f32::INFINITY; n * n];
+    face.id = vec![EMPTY; n * n];
+    let view = &face.view;
+    let ortho = face.ortho;
+    let mut tris = Vec::new();
+    for (i, t) in scene.triangles.iter().enumerate() {
+        setup_face_triangle(view, ortho, t, i as u32, size, &mut tris);
+    }
+    let bins = bin_rows(tris.iter().map(|t| t.ft.bbox), 0, size, BAND);
+    let spheres: Vec<(u32, &Sphere, PixelRect)> = scene
+        .spheres
+        .iter()
+        .enumerate()
+        .filter_map(|(i, s)| sphere_rect(view, ortho, s, size).map(|r| (i as u32, s, r)))
+        .collect();
+    let band = |(b, (depth, id)): (usize, (&mut [f32], &mut [u32]))| {
+        let y0 = b as u32 * BAND;
+        let rect = PixelRect::new(0, y0, size, (y0 + BAND).min(size));
+        draw_band(view, ortho, &tris, &bins[b], &spheres, rect, depth, id);
+    };
+    let chunks = face.depth.chunks_mut(n * BAND as usize).zip(face.id.chunks_mut(n * BAND as usize));
+    if parallel {
+        chunks.enumerate().par_bridge().for_each(band);
+    } else {
+        chunks.enumerate().for_each(band);
+    }
+}
+
+/// Culls, transforms, clips and projects one scene triangle for a face.
+fn setup_face_triangle(view: &CameraView, ortho: bool, t: &Triangle, index: u32, size: u32, out: &mut Vec<FaceTri>) {
+    let c = t.v.map(|v| view.to_camera(v));
+    let n = (c[1] - c[0]).cross(c[2] - c[0]);
+    // Keep what a shadow ray can hit: one-sided triangles only when they face
+    // away from the light, i.e. along the light's rays.
+    if !t.two_sided {
+        let toward = if ortho { n.dot(Vec3::NEG_Z) } else { n.dot(c[0]) };
+        if !(toward > 0.0) {
+            return;
+        }
+    }
+    let k = n.dot(c[0]);
+    let off = Vec2::splat(0.5);
+    let soff = fixed::snap_offset(off);
+    let mut push = |p: [Vec2; 3], z: [f32; 3]| {
+        let Some(st) = ScreenTri::new(index, p, [1.0; 3], [Vec3::X, Vec3::Y, Vec3::Z], off, size, size) else { return };
+        let Some(ft) = FixedTri::new(&st, soff, off, size, size) else { return };
+        let (z_lo, z_hi) = (z[0].min(z[1]).min(z[2]), z[0].max(z[1]).max(z[2]));
+        out.push(FaceTri { ft, n, k, z_lo, z_hi });
+    };
+    if ortho {
+        push(c.map(|c| ortho_project(view, c)), c.map(|c| -c.z));
+        return;
+    }
+    // Entirely outside one side of the 90-degree frustum: nothing to draw.
+    let outside = |f: &dyn Fn(Vec3) -> bool| c.iter().all(|&v| f(v));
+    if outside(&|v| -v.z < view.near) || outside(&|v| v.x > -v.z) || outside(&|v| v.x < v.z) || outside(&|v| v.y > -v.z) || outside(&|v| v.y < v.z) {
+        return;
+    }
+    for piece in clip_near(triangle_vertices(c), view.near).as_slice() {
+        push(piece.map(|v| view.project_camera(v.pos)), piece.map(|v| -v.pos.z));
+    }
+}
+
+/// Texels a sphere may cover in a face.
+fn sphere_rect(view: &CameraView, ortho: bool, s: &Sphere, size: u32) -> Option<PixelRect> {
+    if !ortho {
+        return sphere_bounds(view, s, Vec2::splat(0.5));
+    }
+    let c = view.to_camera(s.center);
+    let lo = ortho_project(view, c + Vec3::new(-s.radius, s.radius, 0.0));
+    let hi = ortho_project(view, c + Vec3::new(s.radius, -s.radius, 0.0));
+    let (x0, x1) = sample_span(lo.x - 1.0, hi.x + 1.0, 0.5, size);
+    let (y0, y1) = sample_span(lo.y - 1.0, hi.y + 1.0, 0.5, size);
+    let r = PixelRect::new(x0, y0, x1, y1);
+    (!r.is_empty()).then_some(r)
+}
+
+/// Camera-space ray of texel `(x, y)`: origin and direction, the direction's
+/// view-axis component being 1 (so ray parameter = view depth).
+#[inline(always)]
+fn texel_ray(view: &CameraView, ortho: bool, x: u32, y: u32) -> (Vec3, Vec3) {
+    let sx = (2.0 * (x as f32 + 0.5) / view.width as f32 - 1.0) * view.half_x;
+    let sy = (1.0 - 2.0 * (y as f32 + 0.5) / view.height as f32) * view.half_y;
+    if ortho {
+        (Vec3::new(sx, sy, 0.0), Vec3::NEG_Z)
+    } else {
+        (Vec3::ZERO, Vec3::new(sx, sy, -1.0))
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn draw_band(
+    view: &CameraView,
+    ortho: bool,
+    tris: &[FaceTri],
+    bin: &[u32],
+    spheres: &[(u32, &Sphere, PixelRect)],
+    rect: PixelRect,
+    depth: &mut [f32],
+    id: &mut [u32],
+) {
+    let stride = rect.width() as usize;
+    let off = fixed::snap_offset(Vec2::splat(0.5));
+    let mut tested = 0u64;
+    for &ti in bin {
+        let t = &tris[ti as usize];
+        fixed::raster(&t.ft, rect, off, &mut tested, |x, y, _| {
+            let (o, d) = texel_ray(view, ortho, x, y);
+            // The plane n . (o + z d) = k; NaN-safe clamp to the piece's depths.
+            let z = ((t.k - t.n.dot(o)) / t.n.dot(d)).max(t.z_lo).min(t.z_hi);
+            let value = if ortho { z } else { z * d.length() };
+            let i = (x - rect.x0) as usize + (y - rect.y0) as usize * stride;
+            if value < depth[i] {
+                depth[i] = value;
+                id[i] = t.ft.st.tri;
+            }
+        });
+    }
+    for &(si, s, r) in spheres {
+        let r = r.intersect(&rect);
+        if r.is_empty() {
+            continue;
+        }
+        let c = view.to_camera(s.center);
+        for y in r.y0..r.y1 {
+            for x in r.x0..r.x1 {
+                let (o, d) = texel_ray(view, ortho, x, y);
+                let Some(value) = sphere_entry(o, d, c, s.radius, ortho) else { continue };
+                let i = (x - rect.x0) as usize + (y - rect.y0) as usize * stride;
+                if value < depth[i] {
+                    depth[i] = value;
+                    id[i] = si | SPHERE_BIT;
+                }
+            }
+        }
+    }
+}
+
+/// Where the ray `o + t d` first meets the sphere (centre `c`) ahead of `o`:
+/// the distance along the unit direction (perspective) or the view depth
+/// (orthographic, `o` on the plane z = 0, every depth counts); `None` on a
+/// miss. From inside the sphere (a light in a glass ball) it is the exit. The
+/// centre-to-line form keeps huge spheres accurate.
+#[inline]
+fn sphere_entry(o: Vec3, d: Vec3, c: Vec3, radius: f32, ortho: bool) -> Option<f32> {
+    let u = d.normalize();
+    let f = o - c;
+    let b = -f.dot(u);
+    let l = f + u * b;
+    let dist = l.length();
+    let disc = (radius - dist) * (radius + dist);
+    if !(disc >= 0.0) {
+        return None;
+    }
+    let h = disc.sqrt();
+    if ortho {
+        return Some(b - h);
+    }
+    let t = if f.length() > radius { b - h } else { b + h };
+    (t > 0.0).then_some(t)
+}
+
+/// The last shadow maps built for a `PreparedScene`, keyed by `shadow_map_size`
+/// and the lights. `id` tells one prepared scene's cache from another's.
+pub struct ShadowMapCache {
+    id: u64,
+    slot: Mutex<Option<Arc<ShadowMaps>>>,
+}
+
+impl Default for ShadowMapCache {
+    fn default() -> Self {
+        static NEXT: AtomicU64 = AtomicU64::new(1);
+        ShadowMapCache { id: NEXT.fetch_add(1, Ordering::Relaxed), slot: Mutex::new(None) }
+    }
+}
+
+impl ShadowMapCache {
+    /// The maps for `scene` at `size`, built now unless the cached ones match.
+    /// See `ShadowMaps::build` for `parallel`.
+    pub fn get(&self, scene: &Scene, size: u32, parallel: bool) -> Arc<ShadowMaps> {
+        let mut slot = self.slot.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(m) = slot.as_ref() {
+            if m.matches(scene, size) {
+                return m.clone();
+            }
+        }
+        let m = Arc::new(ShadowMaps::build(scene, size, parallel));
+        *slot = Some(m.clone());
+        m
+    }
+}
+
+impl PreparedScene {
+    /// The scene's shadow maps at `size` texels per side, from the cache or
+    /// built now in parallel. Call it outside a parallel pass (before the
+    /// frame); inside one, `with_maps` builds on the calling thread instead.
+    pub fn shadow_maps(&self, size: u32) -> Arc<ShadowMaps> {
+        self.shadow_cache.get(&self.scene, size, true)
+    }
+}
+
+thread_local! {
+    /// The maps this thread used last, so samples find them without a lock.
+    static CURRENT: RefCell<Option<(u64, Arc<ShadowMaps>)>> = const { RefCell::new(None) };
+}
+
+/// Runs `f` with the shadow maps for `prepared` and `settings`: from this
+/// thread's last ones when they still match (no lock, no shared counter per
+/// sample), else from the cache, built serially if missing.
+pub fn with_maps<T>(prepared: &PreparedScene, settings: &RenderSettings, f: impl FnOnce(&ShadowMaps) -> T) -> T {
+    let size = settings.shadow_map_size;
+    let cache = &prepared.shadow_cache;
+    CURRENT.with(|cell| {
+        if let Ok(current) = cell.try_borrow() {
+            if let Some((id, maps)) = current.as_ref() {
+                if *id == cache.id && maps.matches(&prepared.scene, size) {
+                    return f(maps);
+                }
+            }
+        }
+        let maps = cache.get(&prepared.scene, size, false);
+        if let Ok(mut current) = cell.try_borrow_mut() {
+            *current = Some((cache.id, maps.clone()));
+        }
+        f(&maps)
+    })
+}
+
+/// A scene query that also answers shadow visibility from maps: `shade()`
+/// asks `shadow_maps()` when `settings.shadows == ShadowMode::Map`.
+pub struct MapQuery<'a, Q> {
+    pub inner: &'a Q,
+    pub maps: &'a ShadowMaps,
+}
+
+impl<Q: SceneQuery> SceneQuery for MapQuery<'_, Q> {
+    #[inline]
+    fn closest<R: Recorder>(&self, ray: &Ray, t_max: f32, inside: bool, counts: &mut RayCounts, rec: &mut R) -> Option<SurfaceHit> {
+        self.inner.closest(ray, t_max, inside, counts, rec)
+    }
+
+    #[inline]
+    fn occluder<R: Recorder>(&self, ray: &Ray, t_max: f32, counts: &mut RayCounts, rec: &mut R) -> Option<(PrimitiveKind, u32, f32)> {
+        self.inner.occluder(ray, t_max, counts, rec)
+    }
+
+    #[inline]
+    fn shadow_maps(&self) -> Option<&ShadowMaps> {
+        Some(self.maps)
+    }
+}
+
+/// The `shadowmap` view's value for the sample whose eye ray is `ray`: the
+/// ray is projected back to its image position, so every renderer (and the
+/// viewer's passes) draw the same picture through `resolve_sample`.
+pub fn view_sample<R: Recorder>(job: &PassJob, ray: &Ray, rec: &mut R) -> Radiance {
+    let pos = job.view.project_camera(job.view.to_camera(ray.origin + ray.dir));
+    let c = with_maps(job.prepared, job.settings, |maps| maps.view_color(pos, job.view.width, job.view.height));
+    rec.shaded(0, c);
+    c
+}
