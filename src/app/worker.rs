@@ -7,6 +7,7 @@
 
 use crate::image_io;
 use crate::math::{Radiance, Vec3};
+use crate::render::debug::View;
 use crate::render::{self, PassJob, PreparedScene, RayCounts, RenderSettings, Renderer};
 use crate::scene::{Camera, Light, Material, RenderDefaults, Scene};
 use std::ops::Range;
@@ -80,9 +81,37 @@ pub struct Request {
     pub interactive: bool,
 }
 
+/// The inspector asks for one pixel replayed (`render::replay_pixel`) with
+/// the values of a render request.
+#[derive(Clone, Debug)]
+pub struct ReplayRequest {
+    /// Counts every replay asked for; the answer carries it back.
+    pub id: u64,
+    pub scene_id: u64,
+    pub params: SceneParams,
+    pub settings: RenderSettings,
+    pub renderer: String,
+    pub x: u32,
+    pub y: u32,
+}
+
+/// A replayed pixel, or why it could not be replayed.
+pub struct ReplayResult {
+    pub id: u64,
+    pub x: u32,
+    pub y: u32,
+    pub renderer: String,
+    pub result: Result<render::PixelReplay, String>,
+    /// Diff view: the same pixel replayed by `raytrace:brute` (both shaded).
+    pub reference: Option<Result<render::PixelReplay, String>>,
+    /// Time the replay took on the worker, ms.
+    pub ms: f64,
+}
+
 enum Msg {
     SetScene { id: u64, scene: Arc<Scene> },
     Render(Box<Request>),
+    Replay(Box<ReplayRequest>),
     Quit,
 }
 
@@ -127,11 +156,15 @@ pub struct Output {
     pub stats: Stats,
     /// What the renderer reported when it failed (a panic message).
     pub error: Option<String>,
+    /// Diff view, once complete: pixels that differ from `raytrace:brute`.
+    pub differing_pixels: Option<u64>,
 }
 
 pub struct Shared {
     pub output: Mutex<Output>,
     pub changed: Condvar,
+    /// The latest replay answered (the UI takes it).
+    pub replay: Mutex<Option<ReplayResult>>,
 }
 
 /// The UI's handle on the worker thread.
@@ -163,8 +196,10 @@ impl Worker {
                 idle: true,
                 stats: Stats::default(),
                 error: None,
+                differing_pixels: None,
             }),
             changed: Condvar::new(),
+            replay: Mutex::new(None),
         });
         let (c, s) = (cancel.clone(), shared.clone());
         let thread = std::thread::Builder::new()
@@ -184,6 +219,28 @@ impl Worker {
     pub fn request(&self, req: Request) {
         self.cancel.store(true, Ordering::SeqCst);
         let _ = self.tx.send(Msg::Render(Box::new(req)));
+    }
+
+    /// Asks for a pixel replay. Unlike `request`, the frame in flight goes on:
+    /// the replay runs between two of its bands.
+    pub fn replay(&self, req: ReplayRequest) {
+        let _ = self.tx.send(Msg::Replay(Box::new(req)));
+    }
+
+    /// Blocks until the replay `id` (or a later one) was answered (tests only).
+    pub fn wait_replay(&self, id: u64, timeout: Duration) -> bool {
+        let deadline = Instant::now() + timeout;
+        let mut out = self.shared.output.lock().unwrap();
+        loop {
+            if self.shared.replay.lock().unwrap().as_ref().is_some_and(|r| r.id >= id) {
+                return true;
+            }
+            let now = Instant::now();
+            if now >= deadline {
+                return false;
+            }
+            out = self.shared.changed.wait_timeout(out, (deadline - now).min(Duration::from_millis(50))).unwrap().0;
+        }
     }
 
     /// Blocks until the worker is idle with request `generation` done (tests
@@ -218,6 +275,12 @@ impl Drop for Worker {
 struct Frame {
     req: Request,
     renderer: Box<dyn Renderer>,
+    /// What each pass renders with: the request's settings, shaded for the diff view.
+    pass_settings: RenderSettings,
+    /// Diff view: the reference `raytrace:brute` and the sum of its samples,
+    /// rendered band by band beside this renderer; the difference image
+    /// replaces the shaded one when every sample is done.
+    reference: Option<(Box<dyn Renderer>, Vec<Radiance>)>,
     started: Instant,
     width: u32,
     height: u32,
@@ -281,11 +344,14 @@ impl WorkerLoop {
             self.cancel.store(false, Ordering::SeqCst);
             let mut new_scene = None;
             let mut new_req = None;
+            let mut new_replay = None;
             for msg in first.into_iter().chain(self.rx.try_iter()) {
                 match msg {
                     Msg::Quit => return,
                     Msg::SetScene { id, scene } => new_scene = Some((id, scene)),
                     Msg::Render(r) => new_req = Some(*r),
+                    // Only the latest pixel matters.
+                    Msg::Replay(r) => new_replay = Some(*r),
                 }
             }
             if let Some((id, scene)) = new_scene {
@@ -301,6 +367,9 @@ impl WorkerLoop {
             if let Some(req) = new_req {
                 self.set_idle(false);
                 self.start(req);
+            }
+            if let Some(r) = new_replay {
+                self.replay(r);
             }
             if self.frame.is_some() {
                 self.step();
@@ -375,8 +444,12 @@ impl WorkerLoop {
         }
         let slow = self.ms_per_row < 0.0 || self.ms_per_row * height as f64 > 2.0 * BAND_MS;
         let now = Instant::now();
+        let diff = req.settings.view == View::Diff;
+        let pass_settings = if diff { RenderSettings { view: View::Shaded, ..req.settings.clone() } } else { req.settings.clone() };
         self.frame = Some(Frame {
             renderer,
+            pass_settings,
+            reference: diff.then(|| (Box::new(render::raytrace::brute::BruteForce) as Box<dyn Renderer>, vec![Radiance::ZERO; n])),
             started: now,
             width,
             height,
@@ -390,6 +463,38 @@ impl WorkerLoop {
             first_image: false,
             req,
         });
+    }
+
+    /// Replays one pixel through the renderer's own code path with a recorder,
+    /// on this thread between two bands, so the UI never waits for it.
+    fn replay(&mut self, r: ReplayRequest) {
+        let started = Instant::now();
+        let mut reference = None;
+        let result = match self.prepared.as_mut() {
+            Some((id, prepared)) if *id == r.scene_id => {
+                r.params.apply(&mut prepared.scene);
+                // The diff view replays the shaded pixel of both this
+                // renderer and the reference it is compared with.
+                let diff = r.settings.view == View::Diff;
+                let settings = if diff { RenderSettings { view: View::Shaded, ..r.settings.clone() } } else { r.settings.clone() };
+                let pool = &self.pool;
+                let prepared_ref = &*prepared;
+                let run = |renderer: &dyn Renderer| {
+                    pool.install(|| guarded(|| render::replay_pixel(renderer, prepared_ref, &settings, r.x, r.y))).and_then(|x| x)
+                };
+                let result = render::renderer_by_name(&r.renderer).and_then(|renderer| run(renderer.as_ref()));
+                reference = diff.then(|| run(&render::raytrace::brute::BruteForce));
+                // The frame in flight goes on with its own values.
+                if let Some(f) = &self.frame {
+                    f.req.params.apply(&mut prepared.scene);
+                }
+                result
+            }
+            _ => Err("the scene is still loading".to_string()),
+        };
+        let answer = ReplayResult { id: r.id, x: r.x, y: r.y, renderer: r.renderer, result, reference, ms: started.elapsed().as_secs_f64() * 1e3 };
+        *self.shared.replay.lock().unwrap() = Some(answer);
+        self.publish_done();
     }
 
     fn fail(&mut self, req: &Request, message: String) {
@@ -422,7 +527,7 @@ impl WorkerLoop {
             let div = self.preview_div;
             let (pw, ph) = ((f.width / div).max(1), (f.height / div).max(1));
             let view = prepared.scene.camera.view(pw, ph);
-            let mut settings = f.req.settings.clone();
+            let mut settings = f.pass_settings.clone();
             settings.width = pw;
             settings.height = ph;
             settings.spp = 1;
@@ -469,6 +574,7 @@ impl WorkerLoop {
             out.error = None;
             out.stats.first_image_ms = first_ms;
             out.stats.frame_ms = 0.0;
+            out.differing_pixels = None;
             out.version += 1;
             drop(out);
             self.publish_done();
@@ -484,7 +590,7 @@ impl WorkerLoop {
             f.pass_counts = RayCounts::default();
         }
         let view = prepared.scene.camera.view(f.width, f.height);
-        let settings = f.req.settings.clone();
+        let settings = f.pass_settings.clone();
         let mut buf = vec![Radiance::ZERO; (f.width * rows.len() as u32) as usize];
         let job = PassJob { prepared, view: &view, settings: &settings, offset: render::sample_offset(f.pass, spp), rows: rows.clone(), cancel };
         let renderer = &f.renderer;
@@ -501,9 +607,25 @@ impl WorkerLoop {
                 return;
             }
         };
+        let w = f.width as usize;
+        if let Some((reference, ref_sum)) = f.reference.as_mut() {
+            let mut theirs = vec![Radiance::ZERO; buf.len()];
+            let result = self.pool.install(|| guarded(|| reference.render_pass(&job, &mut theirs)));
+            if cancel.load(Ordering::Relaxed) {
+                return;
+            }
+            if let Err(e) = result {
+                let req = f.req.clone();
+                self.fail(&req, e);
+                return;
+            }
+            let a = rows.start as usize * w;
+            for (s, p) in ref_sum[a..a + theirs.len()].iter_mut().zip(&theirs) {
+                *s += if p.is_finite() { *p } else { Vec3::ZERO };
+            }
+        }
         let band_ms = band_start.elapsed().as_secs_f64() * 1e3;
         f.pass_counts += counts;
-        let w = f.width as usize;
         let mut display = Vec::with_capacity(buf.len());
         for (i, y) in rows.clone().enumerate() {
             let row_sum = &mut f.sum[y as usize * w..(y as usize + 1) * w];
@@ -534,6 +656,7 @@ impl WorkerLoop {
         if out.generation != req.generation {
             out.error = None;
             out.passes = 0;
+            out.differing_pixels = None;
         }
         if out.width != f.width || out.height != f.height {
             // Rows not rendered yet show black until their band arrives.
@@ -560,6 +683,16 @@ impl WorkerLoop {
         }
         out.complete = complete;
         if complete {
+            if let Some((_, ref_sum)) = &f.reference {
+                // Averaged as render_frame averages, then the core's diff.
+                let inv = 1.0 / spp as f32;
+                let mine: Vec<Radiance> = f.sum.iter().map(|s| *s * inv).collect();
+                let theirs: Vec<Radiance> = ref_sum.iter().map(|s| *s * inv).collect();
+                let (image, count) = render::debug::diff_image(&mine, &theirs);
+                out.rgb8 = image_io::to_rgb8(&image, req.params.render.exposure, req.gamma);
+                out.linear = image;
+                out.differing_pixels = Some(count);
+            }
             out.stats.frame_ms = f.started.elapsed().as_secs_f64() * 1e3;
         }
         out.version += 1;
