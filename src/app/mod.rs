@@ -6,6 +6,9 @@
 use eframe::egui;
 pub mod camera_control;
 pub mod export;
+pub mod inspect;
+pub mod legend;
+pub mod overlay;
 pub mod open_dialog;
 pub mod panels;
 pub mod settings_store;
@@ -105,7 +108,8 @@ fn screenshot_frame(app: &mut PinholeApp, ctx: &egui::Context) {
     let shown = app.shown_version;
     let ready = !app.loading()
         && app.with_output(|o| o.idle && o.complete && o.generation == generation && o.version == shown)
-        && !app.bench.as_ref().is_some_and(|b| !b.done);
+        && !app.bench.as_ref().is_some_and(|b| !b.done)
+        && !app.inspect.waiting(generation);
     let viewport_rect = app.viewport_rect;
     let Some(shot) = app.screenshot.as_mut() else { return };
     ctx.request_repaint_after(Duration::from_millis(30));

@@ -63,6 +63,8 @@ pub struct PinholeApp {
     pub persist: bool,
     /// `PINHOLE_BENCH_UI`: orbit continuously for this long, print fps, quit.
     pub bench: Option<super::UiBench>,
+    /// Selected pixel and its replay, zoom, overlays (visual debugging).
+    pub inspect: super::inspect::Inspect,
 }
 
 impl PinholeApp {
@@ -118,6 +120,7 @@ impl PinholeApp {
             repaint_ctx,
             persist: false,
             bench: None,
+            inspect: Default::default(),
         };
         app.install_scene(scene, scene_arg);
         app
@@ -366,6 +369,28 @@ impl PinholeApp {
         if ctx.input(|i| i.key_pressed(Key::Home)) {
             self.reset_camera();
         }
+        // V / shift+V: next / previous debug view.
+        if let Some(step) = ctx.input(|i| i.key_pressed(Key::V).then_some(if i.modifiers.shift { -1 } else { 1 })) {
+            use crate::render::debug::View;
+            let n = View::ALL.len() as i64;
+            let at = View::ALL.iter().position(|v| *v == self.settings.view).unwrap_or(0) as i64;
+            self.settings.view = View::ALL[(at + step).rem_euclid(n) as usize];
+        }
+        // Arrows move the selected pixel (shift: by 10), Esc clears it.
+        if let Some((x, y)) = self.inspect.selected {
+            let (dx, dy) = ctx.input_mut(|i| {
+                let step = if i.modifiers.shift { 10 } else { 1 };
+                // NONE matches logically, so shift+arrow counts too.
+                let mut count = |k: Key| step * i.count_and_consume_key(Modifiers::NONE, k) as i64;
+                (count(Key::ArrowRight) - count(Key::ArrowLeft), count(Key::ArrowDown) - count(Key::ArrowUp))
+            });
+            if (dx, dy) != (0, 0) {
+                self.select_pixel(x as i64 + dx, y as i64 + dy);
+            }
+            if ctx.input(|i| i.key_pressed(Key::Escape)) {
+                self.inspect.clear();
+            }
+        }
     }
 
     fn dropped_files(&mut self, ctx: &egui::Context) {
@@ -429,6 +454,7 @@ impl PinholeApp {
                 });
             });
         }
+        super::panels::inspector::show(self, ui);
         egui::CentralPanel::default().frame(egui::Frame::new().fill(egui::Color32::from_gray(24))).show(ui, |ui| {
             super::viewport::show(self, ui);
         });
@@ -438,6 +464,7 @@ impl PinholeApp {
         super::export::show_dialog(self, &ctx);
 
         self.sync_worker();
+        self.sync_inspector();
         super::screenshot_frame(self, &ctx);
     }
 }

@@ -1,8 +1,11 @@
-//! The central viewport: the rendered image (1:1 in pixels when it fits),
-//! light markers drawn over it, and mouse/keyboard navigation.
+//! The central viewport: the rendered image (1:1 in pixels when it fits,
+//! zoomable to pixel level with nearest filtering and a pixel grid), light
+//! markers, the selected pixel and its rays, vertex dots and the debug
+//! view's legend drawn over it; mouse/keyboard navigation and pixel picking.
 
 use eframe::egui;
 use super::camera_control as cc;
+use super::overlay::{self, ImageMap};
 use super::PinholeApp;
 use crate::math::{Vec2, Vec3};
 use crate::scene::Light;
@@ -14,24 +17,42 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
     let ppp = ui.ctx().pixels_per_point();
     let settings = app.effective_settings();
     let (iw, ih) = (settings.width as f32, settings.height as f32);
-    // 1 image pixel = 1 screen pixel when it fits; otherwise scaled to fit.
+
+    // Zoom: ctrl+wheel (or pinch) about the cursor; right drag pans the image.
+    if response.hovered() {
+        let zoom = ui.input(|i| i.zoom_delta());
+        if zoom != 1.0 {
+            let anchor = response.hover_pos().map_or(egui::Vec2::ZERO, |p| p - avail.center());
+            app.inspect.zoom_about(app.inspect.zoom * zoom, anchor);
+        }
+    }
+    if response.dragged_by(egui::PointerButton::Secondary) && app.inspect.zoom > 1.0 {
+        app.inspect.pan += response.drag_delta();
+    }
+
+    // 1 image pixel = 1 screen pixel when it fits; otherwise scaled to fit;
+    // then magnified by the zoom.
     let mut size = egui::vec2(iw / ppp, ih / ppp);
     let fit = (avail.width() / size.x).min(avail.height() / size.y);
     if fit < 1.0 {
         size *= fit;
     }
-    let min = avail.center() - size * 0.5;
+    size *= app.inspect.zoom;
+    let min = avail.center() + app.inspect.pan - size * 0.5;
     let min = Pos2::new((min.x * ppp).round() / ppp, (min.y * ppp).round() / ppp);
     let rect = Rect::from_min_size(min, size);
     app.viewport_rect = Some(rect);
     let painter = ui.painter_at(avail);
     if let Some(t) = &app.texture {
+        // The texture samples with nearest filtering: zoomed pixels stay square.
         painter.image(t.id(), rect, Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0)), Color32::WHITE);
     }
+    let map = ImageMap { rect, width: iw, height: ih };
+    overlay::pixel_grid(&painter, &map, avail);
 
     // Image pixel of a screen point and back.
-    let to_px = |p: Pos2| Vec2::new((p.x - rect.min.x) / rect.width() * iw, (p.y - rect.min.y) / rect.height() * ih);
-    let to_screen = |v: Vec2| Pos2::new(rect.min.x + v.x / iw * rect.width(), rect.min.y + v.y / ih * rect.height());
+    let to_px = |p: Pos2| map.to_px(p);
+    let to_screen = |v: Vec2| map.to_screen(v);
     let px_per_point = iw / rect.width().max(1.0);
 
     let view = app.params.camera.view(settings.width, settings.height);
@@ -45,6 +66,14 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
             Light::Directional { .. } => (i, None),
         })
         .collect();
+
+    // Clicking a pixel selects it for the inspector.
+    if response.clicked() {
+        if let Some((x, y)) = response.interact_pointer_pos().and_then(|p| map.pixel_at(p)) {
+            app.select_pixel(x as i64, y as i64);
+        }
+    }
+    app.inspect.hover = response.hover_pos().and_then(|p| map.pixel_at(p));
 
     // Focus: clicking the viewport gives it the keyboard (WASD/QE fly).
     if response.clicked() || response.drag_started() {
@@ -88,7 +117,7 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
             app.camera_moving = true;
         }
     }
-    if response.hovered() {
+    if response.hovered() && ui.input(|i| i.zoom_delta()) == 1.0 {
         let scroll = ui.input(|i| i.smooth_scroll_delta.y);
         if scroll != 0.0 {
             cc::dolly(&mut app.params.camera, scroll / 50.0);
@@ -97,6 +126,24 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
     }
     if app.viewport_focused && !ui.ctx().egui_wants_keyboard_input() {
         fly_keys(app, ui);
+    }
+
+    if app.inspect.vertices {
+        let (drawn, total) = overlay::vertices(&painter, &map, &view, &app.scene, avail);
+        let note = if drawn * 3 < total && total > overlay::MAX_VERTEX_DOTS { format!("{drawn} of {total} vertices (subsampled)") } else { format!("{drawn} vertices in view") };
+        painter.text(avail.left_top() + egui::vec2(6.0, 6.0), egui::Align2::LEFT_TOP, note, egui::FontId::monospace(11.0), Color32::from_rgb(255, 80, 200));
+    }
+    // The selected pixel's rays, then the pixel itself.
+    if let Some((x, y)) = app.inspect.selected {
+        if app.inspect.paths {
+            if let Some(Ok(replay)) = app.inspect.current(app.generation).map(|r| &r.result) {
+                if let Some((_, trace, _)) = replay.samples.first() {
+                    let length = cc::scene_scale(app.scene.bounds());
+                    overlay::paths(&painter, &map, &view, trace, &app.params.lights, length);
+                }
+            }
+        }
+        overlay::selected_pixel(&painter, &map, x, y);
     }
 
     // Light markers.
@@ -123,6 +170,26 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
     if app.viewport_focused {
         painter.rect_stroke(avail.shrink(1.0), 0.0, Stroke::new(1.0, Color32::from_rgb(80, 120, 200)), egui::StrokeKind::Inside);
     }
+    hover_readout(app, &painter, avail, &view);
+    super::legend::show(app, ui.ctx(), avail);
+}
+
+/// The pixel under the cursor: coordinates, the value on show and what it
+/// means in this view, in the viewport's bottom-left corner.
+fn hover_readout(app: &PinholeApp, painter: &egui::Painter, avail: Rect, view: &crate::scene::CameraView) {
+    let Some((x, y)) = app.inspect.hover else { return };
+    let exposure = app.params.render.exposure;
+    let Some(v) = app.with_output(|o| (x < o.width && y < o.height && o.linear.len() == (o.width * o.height) as usize).then(|| o.linear[(x + y * o.width) as usize])) else { return };
+    let meaning = super::inspect::value_text(app.settings.view.name(), v, view, &app.scene);
+    let d = crate::image_io::display_pixel(v, exposure, app.gamma);
+    let mut text = format!("({x}, {y})  {meaning}  -> {d:?}");
+    if app.settings.view.name() != "shaded" {
+        text = format!("({x}, {y})  {meaning}  linear {}", super::inspect::fmt3(v));
+    }
+    let galley = painter.layout_no_wrap(text, egui::FontId::monospace(12.0), Color32::WHITE);
+    let pos = avail.left_bottom() + egui::vec2(6.0, -6.0 - galley.size().y);
+    painter.rect_filled(Rect::from_min_size(pos, galley.size()).expand(3.0), 3.0, Color32::from_black_alpha(190));
+    painter.galley(pos, galley, Color32::WHITE);
 }
 
 /// WASD/QE fly at a speed proportional to the scene's size.

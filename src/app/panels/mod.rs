@@ -1,8 +1,10 @@
 //! The viewer's panels: the menu bar, the status bar and the side-panel
-//! sections (camera, lights, materials, shading), one file each.
+//! sections (camera, lights, materials, shading) and the pixel inspector,
+//! one file each.
 
 use eframe::egui;
 pub mod camera;
+pub mod inspector;
 pub mod lights;
 pub mod materials;
 pub mod menu;

@@ -1,22 +1,16 @@
-//! Shading section: debug view, shadows (none / ray / map) and the ray bump,
+//! Shading section (the debug view is in the top bar): shadows (none / ray / map) and the ray bump,
 //! samples per pixel, secondary depth, ambient, background, exposure and
 //! gamma on/off.
 
 use eframe::egui;
 use super::{color_edit, section};
 use crate::app::PinholeApp;
-use crate::render::debug::View;
 use crate::render::{Interpolation, ShadowMode};
 
 pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
     let mut open = app.panels.shading;
     section(ui, "Shading", &mut open, |ui| {
         let s = &mut app.settings;
-        egui::ComboBox::from_label("debug view").selected_text(s.view.name()).show_ui(ui, |ui| {
-            for v in View::ALL {
-                ui.selectable_value(&mut s.view, v, v.name());
-            }
-        });
         ui.horizontal(|ui| {
             ui.label("shadows");
             for m in ShadowMode::ALL {

@@ -1,0 +1,280 @@
+//! Visual debugging state (issue 5): the selected pixel and its replay, the
+//! image zoom and pan, the vertex overlay, and what the values of a debug
+//! view mean (for the hover read-out and the inspector).
+//!
+//! The replay itself runs on the render worker between two bands
+//! (`Worker::replay`), through the renderer's own code path with a recorder,
+//! so the UI never waits for it and its radiance is the frame's pixel.
+
+use super::worker::{ReplayRequest, ReplayResult};
+use super::PinholeApp;
+use crate::math::{Radiance, Vec3};
+use crate::render::debug::{cost_color, id_color, COST_SCALE};
+use crate::render::PixelReplay;
+use crate::scene::{CameraView, PrimitiveKind, Scene};
+use eframe::egui;
+use std::time::Duration;
+
+/// A replay answered by the worker, with the request it belongs to.
+pub struct Replayed {
+    pub x: u32,
+    pub y: u32,
+    pub renderer: String,
+    /// The render request (`PinholeApp::generation`) whose values it used.
+    pub generation: u64,
+    pub result: Result<PixelReplay, String>,
+    /// Diff view: the same pixel by `raytrace:brute`.
+    pub reference: Option<Result<PixelReplay, String>>,
+    pub ms: f64,
+}
+
+/// What the user looks at closely.
+pub struct Inspect {
+    /// The selected pixel (image coordinates of the frame on show).
+    pub selected: Option<(u32, u32)>,
+    /// The pixel under the cursor.
+    pub hover: Option<(u32, u32)>,
+    /// The latest replay answered for the selection.
+    pub replay: Option<Replayed>,
+    /// Replay in flight: (id, generation, x, y).
+    in_flight: Option<(u64, u64, u32, u32)>,
+    next_id: u64,
+    /// Image magnification over the fitted size (1 = fit / 1:1), and its
+    /// offset from the centred position, in points.
+    pub zoom: f32,
+    pub pan: egui::Vec2,
+    /// Draw every projected triangle vertex as a dot (CGPP 15.6.2).
+    pub vertices: bool,
+    /// Draw the selected pixel's rays into the view.
+    pub paths: bool,
+}
+
+impl Default for Inspect {
+    fn default() -> Self {
+        Inspect { selected: None, hover: None, replay: None, in_flight: None, next_id: 0, zoom: 1.0, pan: egui::Vec2::ZERO, vertices: false, paths: true }
+    }
+}
+
+/// Most zoom: one image pixel this many times its fitted size.
+pub const MAX_ZOOM: f32 = 64.0;
+
+impl Inspect {
+    /// The replay of the current selection for render request `generation`, if answered.
+    pub fn current(&self, generation: u64) -> Option<&Replayed> {
+        let (x, y) = self.selected?;
+        self.replay.as_ref().filter(|r| r.x == x && r.y == y && r.generation == generation)
+    }
+
+    /// A pixel is selected but its replay for `generation` has not arrived.
+    pub fn waiting(&self, generation: u64) -> bool {
+        self.selected.is_some() && self.current(generation).is_none()
+    }
+
+    pub fn clear(&mut self) {
+        self.selected = None;
+        self.replay = None;
+    }
+
+    /// Sets the zoom, keeping the image point under `anchor` (screen
+    /// position, relative to the viewport centre) where it is.
+    pub fn zoom_about(&mut self, new_zoom: f32, anchor: egui::Vec2) {
+        let new_zoom = new_zoom.clamp(1.0, MAX_ZOOM);
+        let k = new_zoom / self.zoom;
+        // Image point under the anchor: (anchor - pan) / zoom stays fixed.
+        self.pan = anchor - (anchor - self.pan) * k;
+        self.zoom = new_zoom;
+        if self.zoom <= 1.0 {
+            self.pan = egui::Vec2::ZERO;
+        }
+    }
+}
+
+impl PinholeApp {
+    /// Selects pixel `(x, y)` of the image on show (clamped into it).
+    pub fn select_pixel(&mut self, x: i64, y: i64) {
+        let s = self.effective_settings();
+        let x = x.clamp(0, s.width as i64 - 1) as u32;
+        let y = y.clamp(0, s.height as i64 - 1) as u32;
+        self.inspect.selected = Some((x, y));
+    }
+
+    /// Takes the worker's answer and asks for the replay of the selection
+    /// when it is missing or out of date (one replay in flight at a time:
+    /// while the camera moves, replays follow as fast as they finish).
+    pub fn sync_inspector(&mut self) {
+        let answer: Option<ReplayResult> = self.worker.shared.replay.lock().unwrap().take();
+        if let Some(a) = answer {
+            if let Some((id, generation, _, _)) = self.inspect.in_flight {
+                if a.id == id {
+                    self.inspect.in_flight = None;
+                    self.inspect.replay = Some(Replayed { x: a.x, y: a.y, renderer: a.renderer, generation, result: a.result, reference: a.reference, ms: a.ms });
+                }
+            }
+        }
+        let Some((x, y)) = self.inspect.selected else { return };
+        let settings = self.effective_settings();
+        if x >= settings.width || y >= settings.height {
+            self.select_pixel(x as i64, y as i64);
+        }
+        let Some((x, y)) = self.inspect.selected else { return };
+        if self.inspect.in_flight.is_some() || !self.inspect.waiting(self.generation) || self.params.camera.validate().is_err() {
+            return;
+        }
+        self.inspect.next_id += 1;
+        let id = self.inspect.next_id;
+        self.inspect.in_flight = Some((id, self.generation, x, y));
+        self.worker.replay(ReplayRequest {
+            id,
+            scene_id: self.scene_id,
+            params: self.params.clone(),
+            settings,
+            renderer: self.renderer.clone(),
+            x,
+            y,
+        });
+    }
+
+    /// Blocks until the selection's replay for the current values arrived
+    /// (tests and `--screenshot` only). False on timeout.
+    pub fn wait_inspector(&mut self, timeout: Duration) -> bool {
+        let deadline = std::time::Instant::now() + timeout;
+        loop {
+            self.sync_worker();
+            self.sync_inspector();
+            if !self.inspect.waiting(self.generation) {
+                return true;
+            }
+            let now = std::time::Instant::now();
+            if now >= deadline {
+                return false;
+            }
+            let id = self.inspect.in_flight.map_or(0, |f| f.0);
+            self.worker.wait_replay(id, (deadline - now).min(Duration::from_millis(100)));
+        }
+    }
+}
+
+/// Name of the object a primitive belongs to.
+pub fn object_name(scene: &Scene, kind: PrimitiveKind, index: u32) -> String {
+    let object = match kind {
+        PrimitiveKind::Triangle => scene.triangles.get(index as usize).map(|t| t.object),
+        PrimitiveKind::Sphere => scene.spheres.get(index as usize).map(|s| s.object),
+    };
+    object
+        .and_then(|o| scene.objects.get(o as usize).map(|info| format!("{} (object {o})", info.name)))
+        .unwrap_or_else(|| "?".into())
+}
+
+pub fn kind_name(kind: PrimitiveKind) -> &'static str {
+    match kind {
+        PrimitiveKind::Triangle => "triangle",
+        PrimitiveKind::Sphere => "sphere",
+    }
+}
+
+pub fn fmt3(v: Vec3) -> String {
+    format!("({:.5}, {:.5}, {:.5})", v.x, v.y, v.z)
+}
+
+/// The cost whose `cost_color` is nearest `c` (the cost view's heat scale,
+/// inverted): exact for 1 spp up to `COST_SCALE`, saturating above it.
+pub fn invert_cost(c: Vec3) -> f32 {
+    // cost_color is piecewise linear in t between distinct stops: project
+    // onto each segment and keep the closest point.
+    const N: usize = 5;
+    let stop = |i: usize| cost_color(cost_of_t(i as f32 / N as f32));
+    let mut best = (f32::INFINITY, 0.0f32);
+    for i in 0..N {
+        let (a, b) = (stop(i), stop(i + 1));
+        let ab = b - a;
+        let s = ((c - a).dot(ab) / ab.length_squared().max(1e-12)).clamp(0.0, 1.0);
+        let d = (a + ab * s - c).length_squared();
+        if d < best.0 {
+            best = (d, (i as f32 + s) / N as f32);
+        }
+    }
+    cost_of_t(best.1)
+}
+
+/// Inverse of the cost view's log mapping `t = log2(1 + cost) / log2(1 + COST_SCALE)`.
+pub fn cost_of_t(t: f32) -> f32 {
+    (2f32.powf(t * (1.0 + COST_SCALE).log2()) - 1.0).max(0.0)
+}
+
+pub fn t_of_cost(cost: f32) -> f32 {
+    ((1.0 + cost.max(0.0)).log2() / (1.0 + COST_SCALE).log2()).clamp(0.0, 1.0)
+}
+
+/// Distance from the eye for a grey level of the depth view (its inverse).
+pub fn depth_distance(camera: &CameraView, v: f32) -> f32 {
+    camera.near * (camera.far / camera.near).powf(v)
+}
+
+/// View depth z for a grey level of the zbuffer view (1/z, near = 1, far = 0).
+pub fn zbuffer_depth(camera: &CameraView, v: f32) -> f32 {
+    1.0 / (v * (1.0 / camera.near - 1.0 / camera.far) + 1.0 / camera.far)
+}
+
+/// The object whose id colour `c` is, if any.
+pub fn object_of_id_color(scene: &Scene, c: Vec3) -> Option<usize> {
+    (0..scene.objects.len()).find(|&i| (id_color(i as u32) - c).abs().max_element() < 1e-4)
+}
+
+/// What pixel value `v` of the view named `view` means, in words and numbers.
+pub fn value_text(view: &str, v: Radiance, camera: &CameraView, scene: &Scene) -> String {
+    match view {
+        "depth" => {
+            if v.x <= 0.0 {
+                "no hit (or at the near plane)".into()
+            } else {
+                format!("distance {:.4} (grey {:.4})", depth_distance(camera, v.x), v.x)
+            }
+        }
+        "zbuffer" => {
+            if v.x <= 0.0 {
+                "no hit (or at the far plane)".into()
+            } else {
+                format!("z {:.4} (1/z stored as {:.4})", zbuffer_depth(camera, v.x), v.x)
+            }
+        }
+        "cost" => {
+            let c = invert_cost(v);
+            if c >= COST_SCALE * 0.999 {
+                format!("cost >= {COST_SCALE:.0}")
+            } else {
+                format!("cost {:.0}", c.round())
+            }
+        }
+        "id" => match object_of_id_color(scene, v) {
+            Some(i) => format!("object {i}: {}", scene.objects[i].name),
+            None if v == Vec3::ZERO => "no hit".into(),
+            None => format!("colour {}", fmt3(v)),
+        },
+        "barycentric" => format!("b = {}", fmt3(v)),
+        "raydir" | "normal" => format!("{} = {}", if view == "raydir" { "d" } else { "n" }, fmt3(v * 2.0 - Vec3::ONE)),
+        _ => format!("linear {}", fmt3(v)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::debug::depth_value;
+
+    #[test]
+    fn cost_colours_invert_to_their_cost() {
+        for cost in [0.0f32, 1.0, 3.0, 17.0, 100.0, 512.0, 1000.0] {
+            let back = invert_cost(cost_color(cost));
+            assert!((back - cost).abs() < 0.01 * cost.max(1.0), "{cost} -> {back}");
+        }
+    }
+
+    #[test]
+    fn depth_and_zbuffer_invert() {
+        let cam = crate::scene::Camera { near: 0.1, far: 100.0, ..Default::default() }.view(10, 10);
+        let d = depth_distance(&cam, depth_value(&cam, 7.5));
+        assert!((d - 7.5).abs() < 1e-3, "{d}");
+        let inv = |z: f32| (1.0 / z - 1.0 / cam.far) / (1.0 / cam.near - 1.0 / cam.far);
+        assert!((zbuffer_depth(&cam, inv(3.0)) - 3.0).abs() < 1e-3);
+    }
+}

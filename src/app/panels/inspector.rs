@@ -1,0 +1,324 @@
+//! The pixel inspector (issue 5): the record of the selected pixel, replayed
+//! by the renderer's own code path (`render::replay_pixel`). Ray tracers:
+//! the eye ray, its traversal (nodes visited, every primitive tested in
+//! order with t, barycentrics or why it was rejected), the closest hit, each
+//! light's sample with its shadow ray, secondary rays as a tree. Rasterizers:
+//! the fragment history in draw order. Then the final radiance, checked
+//! against the frame's pixel, and the displayed 8-bit value.
+
+use eframe::egui;
+use crate::app::inspect::{fmt3, kind_name, object_name};
+use crate::app::PinholeApp;
+use crate::math::{Radiance, Vec3};
+use crate::pixel_report::miss_reason;
+use crate::render::trace::{FragmentRecord, LightSample, PixelTrace, RayRecord};
+use crate::render::PixelReplay;
+use crate::scene::{Light, Scene};
+use egui::{Color32, RichText};
+
+const DIM: Color32 = Color32::from_gray(150);
+
+/// The inspector as a right-hand panel, while a pixel is selected.
+pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
+    let Some((x, y)) = app.inspect.selected else { return };
+    egui::Panel::right("inspector").default_size(400.0).resizable(true).show(ui, |ui| {
+        ui.horizontal(|ui| {
+            ui.heading("Inspector");
+            if ui.button("clear (Esc)").clicked() {
+                app.inspect.clear();
+            }
+        });
+        ui.horizontal(|ui| {
+            ui.checkbox(&mut app.inspect.paths, "draw rays");
+            ui.label(RichText::new("arrows move · shift+arrows by 10").small().color(DIM));
+        });
+        ui.label(RichText::new(format!("pixel ({x}, {y})")).strong());
+        let generation = app.generation;
+        let current = app.inspect.current(generation).is_some();
+        let Some(replay) = app.inspect.replay.as_ref().filter(|r| r.x == x && r.y == y) else {
+            ui.horizontal(|ui| {
+                ui.spinner();
+                ui.label("replaying…");
+            });
+            return;
+        };
+        ui.label(RichText::new(format!("{} · replayed in {:.1} ms{}", replay.renderer, replay.ms, if current { "" } else { " · updating…" })).small().color(DIM));
+        ui.separator();
+        let scene = scene_now(app);
+        match &replay.result {
+            Err(e) => {
+                ui.colored_label(Color32::LIGHT_RED, format!("cannot replay this pixel: {e}"));
+            }
+            Ok(r) => {
+                egui::ScrollArea::vertical().auto_shrink([false, false]).show(ui, |ui| {
+                    record(app, ui, &scene, r, x, y, current);
+                });
+            }
+        }
+    });
+}
+
+/// The scene with the values being edited (lights, materials) for names.
+fn scene_now(app: &PinholeApp) -> SceneNames<'_> {
+    SceneNames { scene: &app.scene, lights: &app.params.lights, materials: app.params.materials.iter().map(|m| m.name.clone()).collect() }
+}
+
+struct SceneNames<'a> {
+    scene: &'a Scene,
+    lights: &'a [Light],
+    materials: Vec<String>,
+}
+
+fn record(app: &PinholeApp, ui: &mut egui::Ui, names: &SceneNames, r: &PixelReplay, x: u32, y: u32, current: bool) {
+    let many = r.samples.len() > 1;
+    for (i, (offset, trace, value)) in r.samples.iter().enumerate() {
+        if many {
+            egui::CollapsingHeader::new(format!("sample {} at ({:.3}, {:.3}) -> {}", i + 1, offset.x, offset.y, fmt3(*value)))
+                .id_salt(("sample", i))
+                .default_open(i == 0)
+                .show(ui, |ui| sample(ui, names, trace, *value));
+        } else {
+            sample(ui, names, trace, *value);
+        }
+    }
+    ui.separator();
+    if let Some(reference) = app.inspect.replay.as_ref().and_then(|r| r.reference.as_ref()) {
+        // Diff view: both renderers' shaded values; the frame shows their difference.
+        ui.label(RichText::new(format!("{} (shaded) {}", app.renderer, fmt3(r.radiance))).monospace());
+        match reference {
+            Ok(b) => {
+                ui.label(RichText::new(format!("raytrace:brute (shaded) {}", fmt3(b.radiance))).monospace());
+                if crate::render::debug::differs(r.radiance, b.radiance) {
+                    ui.colored_label(Color32::from_rgb(240, 110, 100), "this pixel differs from the reference");
+                } else {
+                    ui.colored_label(Color32::LIGHT_GREEN, "this pixel agrees with the reference");
+                }
+            }
+            Err(e) => {
+                ui.colored_label(Color32::LIGHT_RED, format!("raytrace:brute cannot replay: {e}"));
+            }
+        }
+        return;
+    }
+    final_value(app, ui, r.radiance, x, y, current);
+}
+
+fn sample(ui: &mut egui::Ui, names: &SceneNames, t: &PixelTrace, value: Radiance) {
+    // Rays other than shadow rays, as a tree by depth; shadow rays go with their light.
+    let mut shadow_rays: Vec<&RayRecord> = t.rays.iter().filter(|r| r.shadow).collect();
+    for (i, r) in t.rays.iter().enumerate().filter(|(_, r)| !r.shadow) {
+        let title = if r.depth == 0 { "eye ray".to_string() } else { format!("secondary ray (depth {})", r.depth) };
+        ui.horizontal(|ui| {
+            ui.add_space(12.0 * r.depth as f32);
+            ui.vertical(|ui| {
+                egui::CollapsingHeader::new(RichText::new(title).strong()).id_salt(("ray", i)).default_open(true).show(ui, |ui| {
+                    ray(ui, names, r, i);
+                });
+            });
+        });
+    }
+    if !t.fragments.is_empty() {
+        fragments(ui, names.scene, &t.fragments);
+    }
+    if !t.lights.is_empty() {
+        ui.label(RichText::new("lights").strong());
+        for (k, l) in t.lights.iter().enumerate() {
+            // The shadow ray record that traced this light's shadow ray.
+            let traced = l.shadow_ray.and_then(|(sr, _)| shadow_rays.iter().position(|r| r.ray == sr)).map(|p| shadow_rays.remove(p));
+            light(ui, names, l, traced, k);
+        }
+    }
+    if t.shaded.len() > 1 {
+        ui.label(RichText::new("radiance returned per depth (innermost first)").small().color(DIM));
+        for (d, rad) in &t.shaded {
+            ui.monospace(format!("  depth {d}: {}", fmt3(*rad)));
+        }
+    }
+    ui.monospace(format!("sample radiance {}", fmt3(value)));
+}
+
+fn grid_row(ui: &mut egui::Ui, name: &str, value: String) {
+    ui.label(RichText::new(name).color(DIM));
+    ui.monospace(value);
+    ui.end_row();
+}
+
+fn ray(ui: &mut egui::Ui, names: &SceneNames, r: &RayRecord, index: usize) {
+    let scene = names.scene;
+    egui::Grid::new(("ray-grid", index)).num_columns(2).spacing([8.0, 2.0]).show(ui, |ui| {
+        grid_row(ui, "origin", fmt3(r.ray.origin));
+        grid_row(ui, "direction", fmt3(r.ray.dir));
+        grid_row(ui, "t_max", format!("{:.5}", r.t_max));
+        if !r.nodes_visited.is_empty() {
+            grid_row(ui, "BVH nodes visited", r.nodes_visited.len().to_string());
+        }
+        let tested = r.tests.len() + r.tests_omitted;
+        grid_row(ui, "primitives tested", tested.to_string());
+        if r.depth == 0 {
+            grid_row(ui, "cost (nodes + tests)", (r.nodes_visited.len() + tested).to_string());
+        }
+    });
+    traversal(ui, scene, r, index);
+    match &r.closest {
+        Some(h) => {
+            ui.label(RichText::new("closest hit").strong());
+            egui::Grid::new(("hit-grid", index)).num_columns(2).spacing([8.0, 2.0]).show(ui, |ui| {
+                grid_row(ui, "object", object_name(scene, h.kind, h.primitive));
+                grid_row(ui, kind_name(h.kind), h.primitive.to_string());
+                let mat = names.materials.get(h.material as usize).cloned().unwrap_or_else(|| "?".into());
+                grid_row(ui, "material", format!("{mat} ({})", h.material));
+                grid_row(ui, "t", format!("{:.6}", h.t));
+                grid_row(ui, "P", fmt3(h.position));
+                grid_row(ui, "barycentric", fmt3(h.barycentric));
+                grid_row(ui, "uv", format!("({:.5}, {:.5})", h.uv.x, h.uv.y));
+                grid_row(ui, "geometric normal", fmt3(h.geometric_normal));
+                grid_row(ui, "shading normal", fmt3(h.shading_normal));
+                grid_row(ui, "w_o", fmt3(-r.ray.dir));
+                if h.back_face {
+                    grid_row(ui, "side", "back face (two-sided)".into());
+                }
+            });
+        }
+        None => {
+            ui.label("closest hit: nothing (background)");
+        }
+    }
+}
+
+/// Every primitive test in order, collapsible (brute force tests thousands).
+fn traversal(ui: &mut egui::Ui, scene: &Scene, r: &RayRecord, index: usize) {
+    if r.tests.is_empty() {
+        return;
+    }
+    let hits = r.tests.iter().filter(|t| t.outcome.is_ok()).count();
+    let mut reasons: std::collections::BTreeMap<&str, usize> = Default::default();
+    for t in &r.tests {
+        if let Err(m) = t.outcome {
+            *reasons.entry(miss_reason(m)).or_default() += 1;
+        }
+    }
+    let summary = format!(
+        "tests in order: {hits} hit{}{}{}",
+        if hits == 1 { "" } else { "s" },
+        reasons.iter().map(|(k, v)| format!(", {v} {k}")).collect::<String>(),
+        if r.tests_omitted > 0 { format!(", {} more not kept", r.tests_omitted) } else { String::new() }
+    );
+    egui::CollapsingHeader::new(summary).id_salt(("tests", index)).default_open(false).show(ui, |ui| {
+        let row_h = ui.text_style_height(&egui::TextStyle::Monospace);
+        egui::ScrollArea::vertical().id_salt(("tests-scroll", index)).max_height(240.0).show_rows(ui, row_h, r.tests.len(), |ui, rows| {
+            for i in rows {
+                let t = &r.tests[i];
+                let what = match t.outcome {
+                    Ok((tt, b1, b2)) => format!("hit t = {tt:.6}, b = ({:.4}, {b1:.4}, {b2:.4})", 1.0 - b1 - b2),
+                    Err(m) => miss_reason(m).to_string(),
+                };
+                let obj = object_name(scene, t.kind, t.index);
+                let text = format!("#{i:<5} {} {} [{obj}]: {what}", kind_name(t.kind), t.index);
+                if t.outcome.is_ok() {
+                    ui.label(RichText::new(text).monospace().color(Color32::LIGHT_GREEN));
+                } else {
+                    ui.monospace(text);
+                }
+            }
+        });
+    });
+}
+
+fn light(ui: &mut egui::Ui, names: &SceneNames, l: &LightSample, traced: Option<&RayRecord>, k: usize) {
+    let kind = match names.lights.get(l.light) {
+        Some(Light::Point { .. }) => "point",
+        Some(Light::Directional { .. }) => "directional",
+        None => "?",
+    };
+    let visibility = match (l.shadow_ray, l.blocker) {
+        (_, Some((kd, i, t))) => format!("blocked by {} {i} [{}] at t = {t:.5}", kind_name(kd), object_name(names.scene, kd, i)),
+        (Some(_), None) => "visible".into(),
+        (None, None) => "no shadow ray".into(),
+    };
+    let color = if l.blocker.is_some() { Color32::from_rgb(240, 110, 100) } else { Color32::from_rgb(110, 220, 120) };
+    let title = RichText::new(format!("L{} ({kind}): {visibility}", l.light)).color(color);
+    egui::CollapsingHeader::new(title).id_salt(("light", k)).default_open(true).show(ui, |ui| {
+        egui::Grid::new(("light-grid", k)).num_columns(2).spacing([8.0, 2.0]).show(ui, |ui| {
+            grid_row(ui, "w_i", fmt3(l.w_i));
+            grid_row(ui, "distance", if l.distance.is_finite() { format!("{:.5}", l.distance) } else { "inf".into() });
+            grid_row(ui, "incident radiance", fmt3(l.incident));
+            grid_row(ui, "cos θ", format!("{:.5}", l.cos_theta));
+            if let Some((r, t_max)) = l.shadow_ray {
+                grid_row(ui, "shadow ray origin", fmt3(r.origin));
+                grid_row(ui, "shadow ray direction", fmt3(r.dir));
+                grid_row(ui, "shadow ray t_max", if t_max.is_finite() { format!("{t_max:.5}") } else { "inf".into() });
+            }
+            if let Some(s) = traced {
+                let nodes = if s.nodes_visited.is_empty() { String::new() } else { format!("{} nodes, ", s.nodes_visited.len()) };
+                grid_row(ui, "shadow traversal", format!("{nodes}{} tests", s.tests.len() + s.tests_omitted));
+            }
+            grid_row(ui, "visibility", visibility.clone());
+            grid_row(ui, "BSDF", fmt3(l.bsdf));
+            grid_row(ui, "contribution", fmt3(l.contribution));
+        });
+    });
+}
+
+/// The rasterizer's pixel history (RenderDoc style): every fragment in draw order.
+fn fragments(ui: &mut egui::Ui, scene: &Scene, frags: &[FragmentRecord]) {
+    ui.label(RichText::new(format!("fragment history: {} fragment{} in draw order", frags.len(), if frags.len() == 1 { "" } else { "s" })).strong());
+    egui::ScrollArea::horizontal().id_salt("fragments-scroll").show(ui, |ui| {
+        egui::Grid::new("fragments").striped(true).num_columns(8).spacing([10.0, 2.0]).show(ui, |ui| {
+            for h in ["#", "primitive", "2D weights", "perspective weights", "depth", "stored", "test", "shaded"] {
+                ui.label(RichText::new(h).color(DIM));
+            }
+            ui.end_row();
+            let v = |b: Vec3| format!("{:.4} {:.4} {:.4}", b.x, b.y, b.z);
+            for (i, f) in frags.iter().enumerate() {
+                ui.monospace(i.to_string());
+                ui.monospace(format!("{} {} [{}]", kind_name(f.kind), f.primitive, object_name(scene, f.kind, f.primitive)));
+                ui.monospace(f.screen_barycentric.map(v).unwrap_or_else(|| "–".into()));
+                ui.monospace(v(f.barycentric));
+                ui.monospace(format!("{:.6}", f.depth));
+                ui.monospace(if f.stored_depth.is_finite() { format!("{:.6}", f.stored_depth) } else { "inf (empty)".into() });
+                let (txt, c) = if f.passed_depth_test { ("passed", Color32::LIGHT_GREEN) } else { ("failed", Color32::from_rgb(240, 110, 100)) };
+                ui.label(RichText::new(txt).monospace().color(c));
+                ui.monospace(f.shaded.map(fmt3).unwrap_or_else(|| "–".into()));
+                ui.end_row();
+            }
+        });
+    });
+}
+
+/// The label of the final radiance (tests look for exactly this text).
+pub fn final_radiance_text(r: Radiance) -> String {
+    format!("final radiance ({:.6}, {:.6}, {:.6})", r.x, r.y, r.z)
+}
+
+fn final_value(app: &PinholeApp, ui: &mut egui::Ui, radiance: Radiance, x: u32, y: u32, current: bool) {
+    ui.label(RichText::new(final_radiance_text(radiance)).strong().monospace());
+    // The frame's own pixel: the same number, once the frame is complete.
+    let frame = app.with_output(|o| {
+        (o.complete && o.error.is_none() && o.generation == app.generation && x < o.width && y < o.height)
+            .then(|| o.linear[(x + y * o.width) as usize])
+    });
+    match frame {
+        Some(f) if current && f == radiance => {
+            ui.label(RichText::new("= the frame's pixel, exactly").color(Color32::LIGHT_GREEN));
+        }
+        Some(f) if current => {
+            ui.colored_label(Color32::LIGHT_RED, format!("!= the frame's pixel {} (a replay bug: please report)", fmt3(f)));
+        }
+        _ => {
+            ui.label(RichText::new("the frame is still rendering").color(DIM));
+        }
+    }
+    let exposure = app.params.render.exposure;
+    let d = crate::image_io::display_pixel(radiance, exposure, app.gamma);
+    ui.horizontal(|ui| {
+        let (r, _) = ui.allocate_exact_size(egui::vec2(18.0, 18.0), egui::Sense::hover());
+        ui.painter().rect_filled(r, 2.0, Color32::from_rgb(d[0], d[1], d[2]));
+        ui.monospace(format!(
+            "displayed [{}, {}, {}] (exposure {exposure}, {})",
+            d[0],
+            d[1],
+            d[2],
+            if app.gamma { "sRGB" } else { "no gamma" }
+        ));
+    });
+}
