@@ -121,6 +121,17 @@ struct RenderOpts {
     /// --shadows map: depth bias in texels, slope-scaled (too small: acne; too large: peter-panning).
     #[arg(long = "shadow-bias", value_name = "B")]
     shadow_bias: Option<f32>,
+    /// Rasterizers: coverage samples per pixel with one shade per pixel per
+    /// primitive: 1 (off), 2, 4 or 8. Ray casters ignore it (use --spp).
+    #[arg(long, default_value_t = 1, value_name = "N")]
+    msaa: u32,
+    /// Rasterizers: depth pass first, then one shade per pixel (false: forward shading).
+    #[arg(long = "early-depth", value_name = "BOOL", default_value_t = true, action = clap::ArgAction::Set)]
+    early_depth: bool,
+    /// Rasterizers: forward shading, every fragment that passes the depth test
+    /// is shaded (the same as --early-depth false).
+    #[arg(long)]
+    forward: bool,
 }
 
 /// Parses the arguments and runs the command.
@@ -212,6 +223,11 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
         }
         settings.shadow_map_bias = b;
     }
+    if !render::raster::msaa::COUNTS.contains(&opts.msaa) {
+        return Err(format!("--msaa {} is not one of 1, 2, 4, 8", opts.msaa));
+    }
+    settings.msaa = opts.msaa;
+    settings.early_depth = opts.early_depth && !opts.forward;
     let prepared = pool.install(|| PreparedScene::new(scene));
     Ok(Loaded { prepared, settings, renderer, pool, load_ms })
 }
@@ -242,6 +258,8 @@ fn stats_json(l: &Loaded, render_ms: f64, counts: &RayCounts, spp: u32) -> serde
         "shadows": l.settings.shadows.name(),
         "view": l.settings.view.name(),
         "interpolation": l.settings.interpolation.name(),
+        "early_depth": l.settings.early_depth,
+        "msaa": l.settings.msaa,
         "shadow_map_size": l.settings.shadow_map_size,
         "shadow_map_bias": l.settings.shadow_map_bias,
         "shadow_map_ms": (l.settings.shadows == ShadowMode::Map).then(|| l.prepared.shadow_maps(l.settings.shadow_map_size).build_ms),
@@ -433,6 +451,8 @@ fn cmd_list() {
     }
     println!("  {:24} = {}", "raytrace", render::DEFAULT_RAYTRACE);
     println!("  {:24} = {}", "rasterize", render::raster::DEFAULT_RASTERIZE);
+    println!("  (rasterizers only: --msaa 2|4|8 coverage samples, one shade per pixel per primitive;");
+    println!("   --forward shades every fragment that passes the depth test instead of early depth)");
     println!("views:");
     for v in View::ALL {
         println!("  {}", v.name());

@@ -75,7 +75,7 @@ fn fragment_json(f: &FragmentRecord) -> Value {
     json!({
         "kind": kind(f.kind), "primitive": f.primitive, "screen_barycentric": f.screen_barycentric.map(v3),
         "barycentric": v3(f.barycentric), "depth": f.depth, "stored_depth": finite_or_null(f.stored_depth),
-        "depth_test": if f.passed_depth_test { "passed" } else { "failed" }, "shaded": f.shaded.map(v3),
+        "depth_test": if f.passed_depth_test { "passed" } else { "failed" }, "shaded": f.shaded.map(v3), "msaa_sample": f.sample,
     })
 }
 
@@ -119,6 +119,8 @@ pub fn to_text(renderer: &str, scene: &Scene, x: u32, y: u32, replay: &PixelRepl
             if !r.nodes_visited.is_empty() {
                 let _ = writeln!(s, "{indent}  BVH nodes visited: {}", r.nodes_visited.len());
             }
+            // A rasterizer's eye ray tests nothing: its visibility is the fragment history.
+            let rasterized = r.depth == 0 && r.tests.is_empty() && r.tests_omitted == 0 && !t.fragments.is_empty();
             let hits = r.tests.iter().filter(|t| t.outcome.is_ok()).count();
             let mut reasons: std::collections::BTreeMap<&str, usize> = Default::default();
             for t in &r.tests {
@@ -126,14 +128,16 @@ pub fn to_text(renderer: &str, scene: &Scene, x: u32, y: u32, replay: &PixelRepl
                     *reasons.entry(miss_reason(m)).or_default() += 1;
                 }
             }
-            let _ = writeln!(
-                s,
-                "{indent}  primitives tested: {} ({hits} hit{}{}){}",
-                r.tests.len() + r.tests_omitted,
-                if hits == 1 { "" } else { "s" },
-                reasons.iter().map(|(k, v)| format!(", {v} {k}")).collect::<String>(),
-                if r.tests_omitted > 0 { format!(", {} not kept", r.tests_omitted) } else { String::new() }
-            );
+            if !rasterized {
+                let _ = writeln!(
+                    s,
+                    "{indent}  primitives tested: {} ({hits} hit{}{}){}",
+                    r.tests.len() + r.tests_omitted,
+                    if hits == 1 { "" } else { "s" },
+                    reasons.iter().map(|(k, v)| format!(", {v} {k}")).collect::<String>(),
+                    if r.tests_omitted > 0 { format!(", {} not kept", r.tests_omitted) } else { String::new() }
+                );
+            }
             for t in r.tests.iter().filter(|t| t.outcome.is_ok()) {
                 if let Ok((tt, b1, b2)) = t.outcome {
                     let _ = writeln!(s, "{indent}    {} {} hit at t = {tt:.6}, b = ({:.4}, {b1:.4}, {b2:.4})", kind(t.kind), t.index, 1.0 - b1 - b2);
@@ -160,17 +164,24 @@ pub fn to_text(renderer: &str, scene: &Scene, x: u32, y: u32, replay: &PixelRepl
                 }
             }
         }
-        for f in &t.fragments {
+        if !t.fragments.is_empty() {
+            let _ = writeln!(s, "  fragment history ({} fragment(s) in draw order; z = view depth):", t.fragments.len());
+        }
+        for (n, f) in t.fragments.iter().enumerate() {
+            let sample = f.sample.map(|k| format!(" [MSAA sample {k}]")).unwrap_or_default();
             let _ = writeln!(
                 s,
-                "  fragment: {} {} depth {:.6} vs stored {:.6}: {}  b = {}",
+                "    {}. {} {}{sample}: z {:.6} vs stored {:.6}: depth test {}",
+                n + 1,
                 kind(f.kind),
                 f.primitive,
                 f.depth,
                 f.stored_depth,
                 if f.passed_depth_test { "passed" } else { "failed" },
-                fmt3(f.barycentric)
             );
+            let screen = f.screen_barycentric.map(|w| format!("2D weights {}, ", fmt3(w))).unwrap_or_default();
+            let shaded = f.shaded.map(|c| format!(", shaded {}", fmt3(c))).unwrap_or_default();
+            let _ = writeln!(s, "       {screen}perspective-correct b {}{shaded}", fmt3(f.barycentric));
         }
         for l in &t.lights {
             let blocked = match l.blocker {

@@ -24,8 +24,14 @@ pub enum View {
     Id,
     /// A checker in texture coordinates.
     Uv,
-    /// Work per pixel as a heat map: BVH nodes visited plus primitives tested by
-    /// the eye ray (ray tracers); triangles tested, fragments shaded (rasterizers).
+    /// Work per pixel as a heat map (`cost_color`, the same scale for all):
+    /// ray casters count BVH nodes visited plus primitives tested by the eye
+    /// ray; rasterizers count, per pixel and pass, samples tested (one per
+    /// primitive whose tested region - whole image, bounding box, span or
+    /// block - holds the pixel's sample), plus fragments (covered samples,
+    /// each depth-tested; those that fail are the overdraw), plus fragments
+    /// shaded (one with early depth, one per depth-test pass when forward).
+    /// With MSAA the work of every coverage sample and the shading layer adds up.
     Cost,
     /// This renderer's shaded image minus the reference `raytrace:brute`'s:
     /// red where brighter, blue where darker (amplified), the rest dimmed.

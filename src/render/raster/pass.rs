@@ -253,23 +253,24 @@ pub fn render(method: Method, job: &PassJob, out: &mut [Radiance]) -> RayCounts 
         .reduce(RayCounts::default, sum)
 }
 
-/// Replays pixel `(x, y)` of the pass `render` draws for `job` (whose rows
-/// hold `y`; frames render all rows in one job), recording its fragment
+/// Replays pixel `(x, y)` of the pass `render` draws for all rows of the
+/// image (as `render_frame` does), recording its fragment
 /// history and shading into `rec`. Returns the value `render` stores there.
 pub fn trace(method: Method, job: &PassJob, x: u32, y: u32, rec: &mut PixelTrace) -> Radiance {
     let (width, height) = (job.view.width, job.view.height);
     let query = query(job.prepared);
-    // Only the triangles reaching row y are set up. Band variants rasterize
-    // that row (a pixel's coverage and values do not depend on its band);
-    // tiled rasterizes the pixel's tile of the frame's grid, as the frame does.
-    let row = job_at(job, job.offset, y..y + 1);
+    // The pass is set up as a frame sets it up (all rows: `render_frame`
+    // renders each pass in one job); band variants then rasterize only the
+    // pixel's row of its band (a pixel's coverage and values do not depend on
+    // the rows around it), tiled the pixel's whole tile.
+    let frame = job_at(job, job.offset, 0..height);
     let grid = TileGrid::new(width, 0, height);
-    let layers = layers(method, &row, &grid);
+    let layers = layers(method, &frame, &grid);
     let (rect, region) = if method == Method::Tiled {
         let t = (y / tiled::TILE * grid.nx + x / tiled::TILE) as usize;
         (grid.rect(t), t)
     } else {
-        (PixelRect::new(0, y, width, y + 1), 0)
+        (PixelRect::new(0, y, width, y + 1), (y / BAND_ROWS) as usize)
     };
     let (key, forward) = (depth_key(method), forward(job));
     let mut vbs: Vec<_> = layers
