@@ -107,6 +107,9 @@ pub fn replay_pixel(renderer: &dyn Renderer, prepared: &PreparedScene, settings:
     if x >= settings.width || y >= settings.height {
         return Err(format!("pixel ({x}, {y}) is outside the {}x{} image", settings.width, settings.height));
     }
+    if settings.shadows == super::ShadowMode::Map || settings.view == super::debug::View::Shadowmap {
+        prepared.shadow_maps(settings.shadow_map_size);
+    }
     let view = prepared.scene.camera.view(settings.width, settings.height);
     let cancel = AtomicBool::new(false);
     let spp = settings.spp.max(1);
