@@ -645,3 +645,43 @@ pub fn view_sample<R: Recorder>(job: &PassJob, ray: &Ray, rec: &mut R) -> Radian
     rec.shaded(0, c);
     c
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cube_faces_by_major_axis() {
+        assert_eq!(cube_face(Vec3::new(2.0, 1.0, -1.0)), 0);
+        assert_eq!(cube_face(Vec3::new(-2.0, 1.0, -1.0)), 1);
+        assert_eq!(cube_face(Vec3::new(0.1, 3.0, -1.0)), 2);
+        assert_eq!(cube_face(Vec3::new(0.1, -3.0, -1.0)), 3);
+        assert_eq!(cube_face(Vec3::new(0.1, 0.2, 0.5)), 4);
+        assert_eq!(cube_face(Vec3::new(0.1, 0.2, -0.5)), 5);
+    }
+
+    #[test]
+    fn sphere_entry_by_hand() {
+        // Unit sphere 5 ahead on the axis: entered at 4 from outside; from the
+        // centre, left at 1; a line 0.6 off the axis enters at 5 - 0.8.
+        let c = Vec3::new(0.0, 0.0, -5.0);
+        assert!((sphere_entry(Vec3::ZERO, Vec3::NEG_Z, c, 1.0, false).unwrap() - 4.0).abs() < 1e-6);
+        assert!((sphere_entry(c, Vec3::NEG_Z * 3.0, c, 1.0, false).unwrap() - 1.0).abs() < 1e-6);
+        assert!((sphere_entry(Vec3::new(0.6, 0.0, 0.0), Vec3::NEG_Z, c, 1.0, true).unwrap() - 4.2).abs() < 1e-6);
+        assert_eq!(sphere_entry(Vec3::new(1.5, 0.0, 0.0), Vec3::NEG_Z, c, 1.0, false), None);
+        // Behind a perspective ray's origin: not seen.
+        assert_eq!(sphere_entry(Vec3::ZERO, Vec3::Z, c, 1.0, false), None);
+    }
+
+    #[test]
+    fn caster_bounds_leave_out_huge_primitives() {
+        let mut scene = Scene::default();
+        scene.spheres.push(Sphere { center: Vec3::new(0.0, -1000.0, 0.0), radius: 999.0, material: 0, object: 0 });
+        scene.spheres.push(Sphere { center: Vec3::new(1.0, 0.0, 0.0), radius: 0.5, material: 0, object: 1 });
+        let (lo, hi) = caster_bounds(&scene).unwrap();
+        assert_eq!((lo, hi), (Vec3::new(0.5, -0.5, -0.5), Vec3::new(1.5, 0.5, 0.5)));
+        // Only huge primitives: none left, the caller falls back to the whole scene.
+        scene.spheres.pop();
+        assert_eq!(caster_bounds(&scene), None);
+    }
+}
