@@ -8,6 +8,7 @@
 //! view (`render_pass`, primary rays only) and the shaded frame with shadow rays.
 
 use pinhole::render::raytrace::bvh::{Bvh, BvhQuery, BvhRayTracer};
+use pinhole::render::raytrace::packet::{self, Packet, TILE_H, TILE_W};
 use pinhole::render::trace::NoRecord;
 use pinhole::render::{debug::View, PassJob, PreparedScene, RayCounts, RenderSettings, Renderer, SceneQuery, ShadowMode};
 use pinhole::math::{Radiance, Vec2};
@@ -61,6 +62,35 @@ fn main() {
                 .sum();
         });
 
+        // The same rays as packets of TILE_W x TILE_H pixels (what render_pass does).
+        let mut packet_hits = 0u64;
+        let packets = best_of(reps, || {
+            packet_hits = (0..h.div_ceil(TILE_H as u32))
+                .into_par_iter()
+                .map(|band| {
+                    let mut counts = RayCounts::default();
+                    let mut pk = Packet::new();
+                    let mut n = 0u64;
+                    for x0 in (0..w).step_by(TILE_W) {
+                        let mut valid = 0u64;
+                        for i in 0..TILE_W * TILE_H {
+                            let (tx, ty) = packet::lane_xy(i);
+                            let (x, y) = (x0 + tx as u32, band * TILE_H as u32 + ty as u32);
+                            if x < w && y < h {
+                                let (px, py) = (x as f32 + 0.5, y as f32 + 0.5);
+                                pk.rays[i] = view.eye_ray(px, py);
+                                pk.t_max[i] = view.far_t(px, py);
+                                valid |= 1 << i;
+                            }
+                        }
+                        query.closest_packet(&mut pk, valid, &mut counts);
+                        n += pk.hit_count(valid) as u64;
+                    }
+                    n
+                })
+                .sum();
+        });
+
         let cancel = AtomicBool::new(false);
         let mut out = vec![Radiance::ZERO; (w * h) as usize];
         let mut pass = |view_kind: View, shadows: ShadowMode| {
@@ -75,7 +105,7 @@ fn main() {
         let (depth, dc) = pass(View::Depth, ShadowMode::None);
         let (shaded, sc) = pass(View::Shaded, ShadowMode::Ray);
         println!(
-            "pinhole {} tris={} {}x{} threads={} nodes={} depth={} build_ms={:.1} bare_ms={:.1} bare_mrays_per_s={:.2} hits={} \
+            "pinhole {} tris={} {}x{} threads={} nodes={} depth={} build_ms={:.1} bare_ms={:.1} bare_mrays_per_s={:.2} hits={} packet_ms={:.1} packet_mrays_per_s={:.2} packet_hits={} \
              depth_view_ms={:.1} depth_view_mrays_per_s={:.2} nodes_per_ray={:.1} tests_per_ray={:.1} shaded_ms={:.1} shaded_mrays_per_s={:.2} (primary+shadow)",
             Path::new(&path).file_stem().unwrap().to_string_lossy(),
             prepared.edges.len(),
@@ -88,6 +118,9 @@ fn main() {
             bare * 1e3,
             rays / bare / 1e6,
             hits,
+            packets * 1e3,
+            rays / packets / 1e6,
+            packet_hits,
             depth * 1e3,
             rays / depth / 1e6,
             dc.nodes as f64 / rays,

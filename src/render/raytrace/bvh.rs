@@ -18,7 +18,7 @@
 //! child word that is either a node index or a leaf (first primitive, count).
 
 use super::brute::make_hit;
-use super::{cast_pass, cast_pixel};
+use super::cast_pixel;
 use super::intersect::{intersect_sphere, intersect_triangle, TriangleEdges};
 use crate::math::{Radiance, Ray};
 use crate::render::trace::{PixelTrace, PrimitiveTest, Recorder};
@@ -28,7 +28,7 @@ use glam::{Vec3, Vec3A, Vec4};
 
 /// Primitive ids: triangle index, or sphere index with this bit set. Ordering
 /// the ids as integers orders primitives as brute force scans them.
-const SPHERE_BIT: u32 = 1 << 31;
+pub(super) const SPHERE_BIT: u32 = 1 << 31;
 const BINS: usize = 32;
 /// Leaves never hold more than this; the SAH decides below it.
 const MAX_LEAF: usize = 8;
@@ -42,12 +42,12 @@ const PARALLEL_MIN: usize = 4096;
 const MEDIAN_DEPTH: u32 = 32;
 /// Traversal stack entries kept on the machine stack; deeper trees (which
 /// need more than 3 per level) use a heap stack instead.
-const STACK: usize = 64;
+pub(super) const STACK: usize = 64;
 /// Child words with this bit set are leaves: first primitive << 3 | count - 1.
-const LEAF_BIT: u32 = 1 << 31;
+pub(super) const LEAF_BIT: u32 = 1 << 31;
 /// The slab test's far distance is stretched by this factor (and the near
 /// one shrunk) to absorb its rounding and that of the primitive tests.
-const SLAB_WIDEN: f32 = 1.0e-5;
+pub(super) const SLAB_WIDEN: f32 = 1.0e-5;
 
 /// An axis-aligned box.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -256,29 +256,29 @@ fn build_rec(refs: &mut [PrimRef], first: u32, depth: u32, max_depth: &mut u32) 
 /// y, min z, max z), one lane per child, and the children's words.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
-struct Node4 {
-    planes: [Vec4; 6],
-    child: [u32; 4],
+pub(super) struct Node4 {
+    pub(super) planes: [Vec4; 6],
+    pub(super) child: [u32; 4],
     /// Bit i set when child slot i is used.
-    valid: u32,
+    pub(super) valid: u32,
     _pad: [u32; 3],
 }
 
 /// The hierarchy: 4-wide nodes, with the primitives in leaf order.
 pub struct Bvh {
-    nodes: Vec<Node4>,
+    pub(super) nodes: Vec<Node4>,
     /// The root's word: node 0, or a leaf when the scene is tiny.
-    root: u32,
-    root_bounds: Aabb,
+    pub(super) root: u32,
+    pub(super) root_bounds: Aabb,
     /// Per primitive slot: the triangle's edges (unused for spheres) and the
     /// primitive id (triangle index, or sphere index | SPHERE_BIT).
-    prims: Vec<(TriangleEdges, u32)>,
+    pub(super) prims: Vec<(TriangleEdges, u32)>,
     /// For the debugger: each node's own bounds, and each leaf's (by first slot).
     node_bounds: Vec<Aabb>,
     leaf_bounds: Vec<(u32, Aabb)>,
     depth: u32,
     /// True when a traversal may need more than `STACK` entries.
-    deep: bool,
+    pub(super) deep: bool,
 }
 
 fn aabb(b: Bounds) -> Aabb {
@@ -292,7 +292,7 @@ fn leaf_word(first: u32, count: u32) -> u32 {
 }
 
 #[inline(always)]
-fn leaf_range(word: u32) -> (usize, usize) {
+pub(super) fn leaf_range(word: u32) -> (usize, usize) {
     let first = ((word & !LEAF_BIT) >> 3) as usize;
     (first, first + (word & 7) as usize + 1)
 }
@@ -455,19 +455,19 @@ impl Bvh {
 }
 
 #[inline(always)]
-fn decode(id: u32) -> (PrimitiveKind, u32) {
+pub(super) fn decode(id: u32) -> (PrimitiveKind, u32) {
     if id & SPHERE_BIT == 0 { (PrimitiveKind::Triangle, id) } else { (PrimitiveKind::Sphere, id & !SPHERE_BIT) }
 }
 
 /// The ray, prepared for 4-wide slab tests.
-struct RayPre {
-    origin: [Vec4; 3],
-    inv: [Vec4; 3],
+pub(super) struct RayPre {
+    pub(super) origin: [Vec4; 3],
+    pub(super) inv: [Vec4; 3],
 }
 
 impl RayPre {
     #[inline(always)]
-    fn new(ray: &Ray) -> RayPre {
+    pub(super) fn new(ray: &Ray) -> RayPre {
         // A zero (or denormal) component gets a huge finite inverse, so the
         // slab test never computes 0 * inf.
         let fix = |d: f32| {
@@ -492,7 +492,8 @@ impl RayPre {
     }
 
     /// The same test for one box (the root's).
-    fn slab1(&self, b: &Aabb, t_far: f32) -> bool {
+    #[inline(always)]
+    pub(super) fn slab1(&self, b: &Aabb, t_far: f32) -> bool {
         let mut t = (0.0f32, t_far);
         for axis in 0..3 {
             let o = self.origin[axis].x;
@@ -512,14 +513,15 @@ trait Stack {
 }
 
 struct ArrayStack {
-    items: [(u32, f32); STACK],
+    /// Entries below `len` are initialised (no per-ray clearing of the array).
+    items: [std::mem::MaybeUninit<(u32, f32)>; STACK],
     len: usize,
 }
 
 impl Stack for ArrayStack {
     #[inline(always)]
     fn push(&mut self, word: u32, t: f32) {
-        self.items[self.len] = (word, t);
+        self.items[self.len] = std::mem::MaybeUninit::new((word, t));
         self.len += 1;
     }
     #[inline(always)]
@@ -528,7 +530,8 @@ impl Stack for ArrayStack {
             return None;
         }
         self.len -= 1;
-        Some(self.items[self.len])
+        // SAFETY: every entry below the old `len` was written by `push`.
+        Some(unsafe { self.items[self.len].assume_init() })
     }
 }
 
@@ -543,7 +546,7 @@ impl Stack for Vec<(u32, f32)> {
 
 /// Closest-hit and shadow queries through the scene's BVH.
 pub struct BvhQuery<'a> {
-    prepared: &'a PreparedScene,
+    pub(super) prepared: &'a PreparedScene,
 }
 
 impl<'a> BvhQuery<'a> {
@@ -568,7 +571,7 @@ impl<'a> BvhQuery<'a> {
         if bvh.deep {
             self.traverse_with::<ANY, R, _>(ray, t_max, inside, counts, rec, &mut Vec::new())
         } else {
-            let mut stack = ArrayStack { items: [(0, 0.0); STACK], len: 0 };
+            let mut stack = ArrayStack { items: [const { std::mem::MaybeUninit::uninit() }; STACK], len: 0 };
             self.traverse_with::<ANY, R, _>(ray, t_max, inside, counts, rec, &mut stack)
         }
     }
@@ -723,7 +726,7 @@ impl Renderer for BvhRayTracer {
     }
 
     fn render_pass(&self, job: &PassJob, out: &mut [Radiance]) -> RayCounts {
-        cast_pass(job, &BvhQuery::new(job.prepared), out)
+        super::packet::cast_pass_packets(job, &BvhQuery::new(job.prepared), out)
     }
 
     fn trace_pixel(&self, job: &PassJob, x: u32, y: u32, rec: &mut PixelTrace) -> Option<Radiance> {

@@ -5,6 +5,7 @@
 pub mod brute;
 pub mod bvh;
 pub mod intersect;
+pub mod packet;
 
 use super::trace::{NoRecord, Recorder};
 use super::{resolve_sample, PassJob, RayCounts, SceneQuery};

@@ -1,0 +1,424 @@
+//! Eye rays traced as packets: the rays of a TILE_W x TILE_H pixel tile walk
+//! the 4-wide BVH together. Each node is fetched once per packet and its four
+//! child boxes are tested against four rays at a time (one SIMD lane per
+//! ray), so the per-ray latency chain of single-ray traversal becomes
+//! independent work the CPU overlaps.
+//!
+//! Every ray ends with exactly the hit `BvhQuery::closest` finds for it alone:
+//! - a ray enters a node only when its own slab test (the same arithmetic as
+//!   the single-ray test, lane by lane) accepts the box;
+//! - leaves test only those rays, with the same primitive tests and the same
+//!   tie rule (on equal t the lower primitive id wins), so the order in which
+//!   the packet visits nodes cannot change any ray's winner; the padded boxes
+//!   guarantee no true hit is culled by a box test in either traversal.
+//!
+//! `trace_pixel` replays a pixel through the single-ray path; the hits being
+//! identical and the shading code the same, the replay equals the frame.
+
+use super::brute::make_hit;
+use super::bvh::{decode, leaf_range, BvhQuery, Node4, RayPre, LEAF_BIT, SLAB_WIDEN, SPHERE_BIT, STACK};
+use super::cast_pass;
+use super::intersect::{intersect_sphere, intersect_triangle};
+use crate::math::{Radiance, Ray};
+use crate::render::debug::View;
+use crate::render::trace::NoRecord;
+use crate::render::{resolve_sample, PassJob, RayCounts};
+use crate::scene::SurfaceHit;
+use glam::{Vec3, Vec4};
+use rayon::prelude::*;
+use std::mem::MaybeUninit;
+
+pub const TILE_W: usize = 8;
+pub const TILE_H: usize = 8;
+/// Rays per packet, and groups of four (one SIMD register) per packet.
+const P: usize = TILE_W * TILE_H;
+const _: () = assert!(P <= 64 && TILE_W % 2 == 0 && TILE_H % 2 == 0);
+
+/// Per lane: +inf where the lane is active, -inf where not. `min` with a
+/// ray's far distance keeps it for active rays and makes every box test
+/// fail for the others.
+const LANE_FAR: [Vec4; 16] = {
+    let mut t = [Vec4::ZERO; 16];
+    let mut m = 0;
+    while m < 16 {
+        let mut l = [f32::NEG_INFINITY; 4];
+        let mut bit = 0;
+        while bit < 4 {
+            if m & (1 << bit) != 0 {
+                l[bit] = f32::INFINITY;
+            }
+            bit += 1;
+        }
+        t[m] = Vec4::new(l[0], l[1], l[2], l[3]);
+        m += 1;
+    }
+    t
+};
+
+#[derive(Clone, Copy)]
+#[repr(C, align(16))]
+struct Lanes([f32; P]);
+
+impl Lanes {
+    #[inline(always)]
+    fn group(&self, g: usize) -> Vec4 {
+        Vec4::from_slice(&self.0[g * 4..g * 4 + 4])
+    }
+}
+
+/// Image position within the tile of lane `i`: each group of four lanes is a
+/// 2x2 quad, so a group's rays are as close together as they can be.
+#[inline(always)]
+pub fn lane_xy(i: usize) -> (usize, usize) {
+    let (g, q) = (i / 4, i % 4);
+    (2 * (g % (TILE_W / 2)) + (q & 1), 2 * (g / (TILE_W / 2)) + (q >> 1))
+}
+
+/// The rays of one packet and their traversal state, structure of arrays.
+pub struct Packet {
+    pub rays: [Ray; P],
+    pub t_max: [f32; P],
+    origin: [Lanes; 3],
+    inv: [Lanes; 3],
+    /// The closest hit so far (t_max until one is found): the far end of the box tests.
+    best_t: Lanes,
+    /// Primitive tests accept t < limit: just above best_t once something is
+    /// hit, so an equal-t hit on an earlier primitive can still win the tie.
+    limit: [f32; P],
+    best_id: [u32; P],
+    bary: [(f32, f32); P],
+}
+
+impl Packet {
+    pub fn new() -> Box<Packet> {
+        let ray = Ray::new(Vec3::ZERO, Vec3::Z);
+        let zero = Lanes([0.0; P]);
+        Box::new(Packet {
+            rays: [ray; P],
+            t_max: [0.0; P],
+            origin: [zero; 3],
+            inv: [zero; 3],
+            best_t: zero,
+            limit: [0.0; P],
+            best_id: [u32::MAX; P],
+            bary: [(0.0, 0.0); P],
+        })
+    }
+
+    /// How many of the rays in `valid` hit something.
+    pub fn hit_count(&self, valid: u64) -> u32 {
+        (0..P).filter(|&i| valid & 1 << i != 0 && self.best_id[i] != u32::MAX).count() as u32
+    }
+
+    /// The hit of lane `i` after `closest_packet`, as `closest` returns it.
+    #[inline]
+    pub fn hit(&self, query: &BvhQuery, i: usize) -> Option<SurfaceHit> {
+        let id = self.best_id[i];
+        if id == u32::MAX {
+            return None;
+        }
+        let (kind, index) = decode(id);
+        let (b1, b2) = self.bary[i];
+        Some(make_hit(query.prepared, kind, index, self.best_t.0[i], b1, b2, &self.rays[i]))
+    }
+}
+
+/// The ranges of the packet's origins and inverse directions, per axis: a
+/// box test on them (interval arithmetic) bounds every ray's own box test.
+/// Floating-point operations are monotone, so the bounds hold for the
+/// computed values too, not only the exact ones.
+struct PacketBounds {
+    o_lo: [Vec4; 3],
+    o_hi: [Vec4; 3],
+    inv_lo: [Vec4; 3],
+    inv_hi: [Vec4; 3],
+}
+
+impl PacketBounds {
+    fn new(pk: &Packet, mask: u64) -> PacketBounds {
+        let mut lo = [f32::INFINITY; 6];
+        let mut hi = [f32::NEG_INFINITY; 6];
+        let mut m = mask;
+        while m != 0 {
+            let i = m.trailing_zeros() as usize;
+            m &= m - 1;
+            for a in 0..3 {
+                let (o, v) = (pk.origin[a].0[i], pk.inv[a].0[i]);
+                lo[a] = lo[a].min(o);
+                hi[a] = hi[a].max(o);
+                lo[3 + a] = lo[3 + a].min(v);
+                hi[3 + a] = hi[3 + a].max(v);
+            }
+        }
+        let s = |v: &[f32; 6], k: usize| Vec4::splat(v[k]);
+        PacketBounds {
+            o_lo: [s(&lo, 0), s(&lo, 1), s(&lo, 2)],
+            o_hi: [s(&hi, 0), s(&hi, 1), s(&hi, 2)],
+            inv_lo: [s(&lo, 3), s(&lo, 4), s(&lo, 5)],
+            inv_hi: [s(&hi, 3), s(&hi, 4), s(&hi, 5)],
+        }
+    }
+
+    /// The children of `node` (bit mask) that some ray of the packet, with
+    /// far end at most `far_max`, may meet: a superset of every ray's own
+    /// `slab4` mask. NaNs never cull.
+    #[inline(always)]
+    fn children_possible(&self, node: &Node4, far_max: f32) -> u32 {
+        let mut entry = Vec4::ZERO;
+        let mut exit = Vec4::INFINITY;
+        for a in 0..3 {
+            let (p0, p1) = (node.planes[2 * a], node.planes[2 * a + 1]);
+            let (il, ih) = (self.inv_lo[a], self.inv_hi[a]);
+            let (a0l, a0h) = (p0 - self.o_hi[a], p0 - self.o_lo[a]);
+            let (a1l, a1h) = (p1 - self.o_hi[a], p1 - self.o_lo[a]);
+            let (q0, q1, q2, q3) = (a0l * il, a0l * ih, a0h * il, a0h * ih);
+            let (r0, r1, r2, r3) = (a1l * il, a1l * ih, a1h * il, a1h * ih);
+            let near = q0.min(q1).min(q2.min(q3)).min(r0.min(r1).min(r2.min(r3)));
+            let far = q0.max(q1).max(q2.max(q3)).max(r0.max(r1).max(r2.max(r3)));
+            entry = entry.max(near);
+            exit = exit.min(far);
+        }
+        let entry = entry * (1.0 - SLAB_WIDEN);
+        let exit = (exit * (1.0 + SLAB_WIDEN)).min(Vec4::splat(far_max));
+        // Culled only where entry > exit is certain (false for NaN).
+        !entry.cmpgt(exit).bitmask() & node.valid
+    }
+}
+
+impl BvhQuery<'_> {
+    /// Closest hits of the packet's rays whose bit is set in `valid`. The
+    /// tree must not be `deep` (the stack is fixed).
+    pub fn closest_packet(&self, pk: &mut Packet, valid: u64, counts: &mut RayCounts) {
+        let bvh = &self.prepared.bvh;
+        debug_assert!(!bvh.deep);
+        let spheres = &self.prepared.scene.spheres;
+        let mut mask = 0u64;
+        for i in 0..P {
+            pk.best_id[i] = u32::MAX;
+            if valid & 1 << i == 0 {
+                continue;
+            }
+            let r = RayPre::new(&pk.rays[i]);
+            for a in 0..3 {
+                pk.origin[a].0[i] = r.origin[a].x;
+                pk.inv[a].0[i] = r.inv[a].x;
+            }
+            let t_max = pk.t_max[i];
+            pk.best_t.0[i] = t_max;
+            pk.limit[i] = t_max;
+            if !bvh.prims.is_empty() && r.slab1(&bvh.root_bounds, t_max) {
+                mask |= 1 << i;
+            }
+        }
+        if mask == 0 {
+            return;
+        }
+        let bounds = PacketBounds::new(pk, mask);
+        let mut stack: [MaybeUninit<(u32, u64)>; STACK] = [const { MaybeUninit::uninit() }; STACK];
+        let mut len = 0usize;
+        let mut word = bvh.root;
+        let (mut visits, mut tests) = (0u64, 0u64);
+        loop {
+            visits += mask.count_ones() as u64;
+            if word & LEAF_BIT == 0 {
+                let node = &bvh.nodes[word as usize];
+                let mut child_mask = [0u64; 4];
+                let mut child_near = [f32::INFINITY; 4];
+                // The groups with an active ray, and their lanes' far ends.
+                let mut groups = [(0usize, Vec4::ZERO); P / 4];
+                let mut n_groups = 0;
+                for g in 0..P / 4 {
+                    let gmask = (mask >> (4 * g)) as usize & 15;
+                    groups[n_groups] = (g, pk.best_t.group(g).min(LANE_FAR[gmask]));
+                    n_groups += (gmask != 0) as usize;
+                }
+                // Interval test: the children no ray of the packet can meet.
+                let far_max = groups[..n_groups].iter().fold(Vec4::NEG_INFINITY, |m, g| m.max(g.1)).max_element();
+                let mut valid_children = bounds.children_possible(node, far_max);
+                while valid_children != 0 {
+                    let c = valid_children.trailing_zeros() as usize;
+                    valid_children &= valid_children - 1;
+                    let plane = |k: usize| Vec4::splat(node.planes[k].as_ref()[c]);
+                    let (px0, px1, py0, py1, pz0, pz1) = (plane(0), plane(1), plane(2), plane(3), plane(4), plane(5));
+                    let mut near = Vec4::INFINITY;
+                    let mut bits_all = 0u64;
+                    for &(g, t_far) in &groups[..n_groups] {
+                        let (ox, oy, oz) = (pk.origin[0].group(g), pk.origin[1].group(g), pk.origin[2].group(g));
+                        let (ix, iy, iz) = (pk.inv[0].group(g), pk.inv[1].group(g), pk.inv[2].group(g));
+                        // Lane by lane the single-ray slab test (RayPre::slab4).
+                        let (x0, x1) = ((px0 - ox) * ix, (px1 - ox) * ix);
+                        let (y0, y1) = ((py0 - oy) * iy, (py1 - oy) * iy);
+                        let (z0, z1) = ((pz0 - oz) * iz, (pz1 - oz) * iz);
+                        let tn = x0.min(x1).max(y0.min(y1)).max(z0.min(z1)).max(Vec4::ZERO) * (1.0 - SLAB_WIDEN);
+                        let tf = (x0.max(x1).min(y0.max(y1)).min(z0.max(z1)) * (1.0 + SLAB_WIDEN)).min(t_far);
+                        let hit = tn.cmple(tf);
+                        bits_all |= (hit.bitmask() as u64) << (4 * g);
+                        near = near.min(Vec4::select(hit, tn, Vec4::INFINITY));
+                    }
+                    child_mask[c] = bits_all;
+                    child_near[c] = near.min_element();
+                }
+                // Nearest child next; the others pushed farthest first.
+                let mut order = [(0u32, 0u64, 0.0f32); 4];
+                let mut k = 0;
+                for c in 0..4 {
+                    if child_mask[c] == 0 {
+                        continue;
+                    }
+                    let item = (node.child[c], child_mask[c], child_near[c]);
+                    let mut j = k;
+                    while j > 0 && order[j - 1].2 < item.2 {
+                        order[j] = order[j - 1];
+                        j -= 1;
+                    }
+                    order[j] = item;
+                    k += 1;
+                }
+                if k > 0 {
+                    for &(w, m, _) in &order[..k - 1] {
+                        stack[len] = MaybeUninit::new((w, m));
+                        len += 1;
+                    }
+                    (word, mask) = (order[k - 1].0, order[k - 1].1);
+                    continue;
+                }
+            } else {
+                let (start, end) = leaf_range(word);
+                let prims = &bvh.prims[start..end];
+                let mut m = mask;
+                while m != 0 {
+                    let i = m.trailing_zeros() as usize;
+                    m &= m - 1;
+                    let ray = &pk.rays[i];
+                    let (mut best_t, mut limit, mut best_id) = (pk.best_t.0[i], pk.limit[i], pk.best_id[i]);
+                    let mut bary = pk.bary[i];
+                    for (tri, id) in prims {
+                        let id = *id;
+                        tests += 1;
+                        let found = if id & SPHERE_BIT == 0 {
+                            intersect_triangle(ray, tri, limit).ok()
+                        } else {
+                            intersect_sphere(ray, &spheres[(id & !SPHERE_BIT) as usize], limit, false).ok().map(|t| (t, 0.0, 0.0))
+                        };
+                        if let Some((t, b1, b2)) = found {
+                            // t <= best_t here; on a tie the lower id (scene order) wins.
+                            if t < best_t || id < best_id {
+                                best_t = t;
+                                best_id = id;
+                                bary = (b1, b2);
+                                limit = f32::from_bits(t.to_bits() + 1);
+                            }
+                        }
+                    }
+                    pk.best_t.0[i] = best_t;
+                    pk.limit[i] = limit;
+                    pk.best_id[i] = best_id;
+                    pk.bary[i] = bary;
+                }
+            }
+            if len == 0 {
+                break;
+            }
+            len -= 1;
+            // SAFETY: entries below the old `len` were written above.
+            (word, mask) = unsafe { stack[len].assume_init() };
+        }
+        counts.nodes += visits;
+        counts.tests += tests;
+    }
+}
+
+/// `cast_pass` for the BVH: the same pixels, eye rays traced a tile at a
+/// time. Bands of TILE_H rows run in parallel. The cost view (per-ray work)
+/// and very deep trees take the single-ray path.
+pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) -> RayCounts {
+    if query.prepared.bvh.deep || job.settings.view == View::Cost {
+        return cast_pass(job, query, out);
+    }
+    let width = job.view.width as usize;
+    out.par_chunks_mut(width * TILE_H)
+        .enumerate()
+        .map(|(b, band)| {
+            let mut counts = RayCounts::default();
+            if job.cancelled() {
+                return counts;
+            }
+            let y0 = job.rows.start as usize + b * TILE_H;
+            let rows = band.len() / width;
+            let mut pk = Packet::new();
+            for x0 in (0..width).step_by(TILE_W) {
+                let mut valid = 0u64;
+                for i in 0..P {
+                    let (tx, ty) = lane_xy(i);
+                    if x0 + tx < width && ty < rows {
+                        let p = job.sample_position((x0 + tx) as u32, (y0 + ty) as u32);
+                        pk.rays[i] = job.view.eye_ray(p.x, p.y);
+                        pk.t_max[i] = job.view.far_t(p.x, p.y);
+                        valid |= 1 << i;
+                    }
+                }
+                counts.primary += valid.count_ones() as u64;
+                query.closest_packet(&mut pk, valid, &mut counts);
+                let mut m = valid;
+                while m != 0 {
+                    let i = m.trailing_zeros() as usize;
+                    m &= m - 1;
+                    let (tx, ty) = lane_xy(i);
+                    let hit = pk.hit(query, i);
+                    band[ty * width + x0 + tx] = resolve_sample(job, query, &pk.rays[i], hit.as_ref(), &mut counts, &mut NoRecord);
+                }
+            }
+            counts
+        })
+        .reduce(RayCounts::default, |mut a, b| {
+            a += b;
+            a
+        })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::Vec2;
+    use crate::render::trace::NoRecord;
+    use crate::render::{PreparedScene, SceneQuery};
+    use crate::scene::builtin;
+
+    /// Every lane's hit is bit for bit the single-ray hit, on every builtin
+    /// scene, with tiles cut by the image edges and off-centre samples.
+    #[test]
+    fn packets_find_the_single_ray_hits() {
+        for name in builtin::names() {
+            let prepared = PreparedScene::new(builtin::load_builtin(name).unwrap().unwrap());
+            if prepared.bvh.deep {
+                continue;
+            }
+            let (w, h) = (61u32, 37u32);
+            let view = prepared.scene.camera.view(w, h);
+            let query = BvhQuery::new(&prepared);
+            let mut pk = Packet::new();
+            let key = |h: &Option<SurfaceHit>| h.as_ref().map(|h| (h.kind, h.primitive, h.t.to_bits(), h.barycentric.to_array().map(f32::to_bits)));
+            for offset in [Vec2::splat(0.5), Vec2::new(0.125, 0.875)] {
+                for y0 in (0..h as usize).step_by(TILE_H) {
+                    for x0 in (0..w as usize).step_by(TILE_W) {
+                        let mut valid = 0u64;
+                        for i in 0..P {
+                            let (x, y) = (x0 + lane_xy(i).0, y0 + lane_xy(i).1);
+                            if x < w as usize && y < h as usize {
+                                let p = Vec2::new(x as f32, y as f32) + offset;
+                                pk.rays[i] = view.eye_ray(p.x, p.y);
+                                pk.t_max[i] = view.far_t(p.x, p.y);
+                                valid |= 1 << i;
+                            }
+                        }
+                        query.closest_packet(&mut pk, valid, &mut RayCounts::default());
+                        for i in (0..P).filter(|i| valid & 1 << i != 0) {
+                            let single = query.closest(&pk.rays[i], pk.t_max[i], false, &mut RayCounts::default(), &mut NoRecord);
+                            assert_eq!(key(&pk.hit(&query, i)), key(&single), "{name}: tile ({x0}, {y0}) lane {i}");
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
