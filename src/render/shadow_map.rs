@@ -170,7 +170,7 @@ impl ShadowMaps {
     /// blocker: kind, index, distance from the point), or `None` when lit.
     /// `bias` is in texels, slope-scaled (module documentation).
     pub fn occluder(&self, scene: &Scene, light: usize, hit: &SurfaceHit, w_i: Vec3, bias: f32) -> Option<(PrimitiveKind, u32, f32)> {
-        let map = self.maps.get(light)?;
+        let map = self.maps.get(light).filter(|m| !m.faces.is_empty())?;
         // The same point a shadow ray would leave from (lifted on smooth triangles).
         let p = super::shade::shadow_origin(scene, hit);
         let n = self.size as f32;
@@ -683,5 +683,19 @@ mod tests {
         // Only huge primitives: none left, the caller falls back to the whole scene.
         scene.spheres.pop();
         assert_eq!(caster_bounds(&scene), None);
+    }
+
+    #[test]
+    fn a_scene_without_geometry_has_empty_maps_and_no_shadows() {
+        let mut scene = Scene::default();
+        scene.lights.push(Light::Point { position: Vec3::ZERO, power: Vec3::ONE });
+        let maps = ShadowMaps::build(&scene, 16, false);
+        assert!(maps.maps[0].faces.is_empty());
+        let hit = SurfaceHit {
+            position: Vec3::NEG_Y, geometric_normal: Vec3::Y, shading_normal: Vec3::Y, barycentric: Vec3::ZERO, uv: Vec2::ZERO, t: 1.0,
+            kind: PrimitiveKind::Sphere, primitive: 0, object: 0, material: 0, back_face: false,
+        };
+        assert_eq!(maps.occluder(&scene, 0, &hit, Vec3::Y, 1.0), None);
+        assert!(maps.view_color(Vec2::new(1.0, 1.0), 10, 10).is_finite());
     }
 }
