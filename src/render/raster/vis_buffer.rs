@@ -316,9 +316,10 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         self.color[i] = self.shade(i, x, y);
     }
 
-    /// The eye ray of pixel `(x, y)`'s sample, its far bound, and the
-    /// `SurfaceHit` of what the buffer says it sees.
-    fn eye_hit(&self, i: usize, x: u32, y: u32) -> (Ray, f32, Option<SurfaceHit>) {
+    /// The eye ray of pixel `(x, y)`'s sample and the `SurfaceHit` of what
+    /// the buffer says it sees.
+    #[inline(always)]
+    fn eye_hit(&self, i: usize, x: u32, y: u32) -> (Ray, Option<SurfaceHit>) {
         let p = self.job.sample_position(x, y);
         let ray = self.job.view.eye_ray(p.x, p.y);
         let id = self.id[i];
@@ -340,14 +341,20 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             };
             Some(scene.triangle_hit(id, b, t, &ray))
         };
-        (ray, self.job.view.far_t(p.x, p.y), hit)
+        (ray, hit)
+    }
+
+    /// The far bound of pixel `(x, y)`'s eye ray (for the record).
+    fn far_t(&self, x: u32, y: u32) -> f32 {
+        let p = self.job.sample_position(x, y);
+        self.job.view.far_t(p.x, p.y)
     }
 
     /// Hands what pixel index `i` sees to the shared shading (recorded for the focus pixel).
     pub fn shade(&mut self, i: usize, x: u32, y: u32) -> Radiance {
-        let (ray, t_max, hit) = self.eye_hit(i, x, y);
+        let (ray, hit) = self.eye_hit(i, x, y);
         if self.is_focus(x, y) {
-            self.rec.ray(&ray, t_max, 0);
+            self.rec.ray(&ray, self.far_t(x, y), 0);
             self.rec.closest(hit.as_ref());
             return resolve_sample(self.job, self.query, &ray, hit.as_ref(), &mut self.counts, &mut self.rec);
         }
@@ -374,8 +381,8 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             }
             let c = cost_color(self.work_at(i) as f32);
             if self.is_focus(x, y) {
-                let (ray, t_max, hit) = self.eye_hit(i, x, y);
-                self.rec.ray(&ray, t_max, 0);
+                let (ray, hit) = self.eye_hit(i, x, y);
+                self.rec.ray(&ray, self.far_t(x, y), 0);
                 self.rec.closest(hit.as_ref());
                 self.rec.shaded(0, c);
             }
