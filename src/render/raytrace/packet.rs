@@ -21,9 +21,11 @@ use super::cast_pass;
 use super::intersect::{intersect_sphere, intersect_triangle};
 use crate::math::{Radiance, Ray};
 use crate::render::debug::View;
-use crate::render::trace::NoRecord;
-use crate::render::{resolve_sample, PassJob, RayCounts};
-use crate::scene::SurfaceHit;
+use crate::render::shade::shadow_origin;
+use crate::render::trace::{NoRecord, Recorder};
+use crate::render::{resolve_sample, Interpolation, PassJob, RayCounts, RenderSettings, SceneQuery, ShadowMode};
+use crate::scene::{Light, PrimitiveKind, Scene, SurfaceHit};
+use std::f32::consts::PI;
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 use std::mem::MaybeUninit;
@@ -110,6 +112,17 @@ impl Packet {
         (0..P).filter(|&i| valid & 1 << i != 0 && self.best_id[i] != u32::MAX).count() as u32
     }
 
+    /// After `occluded_packet`: what blocks lane `i`, as `occluder` reports it.
+    #[inline]
+    pub fn occluder(&self, i: usize) -> Option<(PrimitiveKind, u32, f32)> {
+        let id = self.best_id[i];
+        if id == u32::MAX {
+            return None;
+        }
+        let (kind, index) = decode(id);
+        Some((kind, index, self.best_t.0[i]))
+    }
+
     /// The hit of lane `i` after `closest_packet`, as `closest` returns it.
     #[inline]
     pub fn hit(&self, query: &BvhQuery, i: usize) -> Option<SurfaceHit> {
@@ -189,6 +202,20 @@ impl BvhQuery<'_> {
     /// Closest hits of the packet's rays whose bit is set in `valid`. The
     /// tree must not be `deep` (the stack is fixed).
     pub fn closest_packet(&self, pk: &mut Packet, valid: u64, counts: &mut RayCounts) {
+        self.trace_packet::<false>(pk, valid, counts);
+    }
+
+    /// Shadow rays: for each ray in `valid`, whether `occluder` finds
+    /// something (then `Packet::occluder` is some). Which occluder is
+    /// reported may differ from the single-ray query's (both stop at the
+    /// first found); whether there is one cannot: with the far end fixed at
+    /// t_max, a ray meets exactly the leaves it meets alone.
+    pub fn occluded_packet(&self, pk: &mut Packet, valid: u64, counts: &mut RayCounts) {
+        self.trace_packet::<true>(pk, valid, counts);
+    }
+
+    #[inline(always)]
+    fn trace_packet<const ANY: bool>(&self, pk: &mut Packet, valid: u64, counts: &mut RayCounts) {
         let bvh = &self.prepared.bvh;
         debug_assert!(!bvh.deep);
         let spheres = &self.prepared.scene.spheres;
@@ -218,9 +245,16 @@ impl BvhQuery<'_> {
         let mut len = 0usize;
         let mut word = bvh.root;
         let (mut visits, mut tests) = (0u64, 0u64);
+        // Shadow rays that found an occluder.
+        let mut done = 0u64;
         loop {
+            if ANY {
+                mask &= !done;
+            }
             visits += mask.count_ones() as u64;
-            if word & LEAF_BIT == 0 {
+            if mask == 0 {
+                // Every ray of this entry is done.
+            } else if word & LEAF_BIT == 0 {
                 let node = &bvh.nodes[word as usize];
                 let mut child_mask = [0u64; 4];
                 let mut child_near = [f32::INFINITY; 4];
@@ -301,6 +335,11 @@ impl BvhQuery<'_> {
                             intersect_sphere(ray, &spheres[(id & !SPHERE_BIT) as usize], limit, false).ok().map(|t| (t, 0.0, 0.0))
                         };
                         if let Some((t, b1, b2)) = found {
+                            if ANY {
+                                (best_t, best_id) = (t, id);
+                                done |= 1 << i;
+                                break;
+                            }
                             // t <= best_t here; on a tie the lower id (scene order) wins.
                             if t < best_t || id < best_id {
                                 best_t = t;
@@ -328,13 +367,71 @@ impl BvhQuery<'_> {
     }
 }
 
+/// The shadow ray `shade()` casts from `hit` towards `light` when it sees
+/// the surface with normal `n` (its arithmetic, repeated), if it casts one.
+/// Should the two ever drift apart, the ray simply is not found in the
+/// cache below and is traced alone: slower, never different.
+#[inline]
+fn expected_shadow_ray(scene: &Scene, settings: &RenderSettings, hit: &SurfaceHit, n: Vec3, light: &Light) -> Option<(Ray, f32)> {
+    let (w_i, distance, incident) = match *light {
+        Light::Point { position, power } => {
+            let offset = position - hit.position;
+            let d = offset.length();
+            if d <= 0.0 {
+                return None;
+            }
+            (offset / d, d, power / (4.0 * PI * d * d))
+        }
+        Light::Directional { direction, irradiance } => (-direction, f32::INFINITY, irradiance),
+    };
+    if w_i.dot(n) <= 0.0 || incident == Vec3::ZERO {
+        return None;
+    }
+    let eps = settings.shadow_bump;
+    Some((Ray::new(shadow_origin(scene, hit) + w_i * eps, w_i), distance - eps))
+}
+
+/// The query `shade()` gets for one pixel of a tile: the shadow ray towards
+/// the first light was traced with the tile's packet, and is answered from
+/// it when `shade()` asks for exactly that ray (same bits); everything else
+/// goes to the BVH. Recorded queries (pixel replay) always trace.
+struct PixelQuery<'q, 'a> {
+    bvh: &'q BvhQuery<'a>,
+    shadow: Option<(Ray, f32, Option<(PrimitiveKind, u32, f32)>)>,
+}
+
+impl SceneQuery for PixelQuery<'_, '_> {
+    #[inline]
+    fn closest<R: Recorder>(&self, ray: &Ray, t_max: f32, inside: bool, counts: &mut RayCounts, rec: &mut R) -> Option<SurfaceHit> {
+        self.bvh.closest(ray, t_max, inside, counts, rec)
+    }
+
+    #[inline]
+    fn occluder<R: Recorder>(&self, ray: &Ray, t_max: f32, counts: &mut RayCounts, rec: &mut R) -> Option<(PrimitiveKind, u32, f32)> {
+        if let Some((r, t, answer)) = &self.shadow {
+            let bits = |r: &Ray| (r.origin.to_array().map(f32::to_bits), r.dir.to_array().map(f32::to_bits));
+            if !R::ENABLED && t.to_bits() == t_max.to_bits() && bits(r) == bits(ray) {
+                return *answer;
+            }
+        }
+        self.bvh.occluder(ray, t_max, counts, rec)
+    }
+}
+
 /// `cast_pass` for the BVH: the same pixels, eye rays traced a tile at a
-/// time. Bands of TILE_H rows run in parallel. The cost view (per-ray work)
-/// and very deep trees take the single-ray path.
+/// time, then the tile's shadow rays towards the first light as one packet.
+/// Bands of TILE_H rows run in parallel. The cost view (per-ray work) and
+/// very deep trees take the single-ray path.
 pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) -> RayCounts {
     if query.prepared.bvh.deep || job.settings.view == View::Cost {
         return cast_pass(job, query, out);
     }
+    let scene = &query.prepared.scene;
+    let settings = job.settings;
+    let shadow_light = match (settings.view, settings.shadows, settings.interpolation) {
+        (View::Shaded, ShadowMode::Ray, Interpolation::Phong | Interpolation::Flat) => scene.lights.first(),
+        _ => None,
+    };
     let width = job.view.width as usize;
     out.par_chunks_mut(width * TILE_H)
         .enumerate()
@@ -346,6 +443,8 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
             let y0 = job.rows.start as usize + b * TILE_H;
             let rows = band.len() / width;
             let mut pk = Packet::new();
+            let mut shadow_pk = Packet::new();
+            let mut hits = [None; P];
             for x0 in (0..width).step_by(TILE_W) {
                 let mut valid = 0u64;
                 for i in 0..P {
@@ -359,13 +458,32 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
                 }
                 counts.primary += valid.count_ones() as u64;
                 query.closest_packet(&mut pk, valid, &mut counts);
+                let mut shadow_valid = 0u64;
+                let mut m = valid;
+                while m != 0 {
+                    let i = m.trailing_zeros() as usize;
+                    m &= m - 1;
+                    hits[i] = pk.hit(query, i);
+                    if let (Some(light), Some(h)) = (shadow_light, &hits[i]) {
+                        let n = if settings.interpolation == Interpolation::Flat { h.geometric_normal } else { h.shading_normal };
+                        if let Some((ray, t_max)) = expected_shadow_ray(scene, settings, h, n, light) {
+                            shadow_pk.rays[i] = ray;
+                            shadow_pk.t_max[i] = t_max;
+                            shadow_valid |= 1 << i;
+                        }
+                    }
+                }
+                if shadow_valid != 0 {
+                    query.occluded_packet(&mut shadow_pk, shadow_valid, &mut counts);
+                }
                 let mut m = valid;
                 while m != 0 {
                     let i = m.trailing_zeros() as usize;
                     m &= m - 1;
                     let (tx, ty) = lane_xy(i);
-                    let hit = pk.hit(query, i);
-                    band[ty * width + x0 + tx] = resolve_sample(job, query, &pk.rays[i], hit.as_ref(), &mut counts, &mut NoRecord);
+                    let shadow = (shadow_valid & 1 << i != 0).then(|| (shadow_pk.rays[i], shadow_pk.t_max[i], shadow_pk.occluder(i)));
+                    let pixel_query = PixelQuery { bvh: query, shadow };
+                    band[ty * width + x0 + tx] = resolve_sample(job, &pixel_query, &pk.rays[i], hits[i].as_ref(), &mut counts, &mut NoRecord);
                 }
             }
             counts
@@ -418,6 +536,27 @@ mod tests {
                         }
                     }
                 }
+            }
+        }
+    }
+
+    /// Shadow rays answered from the tile's packet leave every pixel as the
+    /// single-ray caster shades it, whatever the interpolation.
+    #[test]
+    fn shaded_frames_equal_the_single_ray_frames() {
+        use crate::render::raytrace::brute::BruteForce;
+        use crate::render::{render_frame, RenderSettings};
+        use std::sync::atomic::AtomicBool;
+        for name in builtin::names() {
+            let prepared = PreparedScene::new(builtin::load_builtin(name).unwrap().unwrap());
+            for interpolation in Interpolation::ALL {
+                let settings = RenderSettings { width: 45, height: 29, interpolation, shadows: ShadowMode::Ray, ..RenderSettings::for_scene(&prepared.scene) };
+                let cancel = AtomicBool::new(false);
+                let a = render_frame(&super::super::bvh::BvhRayTracer, &prepared, &settings, &cancel, None).unwrap();
+                let b = render_frame(&BruteForce, &prepared, &settings, &cancel, None).unwrap();
+                let bits = |p: &[Radiance]| p.iter().map(|c| c.to_array().map(f32::to_bits)).collect::<Vec<_>>();
+                assert!(bits(&a.pixels) == bits(&b.pixels), "{name} {interpolation:?}: images differ");
+                assert_eq!((a.counts.primary, a.counts.shadow), (b.counts.primary, b.counts.shadow), "{name} {interpolation:?}");
             }
         }
     }
