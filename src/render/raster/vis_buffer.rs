@@ -318,7 +318,6 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
 
     /// The eye ray of pixel `(x, y)`'s sample and the `SurfaceHit` of what
     /// the buffer says it sees.
-    #[inline(always)]
     fn eye_hit(&self, i: usize, x: u32, y: u32) -> (Ray, Option<SurfaceHit>) {
         let p = self.job.sample_position(x, y);
         let ray = self.job.view.eye_ray(p.x, p.y);
