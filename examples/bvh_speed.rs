@@ -4,7 +4,8 @@
 //!     cargo run --release --example bvh_speed -- ../shared/bench/stanford-bunny.toml ...
 //!
 //! Prints, per scene: best-of-N build ms, and Mrays/s for bare closest-hit
-//! queries (eye ray + traversal, like Embree's rtcIntersect1 loop), the depth
+//! queries (eye ray + traversal, like Embree's rtcIntersect1 loop), the same
+//! rays as 8x8 packets (what `render_pass` traces, like rtcIntersect8), the depth
 //! view (`render_pass`, primary rays only) and the shaded frame with shadow rays.
 
 use pinhole::render::raytrace::bvh::{Bvh, BvhQuery, BvhRayTracer};
