@@ -1,7 +1,10 @@
 #!/bin/sh
 # Regenerates screenshots/*.png: the viewer (`pinhole --screenshot`) in a real
 # window under Xvfb with Mesa's software OpenGL, on each built-in scene, with
-# each renderer family, and with the panels open.
+# each renderer family, with the panels open, and the visual-debugging tools
+# (debug views with their legends, the pixel inspector with the selected
+# pixel's rays drawn, pixel-level zoom, the vertex overlay).
+# Usage: scripts/screenshots.sh [PATTERN]  (only shots whose name contains PATTERN)
 # Needs: xvfb-run (apt-get install xvfb libgl1-mesa-dri).
 set -eu
 cd "$(dirname "$0")/.."
@@ -10,8 +13,10 @@ bin=target/release/pinhole
 out=screenshots
 mkdir -p "$out"
 
+only=${1:-}
 shot() { # NAME SCENE [VAR=VALUE...]
     name=$1; scene=$2; shift 2
+    case "$name" in *"$only"*) ;; *) return 0 ;; esac
     env LIBGL_ALWAYS_SOFTWARE=1 "$@" xvfb-run -a -s "-screen 0 1280x800x24" \
         "$bin" --screenshot "$out/$name.png" "$scene" >/dev/null
     echo "$out/$name.png"
@@ -32,3 +37,17 @@ shot view-normal bunny PINHOLE_VIEW=normal PINHOLE_PANELS=lights
 # CGPP Figure 15.2: the gamma test pattern with gamma off and on.
 shot gamma-off test-pattern PINHOLE_GAMMA=off PINHOLE_PANELS=shading
 shot gamma-on test-pattern PINHOLE_GAMMA=on PINHOLE_PANELS=shading
+# Debug views with their legends (issue 5).
+shot view-depth teapot PINHOLE_VIEW=depth PINHOLE_PANELS=none
+shot view-zbuffer teapot PINHOLE_VIEW=zbuffer PINHOLE_PANELS=none
+shot view-cost bunny PINHOLE_VIEW=cost PINHOLE_PANELS=none
+shot view-id spheres PINHOLE_VIEW=id PINHOLE_PANELS=none
+shot view-diff teapot PINHOLE_RENDERER=rasterize PINHOLE_VIEW=diff PINHOLE_PANELS=none
+shot view-vertices teapot PINHOLE_VERTICES=on PINHOLE_PANELS=none
+# The inspector on a selected pixel: a ground point whose shadow ray the
+# triangle blocks (red, ending at the blocker); the same zoomed to pixel
+# level; the rasterizer's fragment history where the two-sided triangle's
+# front and back faces cover the same pixel.
+shot inspector-raytrace triangle-ground PINHOLE_SELECT=420,400 PINHOLE_PANELS=none
+shot inspector-zoom triangle-ground PINHOLE_SELECT=420,400 PINHOLE_ZOOM=12 PINHOLE_PANELS=none
+shot inspector-rasterize triangle-ground PINHOLE_RENDERER=rasterize PINHOLE_SELECT=500,380 PINHOLE_PANELS=none

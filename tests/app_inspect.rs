@@ -94,7 +94,7 @@ fn clicking_a_pixel_shows_its_replayed_record() {
     assert!(has_label(&h, "Inspector"));
     assert!(has_label(&h, &format!("pixel ({x}, {y})")));
     assert!(has_label(&h, "eye ray"));
-    assert!(has_label(&h, &format!("{object} (object {})", hit.object)), "hit object {object} not shown");
+    assert!(has_label(&h, &format!("'{object}' (object {})", hit.object)), "hit object {object} not shown");
     assert!(has_label(&h, "contribution"));
     assert!(has_label(&h, &contribution), "light contribution {contribution} not shown");
     assert!(has_label(&h, &final_radiance_text(frame)), "final radiance not shown");
@@ -266,4 +266,17 @@ fn diff_view_counts_pixels_that_differ_from_brute_force() {
     let f = pinhole::render::render_frame(renderer.as_ref(), &prepared, &app.effective_settings(), &Default::default(), None).unwrap();
     assert_eq!(app.with_output(|o| o.linear.clone()), f.pixels);
     assert_eq!(f.differing_pixels, Some(0));
+}
+
+#[test]
+fn the_vertex_overlay_projects_each_distinct_vertex() {
+    let mut h = harness(small_scene("triangle-ground"));
+    h.get_by_label("vertices").click();
+    h.step();
+    h.step();
+    let app = h.state();
+    assert!(app.inspect.vertices);
+    let (_, verts) = app.inspect.vertex_cache.as_ref().expect("vertices gathered");
+    // Two coincident triangles and a two-triangle ground: 3 + 4 distinct corners.
+    assert_eq!(verts.len(), 7);
 }

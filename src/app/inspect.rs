@@ -47,11 +47,15 @@ pub struct Inspect {
     pub vertices: bool,
     /// Draw the selected pixel's rays into the view.
     pub paths: bool,
+    /// Centre the selected pixel in the viewport on the next frame.
+    pub center_on_selection: bool,
+    /// The distinct vertices of scene `.0`, for the vertex overlay.
+    pub vertex_cache: Option<(u64, std::sync::Arc<Vec<Vec3>>)>,
 }
 
 impl Default for Inspect {
     fn default() -> Self {
-        Inspect { selected: None, hover: None, replay: None, in_flight: None, next_id: 0, zoom: 1.0, pan: egui::Vec2::ZERO, vertices: false, paths: true }
+        Inspect { selected: None, hover: None, replay: None, in_flight: None, next_id: 0, zoom: 1.0, pan: egui::Vec2::ZERO, vertices: false, paths: true, center_on_selection: false, vertex_cache: None }
     }
 }
 
@@ -161,7 +165,7 @@ pub fn object_name(scene: &Scene, kind: PrimitiveKind, index: u32) -> String {
         PrimitiveKind::Sphere => scene.spheres.get(index as usize).map(|s| s.object),
     };
     object
-        .and_then(|o| scene.objects.get(o as usize).map(|info| format!("{} (object {o})", info.name)))
+        .and_then(|o| scene.objects.get(o as usize).map(|info| format!("'{}' (object {o})", info.name)))
         .unwrap_or_else(|| "?".into())
 }
 
@@ -251,6 +255,15 @@ pub fn value_text(view: &str, v: Radiance, camera: &CameraView, scene: &Scene) -
             None => format!("colour {}", fmt3(v)),
         },
         "barycentric" => format!("b = {}", fmt3(v)),
+        "diff" => {
+            if v.y == 0.0 && v.x >= 0.5 {
+                "brighter than raytrace:brute".into()
+            } else if v.y == 0.0 && v.z >= 0.5 {
+                "darker than raytrace:brute".into()
+            } else {
+                "same as raytrace:brute".into()
+            }
+        }
         "raydir" | "normal" => format!("{} = {}", if view == "raydir" { "d" } else { "n" }, fmt3(v * 2.0 - Vec3::ONE)),
         _ => format!("linear {}", fmt3(v)),
     }

@@ -157,7 +157,8 @@ fn screenshot_frame(app: &mut PinholeApp, ctx: &egui::Context) {
 
 /// For scripts (screenshots, benchmarks): `PINHOLE_RENDERER=NAME` picks the
 /// renderer, `PINHOLE_VIEW=NAME` the debug view, `PINHOLE_PANELS=camera,lights,
-/// materials,shading` (or `none`) which side-panel sections are open,
+/// materials,shading` (or `none`) which side-panel sections are open (the
+/// inspector shows whenever a pixel is selected),
 /// `PINHOLE_GAMMA=off` turns the sRGB encoding off.
 fn apply_env_overrides(app: &mut PinholeApp) {
     if let Ok(name) = std::env::var("PINHOLE_RENDERER") {
@@ -175,6 +176,28 @@ fn apply_env_overrides(app: &mut PinholeApp) {
     if let Ok(g) = std::env::var("PINHOLE_GAMMA") {
         app.gamma = !matches!(g.as_str(), "0" | "off" | "false");
     }
+    // PINHOLE_SELECT=X,Y selects a pixel for the inspector; PINHOLE_ZOOM=Z
+    // magnifies the image (about the selected pixel, if any);
+    // PINHOLE_VERTICES=on draws the vertex overlay.
+    if let Ok(sel) = std::env::var("PINHOLE_SELECT") {
+        let xy: Vec<i64> = sel.split(',').filter_map(|v| v.trim().parse().ok()).collect();
+        match xy[..] {
+            [x, y] => app.select_pixel(x, y),
+            _ => eprintln!("pinhole: PINHOLE_SELECT: expected X,Y, got \"{sel}\""),
+        }
+    }
+    if let Ok(z) = std::env::var("PINHOLE_ZOOM") {
+        match z.parse::<f32>() {
+            Ok(z) => {
+                app.inspect.zoom = z.clamp(1.0, inspect::MAX_ZOOM);
+                app.inspect.center_on_selection = true;
+            }
+            Err(_) => eprintln!("pinhole: PINHOLE_ZOOM: expected a number, got \"{z}\""),
+        }
+    }
+    if let Ok(v) = std::env::var("PINHOLE_VERTICES") {
+        app.inspect.vertices = !matches!(v.as_str(), "0" | "off" | "false");
+    }
     if let Ok(list) = std::env::var("PINHOLE_PANELS") {
         let has = |n: &str| list.split(',').any(|p| p.trim() == n);
         app.panels.side = list.trim() != "none";
@@ -191,6 +214,11 @@ struct EframeApp(PinholeApp);
 impl eframe::App for EframeApp {
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         self.0.ui(ui);
+    }
+
+    /// Screenshots and benchmarks neither keep nor leave panel sizes behind.
+    fn persist_egui_memory(&self) -> bool {
+        self.0.persist
     }
 
     fn save(&mut self, storage: &mut dyn eframe::Storage) {
@@ -241,6 +269,11 @@ pub fn run(scene: Option<String>, screenshot: Option<PathBuf>) -> Result<(), Str
         options,
         Box::new(move |cc| {
             let persisted = if batch { None } else { settings_store::Persisted::load(cc.storage) };
+            if batch {
+                // Panel sizes and open sections from interactive runs would
+                // make screenshots depend on the machine's history.
+                cc.egui_ctx.memory_mut(|m| *m = egui::Memory::default());
+            }
             let (scene, arg) = match explicit {
                 Some(x) => x,
                 None => {

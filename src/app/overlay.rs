@@ -58,8 +58,9 @@ pub fn pixel_grid(painter: &Painter, map: &ImageMap, clip: Rect) {
     }
     let lo = map.to_px(vis.min);
     let hi = map.to_px(vis.max);
-    let alpha = ((size - GRID_MIN_POINTS) * 8.0).clamp(0.0, 90.0) as u8;
-    let stroke = Stroke::new(1.0, Color32::from_black_alpha(alpha));
+    // Mid grey shows on dark and light pixels alike; it fades in as pixels grow.
+    let alpha = (40.0 + (size - GRID_MIN_POINTS) * 10.0).clamp(40.0, 110.0) as u8;
+    let stroke = Stroke::new(1.0, Color32::from_rgba_unmultiplied(128, 128, 128, alpha));
     for x in lo.x.floor().max(0.0) as u32..=hi.x.ceil().min(map.width) as u32 {
         let sx = map.to_screen(Vec2::new(x as f32, 0.0)).x;
         painter.line_segment([Pos2::new(sx, vis.min.y), Pos2::new(sx, vis.max.y)], stroke);
@@ -159,24 +160,38 @@ pub fn paths(painter: &Painter, map: &ImageMap, view: &CameraView, trace: &Pixel
 /// Most vertex dots drawn; bigger meshes are subsampled evenly.
 pub const MAX_VERTEX_DOTS: usize = 20_000;
 
-/// Every triangle vertex projected to the screen as a dot (every k-th one
-/// past `MAX_VERTEX_DOTS`). Returns (dots drawn, vertices in the scene).
-pub fn vertices(painter: &Painter, map: &ImageMap, view: &CameraView, scene: &Scene, clip: Rect) -> (usize, usize) {
-    let total = scene.triangles.len() * 3;
-    let stride = total.div_ceil(MAX_VERTEX_DOTS).max(1);
-    let vis = map.rect.intersect(clip);
-    let color = Color32::from_rgb(255, 80, 200);
-    let r = (map.pixel_size() * 0.15).clamp(1.0, 4.0);
-    let mut drawn = 0;
-    for i in (0..total).step_by(stride) {
-        let v = scene.triangles[i / 3].v[i % 3];
-        if let Some((p, _)) = view.project(v) {
-            let s = map.to_screen(p);
-            if vis.contains(s) {
-                painter.rect_filled(Rect::from_center_size(s, egui::vec2(2.0 * r, 2.0 * r)), 0.0, color);
-                drawn += 1;
+/// The scene's distinct triangle vertices (triangles store their corners, so
+/// a mesh vertex appears once per triangle around it).
+pub fn unique_vertices(scene: &Scene) -> Vec<Vec3> {
+    let mut seen = std::collections::HashSet::new();
+    let mut out = Vec::new();
+    for t in &scene.triangles {
+        for v in t.v {
+            if seen.insert([v.x.to_bits(), v.y.to_bits(), v.z.to_bits()]) {
+                out.push(v);
             }
         }
     }
-    (drawn, total)
+    out
+}
+
+/// Each vertex projected to the screen as a dot (every k-th one past
+/// `MAX_VERTEX_DOTS`), as one mesh. Returns the dots drawn.
+pub fn vertices(painter: &Painter, map: &ImageMap, view: &CameraView, vertices: &[Vec3], clip: Rect) -> usize {
+    let stride = vertices.len().div_ceil(MAX_VERTEX_DOTS).max(1);
+    let vis = map.rect.intersect(clip);
+    let color = Color32::from_rgb(255, 80, 200);
+    let r = (map.pixel_size() * 0.15).clamp(1.0, 4.0);
+    let mut mesh = egui::Mesh::default();
+    for v in vertices.iter().step_by(stride) {
+        if let Some((p, _)) = view.project(*v) {
+            let s = map.to_screen(p);
+            if vis.contains(s) {
+                mesh.add_colored_rect(Rect::from_center_size(s, egui::vec2(2.0 * r, 2.0 * r)), color);
+            }
+        }
+    }
+    let drawn = mesh.vertices.len() / 4;
+    painter.add(egui::Shape::mesh(mesh));
+    drawn
 }

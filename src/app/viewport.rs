@@ -38,6 +38,12 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
         size *= fit;
     }
     size *= app.inspect.zoom;
+    if std::mem::take(&mut app.inspect.center_on_selection) {
+        if let Some((x, y)) = app.inspect.selected {
+            let (cx, cy) = (x as f32 + 0.5 - iw * 0.5, y as f32 + 0.5 - ih * 0.5);
+            app.inspect.pan = -egui::vec2(cx / iw * size.x, cy / ih * size.y);
+        }
+    }
     let min = avail.center() + app.inspect.pan - size * 0.5;
     let min = Pos2::new((min.x * ppp).round() / ppp, (min.y * ppp).round() / ppp);
     let rect = Rect::from_min_size(min, size);
@@ -129,8 +135,21 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
     }
 
     if app.inspect.vertices {
-        let (drawn, total) = overlay::vertices(&painter, &map, &view, &app.scene, avail);
-        let note = if drawn * 3 < total && total > overlay::MAX_VERTEX_DOTS { format!("{drawn} of {total} vertices (subsampled)") } else { format!("{drawn} vertices in view") };
+        let verts = match &app.inspect.vertex_cache {
+            Some((id, v)) if *id == app.scene_id => v.clone(),
+            _ => {
+                let v = std::sync::Arc::new(overlay::unique_vertices(&app.scene));
+                app.inspect.vertex_cache = Some((app.scene_id, v.clone()));
+                v
+            }
+        };
+        let drawn = overlay::vertices(&painter, &map, &view, &verts, avail);
+        let total = verts.len();
+        let note = if total > overlay::MAX_VERTEX_DOTS {
+            format!("{drawn} vertices drawn (1 in {} of {total})", total.div_ceil(overlay::MAX_VERTEX_DOTS))
+        } else {
+            format!("{drawn} of {total} vertices in view")
+        };
         painter.text(avail.left_top() + egui::vec2(6.0, 6.0), egui::Align2::LEFT_TOP, note, egui::FontId::monospace(11.0), Color32::from_rgb(255, 80, 200));
     }
     // The selected pixel's rays, then the pixel itself.
@@ -182,10 +201,11 @@ fn hover_readout(app: &PinholeApp, painter: &egui::Painter, avail: Rect, view: &
     let Some(v) = app.with_output(|o| (x < o.width && y < o.height && o.linear.len() == (o.width * o.height) as usize).then(|| o.linear[(x + y * o.width) as usize])) else { return };
     let meaning = super::inspect::value_text(app.settings.view.name(), v, view, &app.scene);
     let d = crate::image_io::display_pixel(v, exposure, app.gamma);
-    let mut text = format!("({x}, {y})  {meaning}  -> {d:?}");
-    if app.settings.view.name() != "shaded" {
-        text = format!("({x}, {y})  {meaning}  linear {}", super::inspect::fmt3(v));
-    }
+    let text = if meaning.starts_with("linear") {
+        format!("({x}, {y})  {meaning}  -> {d:?}")
+    } else {
+        format!("({x}, {y})  {meaning}  linear {}", super::inspect::fmt3(v))
+    };
     let galley = painter.layout_no_wrap(text, egui::FontId::monospace(12.0), Color32::WHITE);
     let pos = avail.left_bottom() + egui::vec2(6.0, -6.0 - galley.size().y);
     painter.rect_filled(Rect::from_min_size(pos, galley.size()).expand(3.0), 3.0, Color32::from_black_alpha(190));

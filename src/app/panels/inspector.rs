@@ -9,7 +9,7 @@
 use eframe::egui;
 use crate::app::inspect::{fmt3, kind_name, object_name};
 use crate::app::PinholeApp;
-use crate::math::{Radiance, Vec3};
+use crate::math::Radiance;
 use crate::pixel_report::miss_reason;
 use crate::render::trace::{FragmentRecord, LightSample, PixelTrace, RayRecord};
 use crate::render::PixelReplay;
@@ -21,11 +21,18 @@ const DIM: Color32 = Color32::from_gray(150);
 /// The inspector as a right-hand panel, while a pixel is selected.
 pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
     let Some((x, y)) = app.inspect.selected else { return };
-    egui::Panel::right("inspector").default_size(400.0).resizable(true).show(ui, |ui| {
+    egui::Panel::right("inspector").default_size(420.0).size_range(300.0..=640.0).resizable(true).show(ui, |ui| {
+        // Fill the panel's width (the panel takes the size of its content,
+        // which would otherwise be the narrow "replaying…" of the first frame).
+        ui.set_min_width(ui.available_width());
         ui.horizontal(|ui| {
             ui.heading("Inspector");
             if ui.button("clear (Esc)").clicked() {
                 app.inspect.clear();
+            }
+            if ui.button("zoom to pixel").on_hover_text("magnify 16x around the selected pixel").clicked() {
+                app.inspect.zoom = app.inspect.zoom.max(16.0);
+                app.inspect.center_on_selection = true;
             }
         });
         ui.horizontal(|ui| {
@@ -50,7 +57,7 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
                 ui.colored_label(Color32::LIGHT_RED, format!("cannot replay this pixel: {e}"));
             }
             Ok(r) => {
-                egui::ScrollArea::vertical().auto_shrink([false, false]).show(ui, |ui| {
+                egui::ScrollArea::both().auto_shrink([false, false]).show(ui, |ui| {
                     record(app, ui, &scene, r, x, y, current);
                 });
             }
@@ -106,8 +113,17 @@ fn record(app: &PinholeApp, ui: &mut egui::Ui, names: &SceneNames, r: &PixelRepl
 fn sample(ui: &mut egui::Ui, names: &SceneNames, t: &PixelTrace, value: Radiance) {
     // Rays other than shadow rays, as a tree by depth; shadow rays go with their light.
     let mut shadow_rays: Vec<&RayRecord> = t.rays.iter().filter(|r| r.shadow).collect();
+    // A rasterizer: visibility came from the fragments; its eye ray only carries w_o to shading.
+    let raster = !t.fragments.is_empty();
+    if raster {
+        fragments(ui, names.scene, &t.fragments);
+    }
     for (i, r) in t.rays.iter().enumerate().filter(|(_, r)| !r.shadow) {
-        let title = if r.depth == 0 { "eye ray".to_string() } else { format!("secondary ray (depth {})", r.depth) };
+        let title = match r.depth {
+            0 if raster => "eye ray (for shading; the fragments decided visibility)".to_string(),
+            0 => "eye ray".to_string(),
+            d => format!("secondary ray (depth {d})"),
+        };
         ui.horizontal(|ui| {
             ui.add_space(12.0 * r.depth as f32);
             ui.vertical(|ui| {
@@ -116,9 +132,6 @@ fn sample(ui: &mut egui::Ui, names: &SceneNames, t: &PixelTrace, value: Radiance
                 });
             });
         });
-    }
-    if !t.fragments.is_empty() {
-        fragments(ui, names.scene, &t.fragments);
     }
     if !t.lights.is_empty() {
         ui.label(RichText::new("lights").strong());
@@ -153,8 +166,11 @@ fn ray(ui: &mut egui::Ui, names: &SceneNames, r: &RayRecord, index: usize) {
             grid_row(ui, "BVH nodes visited", r.nodes_visited.len().to_string());
         }
         let tested = r.tests.len() + r.tests_omitted;
-        grid_row(ui, "primitives tested", tested.to_string());
-        if r.depth == 0 {
+        let traced = tested > 0 || !r.nodes_visited.is_empty();
+        if traced {
+            grid_row(ui, "primitives tested", tested.to_string());
+        }
+        if r.depth == 0 && traced {
             grid_row(ui, "cost (nodes + tests)", (r.nodes_visited.len() + tested).to_string());
         }
     });
@@ -231,12 +247,16 @@ fn light(ui: &mut egui::Ui, names: &SceneNames, l: &LightSample, traced: Option<
         None => "?",
     };
     let visibility = match (l.shadow_ray, l.blocker) {
-        (_, Some((kd, i, t))) => format!("blocked by {} {i} [{}] at t = {t:.5}", kind_name(kd), object_name(names.scene, kd, i)),
+        (_, Some((kd, i, t))) => format!("blocked by {} {i} {} at t = {t:.5}", kind_name(kd), object_name(names.scene, kd, i)),
         (Some(_), None) => "visible".into(),
         (None, None) => "no shadow ray".into(),
     };
+    let short = match l.blocker {
+        Some((_, _, t)) => format!("blocked at t = {t:.5}"),
+        None => visibility.clone(),
+    };
     let color = if l.blocker.is_some() { Color32::from_rgb(240, 110, 100) } else { Color32::from_rgb(110, 220, 120) };
-    let title = RichText::new(format!("L{} ({kind}): {visibility}", l.light)).color(color);
+    let title = RichText::new(format!("L{} ({kind}): {short}", l.light)).color(color);
     egui::CollapsingHeader::new(title).id_salt(("light", k)).default_open(true).show(ui, |ui| {
         egui::Grid::new(("light-grid", k)).num_columns(2).spacing([8.0, 2.0]).show(ui, |ui| {
             grid_row(ui, "w_i", fmt3(l.w_i));
@@ -259,30 +279,43 @@ fn light(ui: &mut egui::Ui, names: &SceneNames, l: &LightSample, traced: Option<
     });
 }
 
-/// The rasterizer's pixel history (RenderDoc style): every fragment in draw order.
+/// The rasterizer's pixel history (RenderDoc style): every fragment in draw
+/// order as a table row, its weights and shaded value under it.
 fn fragments(ui: &mut egui::Ui, scene: &Scene, frags: &[FragmentRecord]) {
     ui.label(RichText::new(format!("fragment history: {} fragment{} in draw order", frags.len(), if frags.len() == 1 { "" } else { "s" })).strong());
-    egui::ScrollArea::horizontal().id_salt("fragments-scroll").show(ui, |ui| {
-        egui::Grid::new("fragments").striped(true).num_columns(8).spacing([10.0, 2.0]).show(ui, |ui| {
-            for h in ["#", "primitive", "2D weights", "perspective weights", "depth", "stored", "test", "shaded"] {
-                ui.label(RichText::new(h).color(DIM));
-            }
+    let pass = |f: &FragmentRecord| {
+        if f.passed_depth_test {
+            RichText::new("passed").monospace().color(Color32::LIGHT_GREEN)
+        } else {
+            RichText::new("failed").monospace().color(Color32::from_rgb(240, 110, 100))
+        }
+    };
+    egui::Grid::new("fragments").striped(true).num_columns(5).spacing([10.0, 2.0]).show(ui, |ui| {
+        for h in ["#", "primitive", "depth", "stored depth", "depth test"] {
+            ui.label(RichText::new(h).color(DIM));
+        }
+        ui.end_row();
+        for (i, f) in frags.iter().enumerate() {
+            ui.monospace(i.to_string());
+            ui.monospace(format!("{} {}", kind_name(f.kind), f.primitive));
+            ui.monospace(format!("{:.6}", f.depth));
+            ui.monospace(if f.stored_depth.is_finite() { format!("{:.6}", f.stored_depth) } else { "inf (empty)".into() });
+            ui.label(pass(f));
             ui.end_row();
-            let v = |b: Vec3| format!("{:.4} {:.4} {:.4}", b.x, b.y, b.z);
-            for (i, f) in frags.iter().enumerate() {
-                ui.monospace(i.to_string());
-                ui.monospace(format!("{} {} [{}]", kind_name(f.kind), f.primitive, object_name(scene, f.kind, f.primitive)));
-                ui.monospace(f.screen_barycentric.map(v).unwrap_or_else(|| "–".into()));
-                ui.monospace(v(f.barycentric));
-                ui.monospace(format!("{:.6}", f.depth));
-                ui.monospace(if f.stored_depth.is_finite() { format!("{:.6}", f.stored_depth) } else { "inf (empty)".into() });
-                let (txt, c) = if f.passed_depth_test { ("passed", Color32::LIGHT_GREEN) } else { ("failed", Color32::from_rgb(240, 110, 100)) };
-                ui.label(RichText::new(txt).monospace().color(c));
-                ui.monospace(f.shaded.map(fmt3).unwrap_or_else(|| "–".into()));
-                ui.end_row();
-            }
-        });
+        }
     });
+    for (i, f) in frags.iter().enumerate() {
+        let title = RichText::new(format!("fragment {i}: {} {} {}", kind_name(f.kind), f.primitive, object_name(scene, f.kind, f.primitive)));
+        egui::CollapsingHeader::new(title).id_salt(("fragment", i)).default_open(frags.len() <= 4).show(ui, |ui| {
+            egui::Grid::new(("fragment-grid", i)).num_columns(2).spacing([8.0, 2.0]).show(ui, |ui| {
+                grid_row(ui, "2D (screen) weights", f.screen_barycentric.map(fmt3).unwrap_or_else(|| "-".into()));
+                grid_row(ui, "perspective-correct", fmt3(f.barycentric));
+                let stored = if f.stored_depth.is_finite() { format!("{:.6}", f.stored_depth) } else { "inf".into() };
+                grid_row(ui, "depth vs stored", format!("{:.6} vs {stored}: {}", f.depth, if f.passed_depth_test { "passed" } else { "failed" }));
+                grid_row(ui, "shaded radiance", f.shaded.map(fmt3).unwrap_or_else(|| "- (shaded after visibility)".into()));
+            });
+        });
+    }
 }
 
 /// The label of the final radiance (tests look for exactly this text).
