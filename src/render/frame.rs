@@ -56,14 +56,17 @@ pub fn render_frame_in_bands(
     }
     let view = prepared.scene.camera.view(settings.width, settings.height);
     let n = (settings.width * settings.height) as usize;
-    let mut sum = vec![Radiance::ZERO; n];
-    let mut pass = vec![Radiance::ZERO; n];
-    let mut counts = RayCounts::default();
     let spp = settings.spp.max(1);
+    // With one sample the pass is the frame: render straight into it (adding
+    // to zero and scaling by one would not change a bit, only cost time).
+    let mut sum = vec![Radiance::ZERO; n];
+    let mut pass = if spp == 1 { Vec::new() } else { vec![Radiance::ZERO; n] };
+    let mut counts = RayCounts::default();
     for i in 0..spp {
+        let target = if spp == 1 { &mut sum } else { &mut pass };
         let band_rows = settings.height.div_ceil(bands.clamp(1, settings.height.max(1)));
         let width = settings.width as usize;
-        for (b, out) in pass.chunks_mut(band_rows as usize * width).enumerate() {
+        for (b, out) in target.chunks_mut(band_rows as usize * width).enumerate() {
             let y0 = b as u32 * band_rows;
             let job = PassJob {
                 prepared,
@@ -81,16 +84,20 @@ pub fn render_frame_in_bands(
         if cancel.load(Ordering::Relaxed) {
             return None;
         }
-        for (s, p) in sum.iter_mut().zip(&pass) {
-            *s += *p;
+        if spp > 1 {
+            for (s, p) in sum.iter_mut().zip(&pass) {
+                *s += *p;
+            }
         }
         if let Some(done) = passes_done {
             done.fetch_add(1, Ordering::Relaxed);
         }
     }
-    let inv = 1.0 / spp as f32;
-    for s in &mut sum {
-        *s *= inv;
+    if spp > 1 {
+        let inv = 1.0 / spp as f32;
+        for s in &mut sum {
+            *s *= inv;
+        }
     }
     Some(FrameResult { width: settings.width, height: settings.height, pixels: sum, counts, differing_pixels: None })
 }

@@ -17,7 +17,12 @@ pub fn bsdf(material: &Material, albedo: Vec3, n: Vec3, w_i: Vec3, w_o: Vec3) ->
     if material.has_glossy() {
         let w_h = (w_i + w_o).normalize_or_zero();
         let s = material.sharpness;
-        f += material.glossy * ((s + 8.0) / (8.0 * PI) * n.dot(w_h).max(0.0).powf(s));
+        let c = n.dot(w_h).max(0.0);
+        // c^s <= exp(-s (1 - c)) since ln c <= c - 1: when that bound is below
+        // 1e-9 the lobe adds nothing visible, and the costly powf is skipped.
+        if s * (1.0 - c) < 20.7 {
+            f += material.glossy * ((s + 8.0) / (8.0 * PI) * c.powf(s));
+        }
     }
     f
 }
