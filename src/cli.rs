@@ -106,6 +106,9 @@ struct RenderOpts {
     /// ray | map | none
     #[arg(long, default_value = "ray")]
     shadows: String,
+    /// Rasterizers: interpolate attributes affinely in screen space (no 1/z correction).
+    #[arg(long)]
+    affine: bool,
     /// flat | gouraud | phong: how shading varies across a triangle.
     #[arg(long, default_value = "phong")]
     interpolation: String,
@@ -205,6 +208,7 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
     settings.view = view;
     settings.shadows = shadows;
     settings.interpolation = interpolation;
+    settings.affine = opts.affine;
     if let Some(b) = opts.bump {
         if !(b.is_finite() && b >= 0.0) {
             return Err(format!("--bump {b} must be a finite number >= 0"));

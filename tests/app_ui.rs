@@ -377,3 +377,26 @@ fn dropping_an_obj_on_the_window_opens_it_framed() {
     assert_eq!(shown(app), reference(app));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn rasterizer_knobs_in_the_shading_panel_reach_the_pixels() {
+    // The teapot's ground quad under the uv view: ticking "affine uv" bends the
+    // checker (screen-space interpolation), and MSAA 4x changes edge pixels.
+    let mut h = harness(small_scene("teapot"));
+    h.state_mut().renderer = "rasterize".into();
+    h.state_mut().settings.view = pinhole::render::debug::View::Uv;
+    h.state_mut().panels.shading = true;
+    settle(&mut h);
+    let before = shown(h.state());
+    h.get_by_label("affine uv").click();
+    settle(&mut h);
+    assert!(h.state().settings.affine);
+    let affine = shown(h.state());
+    assert_eq!(affine, reference(h.state()), "the viewer shows what render_frame gives");
+    let changed = before.iter().zip(&affine).filter(|(a, b)| a != b).count();
+    assert!(changed > before.len() / 20, "affine uv changed only {changed} pixels");
+    h.get_by_label("4x").click();
+    settle(&mut h);
+    assert_eq!(h.state().settings.msaa, 4);
+    assert_eq!(shown(h.state()), reference(h.state()));
+}

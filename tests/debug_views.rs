@@ -136,3 +136,46 @@ fn diff_view_counts_differences_from_the_reference() {
     assert_eq!(count, (W * H) as u64);
     assert!(img.iter().all(|c| c.x >= 0.5));
 }
+
+#[test]
+fn geometric_normal_triangle_and_material_ids() {
+    for r in renderer_names() {
+        // The book's triangle lies in z = -2: its face normal is +z everywhere,
+        // while its vertex normals lean away.
+        let g = render_view(r, "one-triangle", View::GeometricNormal);
+        let c = at(&g, W / 2, H / 2) * 2.0 - Vec3::ONE;
+        assert!((c - Vec3::Z).length() < 1e-5, "{r}: {c}");
+        // triangle-ground: the two ground triangles are distinct triangles of
+        // one material; the green triangle has another material.
+        let tri = render_view(r, "triangle-ground", View::TriangleId);
+        let mat = render_view(r, "triangle-ground", View::MaterialId);
+        // Near left is in the first ground triangle, far right in the second
+        // (the diagonal runs from far left to near right).
+        let (left, right) = ((5, H - 2), (W - 5, 80));
+        assert_ne!(at(&tri, left.0, left.1), at(&tri, right.0, right.1), "{r}: the ground's two triangles");
+        assert_eq!(at(&mat, left.0, left.1), at(&mat, right.0, right.1), "{r}: one ground material");
+        assert_ne!(at(&mat, W / 2, 40), at(&mat, left.0, left.1), "{r}: triangle vs ground material");
+    }
+}
+
+#[test]
+fn affine_interpolation_bends_the_uv_checker() {
+    // The teapot's ground quad is strongly foreshortened: perspective-correct
+    // uvs match the ray caster; affine ones (screen-space weights) do not.
+    let scene = builtin("teapot");
+    let mut settings = RenderSettings::for_scene(&scene);
+    settings.width = W;
+    settings.height = H;
+    settings.view = View::Uv;
+    let prepared = PreparedScene::new(scene);
+    let reference = render("raytrace:brute", &prepared, &settings);
+    let differing = |img: &[Radiance]| img.iter().zip(&reference).filter(|(a, b)| a != b).count() as f32 / img.len() as f32;
+    for r in ["rasterize:barycentric", "rasterize:incremental", "rasterize:scanline", "rasterize:fixed", "rasterize:tiled"] {
+        settings.affine = false;
+        let correct = render(r, &prepared, &settings);
+        settings.affine = true;
+        let affine = render(r, &prepared, &settings);
+        assert!(differing(&correct) < 0.005, "{r}: perspective-correct differs on {}", differing(&correct));
+        assert!(differing(&affine) > 0.05, "{r}: affine differs on only {}", differing(&affine));
+    }
+}

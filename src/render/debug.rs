@@ -20,8 +20,15 @@ pub enum View {
     Zbuffer,
     /// Shading normal as (n + 1) / 2.
     Normal,
+    /// Geometric (face) normal as (n + 1) / 2: compare with `Normal` to see
+    /// what the interpolated vertex normals do.
+    GeometricNormal,
     /// Object ids as distinct colours.
     Id,
+    /// Triangle (or sphere) ids as distinct colours: the tessellation.
+    TriangleId,
+    /// Material ids as distinct colours.
+    MaterialId,
     /// A checker in texture coordinates.
     Uv,
     /// Work per pixel as a heat map (`cost_color`, the same scale for all):
@@ -45,7 +52,7 @@ pub enum View {
 pub const COST_SCALE: f32 = 1024.0;
 
 impl View {
-    pub const ALL: [View; 11] = [View::Shaded, View::Barycentric, View::Raydir, View::Depth, View::Zbuffer, View::Normal, View::Id, View::Uv, View::Cost, View::Diff, View::Shadowmap];
+    pub const ALL: [View; 14] = [View::Shaded, View::Barycentric, View::Raydir, View::Depth, View::Zbuffer, View::Normal, View::GeometricNormal, View::Id, View::TriangleId, View::MaterialId, View::Uv, View::Cost, View::Diff, View::Shadowmap];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -55,6 +62,9 @@ impl View {
             View::Depth => "depth",
             View::Normal => "normal",
             View::Id => "id",
+            View::GeometricNormal => "geometric-normal",
+            View::TriangleId => "triangle-id",
+            View::MaterialId => "material-id",
             View::Uv => "uv",
             View::Zbuffer => "zbuffer",
             View::Cost => "cost",
@@ -94,6 +104,13 @@ pub fn view_color(view: View, camera: &CameraView, ray: &Ray, hit: Option<&Surfa
         }
         View::Normal => (h.shading_normal + Vec3::ONE) * 0.5,
         View::Id => id_color(h.object),
+        View::GeometricNormal => (h.geometric_normal + Vec3::ONE) * 0.5,
+        // Spheres after triangles, so a sphere never shares a triangle's colour.
+        View::TriangleId => id_color(match h.kind {
+            crate::scene::PrimitiveKind::Triangle => h.primitive,
+            crate::scene::PrimitiveKind::Sphere => h.primitive.wrapping_add(1 << 20),
+        }),
+        View::MaterialId => id_color(h.material),
         View::Uv => {
             let c = ((h.uv.x * 8.0).floor() as i64 + (h.uv.y * 8.0).floor() as i64).rem_euclid(2);
             if c == 0 { Vec3::new(0.9, 0.9, 0.9) } else { Vec3::new(0.1, 0.1, 0.1) }

@@ -117,6 +117,11 @@ pub struct RenderSettings {
     /// casters ignore it (they antialias with `spp`).
     #[serde(default = "default_one")]
     pub msaa: u32,
+    /// Rasterizers with 2D weights: interpolate attributes affinely in screen
+    /// space instead of perspective-correctly, to show the difference (the uv
+    /// checker bends). Ray casters and the 3D-ray variants ignore it.
+    #[serde(default)]
+    pub affine: bool,
 }
 
 fn default_true() -> bool {
@@ -140,6 +145,7 @@ impl RenderSettings {
             max_depth: 4,
             view: debug::View::Shaded,
             interpolation: Interpolation::Phong,
+            affine: false,
             early_depth: true,
             msaa: 1,
         }

@@ -21,6 +21,17 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
             let l = ui.label("ray bump ε");
             ui.add(egui::Slider::new(&mut s.shadow_bump, 1e-7..=1e-1).logarithmic(true)).labelled_by(l.id);
         });
+        if s.shadows == ShadowMode::Map {
+            // CGPP 15.6.5's knobs: too little bias shows acne, too much peter-panning.
+            ui.horizontal(|ui| {
+                let l = ui.label("map size");
+                ui.add(egui::Slider::new(&mut s.shadow_map_size, 16..=4096).logarithmic(true)).labelled_by(l.id);
+            });
+            ui.horizontal(|ui| {
+                let l = ui.label("map bias (texels)");
+                ui.add(egui::Slider::new(&mut s.shadow_map_bias, 0.0..=32.0)).labelled_by(l.id);
+            });
+        }
         ui.horizontal(|ui| {
             let l = ui.label("samples per pixel");
             ui.add(egui::Slider::new(&mut s.spp, 1..=256).logarithmic(true)).labelled_by(l.id);
@@ -42,6 +53,18 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
             for m in Interpolation::ALL {
                 ui.radio_value(&mut app.settings.interpolation, m, m.name());
             }
+        });
+        // Rasterizer-only knobs; the ray casters ignore them.
+        let s = &mut app.settings;
+        ui.horizontal(|ui| {
+            ui.label("rasterizer: MSAA");
+            for n in [1u32, 2, 4, 8] {
+                ui.radio_value(&mut s.msaa, n, if n == 1 { "off".to_string() } else { format!("{n}x") });
+            }
+        });
+        ui.horizontal(|ui| {
+            ui.checkbox(&mut s.early_depth, "early depth").on_hover_text("depth pass first, then shade once per pixel (CGPP 15.8.3)");
+            ui.checkbox(&mut s.affine, "affine uv").on_hover_text("interpolate in screen space without the 1/z correction: try the uv view");
         });
     });
     app.panels.shading = open;

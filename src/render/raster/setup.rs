@@ -141,6 +141,21 @@ impl ScreenTri {
         [b.y, b.z]
     }
 
+    /// Affine (screen-space) barycentrics (b1, b2) in the original triangle
+    /// for screen-space weights `l`: what interpolating without the 1/z
+    /// correction gives (the `affine` setting shows it).
+    #[inline(always)]
+    pub fn affine_bary_at(&self, l: [f32; 3]) -> [f32; 2] {
+        let b = self.affine_weights(l);
+        [b.y, b.z]
+    }
+
+    /// The 2D weights as weights of the original triangle's three vertices.
+    #[inline(always)]
+    pub fn affine_weights(&self, l: [f32; 3]) -> Vec3 {
+        (0..3).map(|k| self.bz[k] / self.inv_z[k] * l[k]).sum::<Vec3>()
+    }
+
     /// Screen-space (affine, NOT perspective-correct) weights of the sample `q`,
     /// each edge function evaluated directly, relative to the edge's start vertex.
     #[inline(always)]

@@ -205,7 +205,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         if passed {
             self.depth[i] = key;
             self.id[i] = st.tri;
-            self.payload[i] = st.bary_at(l, inv_z);
+            self.payload[i] = if self.job.settings.affine { st.affine_bary_at(l) } else { st.bary_at(l, inv_z) };
             if self.forward {
                 self.shade_now(i, x, y);
             }
@@ -215,7 +215,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         if self.is_focus(x, y) {
             // The 2D weights as weights of the scene triangle's vertices (affine
             // interpolation of the piece's vertex barycentrics).
-            let screen = (0..3).map(|k| st.bz[k] / st.inv_z[k] * l[k]).sum::<Vec3>();
+            let screen = st.affine_weights(l);
             let [b1, b2] = st.bary_at(l, inv_z);
             self.record(PrimitiveKind::Triangle, st.tri, Some(screen), Vec3::new(1.0 - b1 - b2, b1, b2), key, stored, passed, i, x, y);
         }
