@@ -21,7 +21,11 @@ for scene in "${scenes[@]}"; do
     echo "| $name | llvmpipe | $ms | | |"
     for r in $("$bin" list | awk '/^  rasterize:/ {print $1}'); do
         frames=5
-        [ "$r" = rasterize:naive ] && frames=1   # every triangle x every pixel: seconds per frame
+        if [ "$r" = rasterize:naive ]; then
+            # Every triangle x every pixel: ~17 s a frame on the teapot, hours on the bunny.
+            [ "$name" = teapot ] || { echo "| $name | $r | (not run: every triangle x every pixel) | | |"; continue; }
+            frames=1
+        fi
         "$bin" bench "$scene" --renderer "$r" --shadows none --frames $frames | python3 -c "
 import json, sys
 j = json.load(sys.stdin)
