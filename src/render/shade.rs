@@ -68,7 +68,7 @@ pub fn shade<Q: SceneQuery, R: Recorder>(
         if settings.shadows == ShadowMode::Ray {
             // CGPP listing 15.20: start a little along the ray so it does not re-hit P.
             let eps = settings.shadow_bump;
-            let ray = Ray::new(shadow_origin(scene, hit) + w_i * eps, w_i);
+            let ray = Ray::new(shadow_origin(scene, hit, w_i) + w_i * eps, w_i);
             let t_max = distance - eps;
             counts.shadow += 1;
             rec.in_shadow_ray(true);
@@ -98,17 +98,25 @@ pub fn shade<Q: SceneQuery, R: Recorder>(
     l_o
 }
 
-/// Where shadow rays leave a surface point. On a triangle with smooth vertex
-/// normals the flat facet lies below the smooth surface those normals
-/// describe, so near the shadow terminator a shadow ray from the facet hits
-/// the neighbouring facets and leaves black speckles. Following Hanika
-/// ("Hacking the shadow terminator", Ray Tracing Gems II, ch. 4), the origin
-/// is lifted onto the curved surface the vertex normals imply. On flat
-/// triangles and spheres it is the hit point itself.
-pub fn shadow_origin(scene: &Scene, hit: &SurfaceHit) -> Vec3 {
-    if hit.kind != crate::scene::PrimitiveKind::Triangle {
+/// Where a shadow ray towards `w_i` leaves a surface point. Normally the hit
+/// point itself (the ray is then bumped along `w_i`, CGPP listing 15.20). But
+/// on a triangle with smooth vertex normals, where the shading normal faces
+/// the light while the flat facet faces away (the shadow terminator), a ray
+/// from the facet is blocked by the mesh's own neighbouring facets and leaves
+/// black speckles. There, following Hanika ("Hacking the shadow terminator",
+/// Ray Tracing Gems II, ch. 4), the origin is lifted onto the curved surface
+/// the vertex normals imply. Only there: elsewhere the lift would move the
+/// origin of a coarse, strongly bent triangle (the book's) far off its surface.
+pub fn shadow_origin(scene: &Scene, hit: &SurfaceHit, w_i: Vec3) -> Vec3 {
+    if hit.kind != crate::scene::PrimitiveKind::Triangle || hit.geometric_normal.dot(w_i) > 0.0 {
         return hit.position;
     }
+    lifted_position(scene, hit)
+}
+
+/// The hit point lifted onto the surface implied by the vertex normals
+/// (Hanika's construction); the hit point itself on flat triangles.
+pub fn lifted_position(scene: &Scene, hit: &SurfaceHit) -> Vec3 {
     let tri = &scene.triangles[hit.primitive as usize];
     let side = if hit.back_face { -1.0 } else { 1.0 };
     let mut lifted = Vec3::ZERO;
@@ -242,13 +250,16 @@ mod tests {
             position: p, geometric_normal: Vec3::Z, shading_normal: Vec3::Z, barycentric: b, uv: Vec2::ZERO, t: 1.0,
             kind: PrimitiveKind::Triangle, primitive: 0, object: 0, material: 0, back_face: false,
         };
-        let lifted = shadow_origin(&scene, &hit);
+        let lifted = lifted_position(&scene, &hit);
         assert!(lifted.z > 0.05, "the origin must rise above the facet: {lifted}");
         // At a vertex nothing moves; on a flat triangle nothing moves.
         let at_vertex = SurfaceHit { position: v[1], barycentric: Vec3::new(0.0, 1.0, 0.0), ..hit };
-        assert!((shadow_origin(&scene, &at_vertex) - v[1]).length() < 1e-6);
+        assert!((lifted_position(&scene, &at_vertex) - v[1]).length() < 1e-6);
+        // Only towards a light behind the facet: otherwise the book's plain bump.
+        assert_eq!(shadow_origin(&scene, &hit, Vec3::Z), p);
+        assert_eq!(shadow_origin(&scene, &hit, Vec3::new(0.0, 0.6, -0.8)), lifted);
         scene.triangles[0].n = [Vec3::Z; 3];
-        assert!((shadow_origin(&scene, &hit) - p).length() < 1e-7);
+        assert!((lifted_position(&scene, &hit) - p).length() < 1e-7);
     }
 
     #[test]

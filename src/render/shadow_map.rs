@@ -172,7 +172,7 @@ impl ShadowMaps {
     pub fn occluder(&self, scene: &Scene, light: usize, hit: &SurfaceHit, w_i: Vec3, bias: f32) -> Option<(PrimitiveKind, u32, f32)> {
         let map = self.maps.get(light).filter(|m| !m.faces.is_empty())?;
         // The same point a shadow ray would leave from (lifted on smooth triangles).
-        let p = super::shade::shadow_origin(scene, hit);
+        let p = super::shade::shadow_origin(scene, hit, w_i);
         let n = self.size as f32;
         let (face, dist, texel_w) = match scene.lights[light] {
             Light::Point { position, .. } => {

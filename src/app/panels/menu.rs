@@ -61,7 +61,7 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
 /// Every debug view (`View::ALL`, so views the core adds appear here); V and
 /// shift+V step through them.
 pub fn view_combo(app: &mut PinholeApp, ui: &mut egui::Ui) {
-    egui::ComboBox::from_label("debug view").selected_text(app.settings.view.name()).show_ui(ui, |ui| {
+    egui::ComboBox::from_label("debug view").selected_text(app.settings.view.name()).height(800.0).show_ui(ui, |ui| {
         for v in View::ALL {
             ui.selectable_value(&mut app.settings.view, v, v.name());
         }

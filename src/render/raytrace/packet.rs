@@ -388,7 +388,7 @@ fn expected_shadow_ray(scene: &Scene, settings: &RenderSettings, hit: &SurfaceHi
         return None;
     }
     let eps = settings.shadow_bump;
-    Some((Ray::new(shadow_origin(scene, hit) + w_i * eps, w_i), distance - eps))
+    Some((Ray::new(shadow_origin(scene, hit, w_i) + w_i * eps, w_i), distance - eps))
 }
 
 /// The query `shade()` gets for one pixel of a tile: the shadow ray towards
