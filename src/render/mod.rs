@@ -265,6 +265,14 @@ pub fn renderer_by_name(name: &str) -> Result<Box<dyn Renderer>, String> {
         .ok_or_else(|| format!("unknown renderer \"{name}\" (choose from raytrace, rasterize, {})", renderer_names().join(", ")))
 }
 
+/// What `resolve_sample` returns for a sample that sees nothing, when that
+/// does not depend on the ray: the background in the shaded view. Lets a
+/// rasterizer skip building eye rays for empty pixels (most of a frame).
+#[inline]
+pub fn miss_without_ray(job: &PassJob) -> Option<Radiance> {
+    (job.settings.view == debug::View::Shaded).then_some(job.prepared.scene.render.background)
+}
+
 /// The value one sample contributes, given what it sees: `shade()` for the
 /// shaded view, a debug colour otherwise, the background on a miss.
 #[inline]

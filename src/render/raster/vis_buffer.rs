@@ -13,7 +13,7 @@ use super::setup::{PixelRect, ScreenTri, Tested};
 use crate::math::{Radiance, Ray, Vec3};
 use crate::render::debug::{cost_color, View};
 use crate::render::trace::{FragmentRecord, NoRecord, PixelTrace, Recorder};
-use crate::render::{resolve_sample, PassJob, RayCounts, SceneQuery};
+use crate::render::{miss_without_ray, resolve_sample, PassJob, RayCounts, SceneQuery};
 use crate::scene::{PrimitiveKind, SurfaceHit};
 
 /// No primitive covers the sample.
@@ -351,6 +351,11 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
 
     /// Hands what pixel index `i` sees to the shared shading (recorded for the focus pixel).
     pub fn shade(&mut self, i: usize, x: u32, y: u32) -> Radiance {
+        if self.id[i] == EMPTY && !self.is_focus(x, y) {
+            if let Some(background) = miss_without_ray(self.job) {
+                return background;
+            }
+        }
         let (ray, hit) = self.eye_hit(i, x, y);
         if self.is_focus(x, y) {
             self.rec.ray(&ray, self.far_t(x, y), 0);
