@@ -183,7 +183,19 @@ fn faults(m: &Mesh, method: Method) -> Faults {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 400, ..ProptestConfig::default() })]
+    // A fixed seed so CI is repeatable; set PROPTEST_RNG_SEED to explore (50
+    // seeds x 400 meshes were swept clean after the fix for the case saved in
+    // raster_watertight.proptest-regressions: a sliver that only its snapped
+    // vertices bring onto a sample row, once culled by the unsnapped bounds).
+    #![proptest_config(ProptestConfig {
+        cases: 400,
+        rng_seed: if std::env::var_os("PROPTEST_RNG_SEED").is_some() {
+            ProptestConfig::default().rng_seed
+        } else {
+            proptest::test_runner::RngSeed::Fixed(0x7a7e_7719)
+        },
+        ..ProptestConfig::default()
+    })]
 
     #[test]
     fn fixed_and_tiled_cover_every_inside_sample_exactly_once(m in mesh()) {

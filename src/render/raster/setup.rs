@@ -113,8 +113,13 @@ impl ScreenTri {
             inv_z.swap(1, 2);
             bz.swap(1, 2);
         }
-        let lo = p[0].min(p[1]).min(p[2]);
-        let hi = p[0].max(p[1]).max(p[2]);
+        // Padded by one fixed-point unit: snapping (fixed, tiled) moves a vertex
+        // by up to half of one, which can bring a sample row or column into a
+        // sliver that, unsnapped, just misses it. Coverage is decided by each
+        // method's own edge tests, so the float variants are unaffected.
+        let pad = Vec2::splat(1.0 / super::fixed::ONE as f32);
+        let lo = p[0].min(p[1]).min(p[2]) - pad;
+        let hi = p[0].max(p[1]).max(p[2]) + pad;
         let (x0, x1) = sample_span(lo.x, hi.x, off.x, width);
         let (y0, y1) = sample_span(lo.y, hi.y, off.y, height);
         let bbox = PixelRect { x0, y0, x1, y1 };
