@@ -12,20 +12,12 @@ use pinhole::scene::{Light, Scene};
 use std::sync::atomic::AtomicBool;
 use std::time::Duration;
 
-const WAIT: Duration = Duration::from_secs(120);
-
-fn small_scene(name: &str) -> Scene {
-    let mut scene = pinhole::scene::file::load_scene(name).unwrap();
-    scene.render.width = 160;
-    scene.render.height = 100;
-    scene
-}
+#[path = "common/app.rs"]
+mod app_common;
+use app_common::{new_harness, small_scene, WAIT};
 
 fn harness(scene: Scene) -> Harness<'static, PinholeApp> {
-    let app = PinholeApp::new_for_test(scene);
-    let mut h = Harness::builder()
-        .with_size([1280.0, 800.0])
-        .build_ui_state(|ui: &mut egui::Ui, app: &mut PinholeApp| app.ui(ui), app);
+    let mut h = new_harness(scene);
     settle(&mut h);
     h
 }
