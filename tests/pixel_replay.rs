@@ -6,18 +6,6 @@ mod common;
 use common::*;
 use pinhole::render::{renderer_by_name, renderer_names, replay_pixel, PreparedScene, RenderSettings};
 
-/// A small deterministic generator (xorshift) for pixel choices.
-fn pixels(seed: u64, n: usize, w: u32, h: u32) -> Vec<(u32, u32)> {
-    let mut s = seed | 1;
-    (0..n)
-        .map(|_| {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            ((s % w as u64) as u32, ((s >> 32) % h as u64) as u32)
-        })
-        .collect()
-}
 
 #[test]
 fn replayed_radiance_equals_rendered_pixel() {

@@ -20,17 +20,6 @@ fn small(scene: &pinhole::scene::Scene) -> RenderSettings {
     s
 }
 
-fn pixels(seed: u64, n: usize, w: u32, h: u32) -> Vec<(u32, u32)> {
-    let mut s = seed | 1;
-    (0..n)
-        .map(|_| {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            ((s % w as u64) as u32, ((s >> 32) % h as u64) as u32)
-        })
-        .collect()
-}
 
 fn summary(f: &[FragmentRecord]) -> Vec<(u32, bool)> {
     f.iter().map(|f| (f.primitive, f.passed_depth_test)).collect()

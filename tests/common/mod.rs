@@ -29,3 +29,17 @@ pub fn builtin(name: &str) -> Scene {
 pub fn render_with_threads(threads: usize, renderer: &str, prepared: &PreparedScene, settings: &RenderSettings) -> Vec<Radiance> {
     rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(|| render(renderer, prepared, settings))
 }
+
+/// `n` pixels of a `w` x `h` image, chosen by a small deterministic
+/// generator (xorshift) so failures repeat.
+pub fn pixels(seed: u64, n: usize, w: u32, h: u32) -> Vec<(u32, u32)> {
+    let mut s = seed | 1;
+    (0..n)
+        .map(|_| {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            ((s % w as u64) as u32, ((s >> 32) % h as u64) as u32)
+        })
+        .collect()
+}
