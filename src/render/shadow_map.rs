@@ -44,7 +44,9 @@
 
 use super::raster::clip::{clip_near, triangle_vertices};
 use super::raster::fixed::{self, FixedTri};
-use super::raster::setup::{bin_rows, sample_span, PixelRect, ScreenTri};
+use super::raster::rect::{sample_span, PixelRect};
+use super::raster::setup::{bin_rows, ScreenTri};
+use super::raster::subpixel::snap_offset;
 use super::raster::sphere::sphere_bounds;
 use super::trace::Recorder;
 use super::{PassJob, PreparedScene, RayCounts, RenderSettings, SceneQuery};
@@ -426,7 +428,7 @@ fn setup_face_triangle(view: &CameraView, ortho: bool, t: &Triangle, index: u32,
     }
     let k = n.dot(c[0]);
     let off = Vec2::splat(0.5);
-    let soff = fixed::snap_offset(off);
+    let soff = snap_offset(off);
     let mut push = |p: [Vec2; 3], z: [f32; 3]| {
         let Some(st) = ScreenTri::new(index, p, [1.0; 3], [Vec3::X, Vec3::Y, Vec3::Z], off, size, size) else { return };
         let Some(ft) = FixedTri::new(&st, soff, off, size, size) else { return };
@@ -486,7 +488,7 @@ fn draw_band(
     id: &mut [u32],
 ) {
     let stride = rect.width() as usize;
-    let off = fixed::snap_offset(Vec2::splat(0.5));
+    let off = snap_offset(Vec2::splat(0.5));
     let mut tested = 0u64;
     for &ti in bin {
         let t = &tris[ti as usize];

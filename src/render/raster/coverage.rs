@@ -3,10 +3,13 @@
 //! mesh must cover every interior sample exactly once) and suited to a crack
 //! debug view.
 
-use super::fixed::{self, snap_all, snap_offset};
-use super::setup::{PixelRect, ScreenTri};
+use super::fixed::{self, snap_all};
+use super::rect::PixelRect;
+use super::setup::ScreenTri;
+use super::subpixel::snap_offset;
 use super::tiled::{self, TileGrid};
-use super::{barycentric, incremental, scanline, Method};
+use super::method::Method;
+use super::{barycentric, incremental, scanline};
 use crate::math::Vec2;
 
 /// Runs the coverage loop of `method` over 2D triangles given in image

@@ -7,18 +7,14 @@
 //! top-left rule gives a sample lying exactly on the edge to exactly one of them:
 //! no cracks and no double hits, whatever the mesh.
 
-use super::setup::{PixelRect, ScreenTri, Tested};
+use super::rect::{PixelRect, Tested};
+use super::setup::ScreenTri;
+use super::subpixel::{snap, snap_offset, ONE};
 use crate::math::Vec2;
 use std::ops::{Add, Mul, Sub};
 
-/// Bits of sub-pixel precision of snapped vertices and samples.
-pub const SUBPIXEL_BITS: u32 = 8;
-/// One pixel in fixed-point units.
-pub const ONE: i64 = 1 << SUBPIXEL_BITS;
 /// Vertices within +-2^21 pixels use i64 edge functions: every product stays below 2^61.
 const NARROW_LIMIT: i64 = 1 << 29;
-/// Snapped coordinates are clamped here, far beyond any image, so i128 never overflows.
-const CLAMP: f64 = (1u64 << 60) as f64;
 
 /// Integer types the edge functions are evaluated in.
 pub trait EdgeInt: Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Ord + From<i64> {
@@ -37,17 +33,6 @@ impl EdgeInt for i128 {
     fn to_f32(self) -> f32 {
         self as f32
     }
-}
-
-/// A coordinate in pixels snapped to the sub-pixel grid.
-#[inline]
-pub fn snap(v: f32) -> i64 {
-    ((v as f64) * ONE as f64).round().clamp(-CLAMP, CLAMP) as i64
-}
-
-/// The pass's sample offset snapped to the sub-pixel grid.
-pub fn snap_offset(off: Vec2) -> [i64; 2] {
-    [snap(off.x), snap(off.y)]
 }
 
 /// A screen triangle with snapped vertices and integer edge equations.

@@ -6,7 +6,8 @@
 //! the earlier one; rounding in the stepped sums can leave rare holes, which
 //! the `fixed` variant removes).
 
-use super::setup::{edge_function, PixelRect, ScreenTri, Tested};
+use super::rect::{PixelRect, Tested};
+use super::setup::{edge_function, ScreenTri};
 use crate::math::Vec2;
 
 /// Visits the covered samples of `st` inside `rect` with their screen-space

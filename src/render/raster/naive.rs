@@ -5,7 +5,7 @@
 //! strict `<`), so its image is the reference image; it is just slow.
 //! The pass itself (every triangle against the whole region) is in `pass.rs`.
 
-use super::setup::PixelRect;
+use super::rect::PixelRect;
 use super::vis_buffer::{FragmentRecorder, VisBuffer};
 use crate::math::Ray;
 use crate::render::raytrace::intersect::{intersect_triangle, Miss};

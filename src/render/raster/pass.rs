@@ -13,14 +13,17 @@
 //! coverage loops over the region holding the pixel (its row, or its tile),
 //! with a recording `VisBuffer` that keeps that pixel's fragment history.
 
-use super::fixed::{self, snap_all, snap_offset, FixedTri};
+use super::fixed::{self, snap_all, FixedTri};
 use super::msaa;
 use super::naive::{ray_test_rect, region_rays};
-use super::setup::{bin_rows, setup_pass, PixelRect, ScreenTri};
+use super::rect::PixelRect;
+use super::setup::{bin_rows, setup_pass, ScreenTri};
 use super::sphere::{all_sphere_bounds, raster_spheres};
+use super::subpixel::snap_offset;
 use super::tiled::{self, Class, TileGrid};
 use super::vis_buffer::{DepthKey, FragmentRecorder, VisBuffer};
-use super::{barycentric, bbox, incremental, scanline, Method};
+use super::method::Method;
+use super::{barycentric, bbox, incremental, scanline};
 use crate::math::{Radiance, Vec2};
 use crate::render::raytrace::bvh::BvhQuery;
 use crate::render::trace::PixelTrace;
@@ -57,7 +60,7 @@ pub struct Layer<'a> {
     pub job: PassJob<'a>,
     method: Method,
     geo: Geometry,
-    spheres: Vec<Option<crate::render::raster::setup::PixelRect>>,
+    spheres: Vec<Option<PixelRect>>,
     /// MSAA coverage sample index; `None` for the pass's own sample.
     pub sample: Option<u32>,
 }

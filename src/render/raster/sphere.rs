@@ -3,7 +3,7 @@
 //! sphere with the ray tracer's own `intersect_sphere`, and the hit is
 //! depth-tested against the triangles already drawn.
 
-use super::setup::{sample_span, PixelRect};
+use super::rect::{sample_span, PixelRect};
 use super::vis_buffer::{DepthKey, FragmentRecorder, VisBuffer};
 use crate::math::{Vec2, Vec3};
 use crate::render::raytrace::intersect::intersect_sphere;

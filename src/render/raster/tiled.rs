@@ -7,8 +7,9 @@
 //! same exact fixed-point edge functions as `fixed`, so both variants cover the
 //! same samples with the same weights: identical images, bit for bit.
 
-use super::fixed::{self, FixedTri, ONE};
-use super::setup::{PixelRect, Tested};
+use super::fixed::{self, FixedTri};
+use super::rect::{PixelRect, Tested};
+use super::subpixel::ONE;
 
 /// Tile edge length in pixels.
 pub const TILE: u32 = 32;
@@ -189,12 +190,13 @@ mod tests {
     use super::*;
     use crate::math::Vec2;
     use crate::render::raster::setup::ScreenTri;
+    use crate::render::raster::subpixel::snap_offset;
 
     #[test]
     fn classify_by_hand() {
         // Triangle (0,0), (64,0), (0,64) in a 64x64 image, samples at +0.5.
         let st = ScreenTri::flat(0, [Vec2::new(0.0, 0.0), Vec2::new(64.0, 0.0), Vec2::new(0.0, 64.0)], Vec2::splat(0.5), 64, 64).unwrap();
-        let off = fixed::snap_offset(Vec2::splat(0.5));
+        let off = snap_offset(Vec2::splat(0.5));
         let ft = FixedTri::new(&st, off, Vec2::splat(0.5), 64, 64).unwrap();
         assert_eq!(classify(&ft, PixelRect::new(0, 0, 8, 8), off), Class::Accept);
         assert_eq!(classify(&ft, PixelRect::new(56, 56, 64, 64), off), Class::Reject);

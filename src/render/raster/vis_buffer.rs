@@ -9,7 +9,8 @@
 //! fragment (strict `<`), so the earlier triangle in scene order wins, as in
 //! the brute-force caster.
 
-use super::setup::{PixelRect, ScreenTri, Tested};
+use super::rect::{PixelRect, Tested};
+use super::setup::ScreenTri;
 use crate::math::{Radiance, Ray, Vec3};
 use crate::render::debug::{cost_color, View};
 use crate::render::trace::{FragmentRecord, NoRecord, PixelTrace, Recorder};

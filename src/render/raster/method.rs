@@ -1,0 +1,46 @@
+//! The rasterization methods (coverage loops) a rasterizer variant can use,
+//! with the names `--renderer` takes.
+
+/// The rasterization methods, from the book's first version to the fastest.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Method {
+    Naive,
+    BBox,
+    Barycentric,
+    Incremental,
+    Scanline,
+    Fixed,
+    Tiled,
+}
+
+impl Method {
+    pub const ALL: [Method; 7] = [Method::Naive, Method::BBox, Method::Barycentric, Method::Incremental, Method::Scanline, Method::Fixed, Method::Tiled];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Naive => "rasterize:naive",
+            Method::BBox => "rasterize:bbox",
+            Method::Barycentric => "rasterize:barycentric",
+            Method::Incremental => "rasterize:incremental",
+            Method::Scanline => "rasterize:scanline",
+            Method::Fixed => "rasterize:fixed",
+            Method::Tiled => "rasterize:tiled",
+        }
+    }
+
+    pub fn description(self) -> &'static str {
+        match self {
+            Method::Naive => "every triangle against every pixel with the 3D ray test and a depth buffer (CGPP 15.22)",
+            Method::BBox => "the 3D ray test within each triangle's screen bounding box (CGPP 15.23, 15.24)",
+            Method::Barycentric => "2D barycentric weights per pixel, perspective-correct (CGPP 15.25-15.28)",
+            Method::Incremental => "float edge functions stepped by additions, perspective-correct",
+            Method::Scanline => "span filling between the triangle's edges (Computer Graphics from Scratch)",
+            Method::Fixed => "8-bit sub-pixel fixed-point edge functions, top-left rule: watertight",
+            Method::Tiled => "fixed-point edge functions, 32x32 tiles in parallel, 8x8 block masks: watertight",
+        }
+    }
+
+    pub fn parse(name: &str) -> Option<Method> {
+        Self::ALL.into_iter().find(|m| m.name() == name)
+    }
+}
