@@ -189,7 +189,7 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
         .build()
         .map_err(|e| format!("cannot start {threads} worker threads: {e}"))?;
     let start = Instant::now();
-    let scene: Scene = crate::scene::file::load_scene(scene_arg)?;
+    let scene: Scene = crate::scene::load::load_scene(scene_arg)?;
     let load_ms = start.elapsed().as_secs_f64() * 1e3;
     for w in &scene.warnings {
         eprintln!("warning: {w}");

@@ -1,7 +1,8 @@
 //! Untrusted input: bad scene files and OBJs give one clear message naming
 //! the file, line and key, and never panic.
 
-use pinhole::scene::file::{load_scene, load_scene_file};
+use pinhole::scene::file::load_scene_file;
+use pinhole::scene::load::load_scene;
 use std::path::{Path, PathBuf};
 
 fn temp_dir(tag: &str) -> PathBuf {

@@ -21,7 +21,7 @@ const H: u32 = 100;
 
 fn reference_scene(name: &str) -> Scene {
     let path = common::shared_dir().join("references").join(format!("{name}.toml"));
-    pinhole::scene::file::load_scene(path.to_str().unwrap()).unwrap()
+    pinhole::scene::load::load_scene(path.to_str().unwrap()).unwrap()
 }
 
 fn settings(scene: &Scene, shadows: ShadowMode, size: u32, bias: f32) -> RenderSettings {

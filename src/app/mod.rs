@@ -233,10 +233,10 @@ impl eframe::App for EframeApp {
 /// waits for the full-quality frame, saves a screenshot of the whole window
 /// there and exits.
 pub fn run(scene: Option<String>, screenshot: Option<PathBuf>) -> Result<(), String> {
-    use crate::scene::{builtin, file};
+    use crate::scene::{builtin, load};
     // An explicit scene that does not load is an error before any window opens.
     let explicit = match &scene {
-        Some(arg) => Some((file::load_scene(arg)?, arg.clone())),
+        Some(arg) => Some((load::load_scene(arg)?, arg.clone())),
         None => None,
     };
     let shot_result = Arc::new(Mutex::new(None));
@@ -278,11 +278,11 @@ pub fn run(scene: Option<String>, screenshot: Option<PathBuf>) -> Result<(), Str
                 Some(x) => x,
                 None => {
                     let remembered = persisted.as_ref().and_then(|p| p.scene.clone());
-                    match remembered.and_then(|a| file::load_scene(&a).ok().map(|s| (s, a))) {
+                    match remembered.and_then(|a| load::load_scene(&a).ok().map(|s| (s, a))) {
                         Some(x) => x,
                         None => {
                             let name = builtin::DEFAULT_SCENE.to_string();
-                            match file::load_scene(&name) {
+                            match load::load_scene(&name) {
                                 Ok(s) => (s, name),
                                 Err(e) => return Err(e.into()),
                             }

@@ -163,7 +163,7 @@ impl PinholeApp {
         let (tx, rx) = channel();
         let ctx = self.repaint_ctx.lock().unwrap().clone();
         std::thread::spawn(move || {
-            let result = crate::scene::file::load_scene(&arg);
+            let result = crate::scene::load::load_scene(&arg);
             let _ = tx.send((arg, result));
             if let Some(ctx) = ctx {
                 ctx.request_repaint();

@@ -1,11 +1,11 @@
-//! Built-in scenes: the TOML in `assets/scenes/` and the models it uses are
-//! compiled into the binary, so `pinhole render teapot` works from anywhere.
+//! Built-in scenes: the TOML in `assets/scenes/` is compiled into the binary
+//! (the models and textures it uses too, in `assets.rs`), so `pinhole render
+//! teapot` works from anywhere.
 
+use super::assets::BUILTIN_ROOT;
+use super::file::parse_scene;
 use super::Scene;
-use std::path::{Component, Path, PathBuf};
-
-/// The root that built-in scenes' relative paths resolve under.
-pub const BUILTIN_ROOT: &str = "<builtin>";
+use std::path::Path;
 
 const SCENES: &[(&str, &str)] = &[
     ("one-triangle", include_str!("../../assets/scenes/one-triangle.toml")),
@@ -14,14 +14,6 @@ const SCENES: &[(&str, &str)] = &[
     ("spheres", include_str!("../../assets/scenes/spheres.toml")),
     ("bunny", include_str!("../../assets/scenes/bunny.toml")),
     ("test-pattern", include_str!("../../assets/scenes/test-pattern.toml")),
-];
-
-const FILES: &[(&str, &[u8])] = &[
-    ("models/teapot.obj", include_bytes!("../../assets/models/teapot.obj")),
-    ("models/stanford-bunny.obj", include_bytes!("../../assets/models/stanford-bunny.obj")),
-    ("models/suzanne.obj", include_bytes!("../../assets/models/suzanne.obj")),
-    ("models/spot.obj", include_bytes!("../../assets/models/spot.obj")),
-    ("textures/test-pattern.exr", include_bytes!("../../assets/textures/test-pattern.exr")),
 ];
 
 /// The scene the viewer opens when given none.
@@ -40,39 +32,7 @@ pub fn source(name: &str) -> Option<&'static str> {
 pub fn load_builtin(name: &str) -> Option<Result<Scene, String>> {
     let text = source(name)?;
     let base = Path::new(BUILTIN_ROOT).join("scenes");
-    Some(super::file::parse_scene(text, &format!("built-in scene {name}"), &base, name))
-}
-
-/// Reads a file a scene refers to: from the compiled-in assets for paths under
-/// `BUILTIN_ROOT`, otherwise from disk.
-pub fn read_asset(path: &Path) -> Result<Vec<u8>, String> {
-    let clean = lexical_normalize(path);
-    if let Ok(rest) = clean.strip_prefix(BUILTIN_ROOT) {
-        let key = rest.to_string_lossy().replace('\\', "/");
-        return FILES
-            .iter()
-            .find(|(k, _)| *k == key)
-            .map(|(_, bytes)| bytes.to_vec())
-            .ok_or_else(|| format!("{}: no such built-in asset", path.display()));
-    }
-    std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))
-}
-
-/// Resolves `.` and `..` without touching the file system.
-fn lexical_normalize(path: &Path) -> PathBuf {
-    let mut out = PathBuf::new();
-    for c in path.components() {
-        match c {
-            Component::CurDir => {}
-            Component::ParentDir => {
-                if !out.pop() {
-                    out.push("..");
-                }
-            }
-            other => out.push(other.as_os_str()),
-        }
-    }
-    out
+    Some(parse_scene(text, &format!("built-in scene {name}"), &base, name))
 }
 
 #[cfg(test)]
@@ -97,11 +57,5 @@ mod tests {
         assert_eq!(s.triangles[0].v[1], glam::Vec3::new(-1.9, -1.0, -2.0));
         let g = load_builtin("triangle-ground").unwrap().unwrap();
         assert_eq!(g.triangles.len(), 4);
-    }
-
-    #[test]
-    fn builtin_paths_resolve() {
-        assert!(read_asset(Path::new("<builtin>/scenes/../models/teapot.obj")).is_ok());
-        assert!(read_asset(Path::new("<builtin>/scenes/../models/nope.obj")).is_err());
     }
 }

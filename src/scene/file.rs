@@ -2,11 +2,13 @@
 //! descriptions, then checked and turned into a `Scene`. Every error names the
 //! file, the line and the key or table at fault.
 
-use super::{obj, Camera, Fov, Light, Material, ObjectInfo, RenderDefaults, Scene, Sphere, Triangle};
+use super::obj::{self, NormalMode};
+use super::texture::load_texture;
+use super::{Camera, Fov, Light, Material, ObjectInfo, RenderDefaults, Scene, Sphere, Triangle};
 use crate::math::{Vec2, Vec3};
 use serde::Deserialize;
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Arc;
 use toml::Spanned;
 
@@ -92,16 +94,6 @@ struct ObjectDesc {
     center: Option<[f32; 3]>,
     radius: Option<f32>,
     // `normals` for triangles is a list of vectors; meshes use the mode string.
-}
-
-/// How a mesh gets its shading normals.
-#[derive(Deserialize, Clone, Copy, Debug, PartialEq, Eq)]
-#[serde(rename_all = "lowercase")]
-pub enum NormalMode {
-    /// The file's normals, else smooth.
-    Auto,
-    Smooth,
-    Flat,
 }
 
 /// `normals` is a mode string on meshes and a list of three vectors on triangles.
@@ -464,42 +456,4 @@ fn toml_error(origin: &str, text: &str, e: &toml::de::Error) -> String {
         }
         None => format!("{origin}: {msg}"),
     }
-}
-
-/// Loads an 8-bit sRGB image (or a float EXR) into a linear texture.
-pub fn load_texture(path: &Path) -> Result<super::Texture, String> {
-    let bytes = super::builtin::read_asset(path).map_err(|e| format!("cannot read {e}"))?;
-    let img = image::load_from_memory(&bytes).map_err(|e| format!("cannot decode {}: {e}", path.display()))?;
-    let is_float = matches!(img, image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_));
-    let rgb = img.to_rgb32f();
-    let texels = rgb
-        .pixels()
-        .map(|p| {
-            let c = Vec3::new(p[0], p[1], p[2]);
-            if is_float { c } else { Vec3::new(srgb_to_linear(c.x), srgb_to_linear(c.y), srgb_to_linear(c.z)) }
-        })
-        .collect();
-    Ok(super::Texture { width: rgb.width(), height: rgb.height(), texels })
-}
-
-fn srgb_to_linear(c: f32) -> f32 {
-    if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
-}
-
-/// Where a scene argument points: a built-in name, a `.toml` or a bare `.obj`.
-pub fn load_scene(arg: &str) -> Result<Scene, String> {
-    let path = PathBuf::from(arg);
-    let is_obj = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
-    if is_obj {
-        return obj::frame_bare_obj(&path);
-    }
-    if path.exists() || arg.ends_with(".toml") || arg.contains('/') {
-        return load_scene_file(&path);
-    }
-    super::builtin::load_builtin(arg).ok_or_else(|| {
-        format!(
-            "\"{arg}\" is neither a scene file nor a built-in scene (built-in: {})",
-            super::builtin::names().join(", ")
-        )
-    })?
 }

@@ -1,5 +1,6 @@
 //! Materials: the terms of the scene format's BSDF, plus an optional texture.
 
+use super::texture::Texture;
 use crate::math::{Vec2, Vec3};
 use std::sync::Arc;
 
@@ -59,32 +60,5 @@ impl Material {
             Some(t) => self.lambertian * t.sample(uv),
             None => self.lambertian,
         }
-    }
-}
-
-/// A linear-RGB texture, sampled bilinearly with wrapping.
-#[derive(Debug, PartialEq)]
-pub struct Texture {
-    pub width: u32,
-    pub height: u32,
-    pub texels: Vec<Vec3>,
-}
-
-impl Texture {
-    pub fn sample(&self, uv: Vec2) -> Vec3 {
-        let (w, h) = (self.width as i64, self.height as i64);
-        // v = 0 is the bottom row of the image (OBJ convention).
-        let x = uv.x * w as f32 - 0.5;
-        let y = (1.0 - uv.y) * h as f32 - 0.5;
-        if !(x.is_finite() && y.is_finite()) {
-            return Vec3::ZERO;
-        }
-        let (x0, y0) = (x.floor(), y.floor());
-        let (fx, fy) = (x - x0, y - y0);
-        let texel = |xi: i64, yi: i64| self.texels[(xi.rem_euclid(w) + yi.rem_euclid(h) * w) as usize];
-        let (xi, yi) = (x0 as i64, y0 as i64);
-        let top = texel(xi, yi).lerp(texel(xi + 1, yi), fx);
-        let bottom = texel(xi, yi + 1).lerp(texel(xi + 1, yi + 1), fx);
-        top.lerp(bottom, fy)
     }
 }

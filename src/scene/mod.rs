@@ -2,14 +2,18 @@
 //! spheres, lights, materials and the camera. Scene files are parsed into it
 //! by `file.rs`; meshes come from `obj.rs`; built-in scenes from `builtin.rs`.
 
+pub mod assets;
 pub mod builtin;
 pub mod camera;
 pub mod file;
+pub mod load;
 pub mod material;
 pub mod obj;
+pub mod texture;
 
 pub use camera::{Camera, CameraView, Fov};
-pub use material::{Material, Texture};
+pub use material::Material;
+pub use texture::Texture;
 
 use crate::math::{Ray, Vec2, Vec3};
 

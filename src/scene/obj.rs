@@ -4,11 +4,23 @@
 //! MTL mapping: `Kd` -> lambertian, `Ks` -> glossy, `Ns` -> sharpness,
 //! `map_Kd` -> texture. Other MTL terms are ignored.
 
-use super::file::NormalMode;
+use super::assets::read_asset;
+use super::texture::load_texture;
 use super::{Camera, Fov, Light, Material, ObjectInfo, Scene, Triangle};
 use crate::math::{Vec2, Vec3};
+use serde::Deserialize;
 use std::path::Path;
 use std::sync::Arc;
+
+/// How a mesh gets its shading normals.
+#[derive(Deserialize, Clone, Copy, Debug, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum NormalMode {
+    /// The file's normals, else smooth.
+    Auto,
+    Smooth,
+    Flat,
+}
 
 pub struct LoadedMesh {
     /// `material` is an index into `materials`, or `u32::MAX` for "none given".
@@ -20,11 +32,11 @@ pub struct LoadedMesh {
 
 pub fn load_obj(path: &Path, mode: NormalMode) -> Result<LoadedMesh, String> {
     let name = path.display();
-    let bytes = super::builtin::read_asset(path).map_err(|e| format!("cannot read OBJ {e}"))?;
+    let bytes = read_asset(path).map_err(|e| format!("cannot read OBJ {e}"))?;
     let base = path.parent().unwrap_or(Path::new("."));
     let options = tobj::LoadOptions { triangulate: true, single_index: false, ignore_points: true, ignore_lines: true };
     let (models, mtl) = tobj::load_obj_buf(&mut std::io::Cursor::new(bytes), &options, |mtl_path| {
-        let data = super::builtin::read_asset(&base.join(mtl_path)).map_err(|_| tobj::LoadError::OpenFileFailed)?;
+        let data = read_asset(&base.join(mtl_path)).map_err(|_| tobj::LoadError::OpenFileFailed)?;
         tobj::load_mtl_buf(&mut std::io::Cursor::new(data))
     })
     .map_err(|e| format!("{name}: cannot read OBJ: {e}"))?;
@@ -39,7 +51,7 @@ pub fn load_obj(path: &Path, mode: NormalMode) -> Result<LoadedMesh, String> {
                 mat.glossy = m.specular.map(Vec3::from).unwrap_or(Vec3::ZERO);
                 mat.sharpness = m.shininess.unwrap_or(100.0);
                 if let Some(tex) = &m.diffuse_texture {
-                    mat.texture = Some(Arc::new(super::file::load_texture(&base.join(tex)).map_err(|e| format!("{name}: MTL {}: {e}", m.name))?));
+                    mat.texture = Some(Arc::new(load_texture(&base.join(tex)).map_err(|e| format!("{name}: MTL {}: {e}", m.name))?));
                 }
                 if !crate::math::is_finite(mat.lambertian) || !crate::math::is_finite(mat.glossy) || !mat.sharpness.is_finite() {
                     return Err(format!("{name}: MTL material {} has values that are not finite", m.name));

@@ -11,7 +11,7 @@ pub const WAIT: Duration = Duration::from_secs(120);
 
 /// A built-in or file scene at a small size, so frames finish quickly.
 pub fn small_scene(name: &str) -> Scene {
-    let mut scene = pinhole::scene::file::load_scene(name).unwrap();
+    let mut scene = pinhole::scene::load::load_scene(name).unwrap();
     scene.render.width = 160;
     scene.render.height = 100;
     scene

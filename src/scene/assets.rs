@@ -1,0 +1,59 @@
+//! Files a scene refers to: compiled-in assets (the built-in scenes' models
+//! and textures, under `BUILTIN_ROOT`) or real paths on disk.
+
+use std::path::{Component, Path, PathBuf};
+
+/// The root that built-in scenes' relative paths resolve under.
+pub const BUILTIN_ROOT: &str = "<builtin>";
+
+/// The compiled-in assets, by their path under `BUILTIN_ROOT`.
+const FILES: &[(&str, &[u8])] = &[
+    ("models/teapot.obj", include_bytes!("../../assets/models/teapot.obj")),
+    ("models/stanford-bunny.obj", include_bytes!("../../assets/models/stanford-bunny.obj")),
+    ("models/suzanne.obj", include_bytes!("../../assets/models/suzanne.obj")),
+    ("models/spot.obj", include_bytes!("../../assets/models/spot.obj")),
+    ("textures/test-pattern.exr", include_bytes!("../../assets/textures/test-pattern.exr")),
+];
+
+/// Reads a file a scene refers to: from the compiled-in assets for paths under
+/// `BUILTIN_ROOT`, otherwise from disk.
+pub fn read_asset(path: &Path) -> Result<Vec<u8>, String> {
+    let clean = lexical_normalize(path);
+    if let Ok(rest) = clean.strip_prefix(BUILTIN_ROOT) {
+        let key = rest.to_string_lossy().replace('\\', "/");
+        return FILES
+            .iter()
+            .find(|(k, _)| *k == key)
+            .map(|(_, bytes)| bytes.to_vec())
+            .ok_or_else(|| format!("{}: no such built-in asset", path.display()));
+    }
+    std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// Resolves `.` and `..` without touching the file system.
+fn lexical_normalize(path: &Path) -> PathBuf {
+    let mut out = PathBuf::new();
+    for c in path.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir => {
+                if !out.pop() {
+                    out.push("..");
+                }
+            }
+            other => out.push(other.as_os_str()),
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn builtin_paths_resolve() {
+        assert!(read_asset(Path::new("<builtin>/scenes/../models/teapot.obj")).is_ok());
+        assert!(read_asset(Path::new("<builtin>/scenes/../models/nope.obj")).is_err());
+    }
+}

@@ -1,0 +1,26 @@
+//! Opening a scene by the argument the command line and the viewer take: a
+//! built-in scene's name, a `.toml` scene file or a bare `.obj`.
+
+use super::builtin;
+use super::file::load_scene_file;
+use super::obj::frame_bare_obj;
+use super::Scene;
+use std::path::PathBuf;
+
+/// Where a scene argument points: a built-in name, a `.toml` or a bare `.obj`.
+pub fn load_scene(arg: &str) -> Result<Scene, String> {
+    let path = PathBuf::from(arg);
+    let is_obj = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
+    if is_obj {
+        return frame_bare_obj(&path);
+    }
+    if path.exists() || arg.ends_with(".toml") || arg.contains('/') {
+        return load_scene_file(&path);
+    }
+    builtin::load_builtin(arg).ok_or_else(|| {
+        format!(
+            "\"{arg}\" is neither a scene file nor a built-in scene (built-in: {})",
+            builtin::names().join(", ")
+        )
+    })?
+}
