@@ -26,9 +26,4 @@ impl PreparedScene {
         let build_ms = start.elapsed().as_secs_f64() * 1e3;
         PreparedScene { scene, edges, bvh, build_ms, shadow_cache: Default::default() }
     }
-
-    /// Rebuilds after the scene's geometry changed (materials and lights need no rebuild).
-    pub fn rebuild(self) -> PreparedScene {
-        PreparedScene::new(self.scene)
-    }
 }

@@ -118,11 +118,6 @@ impl PixelTrace {
         PixelTrace::default()
     }
 
-    /// Rasterizers report their fragments here.
-    pub fn fragment(&mut self, f: FragmentRecord) {
-        self.fragments.push(f);
-    }
-
     fn current_ray(&mut self) -> Option<&mut RayRecord> {
         self.current.and_then(|i| self.rays.get_mut(i))
     }

@@ -17,23 +17,11 @@ use std::ops::{Add, Mul, Sub};
 const NARROW_LIMIT: i64 = 1 << 29;
 
 /// Integer types the edge functions are evaluated in.
-pub trait EdgeInt: Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Ord + From<i64> {
-    fn to_f32(self) -> f32;
-}
+pub trait EdgeInt: Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Ord + From<i64> {}
 
-impl EdgeInt for i64 {
-    #[inline(always)]
-    fn to_f32(self) -> f32 {
-        self as f32
-    }
-}
+impl EdgeInt for i64 {}
 
-impl EdgeInt for i128 {
-    #[inline(always)]
-    fn to_f32(self) -> f32 {
-        self as f32
-    }
-}
+impl EdgeInt for i128 {}
 
 /// A screen triangle with snapped vertices and integer edge equations.
 #[derive(Clone, Copy, Debug)]

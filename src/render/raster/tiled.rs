@@ -142,22 +142,16 @@ pub fn tile_fragments<F: FnMut(&FixedTri, u32, u32, [f32; 3])>(
                     continue;
                 }
                 tested.add(br);
-                let mut row: [i64; 3] = ft.edges_at_pixel(br.x0, br.y0, off);
                 if c == Class::Accept {
+                    // Every sample covered: no edge function is needed.
                     for y in br.y0..br.y1 {
-                        let mut e = row;
                         for x in br.x0..br.x1 {
                             emit(ft, x, y, ft.weights(x, y));
-                            for k in 0..3 {
-                                e[k] += step_x[k];
-                            }
-                        }
-                        for k in 0..3 {
-                            row[k] += step_y[k];
                         }
                     }
                     continue;
                 }
+                let mut row: [i64; 3] = ft.edges_at_pixel(br.x0, br.y0, off);
                 // Partial block: a coverage mask (bit = dx + 8 dy), then the covered samples.
                 let mut mask = 0u64;
                 for dy in 0..br.height() {

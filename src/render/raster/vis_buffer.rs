@@ -238,13 +238,8 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         self.rec.fragment(f);
     }
 
-    /// The current depth bound of pixel `(x, y)` (the ray casters' `t_max`).
-    #[inline(always)]
-    pub fn depth_at(&self, x: u32, y: u32) -> f32 {
-        self.depth[self.index(x, y)]
-    }
-
-    /// A ray-triangle hit already known to be nearer than `depth_at` (naive, bbox).
+    /// A ray-triangle hit already known to be nearer than the pixel's stored
+    /// depth (naive, bbox: the ray test's `t_max`).
     #[inline(always)]
     pub fn ray_fragment(&mut self, x: u32, y: u32, tri: u32, t: f32, b1: f32, b2: f32) {
         self.counts.samples_covered += 1;
@@ -403,15 +398,10 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         }
     }
 
-    /// Resolves every pixel of the region into `out` (row-major, the region's
-    /// width): early-depth mode shades each visible surface once here; forward
-    /// mode already shaded it. Counts one primary sample per pixel.
-    pub fn finish(mut self, out: &mut [Radiance]) -> RayCounts {
-        let stride = self.stride;
-        self.finish_into(out, stride, 0)
-    }
-
-    /// As `finish`, into rows of `out_stride` pixels starting at column `x_offset`.
+    /// Resolves every pixel of the region into rows of `out_stride` pixels of
+    /// `out` starting at column `x_offset`: early-depth mode shades each
+    /// visible surface once here; forward mode already shaded it. Counts one
+    /// primary sample per pixel.
     pub fn finish_into(&mut self, out: &mut [Radiance], out_stride: usize, x_offset: usize) -> RayCounts {
         let r = self.rect;
         let mut i = 0;
