@@ -4,7 +4,7 @@
 //! when all weights are >= 0; the weights then interpolate 1/z and the
 //! attributes over z (perspective-correct, CGPP 15.6.4.2).
 
-use super::rect::{PixelRect, Tested};
+use super::rect::{PixelRect, TestCounter};
 use super::setup::ScreenTri;
 use crate::math::Vec2;
 
@@ -25,7 +25,7 @@ pub fn bary2d(a: Vec2, b: Vec2, c: Vec2, q: Vec2) -> f32 {
 
 /// Visits the covered samples of `st` inside `rect` with their screen-space weights.
 #[inline]
-pub fn raster<F: FnMut(u32, u32, [f32; 3])>(st: &ScreenTri, rect: PixelRect, off: Vec2, tested: &mut impl Tested, mut emit: F) {
+pub fn raster<F: FnMut(u32, u32, [f32; 3])>(st: &ScreenTri, rect: PixelRect, off: Vec2, tested: &mut impl TestCounter, mut emit: F) {
     let r = st.bbox.intersect(&rect);
     if r.is_empty() {
         return;

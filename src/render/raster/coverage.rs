@@ -3,7 +3,7 @@
 //! mesh must cover every interior sample exactly once) and suited to a crack
 //! debug view.
 
-use super::fixed::{self, snap_all};
+use super::fixed::{self, snap_triangles};
 use super::rect::PixelRect;
 use super::setup::ScreenTri;
 use super::subpixel::snap_offset;
@@ -28,15 +28,15 @@ pub fn coverage_counts(method: Method, width: u32, height: u32, offset: Vec2, tr
         Method::Scanline => sts.iter().for_each(|st| scanline::raster(st, full, offset, &mut tested, |x, y, _| hit(x, y))),
         Method::Fixed => {
             let off = snap_offset(offset);
-            for ft in snap_all(&sts, offset, width, height) {
+            for ft in snap_triangles(&sts, offset, width, height) {
                 fixed::raster(&ft, full, off, &mut tested, |x, y, _| hit(x, y));
             }
         }
         Method::Tiled => {
             let off = snap_offset(offset);
-            let fts = snap_all(&sts, offset, width, height);
+            let fts = snap_triangles(&sts, offset, width, height);
             let grid = TileGrid::new(width, 0, height);
-            let bins = tiled::bin(&fts, &grid, off);
+            let bins = tiled::bin_tiles(&fts, &grid, off);
             for (t, bin) in bins.iter().enumerate() {
                 tiled::tile_fragments(&fts, bin, grid.rect(t), off, &mut tested, |_, x, y, _| hit(x, y));
             }

@@ -7,7 +7,7 @@
 //! top-left rule gives a sample lying exactly on the edge to exactly one of them:
 //! no cracks and no double hits, whatever the mesh.
 
-use super::rect::{PixelRect, Tested};
+use super::rect::{PixelRect, TestCounter};
 use super::setup::ScreenTri;
 use super::subpixel::{snap, snap_offset, ONE};
 use crate::math::Vec2;
@@ -118,7 +118,7 @@ impl FixedTri {
 }
 
 /// Every triangle of the pass snapped (in order; dropped when degenerate after snapping).
-pub fn snap_all(tris: &[ScreenTri], sample_off: Vec2, width: u32, height: u32) -> Vec<FixedTri> {
+pub fn snap_triangles(tris: &[ScreenTri], sample_off: Vec2, width: u32, height: u32) -> Vec<FixedTri> {
     use rayon::prelude::*;
     let off = snap_offset(sample_off);
     tris.par_iter().filter_map(|st| FixedTri::new(st, off, sample_off, width, height)).collect()
@@ -127,7 +127,7 @@ pub fn snap_all(tris: &[ScreenTri], sample_off: Vec2, width: u32, height: u32) -
 /// Visits the covered samples of `ft` inside `rect`, stepping the integer edge
 /// functions by additions, with their screen-space weights.
 #[inline]
-pub fn raster<C: Tested, F: FnMut(u32, u32, [f32; 3])>(ft: &FixedTri, rect: PixelRect, off: [i64; 2], tested: &mut C, emit: F) {
+pub fn raster<C: TestCounter, F: FnMut(u32, u32, [f32; 3])>(ft: &FixedTri, rect: PixelRect, off: [i64; 2], tested: &mut C, emit: F) {
     if ft.wide {
         raster_in::<i128, C, F>(ft, rect, off, tested, emit)
     } else {
@@ -136,7 +136,7 @@ pub fn raster<C: Tested, F: FnMut(u32, u32, [f32; 3])>(ft: &FixedTri, rect: Pixe
 }
 
 #[inline(always)]
-fn raster_in<T: EdgeInt, C: Tested, F: FnMut(u32, u32, [f32; 3])>(ft: &FixedTri, rect: PixelRect, off: [i64; 2], tested: &mut C, mut emit: F) {
+fn raster_in<T: EdgeInt, C: TestCounter, F: FnMut(u32, u32, [f32; 3])>(ft: &FixedTri, rect: PixelRect, off: [i64; 2], tested: &mut C, mut emit: F) {
     let r = ft.bbox.intersect(&rect);
     if r.is_empty() {
         return;

@@ -6,14 +6,14 @@
 //! the earlier one; rounding in the stepped sums can leave rare holes, which
 //! the `fixed` variant removes).
 
-use super::rect::{PixelRect, Tested};
+use super::rect::{PixelRect, TestCounter};
 use super::setup::{edge_function, ScreenTri};
 use crate::math::Vec2;
 
 /// Visits the covered samples of `st` inside `rect` with their screen-space
 /// weights; adds the samples tested to `tested`.
 #[inline]
-pub fn raster<F: FnMut(u32, u32, [f32; 3])>(st: &ScreenTri, rect: PixelRect, off: Vec2, tested: &mut impl Tested, mut emit: F) {
+pub fn raster<F: FnMut(u32, u32, [f32; 3])>(st: &ScreenTri, rect: PixelRect, off: Vec2, tested: &mut impl TestCounter, mut emit: F) {
     let r = st.bbox.intersect(&rect);
     if r.is_empty() {
         return;

@@ -70,7 +70,7 @@ impl Renderer for Rasterizer {
     }
 
     fn trace_pixel(&self, job: &PassJob, x: u32, y: u32, rec: &mut PixelTrace) -> Option<Radiance> {
-        Some(pass::trace(self.method, job, x, y, rec))
+        Some(pass::replay_pixel(self.method, job, x, y, rec))
     }
 }
 

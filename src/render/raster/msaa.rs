@@ -83,7 +83,7 @@ pub fn resolve<Q: SceneQuery, R: FragmentRecorder>(vbs: &mut [VisBuffer<Q, R>], 
 
 /// Resolves the common region of `vbs` into rows of `out_stride` pixels
 /// starting at column `x_offset`, and returns the counts of every layer.
-pub fn finish_into<Q: SceneQuery, R: FragmentRecorder>(vbs: &mut [VisBuffer<Q, R>], out: &mut [Radiance], out_stride: usize, x_offset: usize) -> RayCounts {
+pub fn resolve_into<Q: SceneQuery, R: FragmentRecorder>(vbs: &mut [VisBuffer<Q, R>], out: &mut [Radiance], out_stride: usize, x_offset: usize) -> RayCounts {
     let r = vbs[0].rect;
     let w = r.width() as usize;
     let mut i = 0;

@@ -9,18 +9,18 @@
 //! pass's sample; with MSAA N there are N + 1: the pixel-centre layer that
 //! shading reads and the N coverage samples (`msaa.rs`).
 //!
-//! `trace` replays one pixel through this very code: the same setup and
+//! `replay_pixel` replays one pixel through this very code: the same setup and
 //! coverage loops over the region holding the pixel (its row, or its tile),
 //! with a recording `VisBuffer` that keeps that pixel's fragment history.
 
-use super::fixed::{self, snap_all, FixedTri};
+use super::fixed::{self, snap_triangles, FixedTri};
 use super::msaa;
 use super::naive::{ray_test_rect, region_rays};
 use super::rect::PixelRect;
 use super::setup::{bin_rows, setup_pass, ScreenTri};
 use super::sphere::{all_sphere_bounds, raster_spheres};
 use super::subpixel::snap_offset;
-use super::tiled::{self, Class, TileGrid};
+use super::tiled::{self, RectCoverage, TileGrid};
 use super::vis_buffer::{DepthKey, FragmentRecorder, VisBuffer};
 use super::method::Method;
 use super::{barycentric, bbox, incremental, scanline};
@@ -41,74 +41,76 @@ pub fn query(prepared: &PreparedScene) -> Query<'_> {
 /// Rows per band of the band-parallel variants.
 pub const BAND_ROWS: u32 = 16;
 
-/// What a variant's coverage loop reads, set up once per layer.
+/// What a variant's coverage loop reads, set up once per layer: float screen
+/// triangles, or fixed-point (snapped) ones.
 enum Geometry {
     /// naive: every triangle against every sample of the region.
-    All,
+    AllTriangles,
     /// bbox: each scene triangle's grown box, binned by band.
-    Boxes { boxes: Vec<(u32, PixelRect)>, bins: Vec<Vec<u32>> },
+    TriangleBoxes { boxes: Vec<(u32, PixelRect)>, bins: Vec<Vec<u32>> },
     /// barycentric, incremental, scanline: screen triangles binned by band.
-    Float { tris: Vec<ScreenTri>, bins: Vec<Vec<u32>> },
-    /// fixed: snapped triangles binned by band.
-    Fixed { fts: Vec<FixedTri>, off: [i64; 2], bins: Vec<Vec<u32>> },
-    /// tiled: snapped triangles binned by tile, with their whole-tile class.
-    Tiled { fts: Vec<FixedTri>, off: [i64; 2], bins: Vec<Vec<(u32, Class)>> },
+    FloatTriangles { tris: Vec<ScreenTri>, bins: Vec<Vec<u32>> },
+    /// fixed: fixed-point (snapped) triangles binned by band.
+    FixedTriangles { fts: Vec<FixedTri>, off: [i64; 2], bins: Vec<Vec<u32>> },
+    /// tiled: fixed-point (snapped) triangles binned by tile, with their whole-tile coverage.
+    FixedTriangleTiles { fts: Vec<FixedTri>, off: [i64; 2], bins: Vec<Vec<(u32, RectCoverage)>> },
 }
 
 /// One sample position of a pass, set up.
 pub struct Layer<'a> {
     pub job: PassJob<'a>,
     method: Method,
-    geo: Geometry,
+    geometry: Geometry,
     spheres: Vec<Option<PixelRect>>,
     /// MSAA coverage sample index; `None` for the pass's own sample.
     pub sample: Option<u32>,
 }
 
-fn job_at<'a>(job: &PassJob<'a>, offset: Vec2, rows: Range<u32>) -> PassJob<'a> {
+/// `job` with its sample at `offset` and its rows `rows`.
+fn job_at_offset<'a>(job: &PassJob<'a>, offset: Vec2, rows: Range<u32>) -> PassJob<'a> {
     PassJob { prepared: job.prepared, view: job.view, settings: job.settings, offset, rows, cancel: job.cancel }
 }
 
 impl<'a> Layer<'a> {
     /// Sets up the rows of `job` at sample `offset`; tiles are those of `grid`.
     fn new(method: Method, job: &PassJob<'a>, offset: Vec2, sample: Option<u32>, grid: &TileGrid) -> Layer<'a> {
-        let job = job_at(job, offset, job.rows.clone());
+        let job = job_at_offset(job, offset, job.rows.clone());
         let (r0, r1) = (job.rows.start, job.rows.end);
         let (w, h) = (job.view.width, job.view.height);
-        let geo = match method {
-            Method::Naive => Geometry::All,
+        let geometry = match method {
+            Method::Naive => Geometry::AllTriangles,
             Method::BBox => {
                 let boxes = bbox::triangle_boxes(&job);
                 let bins = bin_rows(boxes.iter().map(|b| b.1), r0, r1, BAND_ROWS);
-                Geometry::Boxes { boxes, bins }
+                Geometry::TriangleBoxes { boxes, bins }
             }
             Method::Barycentric | Method::Incremental | Method::Scanline => {
                 let tris = setup_pass(&job);
                 let bins = bin_rows(tris.iter().map(|t| t.bbox), r0, r1, BAND_ROWS);
-                Geometry::Float { tris, bins }
+                Geometry::FloatTriangles { tris, bins }
             }
             Method::Fixed => {
-                let fts = snap_all(&setup_pass(&job), offset, w, h);
+                let fts = snap_triangles(&setup_pass(&job), offset, w, h);
                 let bins = bin_rows(fts.iter().map(|f| f.bbox), r0, r1, BAND_ROWS);
-                Geometry::Fixed { fts, off: snap_offset(offset), bins }
+                Geometry::FixedTriangles { fts, off: snap_offset(offset), bins }
             }
             Method::Tiled => {
                 let off = snap_offset(offset);
-                let fts = snap_all(&setup_pass(&job), offset, w, h);
-                let bins = tiled::bin(&fts, grid, off);
-                Geometry::Tiled { fts, off, bins }
+                let fts = snap_triangles(&setup_pass(&job), offset, w, h);
+                let bins = tiled::bin_tiles(&fts, grid, off);
+                Geometry::FixedTriangleTiles { fts, off, bins }
             }
         };
         let spheres = all_sphere_bounds(job.view, &job.prepared.scene.spheres, offset);
-        Layer { job, method, geo, spheres, sample }
+        Layer { job, method, geometry, spheres, sample }
     }
 
     /// Rasterizes this layer's triangles of region `region` (band or tile
     /// index), then the spheres, into `vb` (whose rect lies in that region).
     pub fn raster<Q: SceneQuery, R: FragmentRecorder>(&self, vb: &mut VisBuffer<Q, R>, region: usize) {
         let rect = vb.rect;
-        match &self.geo {
-            Geometry::All => {
+        match &self.geometry {
+            Geometry::AllTriangles => {
                 let rays = region_rays(vb);
                 for tri in 0..self.job.prepared.edges.len() as u32 {
                     if self.job.cancelled() {
@@ -117,7 +119,7 @@ impl<'a> Layer<'a> {
                     ray_test_rect(vb, &rays, tri, rect);
                 }
             }
-            Geometry::Boxes { boxes, bins } => {
+            Geometry::TriangleBoxes { boxes, bins } => {
                 let rays = region_rays(vb);
                 for &i in &bins[region] {
                     let (tri, b) = boxes[i as usize];
@@ -127,7 +129,7 @@ impl<'a> Layer<'a> {
                     }
                 }
             }
-            Geometry::Float { tris, bins } => {
+            Geometry::FloatTriangles { tris, bins } => {
                 let off = self.job.offset;
                 let mut tested = vb.begin_tests();
                 for &i in &bins[region] {
@@ -141,7 +143,7 @@ impl<'a> Layer<'a> {
                 }
                 vb.end_tests(tested);
             }
-            Geometry::Fixed { fts, off, bins } => {
+            Geometry::FixedTriangles { fts, off, bins } => {
                 let mut tested = vb.begin_tests();
                 for &i in &bins[region] {
                     let ft = &fts[i as usize];
@@ -149,7 +151,7 @@ impl<'a> Layer<'a> {
                 }
                 vb.end_tests(tested);
             }
-            Geometry::Tiled { fts, off, bins } => {
+            Geometry::FixedTriangleTiles { fts, off, bins } => {
                 let mut tested = vb.begin_tests();
                 tiled::tile_fragments(fts, &bins[region], rect, *off, &mut tested, |ft, x, y, l| vb.triangle_fragment(&ft.st, x, y, l));
                 vb.end_tests(tested);
@@ -175,16 +177,17 @@ fn layers<'a>(method: Method, job: &PassJob<'a>, grid: &TileGrid) -> Vec<Layer<'
     out
 }
 
-/// Resolves the region of `vbs` (one buffer per layer) into `out`.
-fn resolve<Q: SceneQuery, R: FragmentRecorder>(vbs: &mut [VisBuffer<Q, R>], out: &mut [Radiance], stride: usize, x_offset: usize) -> RayCounts {
+/// Resolves the region of `vbs` (one buffer per layer) into `out`: one buffer
+/// on its own, MSAA layers together.
+fn resolve_region<Q: SceneQuery, R: FragmentRecorder>(vbs: &mut [VisBuffer<Q, R>], out: &mut [Radiance], stride: usize, x_offset: usize) -> RayCounts {
     if vbs.len() == 1 {
-        vbs[0].finish_into(out, stride, x_offset)
+        vbs[0].resolve_into(out, stride, x_offset)
     } else {
-        msaa::finish_into(vbs, out, stride, x_offset)
+        msaa::resolve_into(vbs, out, stride, x_offset)
     }
 }
 
-fn buffers<'j, 'a, Q: SceneQuery>(layers: &'j [Layer<'a>], query: &'j Q, rect: PixelRect, key: DepthKey, forward: bool) -> Vec<VisBuffer<'j, 'a, Q>> {
+fn layer_buffers<'j, 'a, Q: SceneQuery>(layers: &'j [Layer<'a>], query: &'j Q, rect: PixelRect, key: DepthKey, forward: bool) -> Vec<VisBuffer<'j, 'a, Q>> {
     layers
         .iter()
         .map(|l| {
@@ -196,7 +199,7 @@ fn buffers<'j, 'a, Q: SceneQuery>(layers: &'j [Layer<'a>], query: &'j Q, rect: P
 }
 
 /// Forward shading applies without MSAA only (MSAA shades once per pixel per primitive).
-fn forward(job: &PassJob) -> bool {
+fn shades_forward(job: &PassJob) -> bool {
     !job.settings.early_depth && job.settings.msaa <= 1
 }
 
@@ -209,7 +212,7 @@ pub fn render(method: Method, job: &PassJob, out: &mut [Radiance]) -> RayCounts 
     let query = query(job.prepared);
     let grid = TileGrid::new(width, job.rows.start, job.rows.end);
     let layers = layers(method, job, &grid);
-    let (key, forward) = (depth_key(method), forward(job));
+    let (key, forward) = (depth_key(method), shades_forward(job));
     let sum = |mut a: RayCounts, b: RayCounts| {
         a += b;
         a
@@ -222,7 +225,7 @@ pub fn render(method: Method, job: &PassJob, out: &mut [Radiance]) -> RayCounts 
             .enumerate()
             .map(|(ty, chunk)| {
                 let mut counts = RayCounts::default();
-                let mut vbs = buffers(&layers, &query, grid.rect(ty * grid.nx as usize), key, forward);
+                let mut vbs = layer_buffers(&layers, &query, grid.rect(ty * grid.nx as usize), key, forward);
                 for tx in 0..grid.nx as usize {
                     if job.cancelled() {
                         break;
@@ -233,7 +236,7 @@ pub fn render(method: Method, job: &PassJob, out: &mut [Radiance]) -> RayCounts 
                         vb.reset(rect);
                         l.raster(vb, t);
                     }
-                    counts += resolve(&mut vbs, chunk, width as usize, rect.x0 as usize);
+                    counts += resolve_region(&mut vbs, chunk, width as usize, rect.x0 as usize);
                 }
                 counts
             })
@@ -247,11 +250,11 @@ pub fn render(method: Method, job: &PassJob, out: &mut [Radiance]) -> RayCounts 
             }
             let y0 = job.rows.start + b as u32 * BAND_ROWS;
             let y1 = (y0 + BAND_ROWS).min(job.rows.end);
-            let mut vbs = buffers(&layers, &query, PixelRect::new(0, y0, width, y1), key, forward);
+            let mut vbs = layer_buffers(&layers, &query, PixelRect::new(0, y0, width, y1), key, forward);
             for (l, vb) in layers.iter().zip(&mut vbs) {
                 l.raster(vb, b);
             }
-            resolve(&mut vbs, chunk, width as usize, 0)
+            resolve_region(&mut vbs, chunk, width as usize, 0)
         })
         .reduce(RayCounts::default, sum)
 }
@@ -259,14 +262,14 @@ pub fn render(method: Method, job: &PassJob, out: &mut [Radiance]) -> RayCounts 
 /// Replays pixel `(x, y)` of the pass `render` draws for all rows of the
 /// image (as `render_frame` does), recording its fragment
 /// history and shading into `rec`. Returns the value `render` stores there.
-pub fn trace(method: Method, job: &PassJob, x: u32, y: u32, rec: &mut PixelTrace) -> Radiance {
+pub fn replay_pixel(method: Method, job: &PassJob, x: u32, y: u32, rec: &mut PixelTrace) -> Radiance {
     let (width, height) = (job.view.width, job.view.height);
     let query = query(job.prepared);
     // The pass is set up as a frame sets it up (all rows: `render_frame`
     // renders each pass in one job); band variants then rasterize only the
     // pixel's row of its band (a pixel's coverage and values do not depend on
     // the rows around it), tiled the pixel's whole tile.
-    let frame = job_at(job, job.offset, 0..height);
+    let frame = job_at_offset(job, job.offset, 0..height);
     let grid = TileGrid::new(width, 0, height);
     let layers = layers(method, &frame, &grid);
     let (rect, region) = if method == Method::Tiled {
@@ -275,7 +278,7 @@ pub fn trace(method: Method, job: &PassJob, x: u32, y: u32, rec: &mut PixelTrace
     } else {
         (PixelRect::new(0, y, width, y + 1), (y / BAND_ROWS) as usize)
     };
-    let (key, forward) = (depth_key(method), forward(job));
+    let (key, forward) = (depth_key(method), shades_forward(job));
     let mut vbs: Vec<_> = layers
         .iter()
         .map(|l| {

@@ -43,12 +43,12 @@ impl PixelRect {
 
 /// Where the coverage loops count the samples they test: a plain total
 /// (`u64`), or a total plus a per-pixel map for the cost view
-/// (`vis_buffer::TestCount`). Called once per rectangle (or span) tested.
-pub trait Tested {
+/// (`vis_buffer::TestCountMap`). Called once per rectangle (or span) tested.
+pub trait TestCounter {
     fn add(&mut self, r: PixelRect);
 }
 
-impl Tested for u64 {
+impl TestCounter for u64 {
     #[inline(always)]
     fn add(&mut self, r: PixelRect) {
         *self += r.area();

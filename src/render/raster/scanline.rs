@@ -7,13 +7,13 @@
 //! barycentrics (the book's 1/z interpolation). It runs on the same clipped
 //! triangles as every other variant and samples at the pass's sample positions.
 
-use super::rect::{PixelRect, Tested};
+use super::rect::{PixelRect, TestCounter};
 use super::setup::ScreenTri;
 use crate::math::{Vec2, Vec3};
 
 /// Position and interpolated weights where the edge `a -> b` crosses row `ys`.
 #[inline(always)]
-fn along(a: (Vec2, Vec3), b: (Vec2, Vec3), ys: f32) -> (f32, Vec3) {
+fn edge_at_row(a: (Vec2, Vec3), b: (Vec2, Vec3), ys: f32) -> (f32, Vec3) {
     let dy = b.0.y - a.0.y;
     let s = if dy > 0.0 { ((ys - a.0.y) / dy).clamp(0.0, 1.0) } else { 0.0 };
     (a.0.x + (b.0.x - a.0.x) * s, a.1 + (b.1 - a.1) * s)
@@ -21,7 +21,7 @@ fn along(a: (Vec2, Vec3), b: (Vec2, Vec3), ys: f32) -> (f32, Vec3) {
 
 /// Visits the covered samples of `st` inside `rect`; the samples tested are the spans.
 #[inline]
-pub fn raster<F: FnMut(u32, u32, [f32; 3])>(st: &ScreenTri, rect: PixelRect, off: Vec2, tested: &mut impl Tested, mut emit: F) {
+pub fn raster<F: FnMut(u32, u32, [f32; 3])>(st: &ScreenTri, rect: PixelRect, off: Vec2, tested: &mut impl TestCounter, mut emit: F) {
     let r = st.bbox.intersect(&rect);
     if r.is_empty() {
         return;
@@ -34,8 +34,8 @@ pub fn raster<F: FnMut(u32, u32, [f32; 3])>(st: &ScreenTri, rect: PixelRect, off
         if ys < v0.0.y || ys > v2.0.y {
             continue;
         }
-        let long = along(v0, v2, ys);
-        let short = if ys < v1.0.y { along(v0, v1, ys) } else { along(v1, v2, ys) };
+        let long = edge_at_row(v0, v2, ys);
+        let short = if ys < v1.0.y { edge_at_row(v0, v1, ys) } else { edge_at_row(v1, v2, ys) };
         let (left, right) = if long.0 <= short.0 { (long, short) } else { (short, long) };
         let x0 = ((left.0 - off.x).ceil().max(r.x0 as f32)) as u32;
         let x1 = (((right.0 - off.x).floor() + 1.0).min(r.x1 as f32)).max(0.0) as u32;

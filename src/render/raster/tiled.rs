@@ -8,7 +8,7 @@
 //! same samples with the same weights: identical images, bit for bit.
 
 use super::fixed::{self, FixedTri};
-use super::rect::{PixelRect, Tested};
+use super::rect::{PixelRect, TestCounter};
 use super::subpixel::ONE;
 
 /// Tile edge length in pixels.
@@ -18,7 +18,7 @@ pub const BLOCK: u32 = 8;
 
 /// How a rectangle of samples relates to a triangle.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Class {
+pub enum RectCoverage {
     /// No sample is covered.
     Reject,
     /// Some samples may be covered: test each.
@@ -58,7 +58,7 @@ impl TileGrid {
 /// edge functions are affine, so their extremes over the samples are at the
 /// corner samples chosen by the signs of the edge's gradient.
 #[inline]
-pub fn classify(ft: &FixedTri, r: PixelRect, off: [i64; 2]) -> Class {
+pub fn classify(ft: &FixedTri, r: PixelRect, off: [i64; 2]) -> RectCoverage {
     let sx = [r.x0 as i64 * ONE + off[0], (r.x1 as i64 - 1) * ONE + off[0]];
     let sy = [r.y0 as i64 * ONE + off[1], (r.y1 as i64 - 1) * ONE + off[1]];
     let mut all_in = true;
@@ -66,17 +66,17 @@ pub fn classify(ft: &FixedTri, r: PixelRect, off: [i64; 2]) -> Class {
         let (ix, iy) = ((ft.a[k] >= 0) as usize, (ft.b[k] >= 0) as usize);
         let max: i64 = ft.edge_at(k, sx[ix], sy[iy]);
         if max < ft.bias[k] {
-            return Class::Reject;
+            return RectCoverage::Reject;
         }
         let min: i64 = ft.edge_at(k, sx[1 - ix], sy[1 - iy]);
         all_in &= min >= ft.bias[k];
     }
-    if all_in { Class::Accept } else { Class::Partial }
+    if all_in { RectCoverage::Accept } else { RectCoverage::Partial }
 }
 
 /// Bins the triangles (in order) into the tiles they may cover, with the
 /// whole-tile classification (always `Partial` for wide triangles).
-pub fn bin(tris: &[FixedTri], grid: &TileGrid, off: [i64; 2]) -> Vec<Vec<(u32, Class)>> {
+pub fn bin_tiles(tris: &[FixedTri], grid: &TileGrid, off: [i64; 2]) -> Vec<Vec<(u32, RectCoverage)>> {
     let mut bins = vec![Vec::new(); grid.count()];
     let rows = PixelRect::new(0, grid.y0, grid.width, grid.y1);
     for (i, ft) in tris.iter().enumerate() {
@@ -91,11 +91,11 @@ pub fn bin(tris: &[FixedTri], grid: &TileGrid, off: [i64; 2]) -> Vec<Vec<(u32, C
                 let t = (ty * grid.nx + tx) as usize;
                 let class = if ft.wide || (tx0 == tx1 && ty0 == ty1) {
                     // A triangle inside one tile is classified per block anyway.
-                    Class::Partial
+                    RectCoverage::Partial
                 } else {
                     classify(ft, grid.rect(t).intersect(&r), off)
                 };
-                if class != Class::Reject {
+                if class != RectCoverage::Reject {
                     bins[t].push((i as u32, class));
                 }
             }
@@ -109,10 +109,10 @@ pub fn bin(tris: &[FixedTri], grid: &TileGrid, off: [i64; 2]) -> Vec<Vec<(u32, C
 #[inline]
 pub fn tile_fragments<F: FnMut(&FixedTri, u32, u32, [f32; 3])>(
     tris: &[FixedTri],
-    bin: &[(u32, Class)],
+    bin: &[(u32, RectCoverage)],
     tile: PixelRect,
     off: [i64; 2],
-    tested: &mut impl Tested,
+    tested: &mut impl TestCounter,
     mut emit: F,
 ) {
     for &(i, class) in bin {
@@ -134,15 +134,15 @@ pub fn tile_fragments<F: FnMut(&FixedTri, u32, u32, [f32; 3])>(
                 let br = PixelRect::new(bx, by, bx + BLOCK, by + BLOCK).intersect(&r);
                 // Small rectangles (most of a fine mesh) are cheaper to test sample by sample.
                 let c = match class {
-                    Class::Accept => Class::Accept,
-                    _ if br.area() <= 16 => Class::Partial,
+                    RectCoverage::Accept => RectCoverage::Accept,
+                    _ if br.area() <= 16 => RectCoverage::Partial,
                     _ => classify(ft, br, off),
                 };
-                if c == Class::Reject {
+                if c == RectCoverage::Reject {
                     continue;
                 }
                 tested.add(br);
-                if c == Class::Accept {
+                if c == RectCoverage::Accept {
                     // Every sample covered: no edge function is needed.
                     for y in br.y0..br.y1 {
                         for x in br.x0..br.x1 {
@@ -192,14 +192,14 @@ mod tests {
         let st = ScreenTri::flat(0, [Vec2::new(0.0, 0.0), Vec2::new(64.0, 0.0), Vec2::new(0.0, 64.0)], Vec2::splat(0.5), 64, 64).unwrap();
         let off = snap_offset(Vec2::splat(0.5));
         let ft = FixedTri::new(&st, off, Vec2::splat(0.5), 64, 64).unwrap();
-        assert_eq!(classify(&ft, PixelRect::new(0, 0, 8, 8), off), Class::Accept);
-        assert_eq!(classify(&ft, PixelRect::new(56, 56, 64, 64), off), Class::Reject);
-        assert_eq!(classify(&ft, PixelRect::new(28, 28, 36, 36), off), Class::Partial);
+        assert_eq!(classify(&ft, PixelRect::new(0, 0, 8, 8), off), RectCoverage::Accept);
+        assert_eq!(classify(&ft, PixelRect::new(56, 56, 64, 64), off), RectCoverage::Reject);
+        assert_eq!(classify(&ft, PixelRect::new(28, 28, 36, 36), off), RectCoverage::Partial);
         // The block just below the diagonal: its top-left sample (32.5, 24.5) has
         // x + y = 57 < 64, its bottom-right (39.5, 31.5) has 71: partial.
-        assert_eq!(classify(&ft, PixelRect::new(32, 24, 40, 32), off), Class::Partial);
+        assert_eq!(classify(&ft, PixelRect::new(32, 24, 40, 32), off), RectCoverage::Partial);
         // Block (24..32, 24..32): bottom-right sample 31.5 + 31.5 = 63 < 64: accept.
-        assert_eq!(classify(&ft, PixelRect::new(24, 24, 32, 32), off), Class::Accept);
+        assert_eq!(classify(&ft, PixelRect::new(24, 24, 32, 32), off), RectCoverage::Accept);
     }
 
     #[test]

@@ -9,7 +9,7 @@
 //! fragment (strict `<`), so the earlier triangle in scene order wins, as in
 //! the brute-force caster.
 
-use super::rect::{PixelRect, Tested};
+use super::rect::{PixelRect, TestCounter};
 use super::setup::ScreenTri;
 use crate::math::{Radiance, Ray, Vec3};
 use crate::render::debug::{cost_color, View};
@@ -46,13 +46,13 @@ impl FragmentRecorder for PixelTrace {
 }
 
 /// Samples tested by a coverage loop, with a per-pixel map for the cost view.
-pub struct TestCount {
+pub struct TestCountMap {
     pub total: u64,
     rect: PixelRect,
     per_pixel: Vec<u32>,
 }
 
-impl Tested for TestCount {
+impl TestCounter for TestCountMap {
     #[inline]
     fn add(&mut self, r: PixelRect) {
         self.total += r.area();
@@ -159,12 +159,12 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
 
     /// A counter for a coverage loop that cannot borrow the buffer while it runs.
     #[inline]
-    pub fn begin_tests(&mut self) -> TestCount {
-        TestCount { total: 0, rect: self.rect, per_pixel: std::mem::take(&mut self.tests) }
+    pub fn begin_tests(&mut self) -> TestCountMap {
+        TestCountMap { total: 0, rect: self.rect, per_pixel: std::mem::take(&mut self.tests) }
     }
 
     #[inline]
-    pub fn end_tests(&mut self, t: TestCount) {
+    pub fn end_tests(&mut self, t: TestCountMap) {
         self.counts.samples_tested += t.total;
         self.tests = t.per_pixel;
     }
@@ -182,7 +182,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
     }
 
     /// The view depth of a depth key at pixel `(x, y)` (for the record).
-    fn key_depth(&self, key: f32, x: u32, y: u32) -> f32 {
+    fn view_depth_of_key(&self, key: f32, x: u32, y: u32) -> f32 {
         match self.key {
             DepthKey::NegInvZ => -1.0 / key,
             DepthKey::RayT => {
@@ -229,8 +229,8 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             primitive,
             screen_barycentric: screen,
             barycentric: b,
-            depth: self.key_depth(key, x, y),
-            stored_depth: self.key_depth(stored, x, y),
+            depth: self.view_depth_of_key(key, x, y),
+            stored_depth: self.view_depth_of_key(stored, x, y),
             passed_depth_test: passed,
             shaded: (passed && self.forward).then(|| self.color[i]),
             sample: self.sample,
@@ -402,7 +402,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
     /// `out` starting at column `x_offset`: early-depth mode shades each
     /// visible surface once here; forward mode already shaded it. Counts one
     /// primary sample per pixel.
-    pub fn finish_into(&mut self, out: &mut [Radiance], out_stride: usize, x_offset: usize) -> RayCounts {
+    pub fn resolve_into(&mut self, out: &mut [Radiance], out_stride: usize, x_offset: usize) -> RayCounts {
         let r = self.rect;
         let mut i = 0;
         for (row, y) in (r.y0..r.y1).enumerate() {
