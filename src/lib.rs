@@ -8,6 +8,7 @@ pub mod cli;
 pub mod image_io;
 pub mod math;
 pub mod metrics;
+pub mod named;
 pub mod pixel_report;
 pub mod render;
 pub mod scene;

@@ -3,83 +3,58 @@
 //! view means the same thing in each.
 
 use crate::math::{Radiance, Ray, Vec3};
+use crate::named::named_enum;
 use crate::scene::{CameraView, SurfaceHit};
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum View {
-    /// The shaded image.
-    Shaded,
-    /// Barycentric weights of v0, v1, v2 as red, green, blue (Figure 15.6).
-    Barycentric,
-    /// Eye-ray direction as (d + 1) / 2 (Figure 15.4).
-    Raydir,
-    /// Distance from the eye along the eye ray, on a log scale from near (black) to far (white).
-    Depth,
-    /// What a depth buffer stores: 1/z, mapped so near = 1 (white) and far = 0 (black).
-    Zbuffer,
-    /// Shading normal as (n + 1) / 2.
-    Normal,
-    /// Geometric (face) normal as (n + 1) / 2: compare with `Normal` to see
-    /// what the interpolated vertex normals do.
-    GeometricNormal,
-    /// Object ids as distinct colours.
-    Id,
-    /// Triangle (or sphere) ids as distinct colours: the tessellation.
-    TriangleId,
-    /// Material ids as distinct colours.
-    MaterialId,
-    /// A checker in texture coordinates.
-    Uv,
-    /// Work per pixel as a heat map (`cost_color`, the same scale for all):
-    /// ray casters count BVH nodes visited plus primitives tested by the eye
-    /// ray; rasterizers count, per pixel and pass, samples tested (one per
-    /// primitive whose tested region - whole image, bounding box, span or
-    /// block - holds the pixel's sample), plus fragments (covered samples,
-    /// each depth-tested; those that fail are the overdraw), plus fragments
-    /// shaded (one with early depth, one per depth-test pass when forward).
-    /// With MSAA the work of every coverage sample and the shading layer adds up.
-    Cost,
-    /// This renderer's shaded image minus the reference `raytrace:brute`'s:
-    /// red where brighter, blue where darker (amplified), the rest dimmed.
-    Diff,
-    /// The lights' shadow maps (CGPP Figure 15.14): depth from the light in
-    /// grey, black near, white far; a point light's six faces in a 3 x 2 grid.
-    Shadowmap,
+named_enum! {
+    /// What a frame shows: the shaded image or a debug view. The spellings
+    /// after `|` are how saved viewer settings once wrote the hyphenated
+    /// names; they still load.
+    #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+    pub enum View ("view") {
+        /// The shaded image.
+        Shaded = "shaded",
+        /// Barycentric weights of v0, v1, v2 as red, green, blue (Figure 15.6).
+        Barycentric = "barycentric",
+        /// Eye-ray direction as (d + 1) / 2 (Figure 15.4).
+        Raydir = "raydir",
+        /// Distance from the eye along the eye ray, on a log scale from near (black) to far (white).
+        Depth = "depth",
+        /// What a depth buffer stores: 1/z, mapped so near = 1 (white) and far = 0 (black).
+        Zbuffer = "zbuffer",
+        /// Shading normal as (n + 1) / 2.
+        Normal = "normal",
+        /// Geometric (face) normal as (n + 1) / 2: compare with `Normal` to see
+        /// what the interpolated vertex normals do.
+        GeometricNormal = "geometric-normal" | "geometricnormal",
+        /// Object ids as distinct colours.
+        Id = "id",
+        /// Triangle (or sphere) ids as distinct colours: the tessellation.
+        TriangleId = "triangle-id" | "triangleid",
+        /// Material ids as distinct colours.
+        MaterialId = "material-id" | "materialid",
+        /// A checker in texture coordinates.
+        Uv = "uv",
+        /// Work per pixel as a heat map (`cost_color`, the same scale for all):
+        /// ray casters count BVH nodes visited plus primitives tested by the eye
+        /// ray; rasterizers count, per pixel and pass, samples tested (one per
+        /// primitive whose tested region - whole image, bounding box, span or
+        /// block - holds the pixel's sample), plus fragments (covered samples,
+        /// each depth-tested; those that fail are the overdraw), plus fragments
+        /// shaded (one with early depth, one per depth-test pass when forward).
+        /// With MSAA the work of every coverage sample and the shading layer adds up.
+        Cost = "cost",
+        /// This renderer's shaded image minus the reference `raytrace:brute`'s:
+        /// red where brighter, blue where darker (amplified), the rest dimmed.
+        Diff = "diff",
+        /// The lights' shadow maps (CGPP Figure 15.14): depth from the light in
+        /// grey, black near, white far; a point light's six faces in a 3 x 2 grid.
+        Shadowmap = "shadowmap",
+    }
 }
 
 /// The cost that maps to the hot end of the cost view's colour scale.
 pub const COST_SCALE: f32 = 1024.0;
-
-impl View {
-    pub const ALL: [View; 14] = [View::Shaded, View::Barycentric, View::Raydir, View::Depth, View::Zbuffer, View::Normal, View::GeometricNormal, View::Id, View::TriangleId, View::MaterialId, View::Uv, View::Cost, View::Diff, View::Shadowmap];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            View::Shaded => "shaded",
-            View::Barycentric => "barycentric",
-            View::Raydir => "raydir",
-            View::Depth => "depth",
-            View::Normal => "normal",
-            View::Id => "id",
-            View::GeometricNormal => "geometric-normal",
-            View::TriangleId => "triangle-id",
-            View::MaterialId => "material-id",
-            View::Uv => "uv",
-            View::Zbuffer => "zbuffer",
-            View::Cost => "cost",
-            View::Diff => "diff",
-            View::Shadowmap => "shadowmap",
-        }
-    }
-
-    pub fn parse(s: &str) -> Result<View, String> {
-        Self::ALL.into_iter().find(|v| v.name() == s).ok_or_else(|| {
-            let names: Vec<_> = Self::ALL.iter().map(|v| v.name()).collect();
-            format!("unknown view \"{s}\" (choose from {})", names.join(", "))
-        })
-    }
-}
 
 /// The colour of one sample in a debug view. Values are "radiance" in [0, 1],
 /// shown with exposure 1.

@@ -18,68 +18,33 @@ pub use frame::{render_frame, render_frame_in_bands, replay_pixel, FrameResult, 
 pub use prepared::PreparedScene;
 
 use crate::math::{Radiance, Ray, Vec2};
+use crate::named::named_enum;
 use crate::scene::{CameraView, PrimitiveKind, SurfaceHit};
 use std::ops::Range;
 use std::sync::atomic::AtomicBool;
 use trace::Recorder;
 
-/// How shadow visibility is resolved.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum ShadowMode {
-    None,
-    Ray,
-    Map,
-}
-
-impl ShadowMode {
-    pub const ALL: [ShadowMode; 3] = [ShadowMode::None, ShadowMode::Ray, ShadowMode::Map];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            ShadowMode::None => "none",
-            ShadowMode::Ray => "ray",
-            ShadowMode::Map => "map",
-        }
-    }
-
-    pub fn parse(s: &str) -> Result<ShadowMode, String> {
-        Self::ALL
-            .into_iter()
-            .find(|m| m.name() == s)
-            .ok_or_else(|| format!("unknown shadow mode \"{s}\" (expected none, ray or map)"))
+named_enum! {
+    /// How shadow visibility is resolved.
+    #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+    pub enum ShadowMode ("shadow mode") {
+        None = "none",
+        Ray = "ray",
+        Map = "map",
     }
 }
 
-/// How shading varies across a triangle (Computer Graphics from Scratch, ch. 13).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Interpolation {
-    /// One normal per face: the geometric normal everywhere.
-    Flat,
-    /// Lighting computed at the three vertices, the radiance interpolated.
-    Gouraud,
-    /// Normals interpolated and lighting computed per sample.
-    #[default]
-    Phong,
-}
-
-impl Interpolation {
-    pub const ALL: [Interpolation; 3] = [Interpolation::Flat, Interpolation::Gouraud, Interpolation::Phong];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Interpolation::Flat => "flat",
-            Interpolation::Gouraud => "gouraud",
-            Interpolation::Phong => "phong",
-        }
-    }
-
-    pub fn parse(s: &str) -> Result<Interpolation, String> {
-        Self::ALL
-            .into_iter()
-            .find(|m| m.name() == s)
-            .ok_or_else(|| format!("unknown interpolation \"{s}\" (expected flat, gouraud or phong)"))
+named_enum! {
+    /// How shading varies across a triangle (Computer Graphics from Scratch, ch. 13).
+    #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+    pub enum Interpolation ("interpolation") {
+        /// One normal per face: the geometric normal everywhere.
+        Flat = "flat",
+        /// Lighting computed at the three vertices, the radiance interpolated.
+        Gouraud = "gouraud",
+        /// Normals interpolated and lighting computed per sample.
+        #[default]
+        Phong = "phong",
     }
 }
 

@@ -1,33 +1,24 @@
 //! The rasterization methods (coverage loops) a rasterizer variant can use,
 //! with the names `--renderer` takes.
 
-/// The rasterization methods, from the book's first version to the fastest.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Method {
-    Naive,
-    BBox,
-    Barycentric,
-    Incremental,
-    Scanline,
-    Fixed,
-    Tiled,
+use crate::named::named_enum;
+
+named_enum! {
+    /// The rasterization methods, from the book's first version to the fastest.
+    #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+    pub enum Method ("rasterizer") {
+        Naive = "rasterize:naive",
+        BBox = "rasterize:bbox",
+        Barycentric = "rasterize:barycentric",
+        Incremental = "rasterize:incremental",
+        Scanline = "rasterize:scanline",
+        Fixed = "rasterize:fixed",
+        Tiled = "rasterize:tiled",
+    }
 }
 
 impl Method {
-    pub const ALL: [Method; 7] = [Method::Naive, Method::BBox, Method::Barycentric, Method::Incremental, Method::Scanline, Method::Fixed, Method::Tiled];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Method::Naive => "rasterize:naive",
-            Method::BBox => "rasterize:bbox",
-            Method::Barycentric => "rasterize:barycentric",
-            Method::Incremental => "rasterize:incremental",
-            Method::Scanline => "rasterize:scanline",
-            Method::Fixed => "rasterize:fixed",
-            Method::Tiled => "rasterize:tiled",
-        }
-    }
-
+    /// What the method does, for `pinhole list`.
     pub fn description(self) -> &'static str {
         match self {
             Method::Naive => "every triangle against every pixel with the 3D ray test and a depth buffer (CGPP 15.22)",
@@ -38,9 +29,5 @@ impl Method {
             Method::Fixed => "8-bit sub-pixel fixed-point edge functions, top-left rule: watertight",
             Method::Tiled => "fixed-point edge functions, 32x32 tiles in parallel, 8x8 block masks: watertight",
         }
-    }
-
-    pub fn parse(name: &str) -> Option<Method> {
-        Self::ALL.into_iter().find(|m| m.name() == name)
     }
 }
