@@ -1,4 +1,4 @@
-//! Scene files (SCENE_FORMAT.md): TOML parsed with serde into plain
+//! Scene files: TOML parsed with serde into plain
 //! descriptions, then checked and turned into a `Scene`. Every error names the
 //! file, the line and the key or table at fault.
 
