@@ -1,10 +1,9 @@
-//! The egui viewer (issue 4): a live framebuffer of the selected renderer
+//! The egui viewer: a live framebuffer of the selected renderer
 //! with camera, light, material and shading panels, navigation and export.
 //! Rendering runs on `worker`; `state` holds what the user edits; `panels`
 //! and `viewport` draw it.
 
 use eframe::egui;
-pub mod camera_control;
 pub mod export;
 pub mod inspect;
 pub mod legend;
@@ -73,7 +72,7 @@ impl UiBench {
         }
         self.last = Some(now);
         if self.orbit {
-            camera_control::orbit(camera, 3.0, 0.0);
+            crate::scene::camera::control::orbit(camera, 3.0, 0.0);
         }
         if !self.done && self.started.elapsed().as_secs_f32() >= self.seconds + 1.0 {
             self.done = true;

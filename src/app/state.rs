@@ -299,7 +299,7 @@ impl PinholeApp {
     pub fn frame_all(&mut self) {
         if let Some(b) = self.scene.bounds() {
             let s = self.effective_settings();
-            super::camera_control::frame_all(&mut self.params.camera, b, s.width, s.height);
+            crate::scene::camera::control::frame_all(&mut self.params.camera, b, s.width, s.height);
             self.camera_moving = true;
         }
     }

@@ -4,7 +4,7 @@
 //! view's legend drawn over it; mouse/keyboard navigation and pixel picking.
 
 use eframe::egui;
-use super::camera_control as cc;
+use crate::scene::camera::control as cc;
 use super::overlay::{self, ImageMap};
 use super::PinholeApp;
 use crate::math::{Vec2, Vec3};

@@ -15,7 +15,7 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
         moved |= vec3_edit(ui, "target", &mut cam.target, 0.01);
         vec3_edit(ui, "up", &mut cam.up, 0.01);
         ui.horizontal(|ui| {
-            let (mut deg, mut horizontal) = crate::app::camera_control::fov_parts(cam.fov);
+            let (mut deg, mut horizontal) = crate::scene::camera::control::fov_parts(cam.fov);
             ui.label("fov");
             let mut c = ui.add(egui::DragValue::new(&mut deg).range(1.0..=179.0).speed(0.2).suffix("°")).changed();
             c |= ui.radio_value(&mut horizontal, false, "y").changed();

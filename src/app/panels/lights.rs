@@ -42,7 +42,7 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
             app.params.lights.remove(i);
         }
         ui.horizontal(|ui| {
-            let scale = crate::app::camera_control::scene_scale(app.scene.bounds());
+            let scale = crate::scene::camera::control::scene_scale(app.scene.bounds());
             if ui.button("+ point").clicked() {
                 let c = &app.params.camera;
                 // Above and behind the camera, lighting what it sees.
