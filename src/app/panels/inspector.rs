@@ -1,4 +1,4 @@
-//! The pixel inspector (issue 5): the record of the selected pixel, replayed
+//! The pixel inspector: the record of the selected pixel, replayed
 //! by the renderer's own code path (`render::replay_pixel`). Ray tracers:
 //! the eye ray, its traversal (nodes visited, every primitive tested in
 //! order with t, barycentrics or why it was rejected), the closest hit, each
