@@ -132,7 +132,7 @@ impl PinholeApp {
             scene_id: self.scene_id,
             params: self.params.clone(),
             settings,
-            renderer: self.renderer.clone(),
+            renderer: self.settings.renderer.clone(),
             x,
             y,
         });

@@ -112,7 +112,7 @@ pub fn show(app: &PinholeApp, ctx: &egui::Context, viewport: Rect) {
                         small(ui, "ticks: view depth z; no hit: black");
                     }
                     "cost" => {
-                        let what = if app.renderer.starts_with("raytrace") {
+                        let what = if app.settings.renderer.starts_with("raytrace") {
                             "BVH nodes visited + primitives tested by the eye ray"
                         } else {
                             "the renderer's work for the pixel's samples"
