@@ -1,6 +1,7 @@
 //! The viewer's state and its frame: what is loaded, what is edited, what
-//! was last asked of the worker. Panels and the viewport read and change
-//! this struct; at the end of each frame a change becomes a render request.
+//! was last asked of the worker. The menu and side-panel sections edit their
+//! slice of it and return `Requests`, applied once per frame (`apply`); at the
+//! end of each frame a change becomes a render request.
 
 use eframe::egui;
 use super::export::ExportDialog;

@@ -1,9 +1,9 @@
-//! The render worker: one thread that owns the `PreparedScene`, renders the
-//! requested frame band by band (a coarse preview first when the frame is
-//! slow or the camera moves), accumulates stratified passes up to the chosen
-//! spp and publishes finished bands for the UI. The UI never waits on it: it
-//! sends requests over a channel, raises the cancel flag, and reads the
-//! latest published image under a short lock.
+//! The render worker: one thread that owns the `PreparedScene` and drives the
+//! core's frame `Accumulator` band by band (a coarse preview first when the
+//! frame is slow or the camera moves), sizing the bands to the time a band
+//! takes, and publishes each band's running average for the UI. The UI never
+//! waits on it: it sends requests over a channel, raises the cancel flag, and
+//! reads the latest published image under a short lock.
 
 use crate::image_io;
 use crate::math::Radiance;
