@@ -1,4 +1,4 @@
-//! Speed against accuracy (DESIGN.md principle 4): sweep the samples per
+//! Speed against accuracy, measured rather than assumed: sweep the samples per
 //! pixel of each renderer, time every frame, measure its error against a
 //! reference image, and draw the trade-off as a chart (PNG) and a table (CSV).
 

@@ -1,6 +1,6 @@
-//! The command line (CLI.md): `render`, `bench`, `compare`, `list`, and the
-//! viewer when no subcommand is given. Errors are returned as one sentence;
-//! `main` prints them and exits non-zero.
+//! The command line: `render`, `bench`, `compare`, `pixel`, `chart`, `list`;
+//! without a subcommand it asks `main` to open the viewer. Errors are returned
+//! as one sentence; `main` prints them and exits non-zero.
 
 use crate::render::{self, debug::View, PreparedScene, RayCounts, RenderSettings, ShadowMode};
 use crate::scene::Scene;
@@ -137,8 +137,20 @@ struct RenderOpts {
     forward: bool,
 }
 
+/// What is left to do once the command line ran: the viewer is not part of
+/// the core, so opening it is the caller's job.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Outcome {
+    /// The command ran to completion.
+    Done,
+    /// No subcommand: open the viewer on `scene` (`None`: the last run's or
+    /// the default scene); with `screenshot`, save a screenshot of the
+    /// window there once the full-quality frame is in, and exit.
+    OpenViewer { scene: Option<String>, screenshot: Option<PathBuf> },
+}
+
 /// Parses the arguments and runs the command.
-pub fn run() -> Result<(), String> {
+pub fn run() -> Result<Outcome, String> {
     let cli = match Cli::try_parse() {
         Ok(c) => c,
         Err(e) => {
@@ -147,8 +159,8 @@ pub fn run() -> Result<(), String> {
             std::process::exit(if e.use_stderr() { 2 } else { 0 });
         }
     };
-    match cli.command {
-        None => crate::app::run(cli.scene, cli.screenshot),
+    let ran = match cli.command {
+        None => return Ok(Outcome::OpenViewer { scene: cli.scene, screenshot: cli.screenshot }),
         Some(Command::Render { scene, output, opts, stats }) => cmd_render(&scene, &output, &opts, stats.as_deref()),
         Some(Command::Bench { scene, opts, frames }) => cmd_bench(&scene, &opts, frames),
         Some(Command::Compare { a, b, json }) => cmd_compare(&a, &b, json),
@@ -160,7 +172,8 @@ pub fn run() -> Result<(), String> {
             cmd_list();
             Ok(())
         }
-    }
+    };
+    ran.map(|()| Outcome::Done)
 }
 
 /// A scene loaded and prepared under the requested thread pool, with timings.

@@ -1,7 +1,8 @@
 //! pinhole: a CPU ray tracer and a CPU rasterizer that render the same scene
 //! through one shading routine, with the tools to compare and debug them.
 //!
-//! The core (everything but `app`) has no GUI types.
+//! The core (everything but `app`) has no GUI types and never refers to
+//! `app`; the binary opens the viewer when `cli::run` asks for it.
 
 pub mod chart;
 pub mod cli;

@@ -1,4 +1,7 @@
-//! The `pinhole` binary: see CLI.md, or `pinhole --help`.
+//! The `pinhole` binary (`pinhole --help`): runs the command line, and opens
+//! the viewer when the command line asks for it.
+
+use pinhole::cli::Outcome;
 
 fn main() {
     // A bug must still end in one sentence, not a backtrace.
@@ -12,7 +15,11 @@ fn main() {
         let at = info.location().map(|l| format!(" at {}:{}", l.file(), l.line())).unwrap_or_default();
         eprintln!("pinhole: internal error{at}: {msg} (please report this)");
     }));
-    if let Err(e) = pinhole::cli::run() {
+    let result = pinhole::cli::run().and_then(|outcome| match outcome {
+        Outcome::Done => Ok(()),
+        Outcome::OpenViewer { scene, screenshot } => pinhole::app::run(scene, screenshot),
+    });
+    if let Err(e) = result {
         eprintln!("pinhole: {e}");
         std::process::exit(1);
     }

@@ -136,11 +136,11 @@ fn the_record_follows_the_renderer_and_rasterizers_show_their_history_or_why_not
     click(&mut h, pos);
     settle(&mut h);
     for name in ["raytrace:brute", "rasterize"] {
-        h.state_mut().renderer = pinhole::render::renderer_by_name(name).unwrap().name().to_string();
+        h.state_mut().settings.renderer = pinhole::render::renderer_by_name(name).unwrap().name().to_string();
         settle(&mut h);
         let app = h.state();
         let replayed = app.inspect.current(app.generation).expect("a replay for the new renderer");
-        assert_eq!(replayed.renderer, app.renderer);
+        assert_eq!(replayed.renderer, app.settings.renderer);
         match &replayed.result {
             Ok(r) => {
                 assert_eq!(r.radiance, pixel(app, 40, 90), "{name}: replay equals the frame");
@@ -253,7 +253,7 @@ fn diff_view_counts_pixels_that_differ_from_brute_force() {
     let mut scene = (*app.scene).clone();
     app.params.apply(&mut scene);
     let prepared = pinhole::render::PreparedScene::new(scene);
-    let renderer = pinhole::render::renderer_by_name(&app.renderer).unwrap();
+    let renderer = pinhole::render::renderer_by_name(&app.settings.renderer).unwrap();
     let f = pinhole::render::render_frame(renderer.as_ref(), &prepared, &app.effective_settings(), &Default::default(), None).unwrap();
     assert_eq!(app.with_output(|o| o.linear.clone()), f.pixels);
     assert_eq!(f.differing_pixels, Some(0));

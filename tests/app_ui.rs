@@ -36,7 +36,7 @@ fn reference(app: &PinholeApp) -> Vec<Radiance> {
     let mut scene = (*app.scene).clone();
     app.params.apply(&mut scene);
     let prepared = PreparedScene::new(scene);
-    let renderer = render::renderer_by_name(&app.renderer).unwrap();
+    let renderer = render::renderer_by_name(&app.settings.renderer).unwrap();
     let settings = app.effective_settings();
     render::render_frame(renderer.as_ref(), &prepared, &settings, &AtomicBool::new(false), None)
         .unwrap()
@@ -68,7 +68,7 @@ fn first_frame_matches_the_reference_renderer() {
 fn renderer_combo_and_number_keys_switch_renderer_in_place() {
     let mut h = harness(small_scene("one-triangle"));
     let names = h.state().renderer_names.clone();
-    let target = *names.iter().find(|n| **n != h.state().renderer).expect("at least two renderers");
+    let target = *names.iter().find(|n| **n != h.state().settings.renderer).expect("at least two renderers");
     let camera = h.state().params.camera.clone();
     h.get_by_label("Renderer").click();
     h.step();
@@ -76,7 +76,7 @@ fn renderer_combo_and_number_keys_switch_renderer_in_place() {
     h.get_by_label(target).click();
     settle(&mut h);
     let app = h.state();
-    assert_eq!(app.renderer, target);
+    assert_eq!(app.settings.renderer, target);
     assert_eq!(app.params.camera, camera, "the camera stays when the renderer changes");
     assert_eq!(shown(app), reference(app), "{target} image differs from render_frame");
     assert!(pinhole::app::panels::status::status_text(app).starts_with(target));
@@ -84,7 +84,7 @@ fn renderer_combo_and_number_keys_switch_renderer_in_place() {
     // Key 1 picks the first renderer.
     h.key_press(egui::Key::Num1);
     settle(&mut h);
-    assert_eq!(h.state().renderer, names[0]);
+    assert_eq!(h.state().settings.renderer, names[0]);
 }
 
 #[test]
@@ -309,18 +309,18 @@ fn settings_persist_between_runs() {
         fn flush(&mut self) {}
     }
     let mut app = PinholeApp::new_for_test(small_scene("one-triangle"));
-    app.renderer = "raytrace:brute".into();
+    app.settings.renderer = "raytrace:brute".into();
     app.settings.spp = 9;
-    app.gamma = false;
-    app.panels.materials = true;
+    app.settings.gamma = false;
+    app.settings.panels.materials = true;
     let mut mem = Mem::default();
-    app.persisted().save(&mut mem);
-    let p = pinhole::app::settings_store::Persisted::load(Some(&mem)).unwrap();
+    app.settings.save(&mut mem);
+    let p = pinhole::app::settings_store::ViewerSettings::load(Some(&mem)).unwrap();
     let again = PinholeApp::new(small_scene("spheres"), "spheres".into(), Some(&p));
     assert_eq!(p.scene.as_deref(), Some("one-triangle"));
-    assert_eq!(again.renderer, "raytrace:brute");
+    assert_eq!(again.settings.renderer, "raytrace:brute");
     assert_eq!(again.settings.spp, 9);
-    assert!(!again.gamma && again.panels.materials);
+    assert!(!again.settings.gamma && again.settings.panels.materials);
 }
 
 #[test]
@@ -375,20 +375,20 @@ fn rasterizer_knobs_in_the_shading_panel_reach_the_pixels() {
     // The teapot's ground quad under the uv view: ticking "affine uv" bends the
     // checker (screen-space interpolation), and MSAA 4x changes edge pixels.
     let mut h = harness(small_scene("teapot"));
-    h.state_mut().renderer = "rasterize".into();
+    h.state_mut().settings.renderer = "rasterize".into();
     h.state_mut().settings.view = pinhole::render::debug::View::Uv;
-    h.state_mut().panels.shading = true;
+    h.state_mut().settings.panels.shading = true;
     settle(&mut h);
     let before = shown(h.state());
     h.get_by_label("affine uv").click();
     settle(&mut h);
-    assert!(h.state().settings.affine);
+    assert!(h.state().settings.per_scene.affine);
     let affine = shown(h.state());
     assert_eq!(affine, reference(h.state()), "the viewer shows what render_frame gives");
     let changed = before.iter().zip(&affine).filter(|(a, b)| a != b).count();
     assert!(changed > before.len() / 20, "affine uv changed only {changed} pixels");
     h.get_by_label("4x").click();
     settle(&mut h);
-    assert_eq!(h.state().settings.msaa, 4);
+    assert_eq!(h.state().settings.per_scene.msaa, 4);
     assert_eq!(shown(h.state()), reference(h.state()));
 }

@@ -1,4 +1,4 @@
-//! Visual debugging state (issue 5): the selected pixel and its replay, the
+//! Visual debugging state: the selected pixel and its replay, the
 //! image zoom and pan, the vertex overlay, and what the values of a debug
 //! view mean (for the hover read-out and the inspector).
 //!
@@ -9,7 +9,7 @@
 use super::worker::{ReplayRequest, ReplayResult};
 use super::PinholeApp;
 use crate::math::{Radiance, Vec3};
-use crate::render::debug::{cost_color, id_color, COST_SCALE};
+use crate::render::debug::{depth_distance, invert_cost, object_of_id_color, zbuffer_depth, COST_SCALE};
 use crate::render::PixelReplay;
 use crate::scene::{CameraView, PrimitiveKind, Scene};
 use eframe::egui;
@@ -132,7 +132,7 @@ impl PinholeApp {
             scene_id: self.scene_id,
             params: self.params.clone(),
             settings,
-            renderer: self.renderer.clone(),
+            renderer: self.settings.renderer.clone(),
             x,
             y,
         });
@@ -180,50 +180,6 @@ pub fn fmt3(v: Vec3) -> String {
     format!("({:.5}, {:.5}, {:.5})", v.x, v.y, v.z)
 }
 
-/// The cost whose `cost_color` is nearest `c` (the cost view's heat scale,
-/// inverted): exact for 1 spp up to `COST_SCALE`, saturating above it.
-pub fn invert_cost(c: Vec3) -> f32 {
-    // cost_color is piecewise linear in t between distinct stops: project
-    // onto each segment and keep the closest point.
-    const N: usize = 5;
-    let stop = |i: usize| cost_color(cost_of_t(i as f32 / N as f32));
-    let mut best = (f32::INFINITY, 0.0f32);
-    for i in 0..N {
-        let (a, b) = (stop(i), stop(i + 1));
-        let ab = b - a;
-        let s = ((c - a).dot(ab) / ab.length_squared().max(1e-12)).clamp(0.0, 1.0);
-        let d = (a + ab * s - c).length_squared();
-        if d < best.0 {
-            best = (d, (i as f32 + s) / N as f32);
-        }
-    }
-    cost_of_t(best.1)
-}
-
-/// Inverse of the cost view's log mapping `t = log2(1 + cost) / log2(1 + COST_SCALE)`.
-pub fn cost_of_t(t: f32) -> f32 {
-    (2f32.powf(t * (1.0 + COST_SCALE).log2()) - 1.0).max(0.0)
-}
-
-pub fn t_of_cost(cost: f32) -> f32 {
-    ((1.0 + cost.max(0.0)).log2() / (1.0 + COST_SCALE).log2()).clamp(0.0, 1.0)
-}
-
-/// Distance from the eye for a grey level of the depth view (its inverse).
-pub fn depth_distance(camera: &CameraView, v: f32) -> f32 {
-    camera.near * (camera.far / camera.near).powf(v)
-}
-
-/// View depth z for a grey level of the zbuffer view (1/z, near = 1, far = 0).
-pub fn zbuffer_depth(camera: &CameraView, v: f32) -> f32 {
-    1.0 / (v * (1.0 / camera.near - 1.0 / camera.far) + 1.0 / camera.far)
-}
-
-/// The object whose id colour `c` is, if any.
-pub fn object_of_id_color(scene: &Scene, c: Vec3) -> Option<usize> {
-    (0..scene.objects.len()).find(|&i| (id_color(i as u32) - c).abs().max_element() < 1e-4)
-}
-
 /// What pixel value `v` of the view named `view` means, in words and numbers.
 pub fn value_text(view: &str, v: Radiance, camera: &CameraView, scene: &Scene) -> String {
     match view {
@@ -266,28 +222,5 @@ pub fn value_text(view: &str, v: Radiance, camera: &CameraView, scene: &Scene) -
         }
         "raydir" | "normal" => format!("{} = {}", if view == "raydir" { "d" } else { "n" }, fmt3(v * 2.0 - Vec3::ONE)),
         _ => format!("linear {}", fmt3(v)),
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::render::debug::depth_value;
-
-    #[test]
-    fn cost_colours_invert_to_their_cost() {
-        for cost in [0.0f32, 1.0, 3.0, 17.0, 100.0, 512.0, 1000.0] {
-            let back = invert_cost(cost_color(cost));
-            assert!((back - cost).abs() < 0.01 * cost.max(1.0), "{cost} -> {back}");
-        }
-    }
-
-    #[test]
-    fn depth_and_zbuffer_invert() {
-        let cam = crate::scene::Camera { near: 0.1, far: 100.0, ..Default::default() }.view(10, 10);
-        let d = depth_distance(&cam, depth_value(&cam, 7.5));
-        assert!((d - 7.5).abs() < 1e-3, "{d}");
-        let inv = |z: f32| (1.0 / z - 1.0 / cam.far) / (1.0 / cam.near - 1.0 / cam.far);
-        assert!((zbuffer_depth(&cam, inv(3.0)) - 3.0).abs() < 1e-3);
     }
 }

@@ -4,7 +4,7 @@
 //! Views are told apart by name, so views added to the core later get a
 //! plain legend (their name) without a change here.
 
-use super::inspect::{cost_of_t, depth_distance, t_of_cost, zbuffer_depth};
+use crate::render::debug::{cost_of_t, depth_distance, t_of_cost, zbuffer_depth};
 use super::PinholeApp;
 use crate::math::Vec3;
 use crate::render::debug::{cost_color, id_color, COST_SCALE};
@@ -112,7 +112,7 @@ pub fn show(app: &PinholeApp, ctx: &egui::Context, viewport: Rect) {
                         small(ui, "ticks: view depth z; no hit: black");
                     }
                     "cost" => {
-                        let what = if app.renderer.starts_with("raytrace") {
+                        let what = if app.settings.renderer.starts_with("raytrace") {
                             "BVH nodes visited + primitives tested by the eye ray"
                         } else {
                             "the renderer's work for the pixel's samples"

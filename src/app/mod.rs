@@ -1,10 +1,9 @@
-//! The egui viewer (issue 4): a live framebuffer of the selected renderer
+//! The egui viewer: a live framebuffer of the selected renderer
 //! with camera, light, material and shading panels, navigation and export.
 //! Rendering runs on `worker`; `state` holds what the user edits; `panels`
 //! and `viewport` draw it.
 
 use eframe::egui;
-pub mod camera_control;
 pub mod export;
 pub mod inspect;
 pub mod legend;
@@ -73,7 +72,7 @@ impl UiBench {
         }
         self.last = Some(now);
         if self.orbit {
-            camera_control::orbit(camera, 3.0, 0.0);
+            crate::scene::camera::control::orbit(camera, 3.0, 0.0);
         }
         if !self.done && self.started.elapsed().as_secs_f32() >= self.seconds + 1.0 {
             self.done = true;
@@ -163,7 +162,7 @@ fn screenshot_frame(app: &mut PinholeApp, ctx: &egui::Context) {
 fn apply_env_overrides(app: &mut PinholeApp) {
     if let Ok(name) = std::env::var("PINHOLE_RENDERER") {
         match crate::render::renderer_by_name(&name) {
-            Ok(r) => app.renderer = r.name().to_string(),
+            Ok(r) => app.settings.renderer = r.name().to_string(),
             Err(e) => eprintln!("pinhole: PINHOLE_RENDERER: {e}"),
         }
     }
@@ -174,7 +173,7 @@ fn apply_env_overrides(app: &mut PinholeApp) {
         }
     }
     if let Ok(g) = std::env::var("PINHOLE_GAMMA") {
-        app.gamma = !matches!(g.as_str(), "0" | "off" | "false");
+        app.settings.gamma = !matches!(g.as_str(), "0" | "off" | "false");
     }
     // PINHOLE_SELECT=X,Y selects a pixel for the inspector; PINHOLE_ZOOM=Z
     // magnifies the image (about the selected pixel, if any);
@@ -200,11 +199,11 @@ fn apply_env_overrides(app: &mut PinholeApp) {
     }
     if let Ok(list) = std::env::var("PINHOLE_PANELS") {
         let has = |n: &str| list.split(',').any(|p| p.trim() == n);
-        app.panels.side = list.trim() != "none";
-        app.panels.camera = has("camera");
-        app.panels.lights = has("lights");
-        app.panels.materials = has("materials");
-        app.panels.shading = has("shading");
+        app.settings.panels.side = list.trim() != "none";
+        app.settings.panels.camera = has("camera");
+        app.settings.panels.lights = has("lights");
+        app.settings.panels.materials = has("materials");
+        app.settings.panels.shading = has("shading");
     }
 }
 
@@ -223,7 +222,7 @@ impl eframe::App for EframeApp {
 
     fn save(&mut self, storage: &mut dyn eframe::Storage) {
         if self.0.persist {
-            self.0.persisted().save(storage);
+            self.0.settings.save(storage);
         }
     }
 }
@@ -268,7 +267,7 @@ pub fn run(scene: Option<String>, screenshot: Option<PathBuf>) -> Result<(), Str
         "pinhole",
         options,
         Box::new(move |cc| {
-            let persisted = if batch { None } else { settings_store::Persisted::load(cc.storage) };
+            let saved = if batch { None } else { settings_store::ViewerSettings::load(cc.storage) };
             if batch {
                 // Panel sizes and open sections from interactive runs would
                 // make screenshots depend on the machine's history.
@@ -277,7 +276,7 @@ pub fn run(scene: Option<String>, screenshot: Option<PathBuf>) -> Result<(), Str
             let (scene, arg) = match explicit {
                 Some(x) => x,
                 None => {
-                    let remembered = persisted.as_ref().and_then(|p| p.scene.clone());
+                    let remembered = saved.as_ref().and_then(|p| p.scene.clone());
                     match remembered.and_then(|a| load::load_scene(&a).ok().map(|s| (s, a))) {
                         Some(x) => x,
                         None => {
@@ -290,10 +289,10 @@ pub fn run(scene: Option<String>, screenshot: Option<PathBuf>) -> Result<(), Str
                     }
                 }
             };
-            let mut app = PinholeApp::new(scene, arg, persisted.as_ref());
+            let mut app = PinholeApp::new(scene, arg, saved.as_ref());
             app.persist = !batch;
             if batch {
-                app.res_scale = 1.0;
+                app.settings.res_scale = 1.0;
             }
             apply_env_overrides(&mut app);
             app.screenshot = shot_state;

@@ -1,25 +1,53 @@
-//! What the viewer remembers between runs (eframe storage): last scene,
-//! renderer, render settings, display settings and which panels are open.
+//! What the viewer remembers between runs (eframe storage): one struct,
+//! `ViewerSettings`, that the viewer edits live and saves and loads whole.
 
-use crate::render::RenderSettings;
+use crate::render::debug::View;
+use crate::render::{shadow_map, Interpolation, RenderSettings, ShadowMode};
+use crate::scene::Scene;
 
 pub const STORAGE_KEY: &str = "pinhole";
 
+/// The user's choices that outlive a scene: renderer, render knobs, display
+/// and panels. `#[serde(default)]`: settings saved by an older version load,
+/// missing values taking their defaults. The knobs marked `skip` are not
+/// remembered between runs and go back to their defaults with a new scene.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default)]
-pub struct Persisted {
+pub struct ViewerSettings {
     /// The scene argument (built-in name or path) last opened.
     pub scene: Option<String>,
-    pub renderer: Option<String>,
+    /// Saved as an option, as older versions saved it; empty: the default.
+    #[serde(with = "saved_as_option")]
+    pub renderer: String,
     pub spp: u32,
-    pub shadows: crate::render::ShadowMode,
+    pub shadows: ShadowMode,
     pub shadow_bump: f32,
     pub max_depth: u32,
-    pub view: crate::render::debug::View,
-    pub interpolation: crate::render::Interpolation,
+    pub view: View,
+    pub interpolation: Interpolation,
+    /// Image size over the scene's size.
     pub res_scale: f32,
+    /// Encode the image as sRGB for display.
     pub gamma: bool,
     pub panels: Panels,
+    #[serde(skip)]
+    pub per_scene: SceneKnobs,
+}
+
+/// Render knobs that go back to their defaults with every scene.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SceneKnobs {
+    pub shadow_map_size: u32,
+    pub shadow_map_bias: f32,
+    pub msaa: u32,
+    pub early_depth: bool,
+    pub affine: bool,
+}
+
+impl Default for SceneKnobs {
+    fn default() -> Self {
+        SceneKnobs { shadow_map_size: shadow_map::DEFAULT_SIZE, shadow_map_bias: shadow_map::DEFAULT_BIAS, msaa: 1, early_depth: true, affine: false }
+    }
 }
 
 /// Which side-panel sections are open.
@@ -39,40 +67,121 @@ impl Default for Panels {
     }
 }
 
-impl Default for Persisted {
+impl Default for ViewerSettings {
     fn default() -> Self {
-        Persisted {
+        ViewerSettings {
             scene: None,
-            renderer: None,
+            renderer: crate::render::DEFAULT_RAYTRACE.to_string(),
             spp: 1,
-            shadows: crate::render::ShadowMode::Ray,
+            shadows: ShadowMode::Ray,
             shadow_bump: 1e-4,
             max_depth: 4,
-            view: crate::render::debug::View::Shaded,
-            interpolation: crate::render::Interpolation::Phong,
+            view: View::Shaded,
+            interpolation: Interpolation::Phong,
             res_scale: 1.0,
             gamma: true,
             panels: Panels::default(),
+            per_scene: SceneKnobs::default(),
         }
     }
 }
 
-impl Persisted {
-    /// Applies the remembered knobs to settings made for a scene.
-    pub fn apply_to(&self, s: &mut RenderSettings) {
-        s.spp = self.spp.clamp(1, 1024);
-        s.shadows = self.shadows;
-        s.shadow_bump = self.shadow_bump;
-        s.max_depth = self.max_depth;
-        s.view = self.view;
-        s.interpolation = self.interpolation;
+impl ViewerSettings {
+    /// Brings loaded values into range: a renderer this build has, spp in
+    /// 1..=1024, a resolution scale in 0.1..=2.
+    pub fn sanitized(mut self, renderer_names: &[&str]) -> ViewerSettings {
+        if !renderer_names.contains(&self.renderer.as_str()) {
+            self.renderer = crate::render::DEFAULT_RAYTRACE.to_string();
+        }
+        self.spp = self.spp.clamp(1, 1024);
+        self.res_scale = self.res_scale.clamp(0.1, 2.0);
+        self
     }
 
-    pub fn load(storage: Option<&dyn eframe::Storage>) -> Option<Persisted> {
+    /// The settings to render `scene` with at `width` x `height`: the scene's
+    /// values with these knobs.
+    pub fn render_settings(&self, scene: &Scene, width: u32, height: u32) -> RenderSettings {
+        let k = &self.per_scene;
+        RenderSettings {
+            width,
+            height,
+            spp: self.spp,
+            shadows: self.shadows,
+            shadow_bump: self.shadow_bump,
+            max_depth: self.max_depth,
+            view: self.view,
+            interpolation: self.interpolation,
+            shadow_map_size: k.shadow_map_size,
+            shadow_map_bias: k.shadow_map_bias,
+            msaa: k.msaa,
+            early_depth: k.early_depth,
+            affine: k.affine,
+            ..RenderSettings::for_scene(scene)
+        }
+    }
+
+    pub fn load(storage: Option<&dyn eframe::Storage>) -> Option<ViewerSettings> {
         storage.and_then(|s| eframe::get_value(s, STORAGE_KEY))
     }
 
     pub fn save(&self, storage: &mut dyn eframe::Storage) {
         eframe::set_value(storage, STORAGE_KEY, self);
+    }
+}
+
+/// A string stored as `Option<String>` (`None` for empty), the form older
+/// versions saved the renderer in.
+mod saved_as_option {
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    pub fn serialize<S: Serializer>(s: &str, ser: S) -> Result<S::Ok, S::Error> {
+        (!s.is_empty()).then_some(s).serialize(ser)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(de: D) -> Result<String, D::Error> {
+        Ok(Option::<String>::deserialize(de)?.unwrap_or_default())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[derive(Default)]
+    struct Mem(std::collections::HashMap<String, String>);
+
+    impl eframe::Storage for Mem {
+        fn get_string(&self, key: &str) -> Option<String> {
+            self.0.get(key).cloned()
+        }
+        fn set_string(&mut self, key: &str, value: String) {
+            self.0.insert(key.into(), value);
+        }
+        fn remove_string(&mut self, key: &str) {
+            self.0.remove(key);
+        }
+        fn flush(&mut self) {}
+    }
+
+    #[test]
+    fn older_saved_settings_load() {
+        // As an older version saved them: a field since dropped, some missing.
+        let old = r#"(scene: Some("spheres"), renderer: Some("raytrace:brute"), spp: 9, shadows: map, gamma: false, retired: 3)"#;
+        let mut mem = Mem::default();
+        eframe::Storage::set_string(&mut mem, STORAGE_KEY, old.into());
+        let s = ViewerSettings::load(Some(&mem)).unwrap();
+        assert_eq!(s.scene.as_deref(), Some("spheres"));
+        assert_eq!(s.renderer, "raytrace:brute");
+        assert_eq!((s.spp, s.shadows, s.gamma), (9, ShadowMode::Map, false));
+        assert_eq!(s.max_depth, 4);
+        s.save(&mut mem);
+        assert_eq!(ViewerSettings::load(Some(&mem)), Some(s));
+    }
+
+    #[test]
+    fn render_settings_match_the_scene_defaults() {
+        let scene = crate::scene::builtin::load_builtin("spheres").unwrap().unwrap();
+        let s = ViewerSettings::default().render_settings(&scene, scene.render.width, scene.render.height);
+        assert_eq!(s, RenderSettings::for_scene(&scene));
     }
 }

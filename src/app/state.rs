@@ -1,11 +1,13 @@
 //! The viewer's state and its frame: what is loaded, what is edited, what
-//! was last asked of the worker. Panels and the viewport read and change
-//! this struct; at the end of each frame a change becomes a render request.
+//! was last asked of the worker. The menu and side-panel sections edit their
+//! slice of it and return `Requests`, applied once per frame (`apply`); at the
+//! end of each frame a change becomes a render request.
 
 use eframe::egui;
 use super::export::ExportDialog;
 use super::open_dialog::OpenDialog;
-use super::settings_store::{Panels, Persisted};
+use super::panels::Requests;
+use super::settings_store::{SceneKnobs, ViewerSettings};
 use super::worker::{Output, Request, SceneParams, Worker};
 use crate::render::{self, RenderSettings};
 use crate::scene::{builtin, Camera, Scene};
@@ -26,13 +28,10 @@ pub struct PinholeApp {
     pub params: SceneParams,
     /// The camera the scene file gave, for "reset".
     pub initial_camera: Camera,
-    /// Render settings at resolution scale 1 (the scene's size).
-    pub settings: RenderSettings,
-    pub res_scale: f32,
-    pub renderer: String,
+    /// Renderer, render knobs, display and panels as the user set them;
+    /// saved whole between runs. `effective_settings()` renders with them.
+    pub settings: ViewerSettings,
     pub renderer_names: Vec<&'static str>,
-    pub gamma: bool,
-    pub panels: Panels,
     pub worker: Worker,
     /// The last request sent (generation counts every request).
     pub generation: u64,
@@ -70,7 +69,7 @@ pub struct PinholeApp {
 impl PinholeApp {
     /// A viewer on `scene`, with no window (tests build it this way; `run`
     /// wraps it in eframe).
-    pub fn new(scene: Scene, scene_arg: String, persisted: Option<&Persisted>) -> PinholeApp {
+    pub fn new(scene: Scene, scene_arg: String, saved: Option<&ViewerSettings>) -> PinholeApp {
         let repaint_ctx: Arc<Mutex<Option<egui::Context>>> = Arc::new(Mutex::new(None));
         let rc = repaint_ctx.clone();
         let worker = Worker::start(Arc::new(move || {
@@ -79,14 +78,7 @@ impl PinholeApp {
             }
         }));
         let renderer_names = render::renderer_names();
-        let p = persisted.cloned().unwrap_or_default();
-        let renderer = p
-            .renderer
-            .clone()
-            .filter(|r| renderer_names.contains(&r.as_str()))
-            .unwrap_or_else(|| render::DEFAULT_RAYTRACE.to_string());
-        let mut settings = RenderSettings::for_scene(&scene);
-        p.apply_to(&mut settings);
+        let settings = saved.cloned().unwrap_or_default().sanitized(&renderer_names);
         let mut app = PinholeApp {
             params: SceneParams::of(&scene),
             initial_camera: scene.camera.clone(),
@@ -94,11 +86,7 @@ impl PinholeApp {
             scene_arg: String::new(),
             scene_id: 0,
             settings,
-            res_scale: p.res_scale.clamp(0.1, 2.0),
-            renderer,
             renderer_names,
-            gamma: p.gamma,
-            panels: p.panels,
             worker,
             generation: 0,
             last_sent: None,
@@ -137,14 +125,8 @@ impl PinholeApp {
         self.scene_id += 1;
         self.params = SceneParams::of(&scene);
         self.initial_camera = scene.camera.clone();
-        let keep = self.settings.clone();
-        self.settings = RenderSettings::for_scene(&scene);
-        self.settings.spp = keep.spp;
-        self.settings.shadows = keep.shadows;
-        self.settings.shadow_bump = keep.shadow_bump;
-        self.settings.max_depth = keep.max_depth;
-        self.settings.view = keep.view;
-        self.settings.interpolation = keep.interpolation;
+        self.settings.per_scene = SceneKnobs::default();
+        self.settings.scene = Some(arg.clone());
         self.message = (!scene.warnings.is_empty()).then(|| scene.warnings.join("; "));
         let path = PathBuf::from(&arg);
         self.watch = (builtin::source(&arg).is_none() && path.exists()).then(|| {
@@ -230,12 +212,16 @@ impl PinholeApp {
         }
     }
 
-    /// The settings the worker renders with (resolution scaled).
+    /// The settings the worker renders with: the scene's, with the user's
+    /// knobs, at the scaled resolution.
     pub fn effective_settings(&self) -> RenderSettings {
-        let mut s = self.settings.clone();
-        s.width = ((s.width as f32 * self.res_scale).round() as u32).max(1);
-        s.height = ((s.height as f32 * self.res_scale).round() as u32).max(1);
-        s
+        let (width, height) = self.image_size();
+        self.settings.render_settings(&self.scene, width, height)
+    }
+
+    /// The image size: the scene's, times the resolution scale.
+    pub fn image_size(&self) -> (u32, u32) {
+        scaled_size(self.scene.render.width, self.scene.render.height, self.settings.res_scale)
     }
 
     /// Sends a request when anything that affects the image changed.
@@ -243,9 +229,9 @@ impl PinholeApp {
         let settings = self.effective_settings();
         if let Some(last) = &self.last_sent {
             if last.scene_id == self.scene_id
-                && last.renderer == self.renderer
+                && last.renderer == self.settings.renderer
                 && last.settings == settings
-                && last.gamma == self.gamma
+                && last.gamma == self.settings.gamma
                 && last.params.same_as(&self.params)
             {
                 return;
@@ -260,8 +246,8 @@ impl PinholeApp {
             scene_id: self.scene_id,
             params: self.params.clone(),
             settings,
-            renderer: self.renderer.clone(),
-            gamma: self.gamma,
+            renderer: self.settings.renderer.clone(),
+            gamma: self.settings.gamma,
             interactive: self.camera_moving,
         };
         self.worker.request(req.clone());
@@ -287,7 +273,7 @@ impl PinholeApp {
     /// The renderer by index (number keys 1..9).
     pub fn select_renderer(&mut self, index: usize) {
         if let Some(n) = self.renderer_names.get(index) {
-            self.renderer = n.to_string();
+            self.settings.renderer = n.to_string();
         }
     }
 
@@ -299,24 +285,32 @@ impl PinholeApp {
     pub fn frame_all(&mut self) {
         if let Some(b) = self.scene.bounds() {
             let s = self.effective_settings();
-            super::camera_control::frame_all(&mut self.params.camera, b, s.width, s.height);
+            crate::scene::camera::control::frame_all(&mut self.params.camera, b, s.width, s.height);
             self.camera_moving = true;
         }
     }
 
-    pub fn persisted(&self) -> Persisted {
-        Persisted {
-            scene: Some(self.scene_arg.clone()),
-            renderer: Some(self.renderer.clone()),
-            spp: self.settings.spp,
-            shadows: self.settings.shadows,
-            shadow_bump: self.settings.shadow_bump,
-            max_depth: self.settings.max_depth,
-            view: self.settings.view,
-            interpolation: self.settings.interpolation,
-            res_scale: self.res_scale,
-            gamma: self.gamma,
-            panels: self.panels,
+    /// Carries out what the panels asked for this frame, in one place.
+    pub fn apply(&mut self, requests: Requests, ctx: &egui::Context) {
+        let Requests { camera_moved, reset_camera, frame_all, open, reload, open_dialog, export, quit } = requests;
+        self.camera_moving |= camera_moved;
+        if reset_camera {
+            self.reset_camera();
+        }
+        if frame_all {
+            self.frame_all();
+        }
+        if open_dialog {
+            self.open_dialog.open = true;
+        }
+        if export {
+            self.export.open_with(&self.scene.name, &self.settings.renderer);
+        }
+        if let Some(arg) = open.or_else(|| reload.then(|| self.scene_arg.clone())) {
+            self.open(arg);
+        }
+        if quit {
+            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
         }
     }
 
@@ -349,7 +343,7 @@ impl PinholeApp {
     fn shortcuts(&mut self, ctx: &egui::Context) {
         use egui::{Key, KeyboardShortcut, Modifiers};
         if ctx.input_mut(|i| i.consume_shortcut(&KeyboardShortcut::new(Modifiers::COMMAND, Key::S))) {
-            self.export.open_with(&self.scene.name, &self.renderer);
+            self.export.open_with(&self.scene.name, &self.settings.renderer);
         }
         if ctx.input_mut(|i| i.consume_shortcut(&KeyboardShortcut::new(Modifiers::COMMAND, Key::O))) {
             self.open_dialog.open = true;
@@ -430,7 +424,8 @@ impl PinholeApp {
         }
         self.update_texture(&ctx);
 
-        super::panels::menu::show(self, ui);
+        let mut requests = Requests::default();
+        requests |= super::panels::menu::show(ui, &mut self.settings, &self.renderer_names, &mut self.inspect, &self.scene.name);
         if let Some(err) = self.error_bar.clone() {
             egui::Panel::top("error-bar")
                 .frame(egui::Frame::new().fill(egui::Color32::from_rgb(110, 20, 20)).inner_margin(6.0))
@@ -444,13 +439,15 @@ impl PinholeApp {
                 });
         }
         super::panels::status::show(self, ui);
-        if self.panels.side {
+        if self.settings.panels.side {
             egui::Panel::left("side-panel").default_size(300.0).resizable(true).show(ui, |ui| {
                 egui::ScrollArea::vertical().show(ui, |ui| {
-                    super::panels::camera::show(self, ui);
-                    super::panels::lights::show(self, ui);
-                    super::panels::materials::show(self, ui);
-                    super::panels::shading::show(self, ui);
+                    let (width, height) = (self.scene.render.width, self.scene.render.height);
+                    let panels = &mut self.settings.panels;
+                    requests |= super::panels::camera::show(ui, &mut panels.camera, &mut self.params.camera, &mut self.settings.res_scale, (width, height));
+                    super::panels::lights::show(ui, &mut panels.lights, &mut self.params.lights, &self.params.camera, &self.scene);
+                    super::panels::materials::show(ui, &mut panels.materials, &mut self.params.materials);
+                    super::panels::shading::show(ui, &mut self.settings, &mut self.params.render);
                 });
             });
         }
@@ -458,6 +455,7 @@ impl PinholeApp {
         egui::CentralPanel::default().frame(egui::Frame::new().fill(egui::Color32::from_gray(24))).show(ui, |ui| {
             super::viewport::show(self, ui);
         });
+        self.apply(requests, &ctx);
         if let Some(path) = self.open_dialog.show(&ctx) {
             self.open(path);
         }
@@ -467,4 +465,9 @@ impl PinholeApp {
         self.sync_inspector();
         super::screenshot_frame(self, &ctx);
     }
+}
+
+/// `width` x `height` times `scale`, rounded, at least one pixel each way.
+pub fn scaled_size(width: u32, height: u32, scale: f32) -> (u32, u32) {
+    (((width as f32 * scale).round() as u32).max(1), ((height as f32 * scale).round() as u32).max(1))
 }

@@ -4,7 +4,7 @@
 //! view's legend drawn over it; mouse/keyboard navigation and pixel picking.
 
 use eframe::egui;
-use super::camera_control as cc;
+use crate::scene::camera::control as cc;
 use super::overlay::{self, ImageMap};
 use super::PinholeApp;
 use crate::math::{Vec2, Vec3};
@@ -200,7 +200,7 @@ fn hover_readout(app: &PinholeApp, painter: &egui::Painter, avail: Rect, view: &
     let exposure = app.params.render.exposure;
     let Some(v) = app.with_output(|o| (x < o.width && y < o.height && o.linear.len() == (o.width * o.height) as usize).then(|| o.linear[(x + y * o.width) as usize])) else { return };
     let meaning = super::inspect::value_text(app.settings.view.name(), v, view, &app.scene);
-    let d = crate::image_io::display_pixel(v, exposure, app.gamma);
+    let d = crate::image_io::display_pixel(v, exposure, app.settings.gamma);
     let text = if meaning.starts_with("linear") {
         format!("({x}, {y})  {meaning}  -> {d:?}")
     } else {

@@ -1,16 +1,16 @@
-//! The render worker: one thread that owns the `PreparedScene`, renders the
-//! requested frame band by band (a coarse preview first when the frame is
-//! slow or the camera moves), accumulates stratified passes up to the chosen
-//! spp and publishes finished bands for the UI. The UI never waits on it: it
-//! sends requests over a channel, raises the cancel flag, and reads the
-//! latest published image under a short lock.
+//! The render worker: one thread that owns the `PreparedScene` and drives the
+//! core's frame `Accumulator` band by band (a coarse preview first when the
+//! frame is slow or the camera moves), sizing the bands to the time a band
+//! takes, and publishes each band's running average for the UI. The UI never
+//! waits on it: it sends requests over a channel, raises the cancel flag, and
+//! reads the latest published image under a short lock.
 
 use crate::image_io;
-use crate::math::{Radiance, Vec3};
+use crate::math::Radiance;
 use crate::render::debug::View;
-use crate::render::{self, PassJob, PreparedScene, RayCounts, RenderSettings, Renderer};
+use crate::render::frame::Accumulator;
+use crate::render::{self, PreparedScene, RayCounts, RenderSettings, Renderer};
 use crate::scene::{Camera, Light, Material, RenderDefaults, Scene};
-use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{channel, Receiver, Sender};
 use std::sync::{Arc, Condvar, Mutex};
@@ -271,25 +271,14 @@ impl Drop for Worker {
     }
 }
 
-/// Progress of the frame being rendered.
+/// The frame being rendered: the request, and the core's accumulator that
+/// holds its samples; the rest is timing for the status bar and band sizing.
 struct Frame {
     req: Request,
     renderer: Box<dyn Renderer>,
-    /// What each pass renders with: the request's settings, shaded for the diff view.
-    pass_settings: RenderSettings,
-    /// Diff view: the reference `raytrace:brute` and the sum of its samples,
-    /// rendered band by band beside this renderer; the difference image
-    /// replaces the shaded one when every sample is done.
-    reference: Option<(Box<dyn Renderer>, Vec<Radiance>)>,
+    frame: Accumulator,
     started: Instant,
-    width: u32,
-    height: u32,
-    /// Sum of the samples per pixel, and per row how many passes it holds.
-    sum: Vec<Radiance>,
-    row_passes: Vec<u32>,
-    /// Next pass and next row to render; `preview_pending` before the passes.
-    pass: u32,
-    row: u32,
+    /// The coarse preview is still to come, before the passes.
     preview_pending: bool,
     pass_started: Instant,
     pass_counts: RayCounts,
@@ -434,8 +423,8 @@ impl WorkerLoop {
                 return;
             }
         };
-        let (width, height) = (req.settings.width.max(1), req.settings.height.max(1));
-        let n = (width * height) as usize;
+        let settings = RenderSettings { width: req.settings.width.max(1), height: req.settings.height.max(1), ..req.settings.clone() };
+        let (width, height) = (settings.width, settings.height);
         if self.timed != (req.renderer.clone(), req.scene_id) {
             // Another renderer or scene: old timings mean nothing.
             self.timed = (req.renderer.clone(), req.scene_id);
@@ -444,19 +433,10 @@ impl WorkerLoop {
         }
         let slow = self.ms_per_row < 0.0 || self.ms_per_row * height as f64 > 2.0 * BAND_MS;
         let now = Instant::now();
-        let diff = req.settings.view == View::Diff;
-        let pass_settings = if diff { RenderSettings { view: View::Shaded, ..req.settings.clone() } } else { req.settings.clone() };
         self.frame = Some(Frame {
             renderer,
-            pass_settings,
-            reference: diff.then(|| (Box::new(render::raytrace::brute::BruteForce) as Box<dyn Renderer>, vec![Radiance::ZERO; n])),
+            frame: Accumulator::new(&settings),
             started: now,
-            width,
-            height,
-            sum: vec![Radiance::ZERO; n],
-            row_passes: vec![0; height as usize],
-            pass: 0,
-            row: 0,
             preview_pending: (req.interactive || slow) && width >= 8 && height >= 8,
             pass_started: now,
             pass_counts: RayCounts::default(),
@@ -516,36 +496,31 @@ impl WorkerLoop {
 
     /// Renders one unit of work: the preview, or one band of one pass.
     fn step(&mut self) {
-        let Some((_, prepared)) = self.prepared.as_ref() else {
-            self.frame = None;
-            return;
-        };
-        let f = self.frame.as_mut().expect("step without a frame");
+        let Some(mut f) = self.frame.take() else { return };
+        let Some((_, prepared)) = self.prepared.as_ref() else { return };
         let cancel: &AtomicBool = &self.cancel;
+        let (width, height) = (f.frame.width(), f.frame.height());
         if f.preview_pending {
             f.preview_pending = false;
             let div = self.preview_div;
-            let (pw, ph) = ((f.width / div).max(1), (f.height / div).max(1));
-            let view = prepared.scene.camera.view(pw, ph);
-            let mut settings = f.pass_settings.clone();
-            settings.width = pw;
-            settings.height = ph;
-            settings.spp = 1;
-            let mut small = vec![Radiance::ZERO; (pw * ph) as usize];
+            let (pw, ph) = ((width / div).max(1), (height / div).max(1));
+            // One sample at 1/div of the resolution, shaded for the diff view.
+            let view = if f.req.settings.view == View::Diff { View::Shaded } else { f.req.settings.view };
+            let settings = RenderSettings { width: pw, height: ph, spp: 1, view, ..f.req.settings.clone() };
+            let mut preview = Accumulator::new(&settings);
             // The preview is not cancelled: it is cheap by construction (its
             // size adapts), and while the camera moves every frame cancels the
             // one before, so a cancellable preview would never be seen.
             let keep_going = AtomicBool::new(false);
-            let job = PassJob { prepared, view: &view, settings: &settings, offset: render::sample_offset(0, 1), rows: 0..ph, cancel: &keep_going };
-            let renderer = &f.renderer;
-            let result = self.pool.install(|| guarded(|| renderer.render_pass(&job, &mut small)));
+            let renderer = f.renderer.as_ref();
+            let result = self.pool.install(|| guarded(|| preview.render_band(renderer, prepared, ph, &keep_going)));
             if let Err(e) = result {
-                let req = f.req.clone();
-                self.fail(&req, e);
+                self.fail(&f.req, e);
                 return;
             }
+            let small = preview.finish().pixels;
             // Nearest-neighbour upsampling into the display image.
-            let (w, h) = (f.width, f.height);
+            let (w, h) = (width, height);
             let mut big = vec![Radiance::ZERO; (w * h) as usize];
             for y in 0..h {
                 let sy = (y * ph / h).min(ph - 1);
@@ -559,7 +534,7 @@ impl WorkerLoop {
             let full_ms = first_ms * (div * div) as f64;
             self.preview_div = ((full_ms / PREVIEW_MS).sqrt().ceil() as u32).clamp(4, 32);
             f.first_image = true;
-            let req = f.req.clone();
+            let req = &f.req;
             let mut out = self.shared.output.lock().unwrap();
             out.rgb8 = image_io::to_rgb8(&big, req.params.render.exposure, req.gamma);
             out.linear = big;
@@ -568,7 +543,7 @@ impl WorkerLoop {
             out.generation = req.generation;
             out.scene_id = req.scene_id;
             out.passes = 0;
-            out.spp = req.settings.spp.max(1);
+            out.spp = f.frame.spp();
             out.preview = true;
             out.complete = false;
             out.error = None;
@@ -577,130 +552,96 @@ impl WorkerLoop {
             out.differing_pixels = None;
             out.version += 1;
             drop(out);
+            self.frame = Some(f);
             self.publish_done();
             return;
         }
 
         // One band of the current pass.
-        let spp = f.req.settings.spp.max(1);
-        let band = if self.ms_per_row > 0.0 { (BAND_MS / self.ms_per_row).clamp(1.0, f.height as f64) as u32 } else { (f.height / 16).max(1) };
-        let rows: Range<u32> = f.row..(f.row + band).min(f.height);
-        if rows.start == 0 {
+        let spp = f.frame.spp();
+        let band_rows = if self.ms_per_row > 0.0 { (BAND_MS / self.ms_per_row).clamp(1.0, height as f64) as u32 } else { (height / 16).max(1) };
+        if f.frame.next_row() == 0 {
             f.pass_started = Instant::now();
             f.pass_counts = RayCounts::default();
         }
-        let view = prepared.scene.camera.view(f.width, f.height);
-        let settings = f.pass_settings.clone();
-        let mut buf = vec![Radiance::ZERO; (f.width * rows.len() as u32) as usize];
-        let job = PassJob { prepared, view: &view, settings: &settings, offset: render::sample_offset(f.pass, spp), rows: rows.clone(), cancel };
-        let renderer = &f.renderer;
         let band_start = Instant::now();
-        let result = self.pool.install(|| guarded(|| renderer.render_pass(&job, &mut buf)));
-        if cancel.load(Ordering::Relaxed) {
-            return;
-        }
-        let counts = match result {
-            Ok(c) => c,
+        let (renderer, frame) = (f.renderer.as_ref(), &mut f.frame);
+        let result = self.pool.install(|| guarded(|| frame.render_band(renderer, prepared, band_rows, cancel)));
+        let band = match result {
+            Ok(Some(band)) => band,
+            Ok(None) => {
+                // Cancelled, nothing added: the loop looks at what came in,
+                // and a display-only change renders this band again.
+                self.frame = Some(f);
+                return;
+            }
             Err(e) => {
-                let req = f.req.clone();
-                self.fail(&req, e);
+                self.fail(&f.req, e);
                 return;
             }
         };
-        let w = f.width as usize;
-        if let Some((reference, ref_sum)) = f.reference.as_mut() {
-            let mut theirs = vec![Radiance::ZERO; buf.len()];
-            let result = self.pool.install(|| guarded(|| reference.render_pass(&job, &mut theirs)));
-            if cancel.load(Ordering::Relaxed) {
-                return;
-            }
-            if let Err(e) = result {
-                let req = f.req.clone();
-                self.fail(&req, e);
-                return;
-            }
-            let a = rows.start as usize * w;
-            for (s, p) in ref_sum[a..a + theirs.len()].iter_mut().zip(&theirs) {
-                *s += if p.is_finite() { *p } else { Vec3::ZERO };
-            }
-        }
         let band_ms = band_start.elapsed().as_secs_f64() * 1e3;
-        f.pass_counts += counts;
-        let mut display = Vec::with_capacity(buf.len());
-        for (i, y) in rows.clone().enumerate() {
-            let row_sum = &mut f.sum[y as usize * w..(y as usize + 1) * w];
-            for (s, p) in row_sum.iter_mut().zip(&buf[i * w..(i + 1) * w]) {
-                *s += if p.is_finite() { *p } else { Vec3::ZERO };
-            }
-            f.row_passes[y as usize] += 1;
-            let inv = 1.0 / f.row_passes[y as usize] as f32;
-            display.extend(row_sum.iter().map(|s| *s * inv));
-        }
+        f.pass_counts += band.counts;
+        let rows = band.rows.clone();
+        let display = f.frame.mean_rows(rows.clone());
         let rgb = image_io::to_rgb8(&display, f.req.params.render.exposure, f.req.gamma);
-        f.row = rows.end;
-        let mut pass_done = false;
-        if f.row >= f.height {
-            f.row = 0;
-            f.pass += 1;
-            pass_done = true;
-            let pass_ms = f.pass_started.elapsed().as_secs_f64() * 1e3;
-            self.ms_per_row = pass_ms / f.height as f64;
-        } else {
-            self.ms_per_row = band_ms / rows.len() as f64;
-        }
-        let complete = f.pass >= spp;
+        let pass_ms = f.pass_started.elapsed().as_secs_f64() * 1e3;
+        self.ms_per_row = if band.pass_done { pass_ms / height as f64 } else { band_ms / rows.len() as f64 };
+        let complete = f.frame.is_complete();
         let first_image = !f.first_image;
         f.first_image = true;
-        let req = &f.req;
+        let passes = f.frame.passes_done();
+        let (generation, scene_id) = (f.req.generation, f.req.scene_id);
+        let (elapsed_ms, pass_counts) = (f.started.elapsed().as_secs_f64() * 1e3, f.pass_counts);
+        // The finished frame replaces the running average whole (for the
+        // diff view it is the difference image).
+        let finished = if complete {
+            let result = f.frame.finish();
+            let rgb8 = image_io::to_rgb8(&result.pixels, f.req.params.render.exposure, f.req.gamma);
+            self.last_req = Some(f.req);
+            Some((result, rgb8))
+        } else {
+            self.frame = Some(f);
+            None
+        };
         let mut out = self.shared.output.lock().unwrap();
-        if out.generation != req.generation {
+        if out.generation != generation {
             out.error = None;
             out.passes = 0;
             out.differing_pixels = None;
         }
-        if out.width != f.width || out.height != f.height {
+        if out.width != width || out.height != height {
             // Rows not rendered yet show black until their band arrives.
-            out.width = f.width;
-            out.height = f.height;
-            out.linear = vec![Radiance::ZERO; (f.width * f.height) as usize];
-            out.rgb8 = vec![0; (f.width * f.height * 3) as usize];
+            out.width = width;
+            out.height = height;
+            out.linear = vec![Radiance::ZERO; (width * height) as usize];
+            out.rgb8 = vec![0; (width * height * 3) as usize];
             out.preview = false;
         }
         if first_image {
-            out.stats.first_image_ms = f.started.elapsed().as_secs_f64() * 1e3;
+            out.stats.first_image_ms = elapsed_ms;
         }
-        let (a, b) = (rows.start as usize * w, rows.end as usize * w);
+        let (a, b) = (rows.start as usize * width as usize, rows.end as usize * width as usize);
         out.linear[a..b].copy_from_slice(&display);
         out.rgb8[a * 3..b * 3].copy_from_slice(&rgb);
-        out.generation = req.generation;
-        out.scene_id = req.scene_id;
+        out.generation = generation;
+        out.scene_id = scene_id;
         out.spp = spp;
-        if pass_done {
-            out.passes = f.pass;
+        if band.pass_done {
+            out.passes = passes;
             out.preview = false;
-            out.stats.pass_ms = f.pass_started.elapsed().as_secs_f64() * 1e3;
-            out.stats.counts = f.pass_counts;
+            out.stats.pass_ms = pass_ms;
+            out.stats.counts = pass_counts;
         }
         out.complete = complete;
-        if complete {
-            if let Some((_, ref_sum)) = &f.reference {
-                // Averaged as render_frame averages, then the core's diff.
-                let inv = 1.0 / spp as f32;
-                let mine: Vec<Radiance> = f.sum.iter().map(|s| *s * inv).collect();
-                let theirs: Vec<Radiance> = ref_sum.iter().map(|s| *s * inv).collect();
-                let (image, count) = render::debug::diff_image(&mine, &theirs);
-                out.rgb8 = image_io::to_rgb8(&image, req.params.render.exposure, req.gamma);
-                out.linear = image;
-                out.differing_pixels = Some(count);
-            }
-            out.stats.frame_ms = f.started.elapsed().as_secs_f64() * 1e3;
+        if let Some((result, rgb8)) = finished {
+            out.linear = result.pixels;
+            out.rgb8 = rgb8;
+            out.differing_pixels = result.differing_pixels;
+            out.stats.frame_ms = elapsed_ms;
         }
         out.version += 1;
         drop(out);
-        if complete {
-            let f = self.frame.take().unwrap();
-            self.last_req = Some(f.req);
-        }
         self.publish_done();
     }
 }

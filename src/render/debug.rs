@@ -71,12 +71,7 @@ pub fn view_color(view: View, camera: &CameraView, ray: &Ray, hit: Option<&Surfa
         View::Shaded | View::Raydir | View::Cost | View::Diff | View::Shadowmap => Vec3::ZERO,
         View::Barycentric => h.barycentric,
         View::Depth => Vec3::splat(depth_value(camera, (h.position - camera.eye).length())),
-        View::Zbuffer => {
-            // 1/z maps near to 1 and far to 0, linear in screen space as rasterizers store it.
-            let z = camera.view_depth(h.position).max(camera.near);
-            let inv = (1.0 / z - 1.0 / camera.far) / (1.0 / camera.near - 1.0 / camera.far);
-            Vec3::splat(inv.clamp(0.0, 1.0))
-        }
+        View::Zbuffer => Vec3::splat(zbuffer_value(camera, camera.view_depth(h.position).max(camera.near))),
         View::Normal => (h.shading_normal + Vec3::ONE) * 0.5,
         View::Id => id_color(h.object),
         View::GeometricNormal => (h.geometric_normal + Vec3::ONE) * 0.5,
@@ -108,10 +103,17 @@ pub fn depth_value(camera: &CameraView, distance: f32) -> f32 {
     ((distance.max(camera.near) / camera.near).ln() / (camera.far / camera.near).ln()).clamp(0.0, 1.0)
 }
 
+/// The zbuffer view's grey level for view depth `z`: 1/z mapped so near = 1
+/// and far = 0, linear in screen space as rasterizers store it.
+pub fn zbuffer_value(camera: &CameraView, z: f32) -> f32 {
+    let inv = (1.0 / z - 1.0 / camera.far) / (1.0 / camera.near - 1.0 / camera.far);
+    inv.clamp(0.0, 1.0)
+}
+
 /// Heat-map colour of a cost: black, blue, magenta, orange, yellow, white on a
 /// log scale up to `COST_SCALE`.
 pub fn cost_color(cost: f32) -> Vec3 {
-    let t = ((1.0 + cost.max(0.0)).log2() / (1.0 + COST_SCALE).log2()).clamp(0.0, 1.0);
+    let t = t_of_cost(cost);
     const STOPS: [Vec3; 6] = [
         Vec3::new(0.0, 0.0, 0.0),
         Vec3::new(0.05, 0.05, 0.6),
@@ -123,6 +125,54 @@ pub fn cost_color(cost: f32) -> Vec3 {
     let x = t * (STOPS.len() - 1) as f32;
     let i = (x.floor() as usize).min(STOPS.len() - 2);
     STOPS[i].lerp(STOPS[i + 1], x - i as f32)
+}
+
+// The inverse maps: what value a debug view's colour stands for (legends,
+// hover read-out, inspector).
+
+/// The cost whose `cost_color` is nearest `c` (the cost view's heat scale,
+/// inverted): exact for 1 spp up to `COST_SCALE`, saturating above it.
+pub fn invert_cost(c: Vec3) -> f32 {
+    // cost_color is piecewise linear in t between distinct stops: project
+    // onto each segment and keep the closest point.
+    const N: usize = 5;
+    let stop = |i: usize| cost_color(cost_of_t(i as f32 / N as f32));
+    let mut best = (f32::INFINITY, 0.0f32);
+    for i in 0..N {
+        let (a, b) = (stop(i), stop(i + 1));
+        let ab = b - a;
+        let s = ((c - a).dot(ab) / ab.length_squared().max(1e-12)).clamp(0.0, 1.0);
+        let d = (a + ab * s - c).length_squared();
+        if d < best.0 {
+            best = (d, (i as f32 + s) / N as f32);
+        }
+    }
+    cost_of_t(best.1)
+}
+
+/// Inverse of the cost view's log mapping `t = log2(1 + cost) / log2(1 + COST_SCALE)`.
+pub fn cost_of_t(t: f32) -> f32 {
+    (2f32.powf(t * (1.0 + COST_SCALE).log2()) - 1.0).max(0.0)
+}
+
+/// The cost view's log mapping of a cost to [0, 1]: where it lies on `cost_color`'s scale.
+pub fn t_of_cost(cost: f32) -> f32 {
+    ((1.0 + cost.max(0.0)).log2() / (1.0 + COST_SCALE).log2()).clamp(0.0, 1.0)
+}
+
+/// Distance from the eye for a grey level of the depth view (its inverse).
+pub fn depth_distance(camera: &CameraView, v: f32) -> f32 {
+    camera.near * (camera.far / camera.near).powf(v)
+}
+
+/// View depth z for a grey level of the zbuffer view (1/z, near = 1, far = 0).
+pub fn zbuffer_depth(camera: &CameraView, v: f32) -> f32 {
+    1.0 / (v * (1.0 / camera.near - 1.0 / camera.far) + 1.0 / camera.far)
+}
+
+/// The object whose id colour `c` is, if any.
+pub fn object_of_id_color(scene: &crate::scene::Scene, c: Vec3) -> Option<usize> {
+    (0..scene.objects.len()).find(|&i| (id_color(i as u32) - c).abs().max_element() < 1e-4)
 }
 
 /// Whether two radiances differ by more than 1e-4 relative in any channel
@@ -155,4 +205,28 @@ pub fn diff_image(test: &[Radiance], reference: &[Radiance]) -> (Vec<Radiance>, 
         })
         .collect();
     (image, count)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cost_colours_invert_to_their_cost() {
+        for cost in [0.0f32, 1.0, 3.0, 17.0, 100.0, 512.0, 1000.0] {
+            let back = invert_cost(cost_color(cost));
+            assert!((back - cost).abs() < 0.01 * cost.max(1.0), "{cost} -> {back}");
+            assert!((cost_of_t(t_of_cost(cost)) - cost).abs() < 0.01 * cost.max(1.0));
+        }
+    }
+
+    #[test]
+    fn depth_and_zbuffer_invert() {
+        let cam = crate::scene::Camera { near: 0.1, far: 100.0, ..Default::default() }.view(10, 10);
+        let d = depth_distance(&cam, depth_value(&cam, 7.5));
+        assert!((d - 7.5).abs() < 1e-3, "{d}");
+        assert!((zbuffer_depth(&cam, zbuffer_value(&cam, 3.0)) - 3.0).abs() < 1e-3);
+        assert_eq!(zbuffer_value(&cam, cam.near), 1.0);
+        assert_eq!(zbuffer_value(&cam, cam.far), 0.0);
+    }
 }

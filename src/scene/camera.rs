@@ -5,6 +5,8 @@
 //! Eye rays start on the near plane, so nothing nearer than `near` is seen by
 //! the ray tracer, just as the rasterizer's near-plane clip removes it.
 
+pub mod control;
+
 use crate::math::{Mat3, Ray, Vec2, Vec3};
 
 /// Which image edges the field of view spans.

@@ -2,20 +2,20 @@
 //! resolution scale; reset and frame-all.
 
 use eframe::egui;
-use super::{section, vec3_edit};
-use crate::app::PinholeApp;
-use crate::scene::Fov;
+use super::{section, vec3_edit, Requests};
+use crate::app::state::scaled_size;
+use crate::scene::{Camera, Fov};
 
-pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
-    let mut open = app.panels.camera;
-    section(ui, "Camera", &mut open, |ui| {
-        let cam = &mut app.params.camera;
+/// `scene_size`: the scene's image size, which `res_scale` scales.
+pub fn show(ui: &mut egui::Ui, open: &mut bool, cam: &mut Camera, res_scale: &mut f32, scene_size: (u32, u32)) -> Requests {
+    let mut requests = Requests::default();
+    section(ui, "Camera", open, |ui| {
         let mut moved = false;
         moved |= vec3_edit(ui, "eye", &mut cam.eye, 0.01);
         moved |= vec3_edit(ui, "target", &mut cam.target, 0.01);
         vec3_edit(ui, "up", &mut cam.up, 0.01);
         ui.horizontal(|ui| {
-            let (mut deg, mut horizontal) = crate::app::camera_control::fov_parts(cam.fov);
+            let (mut deg, mut horizontal) = crate::scene::camera::control::fov_parts(cam.fov);
             ui.label("fov");
             let mut c = ui.add(egui::DragValue::new(&mut deg).range(1.0..=179.0).speed(0.2).suffix("°")).changed();
             c |= ui.radio_value(&mut horizontal, false, "y").changed();
@@ -34,22 +34,16 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
         });
         ui.horizontal(|ui| {
             ui.label("resolution");
-            ui.add(egui::Slider::new(&mut app.res_scale, 0.1..=2.0).step_by(0.05).suffix("×"));
+            ui.add(egui::Slider::new(res_scale, 0.1..=2.0).step_by(0.05).suffix("×"));
         });
-        let s = app.effective_settings();
-        ui.label(format!("image {}x{}", s.width, s.height));
+        let (width, height) = scaled_size(scene_size.0, scene_size.1, *res_scale);
+        ui.label(format!("image {width}x{height}"));
         ui.horizontal(|ui| {
-            if ui.button("Reset (Home)").clicked() {
-                app.reset_camera();
-            }
-            if ui.button("Frame all (F)").clicked() {
-                app.frame_all();
-            }
+            requests.reset_camera = ui.button("Reset (Home)").clicked();
+            requests.frame_all = ui.button("Frame all (F)").clicked();
         });
-        if moved {
-            app.camera_moving = true;
-        }
+        requests.camera_moved = moved;
         ui.label(egui::RichText::new("orbit: left drag · pan: middle or shift drag · dolly: wheel · fly: WASD/QE").small());
     });
-    app.panels.camera = open;
+    requests
 }

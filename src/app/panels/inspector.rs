@@ -1,4 +1,4 @@
-//! The pixel inspector (issue 5): the record of the selected pixel, replayed
+//! The pixel inspector: the record of the selected pixel, replayed
 //! by the renderer's own code path (`render::replay_pixel`). Ray tracers:
 //! the eye ray, its traversal (nodes visited, every primitive tested in
 //! order with t, barycentrics or why it was rejected), the closest hit, each
@@ -91,7 +91,7 @@ fn record(app: &PinholeApp, ui: &mut egui::Ui, names: &SceneNames, r: &PixelRepl
     ui.separator();
     if let Some(reference) = app.inspect.replay.as_ref().and_then(|r| r.reference.as_ref()) {
         // Diff view: both renderers' shaded values; the frame shows their difference.
-        ui.label(RichText::new(format!("{} (shaded) {}", app.renderer, fmt3(r.radiance))).monospace());
+        ui.label(RichText::new(format!("{} (shaded) {}", app.settings.renderer, fmt3(r.radiance))).monospace());
         match reference {
             Ok(b) => {
                 ui.label(RichText::new(format!("raytrace:brute (shaded) {}", fmt3(b.radiance))).monospace());
@@ -342,7 +342,7 @@ fn final_value(app: &PinholeApp, ui: &mut egui::Ui, radiance: Radiance, x: u32, 
         }
     }
     let exposure = app.params.render.exposure;
-    let d = crate::image_io::display_pixel(radiance, exposure, app.gamma);
+    let d = crate::image_io::display_pixel(radiance, exposure, app.settings.gamma);
     ui.horizontal(|ui| {
         let (r, _) = ui.allocate_exact_size(egui::vec2(18.0, 18.0), egui::Sense::hover());
         ui.painter().rect_filled(r, 2.0, Color32::from_rgb(d[0], d[1], d[2]));
@@ -351,7 +351,7 @@ fn final_value(app: &PinholeApp, ui: &mut egui::Ui, radiance: Radiance, x: u32, 
             d[0],
             d[1],
             d[2],
-            if app.gamma { "sRGB" } else { "no gamma" }
+            if app.settings.gamma { "sRGB" } else { "no gamma" }
         ));
     });
 }

@@ -3,15 +3,14 @@
 
 use eframe::egui;
 use super::{color_edit, section, vec3_edit};
-use crate::app::PinholeApp;
 use crate::math::Vec3;
-use crate::scene::Light;
+use crate::scene::{Camera, Light, Scene};
 
-pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
-    let mut open = app.panels.lights;
-    section(ui, "Lights", &mut open, |ui| {
+/// `camera` places new point lights; `scene`'s size sets their distance and power.
+pub fn show(ui: &mut egui::Ui, open: &mut bool, lights: &mut Vec<Light>, camera: &Camera, scene: &Scene) {
+    section(ui, "Lights", open, |ui| {
         let mut remove = None;
-        for (i, light) in app.params.lights.iter_mut().enumerate() {
+        for (i, light) in lights.iter_mut().enumerate() {
             ui.push_id(i, |ui| {
                 ui.horizontal(|ui| {
                     let kind = match light {
@@ -39,22 +38,21 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
             });
         }
         if let Some(i) = remove {
-            app.params.lights.remove(i);
+            lights.remove(i);
         }
         ui.horizontal(|ui| {
-            let scale = crate::app::camera_control::scene_scale(app.scene.bounds());
+            let scale = crate::scene::camera::control::scene_scale(scene.bounds());
             if ui.button("+ point").clicked() {
-                let c = &app.params.camera;
+                let c = camera;
                 // Above and behind the camera, lighting what it sees.
                 let position = c.eye + (c.up.normalize_or(Vec3::Y) * 0.5 - (c.target - c.eye).normalize_or(Vec3::NEG_Z) * 0.2) * scale;
-                app.params.lights.push(Light::Point { position, power: Vec3::splat(10.0 * scale * scale) });
+                lights.push(Light::Point { position, power: Vec3::splat(10.0 * scale * scale) });
             }
             if ui.button("+ directional").clicked() {
-                app.params.lights.push(Light::Directional { direction: Vec3::new(-1.0, -4.0, -4.0).normalize(), irradiance: Vec3::ONE });
+                lights.push(Light::Directional { direction: Vec3::new(-1.0, -4.0, -4.0).normalize(), irradiance: Vec3::ONE });
             }
         });
     });
-    app.panels.lights = open;
 }
 
 /// A light quantity as colour (max channel 1) times strength.

@@ -3,12 +3,11 @@
 
 use eframe::egui;
 use super::{color_edit, section};
-use crate::app::PinholeApp;
+use crate::scene::Material;
 
-pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
-    let mut open = app.panels.materials;
-    section(ui, "Materials", &mut open, |ui| {
-        for (i, m) in app.params.materials.iter_mut().enumerate() {
+pub fn show(ui: &mut egui::Ui, open: &mut bool, materials: &mut [Material]) {
+    section(ui, "Materials", open, |ui| {
+        for (i, m) in materials.iter_mut().enumerate() {
             ui.push_id(i, |ui| {
                 egui::CollapsingHeader::new(format!("{}", m.name)).default_open(i < 3).show(ui, |ui| {
                     color_edit(ui, &format!("{} k_L", m.name), &mut m.lambertian, 1.0);
@@ -30,5 +29,4 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
             });
         }
     });
-    app.panels.materials = open;
 }

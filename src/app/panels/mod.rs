@@ -1,6 +1,8 @@
 //! The viewer's panels: the menu bar, the status bar and the side-panel
 //! sections (camera, lights, materials, shading) and the pixel inspector,
-//! one file each.
+//! one file each. The menu and the side-panel sections get only the values
+//! they edit; what they ask of the viewer beyond that comes back as
+//! `Requests`, which `PinholeApp::apply` carries out once per frame.
 
 use eframe::egui;
 pub mod camera;
@@ -12,6 +14,35 @@ pub mod shading;
 pub mod status;
 
 use crate::math::Vec3;
+
+/// What panels ask the viewer to do this frame, beyond editing their values.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Requests {
+    /// The camera was edited: render a quick preview first.
+    pub camera_moved: bool,
+    pub reset_camera: bool,
+    pub frame_all: bool,
+    /// Load this scene (built-in name or path).
+    pub open: Option<String>,
+    /// Load the current scene again.
+    pub reload: bool,
+    pub open_dialog: bool,
+    pub export: bool,
+    pub quit: bool,
+}
+
+impl std::ops::BitOrAssign for Requests {
+    fn bitor_assign(&mut self, o: Requests) {
+        self.camera_moved |= o.camera_moved;
+        self.reset_camera |= o.reset_camera;
+        self.frame_all |= o.frame_all;
+        self.open = o.open.or(self.open.take());
+        self.reload |= o.reload;
+        self.open_dialog |= o.open_dialog;
+        self.export |= o.export;
+        self.quit |= o.quit;
+    }
+}
 
 /// Three labelled drag values for a vector; true when one changed.
 pub fn vec3_edit(ui: &mut egui::Ui, label: &str, v: &mut Vec3, speed: f32) -> bool {

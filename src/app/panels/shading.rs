@@ -4,13 +4,16 @@
 
 use eframe::egui;
 use super::{color_edit, section};
-use crate::app::PinholeApp;
+use crate::app::settings_store::ViewerSettings;
 use crate::render::{Interpolation, ShadowMode};
+use crate::scene::RenderDefaults;
 
-pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
-    let mut open = app.panels.shading;
+/// `settings`: the render knobs and gamma; `look`: the scene's ambient,
+/// background and exposure.
+pub fn show(ui: &mut egui::Ui, settings: &mut ViewerSettings, look: &mut RenderDefaults) {
+    let mut open = settings.panels.shading;
     section(ui, "Shading", &mut open, |ui| {
-        let s = &mut app.settings;
+        let s = &mut *settings;
         ui.horizontal(|ui| {
             ui.label("shadows");
             for m in ShadowMode::ALL {
@@ -25,11 +28,11 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
             // CGPP 15.6.5's knobs: too little bias shows acne, too much peter-panning.
             ui.horizontal(|ui| {
                 let l = ui.label("map size");
-                ui.add(egui::Slider::new(&mut s.shadow_map_size, 16..=4096).logarithmic(true)).labelled_by(l.id);
+                ui.add(egui::Slider::new(&mut s.per_scene.shadow_map_size, 16..=4096).logarithmic(true)).labelled_by(l.id);
             });
             ui.horizontal(|ui| {
                 let l = ui.label("map bias (texels)");
-                ui.add(egui::Slider::new(&mut s.shadow_map_bias, 0.0..=32.0)).labelled_by(l.id);
+                ui.add(egui::Slider::new(&mut s.per_scene.shadow_map_bias, 0.0..=32.0)).labelled_by(l.id);
             });
         }
         ui.horizontal(|ui| {
@@ -40,22 +43,22 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
             let l = ui.label("max depth");
             ui.add(egui::Slider::new(&mut s.max_depth, 0..=16)).labelled_by(l.id);
         });
-        let r = &mut app.params.render;
+        let r = look;
         color_edit(ui, "ambient", &mut r.ambient, 1.0);
         color_edit(ui, "background", &mut r.background, 1.0);
         ui.horizontal(|ui| {
             let l = ui.label("exposure");
             ui.add(egui::Slider::new(&mut r.exposure, 0.01..=100.0).logarithmic(true)).labelled_by(l.id);
         });
-        ui.checkbox(&mut app.gamma, "gamma (sRGB encode)");
+        ui.checkbox(&mut s.gamma, "gamma (sRGB encode)");
         ui.horizontal(|ui| {
             ui.label("interpolation");
             for m in Interpolation::ALL {
-                ui.radio_value(&mut app.settings.interpolation, m, m.name());
+                ui.radio_value(&mut s.interpolation, m, m.name());
             }
         });
         // Rasterizer-only knobs; the ray casters ignore them.
-        let s = &mut app.settings;
+        let s = &mut s.per_scene;
         ui.horizontal(|ui| {
             ui.label("rasterizer: MSAA");
             for n in [1u32, 2, 4, 8] {
@@ -67,5 +70,5 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
             ui.checkbox(&mut s.affine, "affine uv").on_hover_text("interpolate in screen space without the 1/z correction: try the uv view");
         });
     });
-    app.panels.shading = open;
+    settings.panels.shading = open;
 }

@@ -1,8 +1,8 @@
 //! Camera navigation as plain functions on `Camera`: orbit, pan, dolly, fly
-//! and frame-all. The viewport maps mouse and keys onto them.
+//! and frame-all. The viewer maps mouse and keys onto them.
 
+use super::{Camera, Fov};
 use crate::math::{Mat3, Vec3};
-use crate::scene::{Camera, Fov};
 
 /// Radians of orbit per pixel of drag.
 const ORBIT_PER_PIXEL: f32 = 0.005;
