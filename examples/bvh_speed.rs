@@ -1,5 +1,5 @@
 //! Times the BVH: build and primary rays on benchmark scenes, the figures
-//! DESIGN.md compares with Embree 3 (`tools/peers/embree_primary.py`).
+//! that are compared with Embree 3 (`tools/peers/embree_primary.py`).
 //!
 //!     cargo run --release --example bvh_speed -- ../shared/bench/stanford-bunny.toml ...
 //!

@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
-# Measures pinhole against its peers (../shared/COMPARE.md) in ONE run, on the
+# Measures pinhole against its peers (Embree 3, Mitsuba 3, llvmpipe) in ONE run, on the
 # benchmark scenes, and prints the figures and ratios. Only same-run ratios
 # mean anything on these shared machines.
 #
 #   bash scripts/bench_peers.sh [SCENE.toml ...]     (default: ../shared/bench/*.toml)
 #
-# Needs the peers set up as COMPARE.md says (/tmp/peers venv, libembree-dev, Mesa).
+# Needs the peers installed: a Python venv at /tmp/peers (or PEERS_PYTHON) with
+# Mitsuba 3 and the peer scripts' modules, libembree-dev, and Mesa for llvmpipe.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 shared=$(cd ../shared && pwd)

@@ -37,7 +37,7 @@ shot view-normal bunny PINHOLE_VIEW=normal PINHOLE_PANELS=lights
 # CGPP Figure 15.2: the gamma test pattern with gamma off and on.
 shot gamma-off test-pattern PINHOLE_GAMMA=off PINHOLE_PANELS=shading
 shot gamma-on test-pattern PINHOLE_GAMMA=on PINHOLE_PANELS=shading
-# Debug views with their legends (issue 5).
+# Debug views with their legends.
 shot view-depth teapot PINHOLE_VIEW=depth PINHOLE_PANELS=none
 shot view-zbuffer teapot PINHOLE_VIEW=zbuffer PINHOLE_PANELS=none
 shot view-cost bunny PINHOLE_VIEW=cost PINHOLE_PANELS=none

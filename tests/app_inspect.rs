@@ -1,4 +1,4 @@
-//! Visual debugging in the viewer (issue 5), driven like a user with
+//! Visual debugging in the viewer, driven like a user with
 //! egui_kittest: click a pixel and read its replayed record in the
 //! inspector, move the selection with the arrow keys, switch debug views and
 //! find their legends, zoom to pixel level, compare against the reference.

@@ -1,4 +1,4 @@
-//! The command line as scripts use it (CLI.md): outputs, JSON fields, and
+//! The command line as scripts use it: outputs, JSON fields, and
 //! errors that are one sentence with a non-zero exit, never a panic.
 
 use std::path::PathBuf;

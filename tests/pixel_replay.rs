@@ -1,4 +1,4 @@
-//! Click-a-pixel replay (DESIGN.md principle 6): the record of a pixel is made
+//! Click-a-pixel replay: the record of a pixel is made
 //! by the renderer's own code path, so its final radiance equals the frame's
 //! pixel exactly, for every renderer that can replay.
 

@@ -1,5 +1,5 @@
 //! Every rasterizer variant against the brute-force ray caster on every
-//! built-in scene (DESIGN.md principle 2): the same pixels except a small,
+//! built-in scene (the brute-force caster is the reference): the same pixels except a small,
 //! explained set, namely samples within one pixel of a projected triangle edge or of
 //! a sphere's silhouette, where coverage rules and rounding legitimately differ.
 //! Plus: thread-count independence, `fixed` == `tiled` bit for bit, forward

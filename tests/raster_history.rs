@@ -1,4 +1,4 @@
-//! The rasterizers' pixel history and cost view (issue 5): replaying a pixel
+//! The rasterizers' pixel history and cost view: replaying a pixel
 //! runs the pass's own coverage loops with a recorder, so the record lists the
 //! fragments in draw order with their depth tests and ends in the frame's
 //! value, whatever the variant, shading mode, MSAA or view; the cost view

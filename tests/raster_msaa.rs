@@ -1,4 +1,4 @@
-//! MSAA (issue 3): N coverage samples per pixel, one shade per pixel per
+//! MSAA: N coverage samples per pixel, one shade per pixel per
 //! primitive. It must cut the edge error against the 64-sample image like
 //! supersampling does, while shading about once per pixel and leaving pixels
 //! covered by one primitive exactly as the 1-sample image has them.
