@@ -323,10 +323,13 @@ fn resolve_with<Q: SceneQuery, R: Recorder>(
 ) -> Radiance {
     let scene = &job.prepared.scene;
     match (job.settings.view, hit) {
-        (debug::View::Shaded, Some(h)) => match shading_hit(job.settings.interpolation, h) {
-            Some(shaded) => shade::shade(scene, query, job.settings, &shaded, -ray.dir, 0, counts, rec),
-            None => shade::shade_gouraud(scene, query, job.settings, h, job.view.eye, counts, rec),
-        },
+        (debug::View::Shaded, Some(h)) => {
+            let shaded = with_shading_hit(job.settings.interpolation, h, |s| shade::shade(scene, query, job.settings, s, -ray.dir, 0, counts, rec));
+            match shaded {
+                Some(radiance) => radiance,
+                None => shade::shade_gouraud(scene, query, job.settings, h, job.view.eye, counts, rec),
+            }
+        }
         (debug::View::Shaded, None) => {
             rec.shaded(0, scene.render.background);
             scene.render.background
@@ -339,15 +342,17 @@ fn resolve_with<Q: SceneQuery, R: Recorder>(
     }
 }
 
-/// The surface `shade()` is handed for a sample that sees `hit`: the hit
-/// itself with Phong interpolation, its geometric normal as the shading
-/// normal with flat shading; `None` with Gouraud, which shades the
-/// triangle's vertices instead (`shade::shade_gouraud`).
-#[inline]
-pub fn shading_hit(interpolation: Interpolation, hit: &SurfaceHit) -> Option<SurfaceHit> {
+/// Calls `f` with the surface `shade()` is handed for a sample that sees
+/// `hit`: the hit itself with Phong interpolation, the hit with its
+/// geometric normal as shading normal with flat shading. `None` with
+/// Gouraud, which shades the triangle's vertices instead
+/// (`shade::shade_gouraud`). A callback rather than a returned hit, so the
+/// Phong case copies nothing.
+#[inline(always)]
+pub fn with_shading_hit<T>(interpolation: Interpolation, hit: &SurfaceHit, f: impl FnOnce(&SurfaceHit) -> T) -> Option<T> {
     match interpolation {
-        Interpolation::Phong => Some(*hit),
-        Interpolation::Flat => Some(SurfaceHit { shading_normal: hit.geometric_normal, ..*hit }),
+        Interpolation::Phong => Some(f(hit)),
+        Interpolation::Flat => Some(f(&SurfaceHit { shading_normal: hit.geometric_normal, ..*hit })),
         Interpolation::Gouraud => None,
     }
 }

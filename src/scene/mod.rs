@@ -196,12 +196,6 @@ pub struct SurfaceHit {
 /// make them hit the very surface they leave (CGPP's `rayBumpEpsilon`,
 /// listing 15.20). Each kind of ray has its own offset, kept in one place.
 impl SurfaceHit {
-    /// The identity of the primitive hit.
-    #[inline]
-    pub fn id(&self) -> PrimitiveId {
-        PrimitiveId::new(self.kind, self.primitive)
-    }
-
     /// A ray towards unit `dir` whose origin is the hit point moved `bump`
     /// along `dir` itself (shadow rays).
     #[inline]

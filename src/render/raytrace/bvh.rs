@@ -56,10 +56,6 @@ impl Aabb {
     pub fn contains(&self, o: &Aabb) -> bool {
         self.min.cmple(o.min).all() && self.max.cmpge(o.max).all()
     }
-
-    pub fn is_empty(&self) -> bool {
-        self.min.cmpgt(self.max).any()
-    }
 }
 
 /// What a node holds, for the viewer and the debugger.

@@ -5,15 +5,16 @@
 //! independent work the CPU overlaps.
 //!
 //! Every ray ends with exactly the hit `BvhQuery::closest` finds for it alone:
-//! - a ray enters a node only when its own slab test (the same arithmetic as
-//!   the single-ray test, lane by lane) accepts the box;
-//! - leaves test only those rays, with the same primitive tests and the same
-//!   tie rule (on equal t the lower primitive id wins), so the order in which
-//!   the packet visits nodes cannot change any ray's winner; the padded boxes
-//!   guarantee no true hit is culled by a box test in either traversal.
+//! - a ray enters a node only when its own slab test (`traverse::slab_test`,
+//!   the single-ray test's arithmetic, lane by lane) accepts the box;
+//! - leaves test only those rays, with the same leaf loop
+//!   (`traverse::test_leaf`) and so the same tie rule (on equal t the lower
+//!   primitive id wins): the order in which the packet visits nodes cannot
+//!   change any ray's winner; the padded boxes guarantee no true hit is
+//!   culled by a box test in either traversal.
 //!
-//! `trace_pixel` replays a pixel through the single-ray path; the hits being
-//! identical and the shading code the same, the replay equals the frame.
+//! After the eye rays, the tile's shadow rays towards the first light go as
+//! one packet too (`cast_pass_packets`), and `shade()` is answered from it.
 
 use super::bvh::{leaf_range, BvhQuery, Node4, LEAF_BIT, STACK};
 use super::cast_pass;
@@ -22,7 +23,7 @@ use crate::math::{Radiance, Ray};
 use crate::render::debug::View;
 use crate::render::shade::cast_shadow_ray;
 use crate::render::trace::{NoRecord, Recorder};
-use crate::render::{resolve_sample, shading_hit, Interpolation, Occluder, PassJob, RayCounts, SceneQuery, ShadowMode};
+use crate::render::{resolve_sample, with_shading_hit, Interpolation, Occluder, PassJob, RayCounts, SceneQuery, ShadowMode};
 use crate::scene::{PrimitiveId, SurfaceHit};
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
@@ -162,7 +163,7 @@ impl PacketBounds {
 
     /// The children of `node` (bit mask) that some ray of the packet, with
     /// far end at most `far_max`, may meet: a superset of every ray's own
-    /// `slab4` mask. NaNs never cull.
+    /// `PreparedRay::slab4` mask. NaNs never cull.
     #[inline(always)]
     fn children_possible(&self, node: &Node4, far_max: f32) -> u32 {
         let mut entry = Vec4::ZERO;
@@ -324,15 +325,17 @@ impl BvhQuery<'_> {
 ///
 /// The answer is keyed by the question itself: it is given only when
 /// `shade()` asks for exactly the packet's ray (same bits of origin,
-/// direction and t_max). Both rays come from `shade::cast_shadow_ray`, so
-/// they agree by construction, and the comparison costs seven integer
-/// compares per pixel. What it buys: `shade()` asks this query other
-/// questions too (light 0's shadow ray from every mirror or refraction hit
-/// further down the path), and only the ray itself tells them apart, with no
-/// knowledge here of depths, light indices or interpolation modes; should
-/// the two sides ever drift apart, the ray is traced alone: slower, never
-/// different. Recorded queries always trace, so a record lists the
-/// traversal (pixel replays never use this query: `BvhRayTracer::trace_pixel`).
+/// direction and t_max). Both rays are made by `shade::Incidence` (the
+/// packet's through `shade::cast_shadow_ray`), so they agree by
+/// construction, and the comparison costs seven integer compares per pixel.
+/// Handing `shade()` "light 0's answer" instead would need to know which of
+/// its questions that is: `shade()` also asks for light 0's shadow ray from
+/// every mirror or refraction hit further down the path, and only the ray
+/// tells them apart without this query knowing depths, light indices or
+/// interpolation modes. Should the two sides ever drift apart, the ray is
+/// traced alone: slower, never different. Recorded queries always trace, so
+/// a record lists the traversal (pixel replays do not use this query at all,
+/// see `BvhRayTracer::trace_pixel`).
 struct PixelQuery<'q, 'a> {
     bvh: &'q BvhQuery<'a>,
     shadow: Option<(Ray, f32, Option<Occluder>)>,
@@ -403,8 +406,8 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
                     m &= m - 1;
                     hits[i] = pk.hit(query, i);
                     if let (Some(light), Some(h)) = (shadow_light, &hits[i]) {
-                        let shaded = shading_hit(settings.interpolation, h);
-                        if let Some((ray, t_max)) = shaded.and_then(|h| cast_shadow_ray(scene, &h, light, settings.shadow_bump)) {
+                        let shadow_ray = with_shading_hit(settings.interpolation, h, |h| cast_shadow_ray(scene, h, light, settings.shadow_bump));
+                        if let Some((ray, t_max)) = shadow_ray.flatten() {
                             shadow_pk.rays[i] = ray;
                             shadow_pk.t_max[i] = t_max;
                             shadow_valid |= 1 << i;
