@@ -106,6 +106,11 @@ impl Packet {
         })
     }
 
+    /// How many of the rays in `valid` hit something.
+    pub fn hit_count(&self, valid: u64) -> u32 {
+        (0..P).filter(|&i| valid & 1 << i != 0 && !self.best_id[i].is_none()).count() as u32
+    }
+
     /// After `occluded_packet`: what blocks lane `i`, as `occluder` reports it.
     #[inline]
     pub fn occluder(&self, i: usize) -> Option<Occluder> {
