@@ -485,4 +485,37 @@ mod tests {
             }
         }
     }
+
+    /// The shadow ray the pre-pass traces is, bit for bit, the one `shade()`
+    /// then asks for, so the packet's answer is used (were they to differ,
+    /// the frame would still be right, only slower: no image test sees it).
+    #[test]
+    fn the_pre_pass_traces_the_shadow_ray_shade_casts() {
+        use crate::render::shade::shade;
+        use crate::render::trace::PixelTrace;
+        use crate::render::RenderSettings;
+        let bits = |(r, t): (Ray, f32)| (r.origin.to_array().map(f32::to_bits), r.dir.to_array().map(f32::to_bits), t.to_bits());
+        let mut compared = 0;
+        for name in builtin::names() {
+            let prepared = PreparedScene::new(builtin::load_builtin(name).unwrap().unwrap());
+            let Some(light) = prepared.scene.lights.first() else { continue };
+            let query = BvhQuery::new(&prepared);
+            let (w, h) = (23u32, 17u32);
+            let view = prepared.scene.camera.view(w, h);
+            for interpolation in [Interpolation::Phong, Interpolation::Flat] {
+                let settings = RenderSettings { interpolation, shadows: ShadowMode::Ray, ..RenderSettings::for_scene(&prepared.scene) };
+                for (x, y) in (0..w).flat_map(|x| (0..h).map(move |y| (x, y))) {
+                    let ray = view.eye_ray(x as f32 + 0.5, y as f32 + 0.5);
+                    let Some(hit) = query.closest(&ray, view.far_t(x as f32 + 0.5, y as f32 + 0.5), false, &mut RayCounts::default(), &mut NoRecord) else { continue };
+                    let expected = with_shading_hit(interpolation, &hit, |h| cast_shadow_ray(&prepared.scene, h, light, settings.shadow_bump)).flatten();
+                    let mut trace = PixelTrace::new();
+                    with_shading_hit(interpolation, &hit, |h| shade(&prepared.scene, &query, &settings, h, -ray.dir, 0, &mut RayCounts::default(), &mut trace));
+                    let cast = trace.lights.iter().find(|l| l.light == 0).and_then(|l| l.shadow_ray);
+                    assert_eq!(expected.map(bits), cast.map(bits), "{name} {interpolation:?} pixel ({x}, {y})");
+                    compared += expected.is_some() as u32;
+                }
+            }
+        }
+        assert!(compared > 1000, "only {compared} shadow rays compared");
+    }
 }
