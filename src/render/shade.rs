@@ -138,8 +138,9 @@ impl Incidence {
 }
 
 /// The shadow ray `shade()` casts towards `light` when it shades `hit`, if
-/// it casts one (with `ShadowMode::Ray`). The BVH's packets trace these rays
-/// ahead of `shade()` through this very function, so they are the same rays.
+/// it casts one (with `ShadowMode::Ray`): `shade()`'s own steps for one
+/// light (`Incidence::of`, `illuminates`, `shadow_ray`), for the BVH's
+/// packets, which trace these rays ahead of `shade()`.
 #[inline]
 pub fn cast_shadow_ray(scene: &Scene, hit: &SurfaceHit, light: &Light, bump: f32) -> Option<(Ray, f32)> {
     let incidence = Incidence::of(light, hit.position, hit.shading_normal)?;

@@ -82,6 +82,13 @@ pub struct ChildOrder<T> {
     len: usize,
 }
 
+impl<T: Copy + Default> Default for ChildOrder<T> {
+    #[inline(always)]
+    fn default() -> ChildOrder<T> {
+        ChildOrder::new()
+    }
+}
+
 impl<T: Copy + Default> ChildOrder<T> {
     #[inline(always)]
     pub fn new() -> ChildOrder<T> {
