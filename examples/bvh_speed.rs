@@ -8,7 +8,8 @@
 //! rays as 8x8 packets (what `render_pass` traces, like rtcIntersect8), the depth
 //! view (`render_pass`, primary rays only) and the shaded frame with shadow rays.
 
-use pinhole::render::raytrace::bvh::{Bvh, BvhQuery, BvhRayTracer};
+use pinhole::render::raytrace::bvh::{Bvh, BvhQuery};
+use pinhole::render::raytrace::bvh_renderer::BvhRayTracer;
 use pinhole::render::raytrace::packet::{self, Packet, TILE_H, TILE_W};
 use pinhole::render::trace::NoRecord;
 use pinhole::render::{debug::View, PassJob, PreparedScene, RayCounts, RenderSettings, Renderer, SceneQuery, ShadowMode};

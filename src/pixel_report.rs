@@ -66,7 +66,7 @@ fn light_json(l: &LightSample) -> Value {
     json!({
         "light": l.light, "w_i": v3(l.w_i), "distance": finite_or_null(l.distance), "incident": v3(l.incident),
         "cos_theta": l.cos_theta, "shadow_ray": l.shadow_ray.map(|(r, t)| json!({"origin": v3(r.origin), "direction": v3(r.dir), "t_max": t})),
-        "blocked_by": l.blocker.map(|(k, i, t)| json!({"kind": kind(k), "index": i, "t": t})),
+        "blocked_by": l.blocker.map(|b| json!({"kind": kind(b.kind), "index": b.index, "t": b.t})),
         "bsdf": v3(l.bsdf), "contribution": v3(l.contribution),
     })
 }
@@ -185,7 +185,7 @@ pub fn to_text(renderer: &str, scene: &Scene, x: u32, y: u32, replay: &PixelRepl
         }
         for l in &t.lights {
             let blocked = match l.blocker {
-                Some((k, i, bt)) => format!("blocked by {} {i} at t = {bt:.5}", kind(k)),
+                Some(b) => format!("blocked by {} {} at t = {:.5}", kind(b.kind), b.index, b.t),
                 None if l.shadow_ray.is_some() => "visible".into(),
                 None => "no shadow ray".into(),
             };

@@ -13,7 +13,7 @@ use pinhole::math::{luminance, Radiance, Vec3};
 use pinhole::render::debug::View;
 use pinhole::render::shadow_map::{cube_face, ShadowMaps, DEFAULT_BIAS, DEFAULT_SIZE};
 use pinhole::render::{replay_pixel, renderer_by_name, PreparedScene, RenderSettings, ShadowMode};
-use pinhole::scene::{Light, Scene};
+use pinhole::scene::{Light, PrimitiveId, Scene};
 use std::time::Instant;
 
 const W: u32 = 160;
@@ -153,7 +153,7 @@ fn blocker_distance(b: &Bench, x: u32, y: u32) -> Option<f32> {
     let r = renderer_by_name(b.renderer).unwrap();
     let replay = replay_pixel(r.as_ref(), &b.prepared, &s, x, y).ok()?;
     let trace = &replay.samples[0].1;
-    trace.lights.iter().filter_map(|l| l.blocker.map(|(_, _, t)| t)).reduce(f32::min)
+    trace.lights.iter().filter_map(|l| l.blocker.map(|b| b.t)).reduce(f32::min)
 }
 
 fn median(mut v: Vec<f32>) -> f32 {
@@ -241,17 +241,17 @@ fn point_light_depths_by_hand() {
     let b = -f.dot(u);
     let expect = b - (0.25 - (f + u * b).length_squared()).sqrt();
     assert!((d - expect).abs() < 1e-4, "sphere top: {d} vs {expect} (about {axis})");
-    assert_eq!(faces[3].id[32 + 32 * 64], 1 << 31, "sphere 0");
+    assert_eq!(faces[3].id[32 + 32 * 64], PrimitiveId::sphere(0));
     // A texel near the face's corner sees the plane 3 below: radial 3 sqrt(1 + sx^2 + sy^2).
     let (x, y) = (2u32, 2u32);
     let sx = 2.0 * (x as f32 + 0.5) / 64.0 - 1.0;
     let sy = 1.0 - 2.0 * (y as f32 + 0.5) / 64.0;
     let d = faces[3].depth[(x + y * 64) as usize];
     assert!((d - 3.0 * (1.0 + sx * sx + sy * sy).sqrt()).abs() < 1e-4, "plane: {d}");
-    assert!(faces[3].id[(x + y * 64) as usize] < 2, "a quad triangle");
+    assert!(faces[3].id[(x + y * 64) as usize] < PrimitiveId::triangle(2), "a quad triangle");
     // Looking up (+y, face 2) there is nothing.
     assert!(faces[2].depth.iter().all(|d| d.is_infinite()));
-    assert!(faces[2].id.iter().all(|&i| i == u32::MAX));
+    assert!(faces[2].id.iter().all(|i| i.is_none()));
 }
 
 #[test]
@@ -301,7 +301,7 @@ fn pixel_replay_records_the_map_lookup() {
     assert!(trace.rays.iter().all(|r| !r.shadow), "no shadow ray is cast");
     let light = &trace.lights[0];
     assert!(light.shadow_ray.is_none());
-    let (_, _, t) = light.blocker.expect("the map names the blocker");
+    let t = light.blocker.expect("the map names the blocker").t;
     assert!(t > 0.0 && t < light.distance, "{t}");
     assert_eq!(light.contribution, Vec3::ZERO);
 }

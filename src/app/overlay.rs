@@ -125,7 +125,7 @@ pub fn paths(painter: &Painter, map: &ImageMap, view: &CameraView, trace: &Pixel
     }
     for l in &trace.lights {
         let (start, end, blocked) = match (l.shadow_ray, l.blocker) {
-            (Some((ray, _)), Some((_, _, t))) => (ray.origin, ray.origin + ray.dir * t, true),
+            (Some((ray, _)), Some(b)) => (ray.origin, ray.origin + ray.dir * b.t, true),
             (Some((ray, t_max)), None) => {
                 let t = if t_max.is_finite() { t_max } else { length };
                 (ray.origin, ray.origin + ray.dir * t, false)

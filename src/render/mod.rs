@@ -19,7 +19,7 @@ pub use prepared::PreparedScene;
 
 use crate::math::{Radiance, Ray, Vec2};
 use crate::named::named_enum;
-use crate::scene::{CameraView, PrimitiveKind, SurfaceHit};
+use crate::scene::{CameraView, PrimitiveId, PrimitiveKind, SurfaceHit};
 use std::ops::Range;
 use std::sync::atomic::AtomicBool;
 use trace::Recorder;
@@ -147,15 +147,32 @@ impl std::ops::AddAssign for RayCounts {
     }
 }
 
+/// What blocks a shadow ray: the primitive, and how far along the ray it
+/// lies (from a shadow map: how far before the shaded point).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Occluder {
+    pub kind: PrimitiveKind,
+    /// Index into `Scene::triangles` or `Scene::spheres`.
+    pub index: u32,
+    pub t: f32,
+}
+
+impl Occluder {
+    #[inline]
+    pub fn new(id: PrimitiveId, t: f32) -> Occluder {
+        Occluder { kind: id.kind(), index: id.index(), t }
+    }
+}
+
 /// Closest-hit and any-hit queries against the scene. The brute-force caster
 /// and the BVH implement it; `shade()` uses it for shadow and secondary rays.
 pub trait SceneQuery: Sync {
     /// The closest surface along `ray` with `0 < t < t_max`. `inside` lets a
     /// refracted ray hit the sphere it travels in from inside.
     fn closest<R: Recorder>(&self, ray: &Ray, t_max: f32, inside: bool, counts: &mut RayCounts, rec: &mut R) -> Option<SurfaceHit>;
-    /// The first surface found along `ray` with `0 < t < t_max`, as
-    /// (kind, index, t); `None` when the segment is clear.
-    fn occluder<R: Recorder>(&self, ray: &Ray, t_max: f32, counts: &mut RayCounts, rec: &mut R) -> Option<(PrimitiveKind, u32, f32)>;
+    /// The first surface found along `ray` with `0 < t < t_max`; `None`
+    /// when the segment is clear.
+    fn occluder<R: Recorder>(&self, ray: &Ray, t_max: f32, counts: &mut RayCounts, rec: &mut R) -> Option<Occluder>;
     /// Shadow maps to look light visibility up in (`--shadows map`);
     /// `resolve_sample` wraps the query in a `shadow_map::MapQuery` that has them.
     fn shadow_maps(&self) -> Option<&shadow_map::ShadowMaps> {
@@ -205,7 +222,7 @@ pub trait Renderer: Sync + Send {
 
 /// Every registered renderer, reference first.
 pub fn renderers() -> Vec<Box<dyn Renderer>> {
-    let mut all: Vec<Box<dyn Renderer>> = vec![Box::new(raytrace::brute::BruteForce), Box::new(raytrace::bvh::BvhRayTracer)];
+    let mut all: Vec<Box<dyn Renderer>> = vec![Box::new(raytrace::brute::BruteForce), Box::new(raytrace::bvh_renderer::BvhRayTracer)];
     all.extend(raster::renderers());
     all
 }
@@ -271,14 +288,13 @@ fn resolve_with<Q: SceneQuery, R: Recorder>(
 ) -> Radiance {
     let scene = &job.prepared.scene;
     match (job.settings.view, hit) {
-        (debug::View::Shaded, Some(h)) => match job.settings.interpolation {
-            Interpolation::Phong => shade::shade(scene, query, job.settings, h, -ray.dir, 0, counts, rec),
-            Interpolation::Flat => {
-                let flat = SurfaceHit { shading_normal: h.geometric_normal, ..*h };
-                shade::shade(scene, query, job.settings, &flat, -ray.dir, 0, counts, rec)
+        (debug::View::Shaded, Some(h)) => {
+            let shaded = with_shading_hit(job.settings.interpolation, h, |s| shade::shade(scene, query, job.settings, s, -ray.dir, 0, counts, rec));
+            match shaded {
+                Some(radiance) => radiance,
+                None => shade::shade_gouraud(scene, query, job.settings, h, job.view.eye, counts, rec),
             }
-            Interpolation::Gouraud => shade::shade_gouraud(scene, query, job.settings, h, job.view.eye, counts, rec),
-        },
+        }
         (debug::View::Shaded, None) => {
             rec.shaded(0, scene.render.background);
             scene.render.background
@@ -288,6 +304,21 @@ fn resolve_with<Q: SceneQuery, R: Recorder>(
             rec.shaded(0, c);
             c
         }
+    }
+}
+
+/// Calls `f` with the surface `shade()` is handed for a sample that sees
+/// `hit`: the hit itself with Phong interpolation, the hit with its
+/// geometric normal as shading normal with flat shading. `None` with
+/// Gouraud, which shades the triangle's vertices instead
+/// (`shade::shade_gouraud`). A callback rather than a returned hit, so the
+/// Phong case copies nothing.
+#[inline(always)]
+pub fn with_shading_hit<T>(interpolation: Interpolation, hit: &SurfaceHit, f: impl FnOnce(&SurfaceHit) -> T) -> Option<T> {
+    match interpolation {
+        Interpolation::Phong => Some(f(hit)),
+        Interpolation::Flat => Some(f(&SurfaceHit { shading_normal: hit.geometric_normal, ..*hit })),
+        Interpolation::Gouraud => None,
     }
 }
 

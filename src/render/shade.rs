@@ -45,19 +45,9 @@ pub fn shade<Q: SceneQuery, R: Recorder>(
     let mut l_o = albedo * scene.render.ambient;
 
     for (index, light) in scene.lights.iter().enumerate() {
-        let (w_i, distance, incident) = match *light {
-            Light::Point { position, power } => {
-                let offset = position - p;
-                let d = offset.length();
-                if d <= 0.0 {
-                    continue;
-                }
-                (offset / d, d, power / (4.0 * PI * d * d))
-            }
-            Light::Directional { direction, irradiance } => (-direction, f32::INFINITY, irradiance),
-        };
-        let cos_theta = w_i.dot(n);
-        if cos_theta <= 0.0 || incident == Vec3::ZERO {
+        let Some(incidence) = Incidence::of(light, p, n) else { continue };
+        let Incidence { w_i, distance, incident, cos_theta } = incidence;
+        if !incidence.illuminates() {
             if R::ENABLED {
                 rec.light(LightSample { light: index, w_i, distance, incident, cos_theta, shadow_ray: None, blocker: None, bsdf: Vec3::ZERO, contribution: Vec3::ZERO });
             }
@@ -66,10 +56,7 @@ pub fn shade<Q: SceneQuery, R: Recorder>(
         let mut shadow_ray = None;
         let mut blocker = None;
         if settings.shadows == ShadowMode::Ray {
-            // CGPP listing 15.20: start a little along the ray so it does not re-hit P.
-            let eps = settings.shadow_bump;
-            let ray = Ray::new(shadow_origin(scene, hit, w_i) + w_i * eps, w_i);
-            let t_max = distance - eps;
+            let (ray, t_max) = incidence.shadow_ray(scene, hit, settings.shadow_bump);
             counts.shadow += 1;
             rec.in_shadow_ray(true);
             rec.ray(&ray, t_max, depth + 1);
@@ -96,6 +83,68 @@ pub fn shade<Q: SceneQuery, R: Recorder>(
     }
     rec.shaded(depth, l_o);
     l_o
+}
+
+/// How one light arrives at a surface point: the first half of every light's
+/// term in `shade()`, before visibility and the BSDF.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Incidence {
+    /// Unit direction towards the light.
+    pub w_i: Vec3,
+    /// Distance to the light (infinite for directional lights).
+    pub distance: f32,
+    /// Incident radiance (point, CGPP 15.4.5: power / (4 pi d^2)) or
+    /// irradiance (directional), before visibility.
+    pub incident: Radiance,
+    /// `w_i . n` with the shading normal.
+    pub cos_theta: f32,
+}
+
+impl Incidence {
+    /// Light `light` at point `p` with unit shading normal `n`; `None` when
+    /// a point light sits exactly at `p` (it has no direction there and
+    /// contributes nothing).
+    #[inline]
+    pub fn of(light: &Light, p: Vec3, n: Vec3) -> Option<Incidence> {
+        let (w_i, distance, incident) = match *light {
+            Light::Point { position, power } => {
+                let offset = position - p;
+                let d = offset.length();
+                if d <= 0.0 {
+                    return None;
+                }
+                (offset / d, d, power / (4.0 * PI * d * d))
+            }
+            Light::Directional { direction, irradiance } => (-direction, f32::INFINITY, irradiance),
+        };
+        Some(Incidence { w_i, distance, incident, cos_theta: w_i.dot(n) })
+    }
+
+    /// Whether the light reaches the surface's lit side with some radiance:
+    /// only then can it contribute, and only then is a shadow ray cast.
+    #[inline]
+    pub fn illuminates(&self) -> bool {
+        !(self.cos_theta <= 0.0 || self.incident == Vec3::ZERO)
+    }
+
+    /// The shadow ray from `hit` towards the light, and its far end. It
+    /// leaves from `shadow_origin` and starts `bump` along the ray so it does
+    /// not hit P again (CGPP listing 15.20); it ends `bump` short of the light.
+    #[inline]
+    pub fn shadow_ray(&self, scene: &Scene, hit: &SurfaceHit, bump: f32) -> (Ray, f32) {
+        let leaving = SurfaceHit { position: shadow_origin(scene, hit, self.w_i), ..*hit };
+        (leaving.spawn_ray_along(self.w_i, bump), self.distance - bump)
+    }
+}
+
+/// The shadow ray `shade()` casts towards `light` when it shades `hit`, if
+/// it casts one (with `ShadowMode::Ray`): `shade()`'s own steps for one
+/// light (`Incidence::of`, `illuminates`, `shadow_ray`), for the BVH's
+/// packets, which trace these rays ahead of `shade()`.
+#[inline]
+pub fn cast_shadow_ray(scene: &Scene, hit: &SurfaceHit, light: &Light, bump: f32) -> Option<(Ray, f32)> {
+    let incidence = Incidence::of(light, hit.position, hit.shading_normal)?;
+    incidence.illuminates().then(|| incidence.shadow_ray(scene, hit, bump))
 }
 
 /// Where a shadow ray towards `w_i` leaves a surface point. Normally the hit
@@ -195,20 +244,20 @@ fn secondary<Q: SceneQuery, R: Recorder>(
         if sin2_t < 1.0 {
             let cos_t = (1.0 - sin2_t).sqrt();
             let dir = (-w_o * eta + n * (eta * cos_o - cos_t)).normalize();
-            let ray = Ray::new(hit.position - n * settings.shadow_bump, dir);
-            result += material.transmission * (1.0 - fresnel) * trace(scene, query, settings, &ray, depth + 1, true, counts, rec);
+            let ray = hit.spawn_ray_back(dir, settings.shadow_bump);
+            result += material.transmission * (1.0 - fresnel) * radiance_along(scene, query, settings, &ray, depth + 1, true, counts, rec);
         }
     }
     if reflect_weight != Vec3::ZERO {
-        let ray = Ray::new(hit.position + n * settings.shadow_bump, reflect_dir);
-        result += reflect_weight * trace(scene, query, settings, &ray, depth + 1, false, counts, rec);
+        let ray = hit.spawn_ray_front(reflect_dir, settings.shadow_bump);
+        result += reflect_weight * radiance_along(scene, query, settings, &ray, depth + 1, false, counts, rec);
     }
     result
 }
 
 /// Radiance along a secondary ray: closest hit, then `shade()`; the background on a miss.
 #[allow(clippy::too_many_arguments)]
-pub fn trace<Q: SceneQuery, R: Recorder>(
+pub fn radiance_along<Q: SceneQuery, R: Recorder>(
     scene: &Scene,
     query: &Q,
     settings: &RenderSettings,

@@ -49,9 +49,9 @@ use super::raster::setup::{bin_rows, ScreenTri};
 use super::raster::subpixel::snap_offset;
 use super::raster::sphere::sphere_bounds;
 use super::trace::Recorder;
-use super::{PassJob, PreparedScene, RayCounts, RenderSettings, SceneQuery};
+use super::{Occluder, PassJob, PreparedScene, RayCounts, RenderSettings, SceneQuery};
 use crate::math::{Radiance, Ray, Vec2, Vec3};
-use crate::scene::{Camera, CameraView, Fov, Light, PrimitiveKind, Scene, Sphere, SurfaceHit, Triangle};
+use crate::scene::{Camera, CameraView, Fov, Light, PrimitiveId, Scene, Sphere, SurfaceHit, Triangle};
 use rayon::prelude::*;
 use std::cell::RefCell;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -76,8 +76,6 @@ pub fn default_bias() -> f32 {
     DEFAULT_BIAS
 }
 
-const SPHERE_BIT: u32 = 1 << 31;
-const EMPTY: u32 = u32::MAX;
 /// Rows of a map rasterized together (bands run in parallel).
 const BAND: u32 = 32;
 
@@ -92,9 +90,8 @@ pub struct Face {
     /// along the light direction from the view's eye (orthographic);
     /// `f32::INFINITY` where nothing was drawn.
     pub depth: Vec<f32>,
-    /// Per texel: the primitive stored (triangle index, or sphere index with
-    /// the top bit set), `u32::MAX` when empty.
-    pub id: Vec<u32>,
+    /// Per texel: the primitive stored, `PrimitiveId::NONE` when empty.
+    pub id: Vec<PrimitiveId>,
 }
 
 /// The maps of one light.
@@ -169,9 +166,9 @@ impl ShadowMaps {
 
     /// The map's verdict for light `light` at `hit`: the primitive stored in
     /// the texel and how far before the point it lies (as a shadow ray's
-    /// blocker: kind, index, distance from the point), or `None` when lit.
+    /// blocker, t being the distance from the point), or `None` when lit.
     /// `bias` is in texels, slope-scaled (module documentation).
-    pub fn occluder(&self, scene: &Scene, light: usize, hit: &SurfaceHit, w_i: Vec3, bias: f32) -> Option<(PrimitiveKind, u32, f32)> {
+    pub fn occluder(&self, scene: &Scene, light: usize, hit: &SurfaceHit, w_i: Vec3, bias: f32) -> Option<Occluder> {
         let map = self.maps.get(light).filter(|m| !m.faces.is_empty())?;
         // The same point a shadow ray would leave from (lifted on smooth triangles).
         let p = super::shade::shadow_origin(scene, hit, w_i);
@@ -190,15 +187,14 @@ impl ShadowMaps {
         let (x, y) = face.texel_of(p)?;
         let i = (x + y * self.size) as usize;
         let id = face.id[i];
-        if id == EMPTY {
+        if id.is_none() {
             return None;
         }
         let cos = hit.geometric_normal.dot(w_i).abs().clamp(1e-6, 1.0);
         let tan = ((1.0 - cos * cos).max(0.0).sqrt() / cos).min(MAX_SLOPE);
         let gap = dist - face.depth[i];
         if gap > bias * texel_w * (1.0 + tan) {
-            let kind = if id & SPHERE_BIT != 0 { PrimitiveKind::Sphere } else { PrimitiveKind::Triangle };
-            Some((kind, id & !SPHERE_BIT, gap))
+            Some(Occluder::new(id, gap))
         } else {
             None
         }
@@ -387,7 +383,7 @@ pub fn caster_bounds(scene: &Scene) -> Option<(Vec3, Vec3)> {
 fn draw_face(scene: &Scene, face: &mut Face, size: u32, parallel: bool) {
     let n = size as usize;
     face.depth = vec![f32::INFINITY; n * n];
-    face.id = vec![EMPTY; n * n];
+    face.id = vec![PrimitiveId::NONE; n * n];
     let view = &face.view;
     let ortho = face.ortho;
     let mut tris = Vec::new();
@@ -401,7 +397,7 @@ fn draw_face(scene: &Scene, face: &mut Face, size: u32, parallel: bool) {
         .enumerate()
         .filter_map(|(i, s)| sphere_rect(view, ortho, s, size).map(|r| (i as u32, s, r)))
         .collect();
-    let band = |(b, (depth, id)): (usize, (&mut [f32], &mut [u32]))| {
+    let band = |(b, (depth, id)): (usize, (&mut [f32], &mut [PrimitiveId]))| {
         let y0 = b as u32 * BAND;
         let rect = PixelRect::new(0, y0, size, (y0 + BAND).min(size));
         draw_band(view, ortho, &tris, &bins[b], &spheres, rect, depth, id);
@@ -485,7 +481,7 @@ fn draw_band(
     spheres: &[(u32, &Sphere, PixelRect)],
     rect: PixelRect,
     depth: &mut [f32],
-    id: &mut [u32],
+    id: &mut [PrimitiveId],
 ) {
     let stride = rect.width() as usize;
     let off = snap_offset(Vec2::splat(0.5));
@@ -500,7 +496,7 @@ fn draw_band(
             let i = (x - rect.x0) as usize + (y - rect.y0) as usize * stride;
             if value < depth[i] {
                 depth[i] = value;
-                id[i] = t.ft.st.tri;
+                id[i] = PrimitiveId::triangle(t.ft.st.tri);
             }
         });
     }
@@ -517,7 +513,7 @@ fn draw_band(
                 let i = (x - rect.x0) as usize + (y - rect.y0) as usize * stride;
                 if value < depth[i] {
                     depth[i] = value;
-                    id[i] = si | SPHERE_BIT;
+                    id[i] = PrimitiveId::sphere(si);
                 }
             }
         }
@@ -628,7 +624,7 @@ impl<Q: SceneQuery> SceneQuery for MapQuery<'_, Q> {
     }
 
     #[inline]
-    fn occluder<R: Recorder>(&self, ray: &Ray, t_max: f32, counts: &mut RayCounts, rec: &mut R) -> Option<(PrimitiveKind, u32, f32)> {
+    fn occluder<R: Recorder>(&self, ray: &Ray, t_max: f32, counts: &mut RayCounts, rec: &mut R) -> Option<Occluder> {
         self.inner.occluder(ray, t_max, counts, rec)
     }
 
@@ -695,7 +691,7 @@ mod tests {
         assert!(maps.maps[0].faces.is_empty());
         let hit = SurfaceHit {
             position: Vec3::NEG_Y, geometric_normal: Vec3::Y, shading_normal: Vec3::Y, barycentric: Vec3::ZERO, uv: Vec2::ZERO, t: 1.0,
-            kind: PrimitiveKind::Sphere, primitive: 0, object: 0, material: 0, back_face: false,
+            kind: crate::scene::PrimitiveKind::Sphere, primitive: 0, object: 0, material: 0, back_face: false,
         };
         assert_eq!(maps.occluder(&scene, 0, &hit, Vec3::Y, 1.0), None);
         assert!(maps.view_color(Vec2::new(1.0, 1.0), 10, 10).is_finite());

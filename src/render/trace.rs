@@ -1,9 +1,10 @@
-//! The pixel recorder (DESIGN.md principle 6): renderers and `shade()` report
-//! what they do to a `Recorder`. Frames pass `NoRecord`, whose methods are
-//! empty and compile away; `pinhole pixel` and the inspector pass a
-//! `PixelTrace` through the very same code.
+//! The pixel recorder: renderers and `shade()` report what they do to a
+//! `Recorder`. Frames pass `NoRecord`, whose methods are empty and compile
+//! away; `pinhole pixel` and the inspector pass a `PixelTrace` through the
+//! very same code.
 
 use super::raytrace::intersect::Miss;
+use super::Occluder;
 use crate::math::{Radiance, Ray, Vec3};
 use crate::scene::{PrimitiveKind, SurfaceHit};
 
@@ -28,8 +29,8 @@ pub struct LightSample {
     pub cos_theta: f32,
     /// The shadow ray, when one was cast.
     pub shadow_ray: Option<(Ray, f32)>,
-    /// What blocked the shadow ray: primitive and t.
-    pub blocker: Option<(PrimitiveKind, u32, f32)>,
+    /// What blocked the shadow ray (or, with shadow maps, the stored caster).
+    pub blocker: Option<Occluder>,
     pub bsdf: Vec3,
     pub contribution: Radiance,
 }

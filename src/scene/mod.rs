@@ -64,6 +64,70 @@ pub enum PrimitiveKind {
     Sphere,
 }
 
+/// One primitive named by a single integer: a triangle index, or a sphere
+/// index with the top bit set. Compared as integers, ids order primitives as
+/// the brute-force caster scans them (every triangle, then every sphere, each
+/// by index), which is the order every renderer's tie rule follows. `NONE`
+/// names no primitive (an empty buffer entry, no hit yet) and compares above
+/// every real id.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[repr(transparent)]
+pub struct PrimitiveId(u32);
+
+impl PrimitiveId {
+    const SPHERE_BIT: u32 = 1 << 31;
+    /// No primitive.
+    pub const NONE: PrimitiveId = PrimitiveId(u32::MAX);
+
+    /// Triangle `index` of `Scene::triangles` (below 2^31).
+    #[inline(always)]
+    pub const fn triangle(index: u32) -> PrimitiveId {
+        PrimitiveId(index)
+    }
+
+    /// Sphere `index` of `Scene::spheres` (below 2^31 - 1).
+    #[inline(always)]
+    pub const fn sphere(index: u32) -> PrimitiveId {
+        PrimitiveId(index | Self::SPHERE_BIT)
+    }
+
+    #[inline(always)]
+    pub fn new(kind: PrimitiveKind, index: u32) -> PrimitiveId {
+        match kind {
+            PrimitiveKind::Triangle => PrimitiveId::triangle(index),
+            PrimitiveKind::Sphere => PrimitiveId::sphere(index),
+        }
+    }
+
+    #[inline(always)]
+    pub fn is_none(self) -> bool {
+        self == PrimitiveId::NONE
+    }
+
+    #[inline(always)]
+    pub fn is_sphere(self) -> bool {
+        self.0 & Self::SPHERE_BIT != 0
+    }
+
+    /// The kind of primitive (meaningless for `NONE`).
+    #[inline(always)]
+    pub fn kind(self) -> PrimitiveKind {
+        if self.is_sphere() { PrimitiveKind::Sphere } else { PrimitiveKind::Triangle }
+    }
+
+    /// Index into `Scene::triangles` or `Scene::spheres` (meaningless for `NONE`).
+    #[inline(always)]
+    pub fn index(self) -> u32 {
+        self.0 & !Self::SPHERE_BIT
+    }
+
+    /// Kind and index, `None` for `NONE`.
+    #[inline(always)]
+    pub fn decode(self) -> Option<(PrimitiveKind, u32)> {
+        (!self.is_none()).then(|| (self.kind(), self.index()))
+    }
+}
+
 /// One `[[object]]` of the scene file, for id views and the inspector.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ObjectInfo {
@@ -111,8 +175,7 @@ pub struct Scene {
 }
 
 /// Everything a renderer found about the surface a sample sees. Renderers
-/// answer visibility only; `shade()` turns this into radiance (DESIGN.md
-/// principle 1).
+/// answer visibility only; `shade()` turns this into radiance.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SurfaceHit {
     pub position: Vec3,
@@ -131,6 +194,33 @@ pub struct SurfaceHit {
     pub material: u32,
     /// True when the surface was hit from its back (two-sided surfaces only).
     pub back_face: bool,
+}
+
+/// Rays leaving a surface start a little off it, so that rounding cannot
+/// make them hit the very surface they leave (CGPP's `rayBumpEpsilon`,
+/// listing 15.20). Each kind of ray has its own offset, kept in one place.
+impl SurfaceHit {
+    /// A ray towards unit `dir` whose origin is the hit point moved `bump`
+    /// along `dir` itself (shadow rays).
+    #[inline]
+    pub fn spawn_ray_along(&self, dir: Vec3, bump: f32) -> Ray {
+        Ray::new(self.position + dir * bump, dir)
+    }
+
+    /// A ray towards `dir` whose origin is the hit point moved `bump` along
+    /// the geometric normal, to the side the surface was seen from (mirror
+    /// reflections).
+    #[inline]
+    pub fn spawn_ray_front(&self, dir: Vec3, bump: f32) -> Ray {
+        Ray::new(self.position + self.geometric_normal * bump, dir)
+    }
+
+    /// A ray towards `dir` whose origin is the hit point moved `bump` against
+    /// the geometric normal, through to the surface's far side (refraction).
+    #[inline]
+    pub fn spawn_ray_back(&self, dir: Vec3, bump: f32) -> Ray {
+        Ray::new(self.position - self.geometric_normal * bump, dir)
+    }
 }
 
 impl Scene {
@@ -209,6 +299,17 @@ impl Scene {
         }
     }
 
+    /// The surface record for a ray that hit primitive `id` at parameter `t`;
+    /// `(b1, b2)` are a triangle hit's barycentric weights of v1 and v2
+    /// (ignored for spheres). Both ray casters build their hits here.
+    #[inline]
+    pub fn primitive_hit(&self, id: PrimitiveId, t: f32, b1: f32, b2: f32, ray: &Ray) -> SurfaceHit {
+        match id.kind() {
+            PrimitiveKind::Triangle => self.triangle_hit(id.index(), Vec3::new(1.0 - b1 - b2, b1, b2), t, ray),
+            PrimitiveKind::Sphere => self.sphere_hit(id.index(), t, ray),
+        }
+    }
+
     /// A default grey Lambertian material, added on demand.
     pub fn default_material_index(&mut self) -> u32 {
         if let Some(i) = self.materials.iter().position(|m| m.name == material::DEFAULT_MATERIAL) {
@@ -216,5 +317,24 @@ impl Scene {
         }
         self.materials.push(Material::default_grey());
         (self.materials.len() - 1) as u32
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn primitive_ids_encode_kind_and_index_in_scan_order() {
+        let (t, s) = (PrimitiveId::triangle(7), PrimitiveId::sphere(3));
+        assert_eq!(t.decode(), Some((PrimitiveKind::Triangle, 7)));
+        assert_eq!(s.decode(), Some((PrimitiveKind::Sphere, 3)));
+        assert_eq!(PrimitiveId::new(PrimitiveKind::Sphere, 3), s);
+        assert_eq!(PrimitiveId::NONE.decode(), None);
+        assert!(PrimitiveId::NONE.is_none() && !t.is_none() && !s.is_none());
+        // Every triangle before every sphere, each by index; NONE above all.
+        assert!(PrimitiveId::triangle(6) < t && t < PrimitiveId::triangle(u32::MAX >> 1));
+        assert!(PrimitiveId::triangle(u32::MAX >> 1) < PrimitiveId::sphere(0) && PrimitiveId::sphere(0) < s);
+        assert!(s < PrimitiveId::NONE);
     }
 }

@@ -247,12 +247,12 @@ fn light(ui: &mut egui::Ui, names: &SceneNames, l: &LightSample, traced: Option<
         None => "?",
     };
     let visibility = match (l.shadow_ray, l.blocker) {
-        (_, Some((kd, i, t))) => format!("blocked by {} {i} {} at t = {t:.5}", kind_name(kd), object_name(names.scene, kd, i)),
+        (_, Some(b)) => format!("blocked by {} {} {} at t = {:.5}", kind_name(b.kind), b.index, object_name(names.scene, b.kind, b.index), b.t),
         (Some(_), None) => "visible".into(),
         (None, None) => "no shadow ray".into(),
     };
     let short = match l.blocker {
-        Some((_, _, t)) => format!("blocked at t = {t:.5}"),
+        Some(b) => format!("blocked at t = {:.5}", b.t),
         None => visibility.clone(),
     };
     let color = if l.blocker.is_some() { Color32::from_rgb(240, 110, 100) } else { Color32::from_rgb(110, 220, 120) };

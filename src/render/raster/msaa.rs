@@ -11,10 +11,11 @@
 //! the resolve. With `spp` passes the pattern is scaled into the pass's
 //! stratum: sample k sits at `offset + pattern_k / sqrt(spp)`.
 
-use super::vis_buffer::{FragmentRecorder, VisBuffer, EMPTY};
+use super::vis_buffer::{FragmentRecorder, VisBuffer};
 use crate::math::{Radiance, Vec2};
 use crate::render::debug::cost_color;
 use crate::render::{RayCounts, SceneQuery};
+use crate::scene::PrimitiveId;
 
 /// The sample counts accepted by `--msaa`.
 pub const COUNTS: [u32; 4] = [1, 2, 4, 8];
@@ -52,7 +53,7 @@ pub fn resolve<Q: SceneQuery, R: FragmentRecorder>(vbs: &mut [VisBuffer<Q, R>], 
     vbs[0].counts.primary += 1;
     let centre = vbs[0].id[i];
     // (primitive id, samples covered, layer to shade from), in sample order.
-    let mut groups = [(EMPTY, 0u32, 0usize); 8];
+    let mut groups = [(PrimitiveId::NONE, 0u32, 0usize); 8];
     let mut ng = 0;
     for k in 1..=n {
         let id = vbs[k].id[i];
@@ -65,14 +66,14 @@ pub fn resolve<Q: SceneQuery, R: FragmentRecorder>(vbs: &mut [VisBuffer<Q, R>], 
         }
     }
     if vbs[0].cost_view() {
-        let shades = groups[..ng].iter().filter(|g| g.0 != EMPTY).count() as u32;
+        let shades = groups[..ng].iter().filter(|g| !g.0.is_none()).count() as u32;
         vbs[0].counts.fragments_shaded += shades as u64;
         let work: u32 = vbs.iter().map(|vb| vb.work_at(i)).sum::<u32>() + shades;
         return cost_color(work as f32);
     }
     let mut value = Radiance::ZERO;
     for &(id, count, src) in &groups[..ng] {
-        if id != EMPTY {
+        if !id.is_none() {
             vbs[src].counts.fragments_shaded += 1;
         }
         let v = vbs[src].shade(i, x, y);

@@ -15,12 +15,8 @@ use crate::math::{Radiance, Ray, Vec3};
 use crate::render::debug::{cost_color, View};
 use crate::render::trace::{FragmentRecord, NoRecord, PixelTrace, Recorder};
 use crate::render::{miss_without_ray, resolve_sample, PassJob, RayCounts, SceneQuery};
-use crate::scene::{PrimitiveKind, SurfaceHit};
+use crate::scene::{PrimitiveId, PrimitiveKind, SurfaceHit};
 
-/// No primitive covers the sample.
-pub const EMPTY: u32 = u32::MAX;
-/// Set in an id for spheres; clear for triangles.
-pub const SPHERE_BIT: u32 = 1 << 31;
 
 /// What a depth key measures.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -78,7 +74,8 @@ pub struct VisBuffer<'j, 'a, Q: SceneQuery, R: FragmentRecorder = NoRecord> {
     /// once per pixel after visibility is known (early depth).
     pub forward: bool,
     pub depth: Vec<f32>,
-    pub id: Vec<u32>,
+    /// What each sample sees; `PrimitiveId::NONE` where nothing covers it.
+    pub id: Vec<PrimitiveId>,
     /// Triangles: perspective-correct (b1, b2) in the scene triangle. Spheres: (t, 0).
     pub payload: Vec<[f32; 2]>,
     color: Vec<Radiance>,
@@ -126,7 +123,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             key,
             forward,
             depth,
-            id: vec![EMPTY; n],
+            id: vec![PrimitiveId::NONE; n],
             payload: vec![[0.0; 2]; n],
             color: if forward { vec![Radiance::ZERO; n] } else { Vec::new() },
             work: if cost { vec![0; n] } else { Vec::new() },
@@ -205,7 +202,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         let passed = key < stored;
         if passed {
             self.depth[i] = key;
-            self.id[i] = st.tri;
+            self.id[i] = PrimitiveId::triangle(st.tri);
             self.payload[i] = if self.job.settings.affine { st.affine_bary_at(l) } else { st.bary_at(l, inv_z) };
             if self.forward {
                 self.shade_now(i, x, y);
@@ -247,7 +244,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         self.count_work(i);
         let stored = self.depth[i];
         self.depth[i] = t;
-        self.id[i] = tri;
+        self.id[i] = PrimitiveId::triangle(tri);
         self.payload[i] = [b1, b2];
         if self.forward {
             self.shade_now(i, x, y);
@@ -284,16 +281,16 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         self.count_work(i);
         let cur = self.id[i];
         let stored = self.depth[i];
-        let nearer = if cur == EMPTY {
+        let nearer = if cur.is_none() {
             true
-        } else if cur & SPHERE_BIT != 0 {
+        } else if cur.is_sphere() {
             t < self.payload[i][0]
         } else {
             key < self.depth[i]
         };
         if nearer {
             self.depth[i] = key;
-            self.id[i] = s | SPHERE_BIT;
+            self.id[i] = PrimitiveId::sphere(s);
             self.payload[i] = [t, 0.0];
             if self.forward {
                 self.shade_now(i, x, y);
@@ -319,22 +316,22 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         let ray = self.job.view.eye_ray(p.x, p.y);
         let id = self.id[i];
         let scene = &self.job.prepared.scene;
-        let hit = if id == EMPTY {
+        let hit = if id.is_none() {
             None
-        } else if id & SPHERE_BIT != 0 {
-            Some(scene.sphere_hit(id & !SPHERE_BIT, self.payload[i][0], &ray))
+        } else if id.is_sphere() {
+            Some(scene.sphere_hit(id.index(), self.payload[i][0], &ray))
         } else {
             let [b1, b2] = self.payload[i];
             let b = Vec3::new(1.0 - b1 - b2, b1, b2);
             let t = match self.key {
                 DepthKey::RayT => self.depth[i],
                 DepthKey::NegInvZ => {
-                    let v = &scene.triangles[id as usize].v;
+                    let v = &scene.triangles[id.index() as usize].v;
                     let pos = v[0] * b.x + v[1] * b.y + v[2] * b.z;
                     (pos - ray.origin).dot(ray.dir)
                 }
             };
-            Some(scene.triangle_hit(id, b, t, &ray))
+            Some(scene.triangle_hit(id.index(), b, t, &ray))
         };
         (ray, hit)
     }
@@ -347,7 +344,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
 
     /// Hands what pixel index `i` sees to the shared shading (recorded for the focus pixel).
     pub fn shade(&mut self, i: usize, x: u32, y: u32) -> Radiance {
-        if self.id[i] == EMPTY && !self.is_focus(x, y) {
+        if self.id[i].is_none() && !self.is_focus(x, y) {
             if let Some(background) = miss_without_ray(self.job) {
                 return background;
             }
@@ -374,7 +371,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         self.counts.primary += 1;
         let id = self.id[i];
         if self.cost_view() {
-            if id != EMPTY && !self.forward {
+            if !id.is_none() && !self.forward {
                 // The shade early depth would do, counted but not computed.
                 self.counts.fragments_shaded += 1;
                 self.count_work(i);
@@ -388,10 +385,10 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             }
             return c;
         }
-        if self.forward && id != EMPTY {
+        if self.forward && !id.is_none() {
             self.color[i]
         } else {
-            if id != EMPTY {
+            if !id.is_none() {
                 self.counts.fragments_shaded += 1;
             }
             self.shade(i, x, y)
@@ -424,7 +421,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         self.depth.clear();
         self.depth.resize(n, -1.0 / self.job.view.far);
         self.id.clear();
-        self.id.resize(n, EMPTY);
+        self.id.resize(n, PrimitiveId::NONE);
         self.payload.clear();
         self.payload.resize(n, [0.0; 2]);
         if self.forward {

@@ -6,8 +6,8 @@ use super::intersect::{intersect_sphere, intersect_triangle};
 use super::{cast_pass, cast_pixel};
 use crate::math::{Radiance, Ray};
 use crate::render::trace::{PixelTrace, PrimitiveTest, Recorder};
-use crate::render::{PassJob, PreparedScene, RayCounts, Renderer, SceneQuery};
-use crate::scene::{PrimitiveKind, SurfaceHit};
+use crate::render::{Occluder, PassJob, PreparedScene, RayCounts, Renderer, SceneQuery};
+use crate::scene::{PrimitiveId, PrimitiveKind, SurfaceHit};
 
 pub struct BruteForce;
 
@@ -36,7 +36,7 @@ impl SceneQuery for BruteQuery<'_> {
     fn closest<R: Recorder>(&self, ray: &Ray, t_max: f32, inside: bool, counts: &mut RayCounts, rec: &mut R) -> Option<SurfaceHit> {
         let prepared = self.0;
         let mut best_t = t_max;
-        let mut best: Option<(PrimitiveKind, u32, f32, f32)> = None;
+        let mut best: Option<(PrimitiveId, f32, f32)> = None;
         for (i, tri) in prepared.edges.iter().enumerate() {
             counts.tests += 1;
             let outcome = intersect_triangle(ray, tri, best_t);
@@ -45,7 +45,7 @@ impl SceneQuery for BruteQuery<'_> {
             }
             if let Ok((t, b1, b2)) = outcome {
                 best_t = t;
-                best = Some((PrimitiveKind::Triangle, i as u32, b1, b2));
+                best = Some((PrimitiveId::triangle(i as u32), b1, b2));
             }
         }
         for (i, s) in prepared.scene.spheres.iter().enumerate() {
@@ -56,13 +56,13 @@ impl SceneQuery for BruteQuery<'_> {
             }
             if let Ok(t) = outcome {
                 best_t = t;
-                best = Some((PrimitiveKind::Sphere, i as u32, 0.0, 0.0));
+                best = Some((PrimitiveId::sphere(i as u32), 0.0, 0.0));
             }
         }
-        best.map(|(kind, i, b1, b2)| make_hit(prepared, kind, i, best_t, b1, b2, ray))
+        best.map(|(id, b1, b2)| prepared.scene.primitive_hit(id, best_t, b1, b2, ray))
     }
 
-    fn occluder<R: Recorder>(&self, ray: &Ray, t_max: f32, counts: &mut RayCounts, rec: &mut R) -> Option<(PrimitiveKind, u32, f32)> {
+    fn occluder<R: Recorder>(&self, ray: &Ray, t_max: f32, counts: &mut RayCounts, rec: &mut R) -> Option<Occluder> {
         let prepared = self.0;
         for (i, tri) in prepared.edges.iter().enumerate() {
             counts.tests += 1;
@@ -71,7 +71,7 @@ impl SceneQuery for BruteQuery<'_> {
                 rec.primitive_test(PrimitiveTest { kind: PrimitiveKind::Triangle, index: i as u32, outcome });
             }
             if let Ok((t, _, _)) = outcome {
-                return Some((PrimitiveKind::Triangle, i as u32, t));
+                return Some(Occluder { kind: PrimitiveKind::Triangle, index: i as u32, t });
             }
         }
         for (i, s) in prepared.scene.spheres.iter().enumerate() {
@@ -81,17 +81,9 @@ impl SceneQuery for BruteQuery<'_> {
                 rec.primitive_test(PrimitiveTest { kind: PrimitiveKind::Sphere, index: i as u32, outcome: outcome.map(|t| (t, 0.0, 0.0)) });
             }
             if let Ok(t) = outcome {
-                return Some((PrimitiveKind::Sphere, i as u32, t));
+                return Some(Occluder { kind: PrimitiveKind::Sphere, index: i as u32, t });
             }
         }
         None
-    }
-}
-
-/// The `SurfaceHit` for a primitive found at `t` with barycentrics `(b1, b2)`.
-pub fn make_hit(prepared: &PreparedScene, kind: PrimitiveKind, index: u32, t: f32, b1: f32, b2: f32, ray: &Ray) -> SurfaceHit {
-    match kind {
-        PrimitiveKind::Triangle => prepared.scene.triangle_hit(index, glam::Vec3::new(1.0 - b1 - b2, b1, b2), t, ray),
-        PrimitiveKind::Sphere => prepared.scene.sphere_hit(index, t, ray),
     }
 }

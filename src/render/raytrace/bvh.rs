@@ -1,6 +1,7 @@
-//! The fast ray caster: a bounding volume hierarchy over the scene's triangles
-//! and analytic spheres, built with the binned surface area heuristic (SAH)
-//! and traversed near child first.
+//! The bounding volume hierarchy over the scene's triangles and analytic
+//! spheres, built with the binned surface area heuristic (SAH), and the
+//! single-ray queries through it (`BvhQuery`), traversed near child first
+//! with the kernels of `traverse.rs`.
 //!
 //! It must see exactly what the brute-force reference sees, so:
 //! - leaves call the same `intersect_triangle` / `intersect_sphere` with the
@@ -17,18 +18,14 @@
 //! structure-of-arrays form, so one SIMD slab test checks all four, and a
 //! child word that is either a node index or a leaf (first primitive, count).
 
-use super::brute::make_hit;
-use super::cast_pixel;
-use super::intersect::{intersect_sphere, intersect_triangle, TriangleEdges};
-use crate::math::{Radiance, Ray};
-use crate::render::trace::{PixelTrace, PrimitiveTest, Recorder};
-use crate::render::{PassJob, PreparedScene, RayCounts, Renderer, SceneQuery};
-use crate::scene::{PrimitiveKind, Scene, SurfaceHit};
+use super::intersect::TriangleEdges;
+use super::traverse::{test_leaf, BestHit, ChildOrder, PreparedRay};
+use crate::math::Ray;
+use crate::render::trace::Recorder;
+use crate::render::{Occluder, PreparedScene, RayCounts, SceneQuery};
+use crate::scene::{PrimitiveId, PrimitiveKind, Scene, SurfaceHit};
 use glam::{Vec3, Vec3A, Vec4};
 
-/// Primitive ids: triangle index, or sphere index with this bit set. Ordering
-/// the ids as integers orders primitives as brute force scans them.
-pub(super) const SPHERE_BIT: u32 = 1 << 31;
 const BINS: usize = 32;
 /// Leaves never hold more than this; the SAH decides below it.
 const MAX_LEAF: usize = 8;
@@ -45,9 +42,6 @@ const MEDIAN_DEPTH: u32 = 32;
 pub(super) const STACK: usize = 64;
 /// Child words with this bit set are leaves: first primitive << 3 | count - 1.
 pub(super) const LEAF_BIT: u32 = 1 << 31;
-/// The slab test's far distance is stretched by this factor (and the near
-/// one shrunk) to absorb its rounding and that of the primitive tests.
-pub(super) const SLAB_WIDEN: f32 = 1.0e-5;
 
 /// An axis-aligned box.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -61,10 +55,6 @@ impl Aabb {
 
     pub fn contains(&self, o: &Aabb) -> bool {
         self.min.cmple(o.min).all() && self.max.cmpge(o.max).all()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.min.cmpgt(self.max).any()
     }
 }
 
@@ -83,7 +73,7 @@ pub enum NodeContent {
 struct PrimRef {
     min: Vec3A,
     max: Vec3A,
-    id: u32,
+    id: PrimitiveId,
 }
 
 impl PrimRef {
@@ -130,16 +120,17 @@ fn padded(min: Vec3A, max: Vec3A) -> (Vec3A, Vec3A) {
     (min - Vec3A::splat(pad), max + Vec3A::splat(pad))
 }
 
-/// The build's tree before flattening.
-enum Tmp {
+/// A node of the binary tree the build makes, before it is collapsed into
+/// 4-wide nodes.
+enum BuildNode {
     Leaf { b: Bounds, first: u32, count: u32 },
-    Inner { b: Bounds, kids: Box<[Tmp; 2]> },
+    Inner { b: Bounds, kids: Box<[BuildNode; 2]> },
 }
 
-impl Tmp {
+impl BuildNode {
     fn bounds(&self) -> Bounds {
         match self {
-            Tmp::Leaf { b, .. } | Tmp::Inner { b, .. } => *b,
+            BuildNode::Leaf { b, .. } | BuildNode::Inner { b, .. } => *b,
         }
     }
 }
@@ -150,7 +141,7 @@ struct Bin {
     n: u32,
 }
 
-fn build_rec(refs: &mut [PrimRef], first: u32, depth: u32, max_depth: &mut u32) -> Tmp {
+fn build_rec(refs: &mut [PrimRef], first: u32, depth: u32, max_depth: &mut u32) -> BuildNode {
     *max_depth = (*max_depth).max(depth);
     let mut b = Bounds::EMPTY;
     let mut cb = Bounds::EMPTY;
@@ -160,7 +151,7 @@ fn build_rec(refs: &mut [PrimRef], first: u32, depth: u32, max_depth: &mut u32) 
         cb.grow(c, c);
     }
     let n = refs.len();
-    let leaf = Tmp::Leaf { b, first, count: n as u32 };
+    let leaf = BuildNode::Leaf { b, first, count: n as u32 };
     if n <= 1 {
         return leaf;
     }
@@ -249,7 +240,7 @@ fn build_rec(refs: &mut [PrimRef], first: u32, depth: u32, max_depth: &mut u32) 
     } else {
         (build_rec(left, first, depth + 1, max_depth), build_rec(right, first + mid as u32, depth + 1, max_depth))
     };
-    Tmp::Inner { b: Bounds::union(l.bounds(), r.bounds()), kids: Box::new([l, r]) }
+    BuildNode::Inner { b: Bounds::union(l.bounds(), r.bounds()), kids: Box::new([l, r]) }
 }
 
 /// A 4-wide node: the children's boxes as planes (min x, max x, min y, max
@@ -271,8 +262,8 @@ pub struct Bvh {
     pub(super) root: u32,
     pub(super) root_bounds: Aabb,
     /// Per primitive slot: the triangle's edges (unused for spheres) and the
-    /// primitive id (triangle index, or sphere index | SPHERE_BIT).
-    pub(super) prims: Vec<(TriangleEdges, u32)>,
+    /// primitive's id.
+    pub(super) prims: Vec<(TriangleEdges, PrimitiveId)>,
     /// For the debugger: each node's own bounds, and each leaf's (by first slot).
     node_bounds: Vec<Aabb>,
     leaf_bounds: Vec<(u32, Aabb)>,
@@ -307,25 +298,25 @@ struct Collapse {
 impl Collapse {
     /// The word for binary subtree `t` at 4-wide level `level`: a leaf, or a
     /// node whose children are `t`'s grandchildren (the larger ones opened first).
-    fn word(&mut self, t: &Tmp, level: u32) -> u32 {
+    fn word(&mut self, t: &BuildNode, level: u32) -> u32 {
         self.depth = self.depth.max(level);
         let (b, kids) = match t {
-            Tmp::Leaf { b, first, count } => {
+            BuildNode::Leaf { b, first, count } => {
                 self.leaf_bounds.push((*first, aabb(*b)));
                 return leaf_word(*first, *count);
             }
-            Tmp::Inner { b, kids } => (*b, kids),
+            BuildNode::Inner { b, kids } => (*b, kids),
         };
-        let mut children: Vec<&Tmp> = vec![&kids[0], &kids[1]];
+        let mut children: Vec<&BuildNode> = vec![&kids[0], &kids[1]];
         while children.len() < 4 {
             let open = children
                 .iter()
                 .enumerate()
-                .filter(|(_, c)| matches!(c, Tmp::Inner { .. }))
+                .filter(|(_, c)| matches!(c, BuildNode::Inner { .. }))
                 .max_by(|(_, a), (_, c)| a.bounds().half_area().total_cmp(&c.bounds().half_area()))
                 .map(|(i, _)| i);
             let Some(i) = open else { break };
-            let Tmp::Inner { kids, .. } = children[i] else { unreachable!() };
+            let BuildNode::Inner { kids, .. } = children[i] else { unreachable!() };
             children.splice(i..=i, [&kids[0], &kids[1]]);
         }
         let index = self.nodes.len();
@@ -354,12 +345,12 @@ impl Bvh {
         for (i, e) in edges.iter().enumerate() {
             let (v0, v1, v2) = (Vec3A::from(e.v0), Vec3A::from(e.v0 + e.e1), Vec3A::from(e.v0 + e.e2));
             let (min, max) = padded(v0.min(v1).min(v2), v0.max(v1).max(v2));
-            refs.push(PrimRef { min, max, id: i as u32 });
+            refs.push(PrimRef { min, max, id: PrimitiveId::triangle(i as u32) });
         }
         for (i, s) in scene.spheres.iter().enumerate() {
             let (c, r) = (Vec3A::from(s.center), Vec3A::splat(s.radius.abs()));
             let (min, max) = padded(c - r, c + r);
-            refs.push(PrimRef { min, max, id: i as u32 | SPHERE_BIT });
+            refs.push(PrimRef { min, max, id: PrimitiveId::sphere(i as u32) });
         }
         let dummy = TriangleEdges { v0: Vec3::ZERO, e1: Vec3::ZERO, e2: Vec3::ZERO, det_epsilon: 0.0, two_sided: false };
         if refs.is_empty() {
@@ -386,7 +377,7 @@ impl Bvh {
         let root_bounds = aabb(tree.bounds());
         drop(tree);
         c.leaf_bounds.sort_unstable_by_key(|(first, _)| *first);
-        let prims = refs.iter().map(|r| (if r.id & SPHERE_BIT == 0 { edges[r.id as usize] } else { dummy }, r.id)).collect();
+        let prims = refs.iter().map(|r| (if r.id.is_sphere() { dummy } else { edges[r.id.index() as usize] }, r.id)).collect();
         Bvh {
             nodes: c.nodes,
             root,
@@ -450,59 +441,8 @@ impl Bvh {
 
     /// The primitive in slot `slot` of the leaf order.
     pub fn primitive(&self, slot: u32) -> (PrimitiveKind, u32) {
-        decode(self.prims[slot as usize].1)
-    }
-}
-
-#[inline(always)]
-pub(super) fn decode(id: u32) -> (PrimitiveKind, u32) {
-    if id & SPHERE_BIT == 0 { (PrimitiveKind::Triangle, id) } else { (PrimitiveKind::Sphere, id & !SPHERE_BIT) }
-}
-
-/// The ray, prepared for 4-wide slab tests.
-pub(super) struct RayPre {
-    pub(super) origin: [Vec4; 3],
-    pub(super) inv: [Vec4; 3],
-}
-
-impl RayPre {
-    #[inline(always)]
-    pub(super) fn new(ray: &Ray) -> RayPre {
-        // A zero (or denormal) component gets a huge finite inverse, so the
-        // slab test never computes 0 * inf.
-        let fix = |d: f32| {
-            let inv = 1.0 / d;
-            if inv.is_finite() { inv } else { f32::MAX.copysign(d) }
-        };
-        let inv = [fix(ray.dir.x), fix(ray.dir.y), fix(ray.dir.z)];
-        RayPre { origin: [Vec4::splat(ray.origin.x), Vec4::splat(ray.origin.y), Vec4::splat(ray.origin.z)], inv: inv.map(Vec4::splat) }
-    }
-
-    /// Which of the node's children the ray meets within [0, t_far] (a bit
-    /// mask), and where it enters each.
-    #[inline(always)]
-    fn slab4(&self, n: &Node4, t_far: f32) -> (u32, Vec4) {
-        let p = &n.planes;
-        let (x0, x1) = ((p[0] - self.origin[0]) * self.inv[0], (p[1] - self.origin[0]) * self.inv[0]);
-        let (y0, y1) = ((p[2] - self.origin[1]) * self.inv[1], (p[3] - self.origin[1]) * self.inv[1]);
-        let (z0, z1) = ((p[4] - self.origin[2]) * self.inv[2], (p[5] - self.origin[2]) * self.inv[2]);
-        let tn = x0.min(x1).max(y0.min(y1)).max(z0.min(z1)).max(Vec4::ZERO) * (1.0 - SLAB_WIDEN);
-        let tf = (x0.max(x1).min(y0.max(y1)).min(z0.max(z1)) * (1.0 + SLAB_WIDEN)).min(Vec4::splat(t_far));
-        (tn.cmple(tf).bitmask() & n.valid, tn)
-    }
-
-    /// The same test for one box (the root's).
-    #[inline(always)]
-    pub(super) fn slab1(&self, b: &Aabb, t_far: f32) -> bool {
-        let mut t = (0.0f32, t_far);
-        for axis in 0..3 {
-            let o = self.origin[axis].x;
-            let inv = self.inv[axis].x;
-            let (a, b) = ((b.min[axis] - o) * inv, (b.max[axis] - o) * inv);
-            t.0 = t.0.max(a.min(b) * (1.0 - SLAB_WIDEN));
-            t.1 = t.1.min(a.max(b) * (1.0 + SLAB_WIDEN));
-        }
-        t.0 <= t.1
+        let id = self.prims[slot as usize].1;
+        (id.kind(), id.index())
     }
 }
 
@@ -563,7 +503,7 @@ impl<'a> BvhQuery<'a> {
         inside: bool,
         counts: &mut RayCounts,
         rec: &mut R,
-    ) -> Option<(u32, f32, f32, f32)> {
+    ) -> Option<BestHit> {
         let bvh = &self.prepared.bvh;
         if bvh.prims.is_empty() {
             return None;
@@ -577,7 +517,7 @@ impl<'a> BvhQuery<'a> {
     }
 
     /// The traversal shared by both queries. `ANY` stops at the first hit.
-    /// Returns (id, t, b1, b2) of the winning primitive.
+    /// Returns the winning primitive's hit.
     #[inline(always)]
     fn traverse_with<const ANY: bool, R: Recorder, S: Stack>(
         &self,
@@ -587,19 +527,14 @@ impl<'a> BvhQuery<'a> {
         counts: &mut RayCounts,
         rec: &mut R,
         stack: &mut S,
-    ) -> Option<(u32, f32, f32, f32)> {
+    ) -> Option<BestHit> {
         let bvh = &self.prepared.bvh;
         let spheres = &self.prepared.scene.spheres;
-        let r = RayPre::new(ray);
-        if !r.slab1(&bvh.root_bounds, t_max) {
+        let r = PreparedRay::new(ray);
+        if !r.slab1(bvh.root_bounds.min, bvh.root_bounds.max, t_max) {
             return None;
         }
-        let mut best_t = t_max;
-        let mut best_id = u32::MAX;
-        let (mut best_b1, mut best_b2) = (0.0f32, 0.0f32);
-        // Primitive tests accept t < limit: t_max, then just above best_t so
-        // an equal-t hit on an earlier primitive can still win the tie.
-        let mut limit = t_max;
+        let mut best = BestHit::nothing_before(t_max);
         let mut word = bvh.root;
         let (mut visits, mut tests) = (0u64, 0u64);
         'walk: loop {
@@ -609,7 +544,7 @@ impl<'a> BvhQuery<'a> {
             }
             if word & LEAF_BIT == 0 {
                 let node = &bvh.nodes[word as usize];
-                let (mask, tn) = r.slab4(node, best_t);
+                let (mask, tn) = r.slab4(&node.planes, node.valid, best.t);
                 if mask != 0 {
                     if mask & (mask - 1) == 0 {
                         word = node.child[mask.trailing_zeros() as usize];
@@ -617,77 +552,44 @@ impl<'a> BvhQuery<'a> {
                     }
                     let tn = tn.to_array();
                     if mask.count_ones() == 2 {
+                        // The common case without the sort. On equal entry
+                        // distances it takes the lower slot first, where
+                        // `ChildOrder` would take the later one: either order
+                        // finds the same hit (the leaf tie rule), and this one
+                        // is kept because pixel replays record the visit order.
                         let (i, j) = (mask.trailing_zeros() as usize, 31 - mask.leading_zeros() as usize);
                         let (near, far) = if tn[i] <= tn[j] { (i, j) } else { (j, i) };
                         stack.push(node.child[far], tn[far]);
                         word = node.child[near];
                         continue 'walk;
                     }
-                    // More: continue with the nearest, push the rest farthest first.
-                    let mut items = [(0u32, 0.0f32); 4];
-                    let mut k = 0;
+                    let mut order = ChildOrder::new();
                     let mut m = mask;
                     while m != 0 {
                         let i = m.trailing_zeros() as usize;
                         m &= m - 1;
-                        let item = (node.child[i], tn[i]);
-                        // Insertion sort, descending t.
-                        let mut j = k;
-                        while j > 0 && items[j - 1].1 < item.1 {
-                            items[j] = items[j - 1];
-                            j -= 1;
+                        order.insert(node.child[i], tn[i]);
+                    }
+                    if let Some((nearest, farther)) = order.nearest_and_farther() {
+                        for &(w, t) in farther {
+                            stack.push(w, t);
                         }
-                        items[j] = item;
-                        k += 1;
+                        word = nearest;
+                        continue 'walk;
                     }
-                    for &(w, t) in &items[..k - 1] {
-                        stack.push(w, t);
-                    }
-                    word = items[k - 1].0;
-                    continue 'walk;
                 }
             } else {
                 let (start, end) = leaf_range(word);
-                for (tri, id) in &bvh.prims[start..end] {
-                    let id = *id;
-                    tests += 1;
-                    let found = if id & SPHERE_BIT == 0 {
-                        let outcome = intersect_triangle(ray, tri, limit);
-                        if R::ENABLED {
-                            rec.primitive_test(PrimitiveTest { kind: PrimitiveKind::Triangle, index: id, outcome });
-                        }
-                        outcome.ok()
-                    } else {
-                        let outcome = intersect_sphere(ray, &spheres[(id & !SPHERE_BIT) as usize], limit, inside && !ANY);
-                        if R::ENABLED {
-                            rec.primitive_test(PrimitiveTest {
-                                kind: PrimitiveKind::Sphere,
-                                index: id & !SPHERE_BIT,
-                                outcome: outcome.map(|t| (t, 0.0, 0.0)),
-                            });
-                        }
-                        outcome.ok().map(|t| (t, 0.0, 0.0))
-                    };
-                    if let Some((t, b1, b2)) = found {
-                        if ANY {
-                            counts.nodes += visits;
-                            counts.tests += tests;
-                            return Some((id, t, b1, b2));
-                        }
-                        // t <= best_t here; on a tie the lower id (scene order) wins.
-                        if t < best_t || id < best_id {
-                            best_t = t;
-                            best_id = id;
-                            best_b1 = b1;
-                            best_b2 = b2;
-                            limit = f32::from_bits(t.to_bits() + 1);
-                        }
-                    }
+                // Shadow rays (`ANY`) never start inside a sphere they may hit.
+                if test_leaf::<ANY, R>(&bvh.prims[start..end], spheres, ray, inside && !ANY, &mut best, &mut tests, rec) {
+                    counts.nodes += visits;
+                    counts.tests += tests;
+                    return Some(best);
                 }
             }
             // Pop the next node that may still hold something nearer.
             while let Some((next, t_enter)) = stack.pop() {
-                if t_enter <= best_t {
+                if t_enter <= best.t {
                     word = next;
                     continue 'walk;
                 }
@@ -696,53 +598,30 @@ impl<'a> BvhQuery<'a> {
         }
         counts.nodes += visits;
         counts.tests += tests;
-        (best_id != u32::MAX).then_some((best_id, best_t, best_b1, best_b2))
+        (!best.id.is_none()).then_some(best)
     }
 }
 
 impl SceneQuery for BvhQuery<'_> {
     fn closest<R: Recorder>(&self, ray: &Ray, t_max: f32, inside: bool, counts: &mut RayCounts, rec: &mut R) -> Option<SurfaceHit> {
-        let (id, t, b1, b2) = self.traverse::<false, R>(ray, t_max, inside, counts, rec)?;
-        let (kind, index) = decode(id);
-        Some(make_hit(self.prepared, kind, index, t, b1, b2, ray))
+        let best = self.traverse::<false, R>(ray, t_max, inside, counts, rec)?;
+        Some(self.prepared.scene.primitive_hit(best.id, best.t, best.bary.0, best.bary.1, ray))
     }
 
-    fn occluder<R: Recorder>(&self, ray: &Ray, t_max: f32, counts: &mut RayCounts, rec: &mut R) -> Option<(PrimitiveKind, u32, f32)> {
-        let (id, t, _, _) = self.traverse::<true, R>(ray, t_max, false, counts, rec)?;
-        let (kind, index) = decode(id);
-        Some((kind, index, t))
-    }
-}
-
-pub struct BvhRayTracer;
-
-impl Renderer for BvhRayTracer {
-    fn name(&self) -> &'static str {
-        "raytrace:bvh"
-    }
-
-    fn description(&self) -> &'static str {
-        "ray casting through a SAH bounding volume hierarchy: same pixels as the reference, far fewer tests"
-    }
-
-    fn render_pass(&self, job: &PassJob, out: &mut [Radiance]) -> RayCounts {
-        super::packet::cast_pass_packets(job, &BvhQuery::new(job.prepared), out)
-    }
-
-    fn trace_pixel(&self, job: &PassJob, x: u32, y: u32, rec: &mut PixelTrace) -> Option<Radiance> {
-        Some(cast_pixel(job, &BvhQuery::new(job.prepared), x, y, &mut RayCounts::default(), rec))
+    fn occluder<R: Recorder>(&self, ray: &Ray, t_max: f32, counts: &mut RayCounts, rec: &mut R) -> Option<Occluder> {
+        let best = self.traverse::<true, R>(ray, t_max, false, counts, rec)?;
+        Some(Occluder::new(best.id, best.t))
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::raytrace::brute::{BruteForce, BruteQuery};
+    use crate::render::raytrace::brute::BruteQuery;
+    use crate::render::raytrace::intersect::intersect_triangle;
     use crate::render::trace::NoRecord;
-    use crate::render::{debug::View, render_frame, RenderSettings, ShadowMode};
     use crate::scene::{builtin, Sphere, Triangle};
     use proptest::prelude::*;
-    use std::sync::atomic::AtomicBool;
 
     /// SplitMix64: a tiny seeded generator for reproducible rays.
     struct Rng(u64);
@@ -854,7 +733,7 @@ mod tests {
             let a = bvh.occluder(ray, *t_max, &mut c1, &mut NoRecord);
             let b = brute.occluder(ray, *t_max, &mut c2, &mut NoRecord);
             if a.is_none() {
-                if let Some((PrimitiveKind::Triangle, k, _)) = b {
+                if let Some(Occluder { kind: PrimitiveKind::Triangle, index: k, .. }) = b {
                     let (t, b1, b2) = intersect_triangle(ray, &prepared.edges[k as usize], *t_max).unwrap();
                     let v = prepared.scene.triangles[k as usize].v;
                     if !accurate(ray, t, v[0] * (1.0 - b1 - b2) + v[1] * b1 + v[2] * b2) {
@@ -880,25 +759,6 @@ mod tests {
             let n = if prepared.edges.len() > 20_000 { 600 } else { 3000 };
             let rays = rays(&prepared.scene, &mut rng, n);
             assert_same_as_brute(&prepared, &rays, name);
-        }
-    }
-
-    #[test]
-    fn frames_match_brute_force_pixel_for_pixel() {
-        for name in builtin::names() {
-            let prepared = load(name);
-            for view in [View::Shaded, View::Depth] {
-                let settings = RenderSettings { width: 96, height: 54, shadows: ShadowMode::Ray, view, ..RenderSettings::for_scene(&prepared.scene) };
-                let cancel = AtomicBool::new(false);
-                let a = render_frame(&BvhRayTracer, &prepared, &settings, &cancel, None).unwrap();
-                let b = render_frame(&BruteForce, &prepared, &settings, &cancel, None).unwrap();
-                let bits = |p: &[Radiance]| p.iter().map(|c| c.to_array().map(f32::to_bits)).collect::<Vec<_>>();
-                assert!(bits(&a.pixels) == bits(&b.pixels), "{name} {view:?}: images differ");
-                assert_eq!((a.counts.primary, a.counts.shadow), (b.counts.primary, b.counts.shadow), "{name}");
-                if prepared.edges.len() > 1000 {
-                    assert!(a.counts.tests * 20 < b.counts.tests, "{name}: the BVH tests too many primitives");
-                }
-            }
         }
     }
 

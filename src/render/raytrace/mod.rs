@@ -1,11 +1,15 @@
 //! Ray casting: for each pixel, find the closest surface along the eye ray.
 //! `brute` is the book's reference (every primitive, in scene order); `bvh`
-//! is the fast method checked against it.
+//! is the fast method checked against it: the hierarchy and its single-ray
+//! queries (`bvh`), packets of rays (`packet`), the traversal kernels both
+//! share (`traverse`) and the renderer that uses them (`bvh_renderer`).
 
 pub mod brute;
 pub mod bvh;
+pub mod bvh_renderer;
 pub mod intersect;
 pub mod packet;
+pub mod traverse;
 
 use super::trace::{NoRecord, Recorder};
 use super::{resolve_sample, PassJob, RayCounts, SceneQuery};

@@ -5,27 +5,26 @@
 //! independent work the CPU overlaps.
 //!
 //! Every ray ends with exactly the hit `BvhQuery::closest` finds for it alone:
-//! - a ray enters a node only when its own slab test (the same arithmetic as
-//!   the single-ray test, lane by lane) accepts the box;
-//! - leaves test only those rays, with the same primitive tests and the same
-//!   tie rule (on equal t the lower primitive id wins), so the order in which
-//!   the packet visits nodes cannot change any ray's winner; the padded boxes
-//!   guarantee no true hit is culled by a box test in either traversal.
+//! - a ray enters a node only when its own slab test (`traverse::slab_test`,
+//!   the single-ray test's arithmetic, lane by lane) accepts the box;
+//! - leaves test only those rays, with the same leaf loop
+//!   (`traverse::test_leaf`) and so the same tie rule (on equal t the lower
+//!   primitive id wins): the order in which the packet visits nodes cannot
+//!   change any ray's winner; the padded boxes guarantee no true hit is
+//!   culled by a box test in either traversal.
 //!
-//! `trace_pixel` replays a pixel through the single-ray path; the hits being
-//! identical and the shading code the same, the replay equals the frame.
+//! After the eye rays, the tile's shadow rays towards the first light go as
+//! one packet too (`cast_pass_packets`), and `shade()` is answered from it.
 
-use super::brute::make_hit;
-use super::bvh::{decode, leaf_range, BvhQuery, Node4, RayPre, LEAF_BIT, SLAB_WIDEN, SPHERE_BIT, STACK};
+use super::bvh::{leaf_range, BvhQuery, Node4, LEAF_BIT, STACK};
 use super::cast_pass;
-use super::intersect::{intersect_sphere, intersect_triangle};
+use super::traverse::{slab_test, test_leaf, BestHit, ChildOrder, PreparedRay, SLAB_WIDEN};
 use crate::math::{Radiance, Ray};
 use crate::render::debug::View;
-use crate::render::shade::shadow_origin;
+use crate::render::shade::cast_shadow_ray;
 use crate::render::trace::{NoRecord, Recorder};
-use crate::render::{resolve_sample, Interpolation, PassJob, RayCounts, RenderSettings, SceneQuery, ShadowMode};
-use crate::scene::{Light, PrimitiveKind, Scene, SurfaceHit};
-use std::f32::consts::PI;
+use crate::render::{resolve_sample, with_shading_hit, Interpolation, Occluder, PassJob, RayCounts, SceneQuery, ShadowMode};
+use crate::scene::{PrimitiveId, SurfaceHit};
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 use std::mem::MaybeUninit;
@@ -87,7 +86,7 @@ pub struct Packet {
     /// Primitive tests accept t < limit: just above best_t once something is
     /// hit, so an equal-t hit on an earlier primitive can still win the tie.
     limit: [f32; P],
-    best_id: [u32; P],
+    best_id: [PrimitiveId; P],
     bary: [(f32, f32); P],
 }
 
@@ -102,37 +101,32 @@ impl Packet {
             inv: [zero; 3],
             best_t: zero,
             limit: [0.0; P],
-            best_id: [u32::MAX; P],
+            best_id: [PrimitiveId::NONE; P],
             bary: [(0.0, 0.0); P],
         })
     }
 
     /// How many of the rays in `valid` hit something.
     pub fn hit_count(&self, valid: u64) -> u32 {
-        (0..P).filter(|&i| valid & 1 << i != 0 && self.best_id[i] != u32::MAX).count() as u32
+        (0..P).filter(|&i| valid & 1 << i != 0 && !self.best_id[i].is_none()).count() as u32
     }
 
     /// After `occluded_packet`: what blocks lane `i`, as `occluder` reports it.
     #[inline]
-    pub fn occluder(&self, i: usize) -> Option<(PrimitiveKind, u32, f32)> {
+    pub fn occluder(&self, i: usize) -> Option<Occluder> {
         let id = self.best_id[i];
-        if id == u32::MAX {
-            return None;
-        }
-        let (kind, index) = decode(id);
-        Some((kind, index, self.best_t.0[i]))
+        (!id.is_none()).then(|| Occluder::new(id, self.best_t.0[i]))
     }
 
     /// The hit of lane `i` after `closest_packet`, as `closest` returns it.
     #[inline]
     pub fn hit(&self, query: &BvhQuery, i: usize) -> Option<SurfaceHit> {
         let id = self.best_id[i];
-        if id == u32::MAX {
+        if id.is_none() {
             return None;
         }
-        let (kind, index) = decode(id);
         let (b1, b2) = self.bary[i];
-        Some(make_hit(query.prepared, kind, index, self.best_t.0[i], b1, b2, &self.rays[i]))
+        Some(query.prepared.scene.primitive_hit(id, self.best_t.0[i], b1, b2, &self.rays[i]))
     }
 }
 
@@ -174,7 +168,7 @@ impl PacketBounds {
 
     /// The children of `node` (bit mask) that some ray of the packet, with
     /// far end at most `far_max`, may meet: a superset of every ray's own
-    /// `slab4` mask. NaNs never cull.
+    /// `PreparedRay::slab4` mask. NaNs never cull.
     #[inline(always)]
     fn children_possible(&self, node: &Node4, far_max: f32) -> u32 {
         let mut entry = Vec4::ZERO;
@@ -221,11 +215,11 @@ impl BvhQuery<'_> {
         let spheres = &self.prepared.scene.spheres;
         let mut mask = 0u64;
         for i in 0..P {
-            pk.best_id[i] = u32::MAX;
+            pk.best_id[i] = PrimitiveId::NONE;
             if valid & 1 << i == 0 {
                 continue;
             }
-            let r = RayPre::new(&pk.rays[i]);
+            let r = PreparedRay::new(&pk.rays[i]);
             for a in 0..3 {
                 pk.origin[a].0[i] = r.origin[a].x;
                 pk.inv[a].0[i] = r.inv[a].x;
@@ -233,7 +227,7 @@ impl BvhQuery<'_> {
             let t_max = pk.t_max[i];
             pk.best_t.0[i] = t_max;
             pk.limit[i] = t_max;
-            if !bvh.prims.is_empty() && r.slab1(&bvh.root_bounds, t_max) {
+            if !bvh.prims.is_empty() && r.slab1(bvh.root_bounds.min, bvh.root_bounds.max, t_max) {
                 mask |= 1 << i;
             }
         }
@@ -272,48 +266,33 @@ impl BvhQuery<'_> {
                 while valid_children != 0 {
                     let c = valid_children.trailing_zeros() as usize;
                     valid_children &= valid_children - 1;
-                    let plane = |k: usize| Vec4::splat(node.planes[k].as_ref()[c]);
-                    let (px0, px1, py0, py1, pz0, pz1) = (plane(0), plane(1), plane(2), plane(3), plane(4), plane(5));
+                    // Child c's box in every lane, against four rays at a time.
+                    let planes: [Vec4; 6] = std::array::from_fn(|k| Vec4::splat(node.planes[k].as_ref()[c]));
                     let mut near = Vec4::INFINITY;
                     let mut bits_all = 0u64;
                     for &(g, t_far) in &groups[..n_groups] {
-                        let (ox, oy, oz) = (pk.origin[0].group(g), pk.origin[1].group(g), pk.origin[2].group(g));
-                        let (ix, iy, iz) = (pk.inv[0].group(g), pk.inv[1].group(g), pk.inv[2].group(g));
-                        // Lane by lane the single-ray slab test (RayPre::slab4).
-                        let (x0, x1) = ((px0 - ox) * ix, (px1 - ox) * ix);
-                        let (y0, y1) = ((py0 - oy) * iy, (py1 - oy) * iy);
-                        let (z0, z1) = ((pz0 - oz) * iz, (pz1 - oz) * iz);
-                        let tn = x0.min(x1).max(y0.min(y1)).max(z0.min(z1)).max(Vec4::ZERO) * (1.0 - SLAB_WIDEN);
-                        let tf = (x0.max(x1).min(y0.max(y1)).min(z0.max(z1)) * (1.0 + SLAB_WIDEN)).min(t_far);
-                        let hit = tn.cmple(tf);
+                        let origin = [pk.origin[0].group(g), pk.origin[1].group(g), pk.origin[2].group(g)];
+                        let inv = [pk.inv[0].group(g), pk.inv[1].group(g), pk.inv[2].group(g)];
+                        let (hit, tn) = slab_test(&planes, &origin, &inv, t_far);
                         bits_all |= (hit.bitmask() as u64) << (4 * g);
                         near = near.min(Vec4::select(hit, tn, Vec4::INFINITY));
                     }
                     child_mask[c] = bits_all;
                     child_near[c] = near.min_element();
                 }
-                // Nearest child next; the others pushed farthest first.
-                let mut order = [(0u32, 0u64, 0.0f32); 4];
-                let mut k = 0;
+                // Nearest child next (its nearest ray's entry); the others pushed farthest first.
+                let mut order = ChildOrder::new();
                 for c in 0..4 {
-                    if child_mask[c] == 0 {
-                        continue;
+                    if child_mask[c] != 0 {
+                        order.insert((node.child[c], child_mask[c]), child_near[c]);
                     }
-                    let item = (node.child[c], child_mask[c], child_near[c]);
-                    let mut j = k;
-                    while j > 0 && order[j - 1].2 < item.2 {
-                        order[j] = order[j - 1];
-                        j -= 1;
-                    }
-                    order[j] = item;
-                    k += 1;
                 }
-                if k > 0 {
-                    for &(w, m, _) in &order[..k - 1] {
-                        stack[len] = MaybeUninit::new((w, m));
+                if let Some((nearest, farther)) = order.nearest_and_farther() {
+                    for &(entry, _) in farther {
+                        stack[len] = MaybeUninit::new(entry);
                         len += 1;
                     }
-                    (word, mask) = (order[k - 1].0, order[k - 1].1);
+                    (word, mask) = nearest;
                     continue;
                 }
             } else {
@@ -323,36 +302,14 @@ impl BvhQuery<'_> {
                 while m != 0 {
                     let i = m.trailing_zeros() as usize;
                     m &= m - 1;
-                    let ray = &pk.rays[i];
-                    let (mut best_t, mut limit, mut best_id) = (pk.best_t.0[i], pk.limit[i], pk.best_id[i]);
-                    let mut bary = pk.bary[i];
-                    for (tri, id) in prims {
-                        let id = *id;
-                        tests += 1;
-                        let found = if id & SPHERE_BIT == 0 {
-                            intersect_triangle(ray, tri, limit).ok()
-                        } else {
-                            intersect_sphere(ray, &spheres[(id & !SPHERE_BIT) as usize], limit, false).ok().map(|t| (t, 0.0, 0.0))
-                        };
-                        if let Some((t, b1, b2)) = found {
-                            if ANY {
-                                (best_t, best_id) = (t, id);
-                                done |= 1 << i;
-                                break;
-                            }
-                            // t <= best_t here; on a tie the lower id (scene order) wins.
-                            if t < best_t || id < best_id {
-                                best_t = t;
-                                best_id = id;
-                                bary = (b1, b2);
-                                limit = f32::from_bits(t.to_bits() + 1);
-                            }
-                        }
+                    let mut best = BestHit { t: pk.best_t.0[i], limit: pk.limit[i], id: pk.best_id[i], bary: pk.bary[i] };
+                    if test_leaf::<ANY, _>(prims, spheres, &pk.rays[i], false, &mut best, &mut tests, &mut NoRecord) {
+                        done |= 1 << i;
                     }
-                    pk.best_t.0[i] = best_t;
-                    pk.limit[i] = limit;
-                    pk.best_id[i] = best_id;
-                    pk.bary[i] = bary;
+                    pk.best_t.0[i] = best.t;
+                    pk.limit[i] = best.limit;
+                    pk.best_id[i] = best.id;
+                    pk.bary[i] = best.bary;
                 }
             }
             if len == 0 {
@@ -367,37 +324,26 @@ impl BvhQuery<'_> {
     }
 }
 
-/// The shadow ray `shade()` casts from `hit` towards `light` when it sees
-/// the surface with normal `n` (its arithmetic, repeated), if it casts one.
-/// Should the two ever drift apart, the ray simply is not found in the
-/// cache below and is traced alone: slower, never different.
-#[inline]
-fn expected_shadow_ray(scene: &Scene, settings: &RenderSettings, hit: &SurfaceHit, n: Vec3, light: &Light) -> Option<(Ray, f32)> {
-    let (w_i, distance, incident) = match *light {
-        Light::Point { position, power } => {
-            let offset = position - hit.position;
-            let d = offset.length();
-            if d <= 0.0 {
-                return None;
-            }
-            (offset / d, d, power / (4.0 * PI * d * d))
-        }
-        Light::Directional { direction, irradiance } => (-direction, f32::INFINITY, irradiance),
-    };
-    if w_i.dot(n) <= 0.0 || incident == Vec3::ZERO {
-        return None;
-    }
-    let eps = settings.shadow_bump;
-    Some((Ray::new(shadow_origin(scene, hit, w_i) + w_i * eps, w_i), distance - eps))
-}
-
 /// The query `shade()` gets for one pixel of a tile: the shadow ray towards
-/// the first light was traced with the tile's packet, and is answered from
-/// it when `shade()` asks for exactly that ray (same bits); everything else
-/// goes to the BVH. Recorded queries (pixel replay) always trace.
+/// the first light was traced with the tile's packet and is answered from
+/// it; everything else goes to the BVH.
+///
+/// The answer is keyed by the question itself: it is given only when
+/// `shade()` asks for exactly the packet's ray (same bits of origin,
+/// direction and t_max). Both rays are made by `shade::Incidence` (the
+/// packet's through `shade::cast_shadow_ray`), so they agree by
+/// construction, and the comparison costs seven integer compares per pixel.
+/// Handing `shade()` "light 0's answer" instead would need to know which of
+/// its questions that is: `shade()` also asks for light 0's shadow ray from
+/// every mirror or refraction hit further down the path, and only the ray
+/// tells them apart without this query knowing depths, light indices or
+/// interpolation modes. Should the two sides ever drift apart, the ray is
+/// traced alone: slower, never different. Recorded queries always trace, so
+/// a record lists the traversal (pixel replays do not use this query at all,
+/// see `BvhRayTracer::trace_pixel`).
 struct PixelQuery<'q, 'a> {
     bvh: &'q BvhQuery<'a>,
-    shadow: Option<(Ray, f32, Option<(PrimitiveKind, u32, f32)>)>,
+    shadow: Option<(Ray, f32, Option<Occluder>)>,
 }
 
 impl SceneQuery for PixelQuery<'_, '_> {
@@ -407,7 +353,7 @@ impl SceneQuery for PixelQuery<'_, '_> {
     }
 
     #[inline]
-    fn occluder<R: Recorder>(&self, ray: &Ray, t_max: f32, counts: &mut RayCounts, rec: &mut R) -> Option<(PrimitiveKind, u32, f32)> {
+    fn occluder<R: Recorder>(&self, ray: &Ray, t_max: f32, counts: &mut RayCounts, rec: &mut R) -> Option<Occluder> {
         if let Some((r, t, answer)) = &self.shadow {
             let bits = |r: &Ray| (r.origin.to_array().map(f32::to_bits), r.dir.to_array().map(f32::to_bits));
             if !R::ENABLED && t.to_bits() == t_max.to_bits() && bits(r) == bits(ray) {
@@ -465,8 +411,8 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
                     m &= m - 1;
                     hits[i] = pk.hit(query, i);
                     if let (Some(light), Some(h)) = (shadow_light, &hits[i]) {
-                        let n = if settings.interpolation == Interpolation::Flat { h.geometric_normal } else { h.shading_normal };
-                        if let Some((ray, t_max)) = expected_shadow_ray(scene, settings, h, n, light) {
+                        let shadow_ray = with_shading_hit(settings.interpolation, h, |h| cast_shadow_ray(scene, h, light, settings.shadow_bump));
+                        if let Some((ray, t_max)) = shadow_ray.flatten() {
                             shadow_pk.rays[i] = ray;
                             shadow_pk.t_max[i] = t_max;
                             shadow_valid |= 1 << i;
@@ -540,24 +486,36 @@ mod tests {
         }
     }
 
-    /// Shadow rays answered from the tile's packet leave every pixel as the
-    /// single-ray caster shades it, whatever the interpolation.
+    /// The shadow ray the pre-pass traces is, bit for bit, the one `shade()`
+    /// then asks for, so the packet's answer is used (were they to differ,
+    /// the frame would still be right, only slower: no image test sees it).
     #[test]
-    fn shaded_frames_equal_the_single_ray_frames() {
-        use crate::render::raytrace::brute::BruteForce;
-        use crate::render::{render_frame, RenderSettings};
-        use std::sync::atomic::AtomicBool;
+    fn the_pre_pass_traces_the_shadow_ray_shade_casts() {
+        use crate::render::shade::shade;
+        use crate::render::trace::PixelTrace;
+        use crate::render::RenderSettings;
+        let bits = |(r, t): (Ray, f32)| (r.origin.to_array().map(f32::to_bits), r.dir.to_array().map(f32::to_bits), t.to_bits());
+        let mut compared = 0;
         for name in builtin::names() {
             let prepared = PreparedScene::new(builtin::load_builtin(name).unwrap().unwrap());
-            for interpolation in Interpolation::ALL {
-                let settings = RenderSettings { width: 45, height: 29, interpolation, shadows: ShadowMode::Ray, ..RenderSettings::for_scene(&prepared.scene) };
-                let cancel = AtomicBool::new(false);
-                let a = render_frame(&super::super::bvh::BvhRayTracer, &prepared, &settings, &cancel, None).unwrap();
-                let b = render_frame(&BruteForce, &prepared, &settings, &cancel, None).unwrap();
-                let bits = |p: &[Radiance]| p.iter().map(|c| c.to_array().map(f32::to_bits)).collect::<Vec<_>>();
-                assert!(bits(&a.pixels) == bits(&b.pixels), "{name} {interpolation:?}: images differ");
-                assert_eq!((a.counts.primary, a.counts.shadow), (b.counts.primary, b.counts.shadow), "{name} {interpolation:?}");
+            let Some(light) = prepared.scene.lights.first() else { continue };
+            let query = BvhQuery::new(&prepared);
+            let (w, h) = (23u32, 17u32);
+            let view = prepared.scene.camera.view(w, h);
+            for interpolation in [Interpolation::Phong, Interpolation::Flat] {
+                let settings = RenderSettings { interpolation, shadows: ShadowMode::Ray, ..RenderSettings::for_scene(&prepared.scene) };
+                for (x, y) in (0..w).flat_map(|x| (0..h).map(move |y| (x, y))) {
+                    let ray = view.eye_ray(x as f32 + 0.5, y as f32 + 0.5);
+                    let Some(hit) = query.closest(&ray, view.far_t(x as f32 + 0.5, y as f32 + 0.5), false, &mut RayCounts::default(), &mut NoRecord) else { continue };
+                    let expected = with_shading_hit(interpolation, &hit, |h| cast_shadow_ray(&prepared.scene, h, light, settings.shadow_bump)).flatten();
+                    let mut trace = PixelTrace::new();
+                    with_shading_hit(interpolation, &hit, |h| shade(&prepared.scene, &query, &settings, h, -ray.dir, 0, &mut RayCounts::default(), &mut trace));
+                    let cast = trace.lights.iter().find(|l| l.light == 0).and_then(|l| l.shadow_ray);
+                    assert_eq!(expected.map(bits), cast.map(bits), "{name} {interpolation:?} pixel ({x}, {y})");
+                    compared += expected.is_some() as u32;
+                }
             }
         }
+        assert!(compared > 1000, "only {compared} shadow rays compared");
     }
 }

@@ -1,0 +1,256 @@
+//! The BVH traversal kernels that single rays (`bvh.rs`) and packets
+//! (`packet.rs`) share: the slab test, the order children are visited in and
+//! the leaf loop with its tie rule. Written once so both traversals find the
+//! same hits; `#[inline(always)]` because they are the hot loops.
+
+use super::intersect::{intersect_sphere, intersect_triangle, TriangleEdges};
+use crate::math::Ray;
+use crate::render::trace::{PrimitiveTest, Recorder};
+use crate::scene::{PrimitiveId, PrimitiveKind, Sphere};
+use glam::{BVec4A, Vec3, Vec4};
+
+/// The slab test's far distance is stretched by this factor (and the near
+/// one shrunk) to absorb its rounding and that of the primitive tests.
+pub const SLAB_WIDEN: f32 = 1.0e-5;
+
+/// Four slab tests at once, lane by lane: ray `origin + t / inv` against the
+/// box with planes (min x, max x, min y, max y, min z, max z), within
+/// [0, t_far]. The lanes may be four boxes and one ray (single rays) or one
+/// box and four rays (packets): the arithmetic is the same. Returns which
+/// lanes meet their box and where they enter it.
+#[inline(always)]
+pub fn slab_test(planes: &[Vec4; 6], origin: &[Vec4; 3], inv: &[Vec4; 3], t_far: Vec4) -> (BVec4A, Vec4) {
+    let p = planes;
+    let (x0, x1) = ((p[0] - origin[0]) * inv[0], (p[1] - origin[0]) * inv[0]);
+    let (y0, y1) = ((p[2] - origin[1]) * inv[1], (p[3] - origin[1]) * inv[1]);
+    let (z0, z1) = ((p[4] - origin[2]) * inv[2], (p[5] - origin[2]) * inv[2]);
+    let tn = x0.min(x1).max(y0.min(y1)).max(z0.min(z1)).max(Vec4::ZERO) * (1.0 - SLAB_WIDEN);
+    let tf = (x0.max(x1).min(y0.max(y1)).min(z0.max(z1)) * (1.0 + SLAB_WIDEN)).min(t_far);
+    (tn.cmple(tf), tn)
+}
+
+/// A ray prepared for slab tests: origin and inverse direction, each
+/// component splatted over four lanes.
+pub struct PreparedRay {
+    pub origin: [Vec4; 3],
+    pub inv: [Vec4; 3],
+}
+
+impl PreparedRay {
+    #[inline(always)]
+    pub fn new(ray: &Ray) -> PreparedRay {
+        // A zero (or denormal) component gets a huge finite inverse, so the
+        // slab test never computes 0 * inf.
+        let fix = |d: f32| {
+            let inv = 1.0 / d;
+            if inv.is_finite() { inv } else { f32::MAX.copysign(d) }
+        };
+        let inv = [fix(ray.dir.x), fix(ray.dir.y), fix(ray.dir.z)];
+        PreparedRay { origin: [Vec4::splat(ray.origin.x), Vec4::splat(ray.origin.y), Vec4::splat(ray.origin.z)], inv: inv.map(Vec4::splat) }
+    }
+
+    /// Which of a node's four child boxes (`planes`, slots used as in
+    /// `valid`) the ray meets within [0, t_far], as a bit mask, and where it
+    /// enters each.
+    #[inline(always)]
+    pub fn slab4(&self, planes: &[Vec4; 6], valid: u32, t_far: f32) -> (u32, Vec4) {
+        let (hit, tn) = slab_test(planes, &self.origin, &self.inv, Vec4::splat(t_far));
+        (hit.bitmask() & valid, tn)
+    }
+
+    /// The slab test for one box (the root's).
+    #[inline(always)]
+    pub fn slab1(&self, min: Vec3, max: Vec3, t_far: f32) -> bool {
+        let mut t = (0.0f32, t_far);
+        for axis in 0..3 {
+            let o = self.origin[axis].x;
+            let inv = self.inv[axis].x;
+            let (a, b) = ((min[axis] - o) * inv, (max[axis] - o) * inv);
+            t.0 = t.0.max(a.min(b) * (1.0 - SLAB_WIDEN));
+            t.1 = t.1.min(a.max(b) * (1.0 + SLAB_WIDEN));
+        }
+        t.0 <= t.1
+    }
+}
+
+/// The children of a node a traversal enters, ordered so that it continues
+/// with the nearest and pushes the others farthest first (they then pop
+/// nearest first). Insertion sort by descending entry distance; of equal
+/// distances the one added last comes out as the nearer.
+pub struct ChildOrder<T> {
+    items: [(T, f32); 4],
+    len: usize,
+}
+
+impl<T: Copy + Default> Default for ChildOrder<T> {
+    #[inline(always)]
+    fn default() -> ChildOrder<T> {
+        ChildOrder::new()
+    }
+}
+
+impl<T: Copy + Default> ChildOrder<T> {
+    #[inline(always)]
+    pub fn new() -> ChildOrder<T> {
+        ChildOrder { items: [(T::default(), 0.0); 4], len: 0 }
+    }
+
+    /// Adds a child the ray (or packet) enters at `t_enter`.
+    #[inline(always)]
+    pub fn insert(&mut self, child: T, t_enter: f32) {
+        let mut j = self.len;
+        while j > 0 && self.items[j - 1].1 < t_enter {
+            self.items[j] = self.items[j - 1];
+            j -= 1;
+        }
+        self.items[j] = (child, t_enter);
+        self.len += 1;
+    }
+
+    /// The child to visit next, and the others farthest first (to push in
+    /// this order); `None` when no child was added.
+    #[inline(always)]
+    pub fn nearest_and_farther(&self) -> Option<(T, &[(T, f32)])> {
+        self.items[..self.len].split_last().map(|(nearest, farther)| (nearest.0, farther))
+    }
+}
+
+/// The best hit found so far along one ray.
+#[derive(Clone, Copy, Debug)]
+pub struct BestHit {
+    /// Its ray parameter (t_max until something is hit): the far end of the
+    /// box tests.
+    pub t: f32,
+    /// Primitive tests accept t < limit: t_max, then just above `t` once
+    /// something is hit, so an equal-t hit on an earlier primitive can still
+    /// win the tie.
+    pub limit: f32,
+    /// `PrimitiveId::NONE` until something is hit.
+    pub id: PrimitiveId,
+    /// A triangle hit's barycentric weights of v1 and v2.
+    pub bary: (f32, f32),
+}
+
+impl BestHit {
+    #[inline(always)]
+    pub fn nothing_before(t_max: f32) -> BestHit {
+        BestHit { t: t_max, limit: t_max, id: PrimitiveId::NONE, bary: (0.0, 0.0) }
+    }
+}
+
+/// Tests `ray` against the primitives of one leaf, counting each test in
+/// `tests` and reporting it to `rec`. With `ANY` it stops at the first hit,
+/// stores it in `best` and returns true. Otherwise `best` keeps the nearest
+/// hit; on equal t the lower id (scene order) wins, as brute force's strict
+/// `t < best_t` scan decides, so the order in which leaves are visited
+/// cannot change which primitive wins. `inside` lets a refracted ray hit the
+/// sphere it travels in from inside.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub fn test_leaf<const ANY: bool, R: Recorder>(
+    prims: &[(TriangleEdges, PrimitiveId)],
+    spheres: &[Sphere],
+    ray: &Ray,
+    inside: bool,
+    best: &mut BestHit,
+    tests: &mut u64,
+    rec: &mut R,
+) -> bool {
+    for (tri, id) in prims {
+        let id = *id;
+        *tests += 1;
+        let found = if !id.is_sphere() {
+            let outcome = intersect_triangle(ray, tri, best.limit);
+            if R::ENABLED {
+                rec.primitive_test(PrimitiveTest { kind: PrimitiveKind::Triangle, index: id.index(), outcome });
+            }
+            outcome.ok()
+        } else {
+            let outcome = intersect_sphere(ray, &spheres[id.index() as usize], best.limit, inside);
+            if R::ENABLED {
+                rec.primitive_test(PrimitiveTest { kind: PrimitiveKind::Sphere, index: id.index(), outcome: outcome.map(|t| (t, 0.0, 0.0)) });
+            }
+            outcome.ok().map(|t| (t, 0.0, 0.0))
+        };
+        if let Some((t, b1, b2)) = found {
+            if ANY {
+                best.t = t;
+                best.id = id;
+                best.bary = (b1, b2);
+                return true;
+            }
+            // t <= best.t here; on a tie the lower id (scene order) wins.
+            if t < best.t || id < best.id {
+                best.t = t;
+                best.id = id;
+                best.bary = (b1, b2);
+                best.limit = f32::from_bits(t.to_bits() + 1);
+            }
+        }
+    }
+    false
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::trace::NoRecord;
+
+    #[test]
+    fn slab_test_by_hand() {
+        // Four unit boxes along +x at 1, 3, 5 and 7; a ray along +x from the origin.
+        let planes = [
+            Vec4::new(1.0, 3.0, 5.0, 7.0),
+            Vec4::new(2.0, 4.0, 6.0, 8.0),
+            Vec4::splat(-0.5),
+            Vec4::splat(0.5),
+            Vec4::splat(-0.5),
+            Vec4::splat(0.5),
+        ];
+        let ray = PreparedRay::new(&Ray::new(Vec3::ZERO, Vec3::X));
+        let (mask, tn) = ray.slab4(&planes, 0b1111, 5.5);
+        assert_eq!(mask, 0b0111, "boxes entered before t = 5.5");
+        assert_eq!(tn.x, 1.0 * (1.0 - SLAB_WIDEN));
+        assert_eq!(tn.z, 5.0 * (1.0 - SLAB_WIDEN));
+        assert_eq!(ray.slab4(&planes, 0b0101, 100.0).0, 0b0101, "unused slots never hit");
+        assert!(ray.slab1(Vec3::new(1.0, -0.5, -0.5), Vec3::new(2.0, 0.5, 0.5), 1.5));
+        assert!(!ray.slab1(Vec3::new(1.0, 0.6, -0.5), Vec3::new(2.0, 1.5, 0.5), 10.0));
+    }
+
+    #[test]
+    fn children_come_out_nearest_first_then_farthest_pushed_first() {
+        let mut order = ChildOrder::<u32>::new();
+        assert!(order.nearest_and_farther().is_none());
+        for (child, t) in [(10, 3.0), (11, 1.0), (12, 2.0), (13, 4.0)] {
+            order.insert(child, t);
+        }
+        let (nearest, farther) = order.nearest_and_farther().unwrap();
+        assert_eq!(nearest, 11);
+        assert_eq!(farther.iter().map(|c| c.0).collect::<Vec<_>>(), [13, 10, 12]);
+        // Equal distances: the one added last is visited first.
+        let mut tie = ChildOrder::<u32>::new();
+        tie.insert(1, 2.0);
+        tie.insert(2, 2.0);
+        assert_eq!(tie.nearest_and_farther().unwrap().0, 2);
+    }
+
+    #[test]
+    fn leaf_ties_go_to_the_lower_id_and_any_stops_at_the_first_hit() {
+        use crate::render::raytrace::intersect::TriangleEdges;
+        use crate::scene::Triangle;
+        // The same triangle twice, listed with the higher id first, and a sphere behind it.
+        let v = [Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, -1.0, 0.0), Vec3::new(0.0, 1.0, 0.0)];
+        let tri = Triangle { v, n: [Vec3::Z; 3], uv: [crate::math::Vec2::ZERO; 3], material: 0, object: 0, two_sided: true };
+        let edges = TriangleEdges::new(&tri);
+        let spheres = [Sphere { center: Vec3::new(0.0, 0.0, -3.0), radius: 1.0, material: 0, object: 0 }];
+        let prims = [(edges, PrimitiveId::sphere(0)), (edges, PrimitiveId::triangle(5)), (edges, PrimitiveId::triangle(2))];
+        let ray = Ray::new(Vec3::new(0.0, 0.0, 1.0), Vec3::NEG_Z);
+        let mut best = BestHit::nothing_before(f32::INFINITY);
+        let mut tests = 0;
+        assert!(!test_leaf::<false, _>(&prims, &spheres, &ray, false, &mut best, &mut tests, &mut NoRecord));
+        assert_eq!((best.id, best.t, tests), (PrimitiveId::triangle(2), 1.0, 3));
+        let mut any = BestHit::nothing_before(f32::INFINITY);
+        assert!(test_leaf::<true, _>(&prims, &spheres, &ray, false, &mut any, &mut tests, &mut NoRecord));
+        assert_eq!((any.id, any.t, tests), (PrimitiveId::sphere(0), 3.0, 4));
+    }
+}
