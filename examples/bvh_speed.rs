@@ -11,7 +11,7 @@
 use pinhole::render::raytrace::bvh::{Bvh, BvhQuery};
 use pinhole::render::raytrace::bvh_renderer::BvhRayTracer;
 use pinhole::render::raytrace::packet::{self, Packet, TILE_H, TILE_W};
-use pinhole::render::trace::NoRecord;
+use pinhole::render::pixel_record::NoRecord;
 use pinhole::render::{debug::View, PassJob, PreparedScene, RayCounts, RenderSettings, Renderer, SceneQuery, ShadowMode};
 use pinhole::math::{Radiance, Vec2};
 use rayon::prelude::*;

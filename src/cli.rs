@@ -383,9 +383,9 @@ fn cmd_pixel(scene_arg: &str, x: u32, y: u32, opts: &RenderOpts, as_json: bool) 
     let replay = render::replay_pixel(l.renderer.as_ref(), &l.prepared, &l.settings, x, y)?;
     let scene = &l.prepared.scene;
     if as_json {
-        write_json("-", &crate::pixel_report::to_json(l.renderer.name(), scene, x, y, &replay))
+        write_json("-", &crate::render::pixel_report::to_json(l.renderer.name(), scene, x, y, &replay))
     } else {
-        print!("{}", crate::pixel_report::to_text(l.renderer.name(), scene, x, y, &replay));
+        print!("{}", crate::render::pixel_report::to_text(l.renderer.name(), scene, x, y, &replay));
         Ok(())
     }
 }

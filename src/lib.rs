@@ -10,7 +10,6 @@ pub mod image_io;
 pub mod math;
 pub mod metrics;
 pub mod named;
-pub mod pixel_report;
 pub mod render;
 pub mod scene;
 pub mod app;

@@ -166,25 +166,24 @@ fn feature_kernels(sigma: f32) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
 
 /// Separable convolution (kx along rows, ky along columns), clamping at edges.
 fn conv2(img: &[f32], w: usize, h: usize, kx: &[f32], ky: &[f32]) -> Vec<f32> {
-    let (rx, ry) = ((kx.len() / 2) as isize, (ky.len() / 2) as isize);
-    let mut tmp = vec![0.0; w * h];
-    for y in 0..h {
-        for x in 0..w {
-            let mut s = 0.0;
-            for (k, wgt) in kx.iter().enumerate() {
-                let xi = (x as isize + k as isize - rx).clamp(0, w as isize - 1) as usize;
-                s += wgt * img[xi + y * w];
-            }
-            tmp[x + y * w] = s;
-        }
-    }
+    let rows = conv1(img, w, h, kx, true);
+    conv1(&rows, w, h, ky, false)
+}
+
+/// One pass of `conv2`: the kernel along rows (`along_rows`) or along columns.
+fn conv1(img: &[f32], w: usize, h: usize, kernel: &[f32], along_rows: bool) -> Vec<f32> {
+    let r = (kernel.len() / 2) as isize;
     let mut out = vec![0.0; w * h];
     for y in 0..h {
         for x in 0..w {
             let mut s = 0.0;
-            for (k, wgt) in ky.iter().enumerate() {
-                let yi = (y as isize + k as isize - ry).clamp(0, h as isize - 1) as usize;
-                s += wgt * tmp[x + yi * w];
+            for (k, wgt) in kernel.iter().enumerate() {
+                let index = if along_rows {
+                    (x as isize + k as isize - r).clamp(0, w as isize - 1) as usize + y * w
+                } else {
+                    x + (y as isize + k as isize - r).clamp(0, h as isize - 1) as usize * w
+                };
+                s += wgt * img[index];
             }
             out[x + y * w] = s;
         }

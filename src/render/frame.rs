@@ -72,7 +72,7 @@ pub fn build_shadow_maps(prepared: &PreparedScene, settings: &RenderSettings) {
 /// renderer returned them), and the final value, which is accumulated exactly
 /// as `render_frame` accumulates it.
 pub struct PixelReplay {
-    pub samples: Vec<(crate::math::Vec2, super::trace::PixelTrace, Radiance)>,
+    pub samples: Vec<(crate::math::Vec2, super::pixel_record::PixelTrace, Radiance)>,
     pub radiance: Radiance,
 }
 
@@ -90,7 +90,7 @@ pub fn replay_pixel(renderer: &dyn Renderer, prepared: &PreparedScene, settings:
     for i in 0..spp {
         let offset = sample_offset(i, spp);
         let job = PassJob { prepared, view: &view, settings, offset, rows: y..y + 1, cancel: &cancel };
-        let mut rec = super::trace::PixelTrace::new();
+        let mut rec = super::pixel_record::PixelTrace::new();
         let value = renderer
             .trace_pixel(&job, x, y, &mut rec)
             .ok_or_else(|| format!("{} cannot replay pixels yet", renderer.name()))?;

@@ -12,7 +12,8 @@ pub mod raster;
 pub mod raytrace;
 pub mod shade;
 pub mod shadow_map;
-pub mod trace;
+pub mod pixel_record;
+pub mod pixel_report;
 
 pub use frame::{render_frame, render_frame_in_bands, replay_pixel, FrameResult, PixelReplay};
 pub use prepared::PreparedScene;
@@ -22,7 +23,7 @@ use crate::named::named_enum;
 use crate::scene::{CameraView, PrimitiveId, PrimitiveKind, SurfaceHit};
 use std::ops::Range;
 use std::sync::atomic::AtomicBool;
-use trace::Recorder;
+use pixel_record::Recorder;
 
 named_enum! {
     /// How shadow visibility is resolved.
@@ -215,7 +216,7 @@ pub trait Renderer: Sync + Send {
     /// Replays pixel `(x, y)` of this pass through the same code path with a
     /// recorder, returning the very value `render_pass` stores there; `None`
     /// when this renderer cannot replay pixels.
-    fn trace_pixel(&self, _job: &PassJob, _x: u32, _y: u32, _rec: &mut trace::PixelTrace) -> Option<Radiance> {
+    fn trace_pixel(&self, _job: &PassJob, _x: u32, _y: u32, _rec: &mut pixel_record::PixelTrace) -> Option<Radiance> {
         None
     }
 }

@@ -2,7 +2,7 @@
 //! `SurfaceHit` to `shade()`. Lights, shadows, BSDF and secondary rays live
 //! here and nowhere else.
 
-use super::trace::{LightSample, Recorder};
+use super::pixel_record::{LightSample, Recorder};
 use super::{RayCounts, RenderSettings, SceneQuery, ShadowMode};
 use crate::math::{Radiance, Ray, Vec3};
 use crate::scene::{Light, Material, Scene, SurfaceHit};

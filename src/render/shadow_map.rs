@@ -48,7 +48,7 @@ use super::raster::rect::{sample_span, PixelRect};
 use super::raster::setup::{bin_rows, ScreenTri};
 use super::raster::subpixel::snap_offset;
 use super::raster::sphere::sphere_bounds;
-use super::trace::Recorder;
+use super::pixel_record::Recorder;
 use super::{Occluder, PassJob, PreparedScene, RayCounts, RenderSettings, SceneQuery};
 use crate::math::{Radiance, Ray, Vec2, Vec3};
 use crate::scene::{Camera, CameraView, Fov, Light, PrimitiveId, Scene, Sphere, SurfaceHit, Triangle};

@@ -232,7 +232,7 @@ impl Accumulator {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::raytrace::bvh::BvhRayTracer;
+    use crate::render::raytrace::bvh_renderer::BvhRayTracer;
     use crate::render::{render_frame, render_frame_in_bands};
     use crate::scene::builtin;
 

@@ -4,7 +4,7 @@
 //! when all weights are >= 0; the weights then interpolate 1/z and the
 //! attributes over z (perspective-correct, CGPP 15.6.4.2).
 
-use super::rect::{PixelRect, TestCounter};
+use super::rect::{tested_rect, PixelRect, TestCounter};
 use super::setup::ScreenTri;
 use crate::math::Vec2;
 
@@ -26,11 +26,9 @@ pub fn bary2d(a: Vec2, b: Vec2, c: Vec2, q: Vec2) -> f32 {
 /// Visits the covered samples of `st` inside `rect` with their screen-space weights.
 #[inline]
 pub fn raster<F: FnMut(u32, u32, [f32; 3])>(st: &ScreenTri, rect: PixelRect, off: Vec2, tested: &mut impl TestCounter, mut emit: F) {
-    let r = st.bbox.intersect(&rect);
-    if r.is_empty() {
+    let Some(r) = tested_rect(&st.bbox, &rect, tested) else {
         return;
-    }
-    tested.add(r);
+    };
     let [p0, p1, p2] = st.p;
     for y in r.y0..r.y1 {
         for x in r.x0..r.x1 {

@@ -7,7 +7,7 @@
 //! top-left rule gives a sample lying exactly on the edge to exactly one of them:
 //! no cracks and no double hits, whatever the mesh.
 
-use super::rect::{PixelRect, TestCounter};
+use super::rect::{tested_rect, PixelRect, TestCounter};
 use super::setup::ScreenTri;
 use super::subpixel::{snap, snap_offset, ONE};
 use crate::math::Vec2;
@@ -137,11 +137,9 @@ pub fn raster<C: TestCounter, F: FnMut(u32, u32, [f32; 3])>(ft: &FixedTri, rect:
 
 #[inline(always)]
 fn raster_in<T: EdgeInt, C: TestCounter, F: FnMut(u32, u32, [f32; 3])>(ft: &FixedTri, rect: PixelRect, off: [i64; 2], tested: &mut C, mut emit: F) {
-    let r = ft.bbox.intersect(&rect);
-    if r.is_empty() {
+    let Some(r) = tested_rect(&ft.bbox, &rect, tested) else {
         return;
-    }
-    tested.add(r);
+    };
     let step_x = [0, 1, 2].map(|k| T::from(ft.a[k]) * T::from(ONE));
     let step_y = [0, 1, 2].map(|k| T::from(ft.b[k]) * T::from(ONE));
     let bias = ft.bias.map(T::from);

@@ -6,7 +6,7 @@
 //! the earlier one; rounding in the stepped sums can leave rare holes, which
 //! the `fixed` variant removes).
 
-use super::rect::{PixelRect, TestCounter};
+use super::rect::{tested_rect, PixelRect, TestCounter};
 use super::setup::{edge_function, ScreenTri};
 use crate::math::Vec2;
 
@@ -14,11 +14,9 @@ use crate::math::Vec2;
 /// weights; adds the samples tested to `tested`.
 #[inline]
 pub fn raster<F: FnMut(u32, u32, [f32; 3])>(st: &ScreenTri, rect: PixelRect, off: Vec2, tested: &mut impl TestCounter, mut emit: F) {
-    let r = st.bbox.intersect(&rect);
-    if r.is_empty() {
+    let Some(r) = tested_rect(&st.bbox, &rect, tested) else {
         return;
-    }
-    tested.add(r);
+    };
     let p = st.p;
     let inv_area = st.inv_area;
     // Edge k is the one opposite vertex k: E_k(q) = a_k q.x + b_k q.y + c_k.

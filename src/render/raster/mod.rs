@@ -32,7 +32,7 @@ pub mod subpixel;
 pub mod tiled;
 pub mod vis_buffer;
 
-use super::trace::PixelTrace;
+use super::pixel_record::PixelTrace;
 use super::{PassJob, RayCounts, Renderer};
 use crate::math::Radiance;
 

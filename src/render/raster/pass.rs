@@ -26,7 +26,7 @@ use super::method::Method;
 use super::{barycentric, bbox, incremental, scanline};
 use crate::math::{Radiance, Vec2};
 use crate::render::raytrace::bvh::BvhQuery;
-use crate::render::trace::PixelTrace;
+use crate::render::pixel_record::PixelTrace;
 use crate::render::{PassJob, PreparedScene, RayCounts, SceneQuery};
 use rayon::prelude::*;
 use std::ops::Range;

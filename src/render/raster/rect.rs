@@ -55,6 +55,18 @@ impl TestCounter for u64 {
     }
 }
 
+/// The samples a triangle's coverage loop visits: its bounding box `bbox`
+/// clipped to `rect`, counted in `tested`; `None` when nothing is left.
+#[inline(always)]
+pub fn tested_rect(bbox: &PixelRect, rect: &PixelRect, tested: &mut impl TestCounter) -> Option<PixelRect> {
+    let r = bbox.intersect(rect);
+    if r.is_empty() {
+        return None;
+    }
+    tested.add(r);
+    Some(r)
+}
+
 /// The pixels `i` in `[0, n)` whose sample `i + off` lies in `[lo, hi]`.
 pub fn sample_span(lo: f32, hi: f32, off: f32, n: u32) -> (u32, u32) {
     if !(lo <= hi) {

@@ -13,7 +13,7 @@ use super::rect::{PixelRect, TestCounter};
 use super::setup::ScreenTri;
 use crate::math::{Radiance, Ray, Vec3};
 use crate::render::debug::{cost_color, View};
-use crate::render::trace::{FragmentRecord, NoRecord, PixelTrace, Recorder};
+use crate::render::pixel_record::{FragmentRecord, NoRecord, PixelTrace, Recorder};
 use crate::render::{miss_without_ray, resolve_sample, PassJob, RayCounts, SceneQuery};
 use crate::scene::{PrimitiveId, PrimitiveKind, SurfaceHit};
 

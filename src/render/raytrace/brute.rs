@@ -5,7 +5,7 @@
 use super::intersect::{intersect_sphere, intersect_triangle};
 use super::{cast_pass, cast_pixel};
 use crate::math::{Radiance, Ray};
-use crate::render::trace::{PixelTrace, PrimitiveTest, Recorder};
+use crate::render::pixel_record::{PixelTrace, PrimitiveTest, Recorder};
 use crate::render::{Occluder, PassJob, PreparedScene, RayCounts, Renderer, SceneQuery};
 use crate::scene::{PrimitiveId, PrimitiveKind, SurfaceHit};
 

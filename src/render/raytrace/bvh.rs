@@ -21,7 +21,7 @@
 use super::intersect::TriangleEdges;
 use super::traverse::{test_leaf, BestHit, ChildOrder, PreparedRay};
 use crate::math::Ray;
-use crate::render::trace::Recorder;
+use crate::render::pixel_record::Recorder;
 use crate::render::{Occluder, PreparedScene, RayCounts, SceneQuery};
 use crate::scene::{PrimitiveId, PrimitiveKind, Scene, SurfaceHit};
 use glam::{Vec3, Vec3A, Vec4};
@@ -619,7 +619,7 @@ mod tests {
     use super::*;
     use crate::render::raytrace::brute::BruteQuery;
     use crate::render::raytrace::intersect::intersect_triangle;
-    use crate::render::trace::NoRecord;
+    use crate::render::pixel_record::NoRecord;
     use crate::scene::{builtin, Sphere, Triangle};
     use proptest::prelude::*;
 

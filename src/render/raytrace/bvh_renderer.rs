@@ -6,7 +6,7 @@ use super::bvh::BvhQuery;
 use super::cast_pixel;
 use super::packet::cast_pass_packets;
 use crate::math::Radiance;
-use crate::render::trace::PixelTrace;
+use crate::render::pixel_record::PixelTrace;
 use crate::render::{PassJob, RayCounts, Renderer};
 
 pub struct BvhRayTracer;

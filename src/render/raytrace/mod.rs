@@ -11,7 +11,7 @@ pub mod intersect;
 pub mod packet;
 pub mod traverse;
 
-use super::trace::{NoRecord, Recorder};
+use super::pixel_record::{NoRecord, Recorder};
 use super::{resolve_sample, PassJob, RayCounts, SceneQuery};
 use super::debug::{cost_color, View};
 use crate::math::Radiance;

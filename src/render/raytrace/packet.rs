@@ -22,7 +22,7 @@ use super::traverse::{slab_test, test_leaf, BestHit, ChildOrder, PreparedRay, SL
 use crate::math::{Radiance, Ray};
 use crate::render::debug::View;
 use crate::render::shade::cast_shadow_ray;
-use crate::render::trace::{NoRecord, Recorder};
+use crate::render::pixel_record::{NoRecord, Recorder};
 use crate::render::{resolve_sample, with_shading_hit, Interpolation, Occluder, PassJob, RayCounts, SceneQuery, ShadowMode};
 use crate::scene::{PrimitiveId, SurfaceHit};
 use glam::{Vec3, Vec4};
@@ -444,7 +444,7 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
 mod tests {
     use super::*;
     use crate::math::Vec2;
-    use crate::render::trace::NoRecord;
+    use crate::render::pixel_record::NoRecord;
     use crate::render::{PreparedScene, SceneQuery};
     use crate::scene::builtin;
 
@@ -492,7 +492,7 @@ mod tests {
     #[test]
     fn the_pre_pass_traces_the_shadow_ray_shade_casts() {
         use crate::render::shade::shade;
-        use crate::render::trace::PixelTrace;
+        use crate::render::pixel_record::PixelTrace;
         use crate::render::RenderSettings;
         let bits = |(r, t): (Ray, f32)| (r.origin.to_array().map(f32::to_bits), r.dir.to_array().map(f32::to_bits), t.to_bits());
         let mut compared = 0;

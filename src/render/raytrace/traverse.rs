@@ -5,7 +5,7 @@
 
 use super::intersect::{intersect_sphere, intersect_triangle, TriangleEdges};
 use crate::math::Ray;
-use crate::render::trace::{PrimitiveTest, Recorder};
+use crate::render::pixel_record::{PrimitiveTest, Recorder};
 use crate::scene::{PrimitiveId, PrimitiveKind, Sphere};
 use glam::{BVec4A, Vec3, Vec4};
 
@@ -194,7 +194,7 @@ pub fn test_leaf<const ANY: bool, R: Recorder>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::trace::NoRecord;
+    use crate::render::pixel_record::NoRecord;
 
     #[test]
     fn slab_test_by_hand() {

@@ -4,7 +4,7 @@
 
 use crate::math::Vec3;
 use crate::render::raytrace::intersect::Miss;
-use crate::render::trace::{FragmentRecord, LightSample, PixelTrace, RayRecord};
+use crate::render::pixel_record::{FragmentRecord, LightSample, PixelTrace, RayRecord};
 use crate::render::PixelReplay;
 use crate::scene::{PrimitiveKind, Scene, SurfaceHit};
 use serde_json::{json, Value};
