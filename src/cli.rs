@@ -135,6 +135,30 @@ struct RenderOpts {
     /// is shaded (the same as --early-depth false).
     #[arg(long)]
     forward: bool,
+    /// Indirect light: none | ao | photons | path.
+    #[arg(long, default_value = "none")]
+    gi: String,
+    /// --gi path: indirect bounces, a number or `inf` (Mitsuba's max_depth = N + 2).
+    #[arg(long, default_value = "inf", value_name = "N|inf")]
+    bounces: String,
+    /// --gi ao: hemisphere rays per sample.
+    #[arg(long = "ao-samples", value_name = "N")]
+    ao_samples: Option<u32>,
+    /// --gi ao: how far the hemisphere rays look for occluders.
+    #[arg(long = "ao-distance", value_name = "D")]
+    ao_distance: Option<f32>,
+    /// --gi photons: photons shot from the lights.
+    #[arg(long, value_name = "N")]
+    photons: Option<u32>,
+    /// --gi photons: nearest photons per density estimate.
+    #[arg(long = "photon-k", value_name = "K")]
+    photon_k: Option<u32>,
+    /// --gi photons: rays gathered at the first hit (0: read the map there).
+    #[arg(long = "final-gather", value_name = "N")]
+    final_gather: Option<u32>,
+    /// Stochastic methods: the image depends on (scene, settings, seed) only.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
 }
 
 /// What is left to do once the command line ran: the viewer is not part of
@@ -245,8 +269,52 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
     }
     settings.msaa = opts.msaa;
     settings.early_depth = opts.early_depth && !opts.forward;
+    settings.gi = gi_settings(opts)?;
     let prepared = pool.install(|| PreparedScene::new(scene));
     Ok(Loaded { prepared, settings, renderer, pool, load_ms })
+}
+
+/// The indirect-light options, checked.
+fn gi_settings(opts: &RenderOpts) -> Result<render::gi::GiSettings, String> {
+    let mut gi = render::gi::GiSettings { mode: render::gi::GiMode::parse(&opts.gi)?, seed: opts.seed, ..Default::default() };
+    gi.bounces = match opts.bounces.as_str() {
+        "inf" => None,
+        n => match n.parse::<u32>() {
+            Ok(b) if b <= render::gi::MAX_BOUNCES => Some(b),
+            _ => return Err(format!("--bounces {n} is neither inf nor a number from 0 to {}", render::gi::MAX_BOUNCES)),
+        },
+    };
+    if let Some(n) = opts.ao_samples {
+        if !(1..=4096).contains(&n) {
+            return Err(format!("--ao-samples {n} is not between 1 and 4096"));
+        }
+        gi.ao_samples = n;
+    }
+    if let Some(d) = opts.ao_distance {
+        if !(d > 0.0) || d.is_nan() {
+            return Err(format!("--ao-distance {d} must be a number > 0 (inf allowed)"));
+        }
+        gi.ao_distance = d;
+    }
+    if let Some(n) = opts.photons {
+        if !(1..=50_000_000).contains(&n) {
+            return Err(format!("--photons {n} is not between 1 and 50000000"));
+        }
+        gi.photons = n;
+    }
+    if let Some(k) = opts.photon_k {
+        if !(1..=4096).contains(&k) {
+            return Err(format!("--photon-k {k} is not between 1 and 4096"));
+        }
+        gi.photon_k = k;
+    }
+    if let Some(n) = opts.final_gather {
+        if n > 4096 {
+            return Err(format!("--final-gather {n} is more than 4096"));
+        }
+        gi.final_gather = n;
+    }
+    Ok(gi)
 }
 
 fn stats_json(l: &Loaded, render_ms: f64, counts: &RayCounts, spp: u32) -> serde_json::Value {
@@ -280,6 +348,9 @@ fn stats_json(l: &Loaded, render_ms: f64, counts: &RayCounts, spp: u32) -> serde
         "shadow_map_size": l.settings.shadow_map_size,
         "shadow_map_bias": l.settings.shadow_map_bias,
         "shadow_map_ms": (l.settings.shadows == ShadowMode::Map).then(|| l.prepared.shadow_maps(l.settings.shadow_map_size).build_ms),
+        "gi": l.settings.gi.mode.name(),
+        "seed": l.settings.gi.seed,
+        "photons": (l.settings.gi.mode == render::gi::GiMode::Photons).then(|| l.prepared.photon_map(&l.settings.gi, l.settings.shadow_bump).len()),
     })
 }
 

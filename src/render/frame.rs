@@ -68,6 +68,13 @@ pub fn build_shadow_maps(prepared: &PreparedScene, settings: &RenderSettings) {
     }
 }
 
+/// The photon map the passes read, built (once, in parallel) before them,
+/// when the settings ask for photon mapping on the shaded view.
+pub fn build_photon_map(prepared: &PreparedScene, settings: &RenderSettings) -> Option<std::sync::Arc<super::photon_map::PhotonMap>> {
+    (settings.gi.mode == super::gi::GiMode::Photons && matches!(settings.view, super::debug::View::Shaded | super::debug::View::Diff))
+        .then(|| prepared.photon_map(&settings.gi, settings.shadow_bump))
+}
+
 /// A pixel replayed sample by sample: the records (with the samples as the
 /// renderer returned them), and the final value, which is accumulated exactly
 /// as `render_frame` accumulates it.
@@ -82,6 +89,7 @@ pub fn replay_pixel(renderer: &dyn Renderer, prepared: &PreparedScene, settings:
         return Err(format!("pixel ({x}, {y}) is outside the {}x{} image", settings.width, settings.height));
     }
     build_shadow_maps(prepared, settings);
+    let photons = build_photon_map(prepared, settings);
     let view = prepared.scene.camera.view(settings.width, settings.height);
     let cancel = AtomicBool::new(false);
     let spp = settings.spp.max(1);
@@ -89,7 +97,7 @@ pub fn replay_pixel(renderer: &dyn Renderer, prepared: &PreparedScene, settings:
     let mut samples = Vec::new();
     for i in 0..spp {
         let offset = sample_offset(i, spp);
-        let job = PassJob { prepared, view: &view, settings, offset, rows: y..y + 1, cancel: &cancel };
+        let job = PassJob { prepared, view: &view, settings, offset, sample: i, photons: photons.as_deref(), rows: y..y + 1, cancel: &cancel };
         let mut rec = super::pixel_record::PixelTrace::new();
         let value = renderer
             .trace_pixel(&job, x, y, &mut rec)

@@ -5,9 +5,14 @@
 //! requested rows it finds the `SurfaceHit` the sample sees and hands it to
 //! `resolve_sample`, which shades it (or draws a debug view).
 
+pub mod bsdf_sampling;
 pub mod debug;
 pub mod frame;
+pub mod gi;
+pub mod kd_tree;
+pub mod photon_map;
 pub mod prepared;
+pub mod sampling;
 pub mod raster;
 pub mod raytrace;
 pub mod shade;
@@ -88,6 +93,9 @@ pub struct RenderSettings {
     /// checker bends). Ray casters and the 3D-ray variants ignore it.
     #[serde(default)]
     pub affine: bool,
+    /// Indirect light and its knobs.
+    #[serde(default)]
+    pub gi: gi::GiSettings,
 }
 
 fn default_true() -> bool {
@@ -114,6 +122,7 @@ impl RenderSettings {
             affine: false,
             early_depth: true,
             msaa: 1,
+            gi: gi::GiSettings::default(),
         }
     }
 }
@@ -188,6 +197,11 @@ pub struct PassJob<'a> {
     pub settings: &'a RenderSettings,
     /// Sub-pixel position of this pass's sample in [0, 1)^2 (0.5, 0.5 = centre).
     pub offset: Vec2,
+    /// Index of this pass's sample (0-based): with the pixel, it keys the
+    /// sample's random numbers.
+    pub sample: u32,
+    /// `--gi photons`: the photon map, built before the passes.
+    pub photons: Option<&'a photon_map::PhotonMap>,
     /// Rows to render; `out` holds `width * rows.len()` pixels.
     pub rows: Range<u32>,
     pub cancel: &'a AtomicBool,
@@ -196,6 +210,12 @@ pub struct PassJob<'a> {
 impl PassJob<'_> {
     pub fn cancelled(&self) -> bool {
         self.cancel.load(std::sync::atomic::Ordering::Relaxed)
+    }
+
+    /// The index of pixel `(x, y)` that keys its samples' random numbers.
+    #[inline]
+    pub fn pixel_index(&self, x: u32, y: u32) -> u32 {
+        x.wrapping_add(y.wrapping_mul(self.view.width))
     }
 
     /// Image position of this pass's sample in pixel `(x, y)`.
@@ -264,6 +284,7 @@ pub fn resolve_sample<Q: SceneQuery, R: Recorder>(
     query: &Q,
     ray: &Ray,
     hit: Option<&SurfaceHit>,
+    pixel: u32,
     counts: &mut RayCounts,
     rec: &mut R,
 ) -> Radiance {
@@ -272,10 +293,10 @@ pub fn resolve_sample<Q: SceneQuery, R: Recorder>(
     }
     if job.settings.shadows == ShadowMode::Map && job.settings.view == debug::View::Shaded && hit.is_some() {
         return shadow_map::with_maps(job.prepared, job.settings, |maps| {
-            resolve_with(job, &shadow_map::MapQuery { inner: query, maps }, ray, hit, counts, rec)
+            resolve_with(job, &shadow_map::MapQuery { inner: query, maps }, ray, hit, pixel, counts, rec)
         });
     }
-    resolve_with(job, query, ray, hit, counts, rec)
+    resolve_with(job, query, ray, hit, pixel, counts, rec)
 }
 
 #[inline]
@@ -284,16 +305,18 @@ fn resolve_with<Q: SceneQuery, R: Recorder>(
     query: &Q,
     ray: &Ray,
     hit: Option<&SurfaceHit>,
+    pixel: u32,
     counts: &mut RayCounts,
     rec: &mut R,
 ) -> Radiance {
     let scene = &job.prepared.scene;
     match (job.settings.view, hit) {
         (debug::View::Shaded, Some(h)) => {
-            let shaded = with_shading_hit(job.settings.interpolation, h, |s| shade::shade(scene, query, job.settings, s, -ray.dir, 0, counts, rec));
+            let mut path = gi::PathState::new(pixel, job.sample, job.settings.spp, &job.settings.gi, job.photons);
+            let shaded = with_shading_hit(job.settings.interpolation, h, |s| shade::shade(scene, query, job.settings, s, -ray.dir, 0, &mut path, counts, rec));
             match shaded {
                 Some(radiance) => radiance,
-                None => shade::shade_gouraud(scene, query, job.settings, h, job.view.eye, counts, rec),
+                None => shade::shade_gouraud(scene, query, job.settings, h, job.view.eye, &mut path, counts, rec),
             }
         }
         (debug::View::Shaded, None) => {

@@ -50,6 +50,27 @@ pub trait Recorder {
     fn shaded(&mut self, _depth: u32, _radiance: Radiance) {}
     /// While true, `primitive_test` and `node_visit` come from a shadow ray.
     fn in_shadow_ray(&mut self, _active: bool) {}
+    /// Path tracing sampled the next direction of the path.
+    fn bounce(&mut self, _bounce: Bounce) {}
+    /// Photon mapping read this radiance from the map.
+    fn photons(&mut self, _radiance: Radiance) {}
+}
+
+/// One sampled bounce of a path: where it goes and what it weighs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bounce {
+    /// Depth of the surface the path leaves (0 = the eye ray's hit).
+    pub depth: u32,
+    pub w_i: Vec3,
+    /// Density of `w_i` (solid angle).
+    pub pdf: f32,
+    /// `f cos / pdf` of this bounce.
+    pub weight: Vec3,
+    /// The path's throughput after this bounce, before roulette.
+    pub throughput: Vec3,
+    /// Probability that Russian roulette let the path go on (1: no roulette
+    /// at this depth, 0: the path ended here).
+    pub survival: f32,
 }
 
 /// Records nothing; the frame's recorder.
@@ -108,6 +129,10 @@ pub struct PixelTrace {
     pub fragments: Vec<FragmentRecord>,
     /// Radiance returned at each shading depth, innermost first.
     pub shaded: Vec<(u32, Radiance)>,
+    /// Path tracing: the sampled bounces, in order.
+    pub bounces: Vec<Bounce>,
+    /// Photon mapping: the density estimates read, in order.
+    pub photon_estimates: Vec<Radiance>,
     shadow_active: bool,
     /// Index of the ray that events go to (shadow rays interleave with the parent's).
     current: Option<usize>,
@@ -125,6 +150,14 @@ impl PixelTrace {
 }
 
 impl Recorder for PixelTrace {
+    fn bounce(&mut self, bounce: Bounce) {
+        self.bounces.push(bounce);
+    }
+
+    fn photons(&mut self, radiance: Radiance) {
+        self.photon_estimates.push(radiance);
+    }
+
     fn ray(&mut self, ray: &Ray, t_max: f32, depth: u32) {
         if let Some(c) = self.current {
             self.parent.push(c);

@@ -16,6 +16,8 @@ pub struct PreparedScene {
     /// The last shadow maps built (`--shadows map`), keyed by size and lights;
     /// see `PreparedScene::shadow_maps`.
     pub shadow_cache: super::shadow_map::ShadowMapCache,
+    /// The last photon map built (`--gi photons`); see `PreparedScene::photon_map`.
+    pub photon_cache: super::photon_map::PhotonMapCache,
 }
 
 impl PreparedScene {
@@ -24,6 +26,12 @@ impl PreparedScene {
         let start = Instant::now();
         let bvh = Bvh::build(&scene, &edges);
         let build_ms = start.elapsed().as_secs_f64() * 1e3;
-        PreparedScene { scene, edges, bvh, build_ms, shadow_cache: Default::default() }
+        PreparedScene { scene, edges, bvh, build_ms, shadow_cache: Default::default(), photon_cache: Default::default() }
+    }
+
+    /// The photon map for the scene's current lights and materials and the
+    /// photon settings `gi`, from the cache or built now.
+    pub fn photon_map(&self, gi: &super::gi::GiSettings, bump: f32) -> std::sync::Arc<super::photon_map::PhotonMap> {
+        self.photon_cache.get(self, gi, bump)
     }
 }

@@ -2,6 +2,7 @@
 //! `SurfaceHit` to `shade()`. Lights, shadows, BSDF and secondary rays live
 //! here and nowhere else.
 
+use super::gi::{self, GiMode, PathState};
 use super::pixel_record::{LightSample, Recorder};
 use super::{RayCounts, RenderSettings, SceneQuery, ShadowMode};
 use crate::math::{Radiance, Ray, Vec3};
@@ -35,6 +36,7 @@ pub fn shade<Q: SceneQuery, R: Recorder>(
     hit: &SurfaceHit,
     w_o: Vec3,
     depth: u32,
+    path: &mut PathState,
     counts: &mut RayCounts,
     rec: &mut R,
 ) -> Radiance {
@@ -42,7 +44,16 @@ pub fn shade<Q: SceneQuery, R: Recorder>(
     let n = hit.shading_normal;
     let p = hit.position;
     let albedo = material.albedo(hit.uv);
-    let mut l_o = albedo * scene.render.ambient;
+    let mut l_o = match settings.gi.mode {
+        GiMode::None => albedo * scene.render.ambient,
+        // The constant ambient term, dimmed where nearby geometry hides the sky.
+        GiMode::Ao if scene.render.ambient != Vec3::ZERO && albedo != Vec3::ZERO => {
+            let open = gi::ambient_occlusion(query, hit, &settings.gi, settings.shadow_bump, &mut path.rng, counts, rec);
+            albedo * scene.render.ambient * open
+        }
+        // Traced or mapped indirect light replaces the constant.
+        GiMode::Ao | GiMode::Photons | GiMode::Path => Vec3::ZERO,
+    };
 
     for (index, light) in scene.lights.iter().enumerate() {
         let Some(incidence) = Incidence::of(light, p, n) else { continue };
@@ -78,11 +89,174 @@ pub fn shade<Q: SceneQuery, R: Recorder>(
         }
     }
 
-    if material.has_secondary() && depth < settings.max_depth {
-        l_o += secondary(scene, query, settings, hit, material, w_o, depth, counts, rec);
+    match settings.gi.mode {
+        GiMode::Path if depth < settings.gi.max_path_depth() => {
+            l_o += indirect_path(scene, query, settings, hit, material, albedo, w_o, depth, path, counts, rec);
+        }
+        GiMode::Photons => l_o += indirect_photons(scene, query, settings, hit, material, albedo, w_o, depth, path, counts, rec),
+        _ => {}
+    }
+
+    if material.has_secondary() {
+        if settings.gi.mode == GiMode::Path {
+            if depth < settings.gi.max_path_depth() {
+                l_o += secondary_sampled(scene, query, settings, hit, material, w_o, depth, path, counts, rec);
+            }
+        } else if depth < settings.max_depth {
+            l_o += secondary(scene, query, settings, hit, material, w_o, depth, path, counts, rec);
+        }
     }
     rec.shaded(depth, l_o);
     l_o
+}
+
+/// Path tracing's indirect term: one direction sampled from the diffuse and
+/// glossy lobes, the radiance found along it weighted by `f cos / pdf`.
+#[allow(clippy::too_many_arguments)]
+fn indirect_path<Q: SceneQuery, R: Recorder>(
+    scene: &Scene,
+    query: &Q,
+    settings: &RenderSettings,
+    hit: &SurfaceHit,
+    material: &Material,
+    albedo: Vec3,
+    w_o: Vec3,
+    depth: u32,
+    path: &mut PathState,
+    counts: &mut RayCounts,
+    rec: &mut R,
+) -> Radiance {
+    let Some((w_i, weight)) = gi::sample_bounce(material, albedo, hit, w_o, depth, path, rec) else {
+        return Vec3::ZERO;
+    };
+    let ray = hit.spawn_ray_front(w_i, settings.shadow_bump);
+    weight * follow(scene, query, settings, &ray, depth, false, weight, path, counts, rec)
+}
+
+/// `radiance_along` with the path's throughput multiplied by `weight` for
+/// the rest of the path (Russian roulette reads it), restored afterwards.
+#[allow(clippy::too_many_arguments)]
+fn follow<Q: SceneQuery, R: Recorder>(
+    scene: &Scene,
+    query: &Q,
+    settings: &RenderSettings,
+    ray: &Ray,
+    depth: u32,
+    inside: bool,
+    weight: Vec3,
+    path: &mut PathState,
+    counts: &mut RayCounts,
+    rec: &mut R,
+) -> Radiance {
+    let before = path.throughput;
+    path.throughput *= weight;
+    let l = radiance_along(scene, query, settings, ray, depth + 1, inside, path, counts, rec);
+    path.throughput = before;
+    l
+}
+
+/// Photon mapping's indirect term: the map's density estimate at diffuse
+/// surfaces, or at the first hit a final gather of sampled rays whose hits
+/// read the map.
+#[allow(clippy::too_many_arguments)]
+fn indirect_photons<Q: SceneQuery, R: Recorder>(
+    scene: &Scene,
+    query: &Q,
+    settings: &RenderSettings,
+    hit: &SurfaceHit,
+    material: &Material,
+    albedo: Vec3,
+    w_o: Vec3,
+    depth: u32,
+    path: &mut PathState,
+    counts: &mut RayCounts,
+    rec: &mut R,
+) -> Radiance {
+    let Some(map) = path.photons else { return Vec3::ZERO };
+    let gather = settings.gi.final_gather;
+    if depth == 0 && gather > 0 {
+        let mut sum = Vec3::ZERO;
+        for _ in 0..gather {
+            let choice = path.rng.next_f32();
+            let u = path.rng.next_2d();
+            if let Some(s) = super::bsdf_sampling::sample_bsdf(material, albedo, hit.shading_normal, w_o, choice, u) {
+                if s.w_i.dot(hit.geometric_normal) > 0.0 {
+                    let ray = hit.spawn_ray_front(s.w_i, settings.shadow_bump);
+                    sum += s.weight * follow(scene, query, settings, &ray, depth, false, s.weight, path, counts, rec);
+                }
+            }
+        }
+        return sum / gather as f32;
+    }
+    if albedo == Vec3::ZERO && !material.has_glossy() {
+        return Vec3::ZERO;
+    }
+    let l = map.radiance(hit, material, albedo, w_o, settings.gi.photon_k as usize);
+    if R::ENABLED {
+        rec.photons(l);
+    }
+    l
+}
+
+/// The Fresnel reflectance (Schlick's approximation) at a dielectric seen
+/// from `w_o`, and the refracted direction unless the light is totally
+/// reflected. Entering when the front side faces us (spheres flip
+/// `back_face` inside).
+#[inline]
+pub fn refraction(hit: &SurfaceHit, material: &Material, w_o: Vec3) -> (f32, Option<Vec3>) {
+    let n = hit.geometric_normal;
+    let cos_o = w_o.dot(n).clamp(-1.0, 1.0);
+    let (eta_i, eta_t) = if hit.back_face { (material.ior, 1.0) } else { (1.0, material.ior) };
+    let eta = eta_i / eta_t;
+    let sin2_t = eta * eta * (1.0 - cos_o * cos_o).max(0.0);
+    let r0 = ((eta_i - eta_t) / (eta_i + eta_t)).powi(2);
+    let fresnel = if sin2_t >= 1.0 { 1.0 } else { r0 + (1.0 - r0) * (1.0 - cos_o.abs()).powi(5) };
+    let refracted = (sin2_t < 1.0).then(|| {
+        let cos_t = (1.0 - sin2_t).sqrt();
+        (-w_o * eta + n * (eta * cos_o - cos_t)).normalize()
+    });
+    (fresnel, refracted)
+}
+
+/// Path tracing's delta lobes: one of mirror reflection and refraction,
+/// chosen in proportion to its weight, instead of both.
+#[allow(clippy::too_many_arguments)]
+fn secondary_sampled<Q: SceneQuery, R: Recorder>(
+    scene: &Scene,
+    query: &Q,
+    settings: &RenderSettings,
+    hit: &SurfaceHit,
+    material: &Material,
+    w_o: Vec3,
+    depth: u32,
+    path: &mut PathState,
+    counts: &mut RayCounts,
+    rec: &mut R,
+) -> Radiance {
+    let n = hit.geometric_normal;
+    let cos_o = w_o.dot(n).clamp(-1.0, 1.0);
+    let mut reflect_weight = material.mirror;
+    let mut refract = None;
+    if material.transmission != Vec3::ZERO {
+        let (fresnel, dir) = refraction(hit, material, w_o);
+        reflect_weight += material.transmission * fresnel;
+        refract = dir.map(|d| (d, material.transmission * (1.0 - fresnel)));
+    }
+    let refract_weight = refract.map_or(Vec3::ZERO, |r| r.1);
+    let (take_reflection, scale) = gi::choose_lobe(reflect_weight, refract_weight, &mut path.rng);
+    let (ray, weight, inside) = match refract {
+        Some((dir, w)) if !take_reflection => (hit.spawn_ray_back(dir, settings.shadow_bump), w * scale, true),
+        _ if reflect_weight != Vec3::ZERO => {
+            let dir = (2.0 * cos_o * n - w_o).normalize();
+            (hit.spawn_ray_front(dir, settings.shadow_bump), reflect_weight * scale, false)
+        }
+        _ => return Vec3::ZERO,
+    };
+    let Some((survive, _)) = gi::roulette(depth, path.throughput * weight, &mut path.rng) else {
+        return Vec3::ZERO;
+    };
+    let weight = weight * survive;
+    weight * follow(scene, query, settings, &ray, depth, inside, weight, path, counts, rec)
 }
 
 /// How one light arrives at a surface point: the first half of every light's
@@ -189,12 +363,13 @@ pub fn shade_gouraud<Q: SceneQuery, R: Recorder>(
     settings: &RenderSettings,
     hit: &SurfaceHit,
     eye: Vec3,
+    path: &mut PathState,
     counts: &mut RayCounts,
     rec: &mut R,
 ) -> Radiance {
     if hit.kind != crate::scene::PrimitiveKind::Triangle {
         let w_o = (eye - hit.position).normalize_or_zero();
-        return shade(scene, query, settings, hit, w_o, 0, counts, rec);
+        return shade(scene, query, settings, hit, w_o, 0, path, counts, rec);
     }
     let tri = &scene.triangles[hit.primitive as usize];
     let side = if hit.back_face { -1.0 } else { 1.0 };
@@ -210,12 +385,13 @@ pub fn shade_gouraud<Q: SceneQuery, R: Recorder>(
             ..*hit
         };
         let w_o = (eye - tri.v[k]).normalize_or_zero();
-        l_o += hit.barycentric[k] * shade(scene, query, settings, &vertex, w_o, 0, counts, rec);
+        l_o += hit.barycentric[k] * shade(scene, query, settings, &vertex, w_o, 0, path, counts, rec);
     }
     l_o
 }
 
 /// Perfect mirror reflection and Fresnel-weighted refraction.
+#[allow(clippy::too_many_arguments)]
 fn secondary<Q: SceneQuery, R: Recorder>(
     scene: &Scene,
     query: &Q,
@@ -224,6 +400,7 @@ fn secondary<Q: SceneQuery, R: Recorder>(
     material: &Material,
     w_o: Vec3,
     depth: u32,
+    path: &mut PathState,
     counts: &mut RayCounts,
     rec: &mut R,
 ) -> Radiance {
@@ -233,24 +410,16 @@ fn secondary<Q: SceneQuery, R: Recorder>(
     let mut reflect_weight = material.mirror;
     let mut result = Vec3::ZERO;
     if material.transmission != Vec3::ZERO {
-        // Entering when the front side faces us (spheres flip `back_face` inside).
-        let (eta_i, eta_t) = if hit.back_face { (material.ior, 1.0) } else { (1.0, material.ior) };
-        let eta = eta_i / eta_t;
-        let sin2_t = eta * eta * (1.0 - cos_o * cos_o).max(0.0);
-        // Schlick's approximation of the Fresnel reflectance.
-        let r0 = ((eta_i - eta_t) / (eta_i + eta_t)).powi(2);
-        let fresnel = if sin2_t >= 1.0 { 1.0 } else { r0 + (1.0 - r0) * (1.0 - cos_o.abs()).powi(5) };
+        let (fresnel, refracted) = refraction(hit, material, w_o);
         reflect_weight += material.transmission * fresnel;
-        if sin2_t < 1.0 {
-            let cos_t = (1.0 - sin2_t).sqrt();
-            let dir = (-w_o * eta + n * (eta * cos_o - cos_t)).normalize();
+        if let Some(dir) = refracted {
             let ray = hit.spawn_ray_back(dir, settings.shadow_bump);
-            result += material.transmission * (1.0 - fresnel) * radiance_along(scene, query, settings, &ray, depth + 1, true, counts, rec);
+            result += material.transmission * (1.0 - fresnel) * radiance_along(scene, query, settings, &ray, depth + 1, true, path, counts, rec);
         }
     }
     if reflect_weight != Vec3::ZERO {
         let ray = hit.spawn_ray_front(reflect_dir, settings.shadow_bump);
-        result += reflect_weight * radiance_along(scene, query, settings, &ray, depth + 1, false, counts, rec);
+        result += reflect_weight * radiance_along(scene, query, settings, &ray, depth + 1, false, path, counts, rec);
     }
     result
 }
@@ -264,6 +433,7 @@ pub fn radiance_along<Q: SceneQuery, R: Recorder>(
     ray: &Ray,
     depth: u32,
     inside: bool,
+    path: &mut PathState,
     counts: &mut RayCounts,
     rec: &mut R,
 ) -> Radiance {
@@ -272,7 +442,7 @@ pub fn radiance_along<Q: SceneQuery, R: Recorder>(
     let hit = query.closest(ray, f32::INFINITY, inside, counts, rec);
     rec.closest(hit.as_ref());
     match hit {
-        Some(h) => shade(scene, query, settings, &h, -ray.dir, depth, counts, rec),
+        Some(h) => shade(scene, query, settings, &h, -ray.dir, depth, path, counts, rec),
         None => {
             rec.shaded(depth, scene.render.background);
             scene.render.background

@@ -14,6 +14,7 @@ const SCENES: &[(&str, &str)] = &[
     ("spheres", include_str!("../../assets/scenes/spheres.toml")),
     ("bunny", include_str!("../../assets/scenes/bunny.toml")),
     ("test-pattern", include_str!("../../assets/scenes/test-pattern.toml")),
+    ("cornell-gi", include_str!("../../assets/scenes/cornell-gi.toml")),
 ];
 
 /// The scene the viewer opens when given none.

@@ -70,6 +70,8 @@ pub struct Accumulator {
     /// The next band starts at row `row` of pass `pass`.
     pass: u32,
     row: u32,
+    /// The photon map every pass reads (`--gi photons`), built with the first band.
+    photons: Option<std::sync::Arc<crate::render::photon_map::PhotonMap>>,
 }
 
 impl Accumulator {
@@ -87,6 +89,7 @@ impl Accumulator {
             counts: RayCounts::default(),
             pass: 0,
             row: 0,
+            photons: None,
             settings,
         }
     }
@@ -126,6 +129,7 @@ impl Accumulator {
         let (width, height) = (self.settings.width, self.settings.height);
         if self.pass == 0 && self.row == 0 {
             super::build_shadow_maps(prepared, &self.settings);
+            self.photons = super::build_photon_map(prepared, &self.settings);
         }
         let rows = self.row..(self.row + max_rows.max(1)).min(height);
         let mut counts = RayCounts::default();
@@ -136,6 +140,8 @@ impl Accumulator {
                 view: &view,
                 settings: &self.settings,
                 offset: sample_offset(self.pass, self.spp),
+                sample: self.pass,
+                photons: self.photons.as_deref(),
                 rows: rows.clone(),
                 cancel,
             };

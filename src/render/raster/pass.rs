@@ -68,7 +68,7 @@ pub struct Layer<'a> {
 
 /// `job` with its sample at `offset` and its rows `rows`.
 fn job_at_offset<'a>(job: &PassJob<'a>, offset: Vec2, rows: Range<u32>) -> PassJob<'a> {
-    PassJob { prepared: job.prepared, view: job.view, settings: job.settings, offset, rows, cancel: job.cancel }
+    PassJob { offset, rows, ..*job }
 }
 
 impl<'a> Layer<'a> {

@@ -353,9 +353,9 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         if self.is_focus(x, y) {
             self.rec.ray(&ray, self.far_t(x, y), 0);
             self.rec.closest(hit.as_ref());
-            return resolve_sample(self.job, self.query, &ray, hit.as_ref(), &mut self.counts, &mut self.rec);
+            return resolve_sample(self.job, self.query, &ray, hit.as_ref(), self.job.pixel_index(x, y), &mut self.counts, &mut self.rec);
         }
-        resolve_sample(self.job, self.query, &ray, hit.as_ref(), &mut self.counts, &mut NoRecord)
+        resolve_sample(self.job, self.query, &ray, hit.as_ref(), self.job.pixel_index(x, y), &mut self.counts, &mut NoRecord)
     }
 
     /// True when the frame shows the cost view instead of shading.

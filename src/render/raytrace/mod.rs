@@ -56,5 +56,5 @@ pub fn cast_pixel<Q: SceneQuery, R: Recorder>(job: &PassJob, query: &Q, x: u32, 
         rec.shaded(0, c);
         return c;
     }
-    resolve_sample(job, query, &ray, hit.as_ref(), counts, rec)
+    resolve_sample(job, query, &ray, hit.as_ref(), job.pixel_index(x, y), counts, rec)
 }

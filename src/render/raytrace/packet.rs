@@ -429,7 +429,7 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
                     let (tx, ty) = lane_xy(i);
                     let shadow = (shadow_valid & 1 << i != 0).then(|| (shadow_pk.rays[i], shadow_pk.t_max[i], shadow_pk.occluder(i)));
                     let pixel_query = PixelQuery { bvh: query, shadow };
-                    band[ty * width + x0 + tx] = resolve_sample(job, &pixel_query, &pk.rays[i], hits[i].as_ref(), &mut counts, &mut NoRecord);
+                    band[ty * width + x0 + tx] = resolve_sample(job, &pixel_query, &pk.rays[i], hits[i].as_ref(), job.pixel_index((x0 + tx) as u32, (y0 + ty) as u32), &mut counts, &mut NoRecord);
                 }
             }
             counts
@@ -509,7 +509,7 @@ mod tests {
                     let Some(hit) = query.closest(&ray, view.far_t(x as f32 + 0.5, y as f32 + 0.5), false, &mut RayCounts::default(), &mut NoRecord) else { continue };
                     let expected = with_shading_hit(interpolation, &hit, |h| cast_shadow_ray(&prepared.scene, h, light, settings.shadow_bump)).flatten();
                     let mut trace = PixelTrace::new();
-                    with_shading_hit(interpolation, &hit, |h| shade(&prepared.scene, &query, &settings, h, -ray.dir, 0, &mut RayCounts::default(), &mut trace));
+                    with_shading_hit(interpolation, &hit, |h| shade(&prepared.scene, &query, &settings, h, -ray.dir, 0, &mut crate::render::gi::PathState::new(0, 0, 1, &settings.gi, None), &mut RayCounts::default(), &mut trace));
                     let cast = trace.lights.iter().find(|l| l.light == 0).and_then(|l| l.shadow_ray);
                     assert_eq!(expected.map(bits), cast.map(bits), "{name} {interpolation:?} pixel ({x}, {y})");
                     compared += expected.is_some() as u32;

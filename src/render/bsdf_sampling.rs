@@ -1,0 +1,161 @@
+//! Importance sampling of the BSDF's non-delta lobes for path tracing: the
+//! Lambertian lobe by cosine and the normalized Blinn-Phong lobe by its half
+//! vector, chosen between in proportion to their albedo. `bsdf()` itself
+//! stays the one definition of the reflectance.
+
+use super::sampling::{blinn_phong_half, blinn_phong_pdf, cosine_hemisphere, cosine_hemisphere_pdf, from_local, luminance, reflect};
+use super::shade::bsdf;
+use crate::math::{Vec2, Vec3};
+use crate::scene::Material;
+
+/// A sampled incoming direction with what the estimator needs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BsdfSample {
+    /// Unit, pointing away from the surface.
+    pub w_i: Vec3,
+    /// The density of `w_i` under the lobe mixture (solid angle).
+    pub pdf: f32,
+    /// `f(w_i, w_o) cos(theta_i) / pdf`: what the radiance arriving along
+    /// `w_i` is multiplied by.
+    pub weight: Vec3,
+}
+
+/// The probability of choosing the Lambertian lobe; the glossy lobe takes the rest.
+#[inline]
+fn diffuse_probability(material: &Material, albedo: Vec3) -> f32 {
+    let d = luminance(albedo).max(0.0);
+    let g = if material.has_glossy() { luminance(material.glossy).max(0.0) } else { 0.0 };
+    if d + g > 0.0 { d / (d + g) } else { 0.0 }
+}
+
+/// The density with which `sample_bsdf` returns `w_i`.
+pub fn bsdf_pdf(material: &Material, albedo: Vec3, n: Vec3, w_o: Vec3, w_i: Vec3) -> f32 {
+    let p_d = diffuse_probability(material, albedo);
+    let mut pdf = p_d * cosine_hemisphere_pdf(n.dot(w_i));
+    if material.has_glossy() && p_d < 1.0 {
+        pdf += (1.0 - p_d) * blinn_phong_pdf(n, w_o, w_i, material.sharpness);
+    }
+    pdf
+}
+
+/// Samples an incoming direction at a surface with shading normal `n` seen
+/// from `w_o`; `choice` picks the lobe, `u` places the direction. `None` when
+/// the material reflects nothing diffusely or glossily, or the sample falls
+/// below the surface (that path ends: its light is absorbed).
+pub fn sample_bsdf(material: &Material, albedo: Vec3, n: Vec3, w_o: Vec3, choice: f32, u: Vec2) -> Option<BsdfSample> {
+    let p_d = diffuse_probability(material, albedo);
+    let has_glossy = material.has_glossy() && p_d < 1.0;
+    if p_d <= 0.0 && !has_glossy {
+        return None;
+    }
+    let w_i = if choice < p_d {
+        from_local(cosine_hemisphere(u), n)
+    } else {
+        let h = from_local(blinn_phong_half(u, material.sharpness), n);
+        reflect(w_o, h)
+    };
+    if !(n.dot(w_i) > 0.0) {
+        return None;
+    }
+    let w_i = w_i.normalize();
+    let cos_i = n.dot(w_i);
+    let pdf = bsdf_pdf(material, albedo, n, w_o, w_i);
+    if !(pdf > 0.0 && pdf.is_finite()) {
+        return None;
+    }
+    let weight = bsdf(material, albedo, n, w_i, w_o) * (cos_i / pdf);
+    weight.is_finite().then_some(BsdfSample { w_i, pdf, weight })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::sampling::SampleRng;
+
+    /// The Monte Carlo estimate of the directional albedo `∫ f cos dw`.
+    fn albedo_estimate(m: &Material, w_o: Vec3, n: usize) -> Vec3 {
+        let mut r = SampleRng::for_index(21, 0, 1);
+        // Summed in f64: 10^5 f32 additions would drift by more than the test allows.
+        let mut sum = glam::DVec3::ZERO;
+        for _ in 0..n {
+            let choice = r.next_f32();
+            if let Some(s) = sample_bsdf(m, m.lambertian, Vec3::Z, w_o, choice, r.next_2d()) {
+                sum += s.weight.as_dvec3();
+            }
+        }
+        (sum / n as f64).as_vec3()
+    }
+
+    #[test]
+    fn lambertian_reflects_its_albedo() {
+        let mut m = Material::black();
+        m.lambertian = Vec3::new(0.73, 0.4, 0.1);
+        for w_o in [Vec3::Z, Vec3::new(0.8, 0.0, 0.6)] {
+            let a = albedo_estimate(&m, w_o, 20_000);
+            assert!((a - m.lambertian).abs().max_element() < 1e-4, "{a}");
+        }
+    }
+
+    /// `∫ f cos dw` of the glossy lobe by a midpoint rule over the hemisphere:
+    /// an estimate that shares no code with the sampling.
+    fn albedo_by_quadrature(m: &Material, w_o: Vec3) -> f32 {
+        let (n_theta, n_phi) = (200, 400);
+        let (d_theta, d_phi) = (std::f32::consts::FRAC_PI_2 / n_theta as f32, 2.0 * std::f32::consts::PI / n_phi as f32);
+        let mut sum = 0.0f64;
+        for i in 0..n_theta {
+            let theta = (i as f32 + 0.5) * d_theta;
+            for j in 0..n_phi {
+                let phi = (j as f32 + 0.5) * d_phi;
+                let w_i = Vec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos());
+                sum += (bsdf(m, Vec3::ZERO, Vec3::Z, w_i, w_o).x * w_i.z * theta.sin() * d_theta * d_phi) as f64;
+            }
+        }
+        sum as f32
+    }
+
+    /// Sampling the glossy lobe estimates its albedo without bias, at every
+    /// sharpness and angle. The lobe's normalization `(s + 8) / (8 pi)` is
+    /// itself an approximation: at normal incidence it reflects up to about
+    /// 7.5% more than arrives (s near 8); the test pins that excess down so a
+    /// change to the lobe is noticed.
+    #[test]
+    fn blinn_phong_sampling_estimates_the_lobes_albedo() {
+        for sharpness in [0.0f32, 1.0, 4.0, 16.0, 64.0, 256.0, 2048.0] {
+            let mut m = Material::black();
+            m.glossy = Vec3::ONE;
+            m.sharpness = sharpness;
+            for cos_o in [1.0f32, 0.7, 0.3] {
+                let w_o = Vec3::new((1.0 - cos_o * cos_o).sqrt(), 0.0, cos_o);
+                let sampled = albedo_estimate(&m, w_o, 100_000).x;
+                let exact = albedo_by_quadrature(&m, w_o);
+                assert!((sampled - exact).abs() < 0.02 * exact.max(0.1), "sharpness {sharpness}, cos_o {cos_o}: sampled {sampled}, quadrature {exact}");
+                assert!(exact <= 1.08, "sharpness {sharpness}, cos_o {cos_o}: the lobe reflects {exact}");
+            }
+        }
+    }
+
+    #[test]
+    fn pdf_agrees_with_the_sampled_mixture() {
+        // The mixture density must integrate to at most one over the hemisphere
+        // and to one when no sample can fall below it (w_o along n, diffuse).
+        let mut m = Material::black();
+        m.lambertian = Vec3::splat(0.5);
+        m.glossy = Vec3::splat(0.3);
+        m.sharpness = 20.0;
+        let w_o = Vec3::new(0.3, 0.1, 0.9).normalize();
+        let mut r = SampleRng::for_index(22, 0, 1);
+        let n = 200_000;
+        let mut integral = 0.0f64;
+        for _ in 0..n {
+            // Uniform hemisphere: integral of pdf = mean(pdf / (1 / 2 pi)).
+            let u = r.next_2d();
+            let z = u.x;
+            let s = (1.0 - z * z).sqrt();
+            let phi = 2.0 * std::f32::consts::PI * u.y;
+            let w_i = Vec3::new(s * phi.cos(), s * phi.sin(), z);
+            integral += (bsdf_pdf(&m, m.lambertian, Vec3::Z, w_o, w_i) * 2.0 * std::f32::consts::PI) as f64;
+        }
+        let integral = integral / n as f64;
+        assert!(integral <= 1.01 && integral > 0.9, "{integral}");
+    }
+}

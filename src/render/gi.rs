@@ -1,0 +1,232 @@
+//! Indirect light behind every renderer's primary visibility: ambient
+//! occlusion, unidirectional path tracing and photon mapping. All three are
+//! parts of `shade()`, so the ray casters and the rasterizers get them alike;
+//! their random numbers come from the sample's own stream (`SampleRng`).
+
+use super::bsdf_sampling::sample_bsdf;
+use super::photon_map::PhotonMap;
+use super::pixel_record::{Bounce, Recorder};
+use super::sampling::{cosine_hemisphere, from_local, luminance, SampleRng};
+use super::{RayCounts, SceneQuery};
+use crate::math::{Radiance, Vec3};
+use crate::named::named_enum;
+use crate::scene::SurfaceHit;
+
+named_enum! {
+    /// How light that has bounced off other surfaces is accounted for.
+    #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+    pub enum GiMode ("gi mode") {
+        /// Direct light plus the scene's constant ambient term.
+        #[default]
+        None = "none",
+        /// The ambient term weighted by the unoccluded part of the hemisphere.
+        Ao = "ao",
+        /// Indirect light estimated from photons shot from the lights.
+        Photons = "photons",
+        /// Unidirectional path tracing with next-event estimation.
+        Path = "path",
+    }
+}
+
+/// The knobs of the indirect-light modes.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
+pub struct GiSettings {
+    pub mode: GiMode,
+    /// Path tracing: indirect bounces; `None` = as many as Russian roulette
+    /// lets live (up to `MAX_BOUNCES`).
+    pub bounces: Option<u32>,
+    /// Ambient occlusion: hemisphere rays per sample, and how far they look.
+    pub ao_samples: u32,
+    pub ao_distance: f32,
+    /// Photon mapping: photons shot, and neighbours per density estimate.
+    pub photons: u32,
+    pub photon_k: u32,
+    /// Photon mapping: rays gathered at the first hit (0: read the map there).
+    pub final_gather: u32,
+    /// Every random number depends on (pixel, sample index, seed) only.
+    pub seed: u64,
+}
+
+impl Default for GiSettings {
+    fn default() -> Self {
+        GiSettings { mode: GiMode::None, bounces: None, ao_samples: 16, ao_distance: 1.0, photons: 200_000, photon_k: 64, final_gather: 0, seed: 0 }
+    }
+}
+
+/// Unbounded paths still stop here, so recursion depth stays bounded; the
+/// throughput left after this many bounces off anything but a perfect
+/// mirror is far below what a pixel can show.
+pub const MAX_BOUNCES: u32 = 100;
+
+/// Paths shorter than this never face Russian roulette.
+const ROULETTE_DEPTH: u32 = 5;
+
+impl GiSettings {
+    /// The deepest ray a path may cast (0 = eye ray), for `Path`.
+    pub fn max_path_depth(&self) -> u32 {
+        self.bounces.map_or(MAX_BOUNCES, |b| b.min(MAX_BOUNCES))
+    }
+}
+
+/// What a sample carries down its path: its random numbers, the product of
+/// the weights so far (for Russian roulette), and the photon map to read.
+pub struct PathState<'a> {
+    pub rng: SampleRng,
+    pub throughput: Vec3,
+    pub photons: Option<&'a PhotonMap>,
+}
+
+impl<'a> PathState<'a> {
+    pub fn new(pixel: u32, sample: u32, spp: u32, gi: &GiSettings, photons: Option<&'a PhotonMap>) -> PathState<'a> {
+        PathState { rng: SampleRng::stratified(pixel, sample, spp, gi.seed), throughput: Vec3::ONE, photons }
+    }
+}
+
+/// The unoccluded fraction of the cosine-weighted hemisphere above `hit`
+/// within `distance`, estimated with `samples` rays.
+pub fn ambient_occlusion<Q: SceneQuery, R: Recorder>(
+    query: &Q,
+    hit: &SurfaceHit,
+    gi: &GiSettings,
+    bump: f32,
+    rng: &mut SampleRng,
+    counts: &mut RayCounts,
+    rec: &mut R,
+) -> f32 {
+    let samples = gi.ao_samples.max(1);
+    let mut open = 0u32;
+    for _ in 0..samples {
+        let dir = from_local(cosine_hemisphere(rng.next_2d()), hit.shading_normal);
+        // Directions below the geometric surface are blocked by it.
+        if dir.dot(hit.geometric_normal) <= 0.0 {
+            continue;
+        }
+        let ray = hit.spawn_ray_front(dir, bump);
+        counts.shadow += 1;
+        rec.in_shadow_ray(true);
+        rec.ray(&ray, gi.ao_distance, 1);
+        let blocked = query.occluder(&ray, gi.ao_distance, counts, rec).is_some();
+        rec.in_shadow_ray(false);
+        open += (!blocked) as u32;
+    }
+    open as f32 / samples as f32
+}
+
+/// Russian roulette for a path about to continue with `throughput`: `None`
+/// ends it, otherwise the factor that keeps the estimate unbiased.
+pub fn roulette(depth: u32, throughput: Vec3, rng: &mut SampleRng) -> Option<(f32, f32)> {
+    if depth < ROULETTE_DEPTH {
+        return Some((1.0, 1.0));
+    }
+    let q = throughput.max_element().clamp(0.05, 0.95);
+    (rng.next_f32() < q).then_some((1.0 / q, q))
+}
+
+/// One sampled bounce off the non-delta lobes at `hit`: the direction and
+/// its weight, with the roulette applied; `None` when the path ends here.
+#[allow(clippy::too_many_arguments)]
+pub fn sample_bounce<R: Recorder>(
+    material: &crate::scene::Material,
+    albedo: Vec3,
+    hit: &SurfaceHit,
+    w_o: Vec3,
+    depth: u32,
+    path: &mut PathState,
+    rec: &mut R,
+) -> Option<(Vec3, Vec3)> {
+    let choice = path.rng.next_f32();
+    let u = path.rng.next_2d();
+    let s = sample_bsdf(material, albedo, hit.shading_normal, w_o, choice, u)?;
+    // A direction into the geometric surface would leave from its far side.
+    if s.w_i.dot(hit.geometric_normal) <= 0.0 {
+        return None;
+    }
+    let survival = roulette(depth, path.throughput * s.weight, &mut path.rng);
+    if R::ENABLED {
+        rec.bounce(Bounce { depth, w_i: s.w_i, pdf: s.pdf, weight: s.weight, throughput: path.throughput * s.weight, survival: survival.map_or(0.0, |x| x.1) });
+    }
+    let (scale, _) = survival?;
+    Some((s.w_i, s.weight * scale))
+}
+
+/// Radiance from the photon map at a diffuse point seen from `w_o`.
+pub fn photon_estimate(photons: &PhotonMap, hit: &SurfaceHit, material: &crate::scene::Material, albedo: Vec3, w_o: Vec3, k: u32) -> Radiance {
+    photons.radiance(hit, material, albedo, w_o, k as usize)
+}
+
+/// Choose between two delta lobes with weights `a` and `b` in proportion to
+/// their luminance: `Some(true)` picks `a`; the factor keeps the estimate unbiased.
+pub fn choose_lobe(a: Vec3, b: Vec3, rng: &mut SampleRng) -> (bool, f32) {
+    let (la, lb) = (luminance(a).max(0.0), luminance(b).max(0.0));
+    if lb <= 0.0 {
+        return (true, 1.0);
+    }
+    if la <= 0.0 {
+        return (false, 1.0);
+    }
+    let p = la / (la + lb);
+    if rng.next_f32() < p { (true, 1.0 / p) } else { (false, 1.0 / (1.0 - p)) }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::PreparedScene;
+    use crate::render::pixel_record::NoRecord;
+    use crate::render::raytrace::bvh::BvhQuery;
+    use crate::scene::{PrimitiveKind, Scene, Triangle};
+    use crate::math::Vec2;
+
+    /// A point at distance d from an infinite wall, facing it, sees the wall
+    /// within distance D in the directions with cos(theta) > d / D, whose
+    /// cosine-weighted share is 1 - (d/D)^2: the unoccluded fraction is (d/D)^2.
+    #[test]
+    fn occlusion_by_a_wall_matches_the_analytic_fraction() {
+        let big = 1e4;
+        let mut scene = Scene::default();
+        scene.materials.push(crate::scene::Material::default_grey());
+        let wall = [Vec3::new(-big, -big, 0.0), Vec3::new(big, -big, 0.0), Vec3::new(big, big, 0.0), Vec3::new(-big, big, 0.0)];
+        for t in [[0, 1, 2], [0, 2, 3]] {
+            scene.triangles.push(Triangle { v: t.map(|i| wall[i]), n: [Vec3::Z; 3], uv: [Vec2::ZERO; 3], material: 0, object: 0, two_sided: true });
+        }
+        let prepared = PreparedScene::new(scene);
+        let query = BvhQuery::new(&prepared);
+        for (d, distance) in [(0.5f32, 1.0f32), (0.25, 1.0), (1.0, 4.0), (2.0, 1.0)] {
+            let hit = SurfaceHit {
+                position: Vec3::new(0.3, -0.2, d),
+                geometric_normal: -Vec3::Z,
+                shading_normal: -Vec3::Z,
+                barycentric: Vec3::ZERO,
+                uv: Vec2::ZERO,
+                t: 1.0,
+                kind: PrimitiveKind::Sphere,
+                primitive: 0,
+                object: 0,
+                material: 0,
+                back_face: false,
+            };
+            let gi = GiSettings { mode: GiMode::Ao, ao_samples: 20_000, ao_distance: distance, ..GiSettings::default() };
+            let mut rng = SampleRng::for_pixel(1, 2, 3);
+            let open = ambient_occlusion(&query, &hit, &gi, 0.0, &mut rng, &mut RayCounts::default(), &mut NoRecord);
+            let exact = (d / distance).min(1.0).powi(2);
+            let sigma = (exact * (1.0 - exact) / 20_000.0).sqrt();
+            assert!((open - exact).abs() <= 4.0 * sigma + 1e-6, "d {d}, D {distance}: {open} vs {exact}");
+        }
+    }
+
+    #[test]
+    fn roulette_keeps_the_expected_weight() {
+        let mut rng = SampleRng::for_index(5, 0, 0);
+        let t = Vec3::splat(0.3);
+        let n = 100_000;
+        let mut sum = 0.0f64;
+        for _ in 0..n {
+            if let Some((scale, _)) = roulette(10, t, &mut rng) {
+                sum += scale as f64;
+            }
+        }
+        assert!((sum / n as f64 - 1.0).abs() < 0.02, "{}", sum / n as f64);
+        assert_eq!(roulette(0, Vec3::ZERO, &mut rng), Some((1.0, 1.0)));
+    }
+}

@@ -1,0 +1,246 @@
+//! Photon mapping (Jensen): photons shot from the lights bounce through the
+//! scene and are stored where they land on diffuse surfaces after at least
+//! one bounce, so the map holds the indirect light, caustics included, while
+//! `shade()` keeps computing direct light with shadow rays. Radiance is
+//! estimated from the k nearest photons. The map is built once per scene,
+//! lights, materials and photon settings, and cached on the prepared scene.
+
+use super::gi::GiSettings;
+use super::kd_tree::{KdTree, Neighbour};
+use super::pixel_record::NoRecord;
+use super::raytrace::bvh::BvhQuery;
+use super::sampling::{cosine_hemisphere, from_local, luminance, tangents, uniform_disk, uniform_sphere, SampleRng};
+use super::shade::{bsdf, refraction};
+use super::{PreparedScene, RayCounts, SceneQuery};
+use crate::math::{Radiance, Ray, Vec3};
+use crate::scene::{Light, Material, Scene, SurfaceHit};
+use rayon::prelude::*;
+use std::cell::RefCell;
+use std::f32::consts::PI;
+use std::sync::{Arc, Mutex};
+
+/// One stored photon.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Photon {
+    pub position: Vec3,
+    /// Unit direction back towards where the photon came from.
+    pub w_i: Vec3,
+    /// Flux it carries (watts per colour channel).
+    pub power: Vec3,
+    /// The geometric normal of the surface it landed on (photons on the
+    /// other side of a thin wall must not light this side).
+    pub normal: Vec3,
+}
+
+/// The seed stream photons draw from, apart from every pixel's.
+const PHOTON_STREAM: u64 = 0x70686f746f6e;
+
+/// A photon path ends after this many bounces whatever roulette says.
+const MAX_PHOTON_BOUNCES: u32 = 32;
+
+pub struct PhotonMap {
+    tree: KdTree<Photon>,
+    /// Photons shot (the stored ones are fewer: some escape or are absorbed).
+    pub shot: u32,
+    /// No photon farther than this (squared) enters an estimate.
+    max_radius2: f32,
+    /// What the map was built from, to know when it must be rebuilt.
+    key: MapKey,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+struct MapKey {
+    lights: Vec<Light>,
+    /// Per material: the terms photons read (textures are never edited).
+    materials: Vec<[f32; 13]>,
+    photons: u32,
+    seed: u64,
+    bump: u32,
+}
+
+impl MapKey {
+    fn of(scene: &Scene, gi: &GiSettings, bump: f32) -> MapKey {
+        let m = |m: &Material| {
+            let (l, g, r, t) = (m.lambertian, m.glossy, m.mirror, m.transmission);
+            [l.x, l.y, l.z, g.x, g.y, g.z, r.x, r.y, r.z, t.x, t.y, t.z, m.ior]
+        };
+        MapKey { lights: scene.lights.clone(), materials: scene.materials.iter().map(m).collect(), photons: gi.photons, seed: gi.seed, bump: bump.to_bits() }
+    }
+}
+
+/// The last map built for a prepared scene.
+#[derive(Default)]
+pub struct PhotonMapCache(Mutex<Option<Arc<PhotonMap>>>);
+
+impl PhotonMapCache {
+    /// The map for the scene as it is now, built (in parallel) if the cached
+    /// one was made from other lights, materials or settings.
+    pub fn get(&self, prepared: &PreparedScene, gi: &GiSettings, bump: f32) -> Arc<PhotonMap> {
+        let key = MapKey::of(&prepared.scene, gi, bump);
+        let mut cached = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(map) = cached.as_ref() {
+            if map.key == key {
+                return map.clone();
+            }
+        }
+        let map = Arc::new(PhotonMap::build(prepared, gi, bump, key));
+        *cached = Some(map.clone());
+        map
+    }
+}
+
+thread_local! {
+    static NEIGHBOURS: RefCell<Vec<Neighbour>> = const { RefCell::new(Vec::new()) };
+}
+
+impl PhotonMap {
+    fn build(prepared: &PreparedScene, gi: &GiSettings, bump: f32, key: MapKey) -> PhotonMap {
+        let scene = &prepared.scene;
+        let query = BvhQuery::new(prepared);
+        let (center, radius) = match scene.bounds() {
+            Some((lo, hi)) => ((lo + hi) * 0.5, ((hi - lo).length() * 0.5).max(1e-3)),
+            None => (Vec3::ZERO, 1.0),
+        };
+        // Lights are picked in proportion to the flux they send into the scene.
+        let flux: Vec<Vec3> = scene
+            .lights
+            .iter()
+            .map(|l| match *l {
+                Light::Point { power, .. } => power,
+                Light::Directional { irradiance, .. } => irradiance * (PI * radius * radius),
+            })
+            .collect();
+        let weights: Vec<f32> = flux.iter().map(|f| luminance(*f).max(0.0)).collect();
+        let total: f32 = weights.iter().sum();
+        let shot = gi.photons;
+        let photons: Vec<Photon> = if total > 0.0 && total.is_finite() && shot > 0 {
+            (0..shot)
+                .into_par_iter()
+                .map(|i| {
+                    let mut rng = SampleRng::for_index(PHOTON_STREAM, i as u64, gi.seed);
+                    let mut pick = rng.next_f32() * total;
+                    let mut light = weights.len() - 1;
+                    for (k, w) in weights.iter().enumerate() {
+                        if pick < *w {
+                            light = k;
+                            break;
+                        }
+                        pick -= w;
+                    }
+                    let p_light = weights[light] / total;
+                    let power = flux[light] / (shot as f32 * p_light);
+                    let ray = match scene.lights[light] {
+                        Light::Point { position, .. } => Ray::new(position, uniform_sphere(rng.next_2d())),
+                        Light::Directional { direction, .. } => {
+                            let d = direction.normalize_or_zero();
+                            let (t, b) = tangents(d);
+                            let o = uniform_disk(rng.next_2d()) * radius;
+                            Ray::new(center - d * (2.0 * radius) + t * o.x + b * o.y, d)
+                        }
+                    };
+                    trace_photon(scene, &query, ray, power, bump, &mut rng)
+                })
+                .flatten_iter()
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let tree = KdTree::build(photons, |p| p.position);
+        // The estimate's radius is capped at a tenth of the scene: beyond it,
+        // a sparse map would smear light across whole walls.
+        let max_radius2 = (0.1 * radius) * (0.1 * radius);
+        PhotonMap { tree, shot, max_radius2, key }
+    }
+
+    /// Photons stored.
+    pub fn len(&self) -> usize {
+        self.tree.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.tree.is_empty()
+    }
+
+    /// Reflected radiance towards `w_o` at `hit` from the `k` nearest photons:
+    /// the sum of `f * flux` over a disc of their radius, divided by its area.
+    pub fn radiance(&self, hit: &SurfaceHit, material: &Material, albedo: Vec3, w_o: Vec3, k: usize) -> Radiance {
+        NEIGHBOURS.with(|cell| {
+            let mut found = cell.borrow_mut();
+            self.tree.nearest(hit.position, k.max(1), self.max_radius2, &mut found);
+            let Some(last) = found.last() else { return Radiance::ZERO };
+            let r2 = last.distance2;
+            if r2 <= 0.0 {
+                return Radiance::ZERO;
+            }
+            let mut sum = Vec3::ZERO;
+            for nb in found.iter() {
+                let p = self.tree.item(nb.index);
+                if p.normal.dot(hit.geometric_normal) <= 0.0 || p.w_i.dot(hit.shading_normal) <= 0.0 {
+                    continue;
+                }
+                sum += bsdf(material, albedo, hit.shading_normal, p.w_i, w_o) * p.power;
+            }
+            sum / (PI * r2)
+        })
+    }
+}
+
+/// Follows one photon from the light, storing it at each diffuse surface it
+/// reaches after its first bounce, until it is absorbed or escapes.
+fn trace_photon(scene: &Scene, query: &BvhQuery, mut ray: Ray, mut power: Vec3, bump: f32, rng: &mut SampleRng) -> Vec<Photon> {
+    let mut stored = Vec::new();
+    let mut inside = false;
+    let mut counts = RayCounts::default();
+    for bounce in 0..MAX_PHOTON_BOUNCES {
+        let Some(hit) = query.closest(&ray, f32::INFINITY, inside, &mut counts, &mut NoRecord) else { break };
+        let material = &scene.materials[hit.material as usize];
+        let albedo = material.albedo(hit.uv);
+        let diffuse = albedo + if material.has_glossy() { material.glossy } else { Vec3::ZERO };
+        if bounce > 0 && diffuse != Vec3::ZERO {
+            stored.push(Photon { position: hit.position, w_i: -ray.dir, power, normal: hit.geometric_normal });
+        }
+        // Russian roulette between the lobes by their luminance.
+        let (p_d, p_m, p_t) = (luminance(diffuse).max(0.0), luminance(material.mirror).max(0.0), luminance(material.transmission).max(0.0));
+        let sum = p_d + p_m + p_t;
+        let scale = if sum > 1.0 { 1.0 / sum } else { 1.0 };
+        let (p_d, p_m, p_t) = (p_d * scale, p_m * scale, p_t * scale);
+        let u = rng.next_f32();
+        let w_o = -ray.dir;
+        if u < p_d {
+            let dir = from_local(cosine_hemisphere(rng.next_2d()), hit.shading_normal);
+            if dir.dot(hit.geometric_normal) <= 0.0 {
+                break;
+            }
+            power *= diffuse / p_d;
+            ray = hit.spawn_ray_front(dir, bump);
+            inside = false;
+        } else if u < p_d + p_m {
+            let n = hit.geometric_normal;
+            let dir = (2.0 * w_o.dot(n) * n - w_o).normalize();
+            power *= material.mirror / p_m;
+            ray = hit.spawn_ray_front(dir, bump);
+            inside = false;
+        } else if u < p_d + p_m + p_t {
+            power *= material.transmission / p_t;
+            let (fresnel, refracted) = refraction(&hit, material, w_o);
+            match refracted {
+                Some(dir) if rng.next_f32() >= fresnel => {
+                    ray = hit.spawn_ray_back(dir, bump);
+                    inside = true;
+                }
+                _ => {
+                    let n = hit.geometric_normal;
+                    let dir = (2.0 * w_o.dot(n) * n - w_o).normalize();
+                    ray = hit.spawn_ray_front(dir, bump);
+                    inside = false;
+                }
+            }
+        } else {
+            break;
+        }
+        if !power.is_finite() {
+            break;
+        }
+    }
+    stored
+}

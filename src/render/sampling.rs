@@ -1,0 +1,418 @@
+//! Random numbers and direction sampling for the stochastic shading modes
+//! (ambient occlusion, path tracing, photon mapping). Every number is a pure
+//! function of (pixel, sample index, seed) and its position in the stream, so
+//! images never depend on the thread count and a replayed pixel draws exactly
+//! the numbers its frame drew.
+
+use crate::math::{Vec2, Vec3};
+use std::f32::consts::PI;
+
+/// The uniform numbers of one sample: a counter hashed with the sample's key
+/// (a counter-based generator: no state is shared between samples).
+#[derive(Clone, Debug)]
+pub struct SampleRng {
+    key: u64,
+    counter: u64,
+    /// This sample's index among the pixel's `spp`, and the 2D dimensions
+    /// drawn so far: the first `STRATIFIED_PAIRS` pairs are stratified
+    /// across the pixel's samples (each sample takes its own cell, the
+    /// cells shuffled per pixel and dimension), as a stratified sampler does.
+    sample: u32,
+    spp: u32,
+    pairs: u32,
+}
+
+/// How many 2D draws per sample are stratified across the pixel's samples;
+/// later ones (deep bounces, where stratification no longer pays) are plain.
+const STRATIFIED_PAIRS: u32 = 8;
+
+/// The 64-bit finalizer of SplitMix64: a bijection that scrambles every input
+/// bit into every output bit.
+#[inline]
+fn mix64(mut z: u64) -> u64 {
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+const GOLDEN: u64 = 0x9E37_79B9_7F4A_7C15;
+
+impl SampleRng {
+    /// The stream of sample `sample` of pixel `pixel` (`x + y * width`).
+    /// Cheap to make: the key is scrambled on the first draw, so samples
+    /// that draw nothing (direct light only) pay nothing.
+    #[inline]
+    pub fn for_pixel(pixel: u32, sample: u32, seed: u64) -> SampleRng {
+        SampleRng::stratified(pixel, sample, 1, seed)
+    }
+
+    /// As `for_pixel`, for sample `sample` of `spp`, with the first 2D draws
+    /// stratified across the pixel's `spp` samples.
+    #[inline]
+    pub fn stratified(pixel: u32, sample: u32, spp: u32, seed: u64) -> SampleRng {
+        // The key names the pixel only: the samples of a pixel share their
+        // cell shuffles and differ in which cell they take.
+        let key = (pixel as u64) ^ seed.wrapping_mul(GOLDEN).rotate_left(17);
+        SampleRng { key, counter: (sample as u64) << 32, sample, spp: spp.max(1), pairs: 0 }
+    }
+
+    /// The stream of item `index` of an enumerated task (`stream` names the
+    /// task, e.g. photon shooting), apart from every pixel's stream.
+    pub fn for_index(stream: u64, index: u64, seed: u64) -> SampleRng {
+        SampleRng { key: mix64(seed.wrapping_add(GOLDEN)) ^ mix64(stream.wrapping_mul(GOLDEN) ^ index) ^ (1 << 63), counter: 0, sample: 0, spp: 1, pairs: 0 }
+    }
+
+    /// Uniform in [0, 1): 24 random bits, so 1.0 itself is never returned.
+    #[inline]
+    pub fn next_f32(&mut self) -> f32 {
+        (self.next_bits() >> 40) as f32 * (1.0 / 16_777_216.0)
+    }
+
+    #[inline]
+    fn next_bits(&mut self) -> u64 {
+        if self.counter & 0xffff_ffff == 0 {
+            self.key = mix64(self.key);
+        }
+        self.counter += 1;
+        mix64(self.key.wrapping_add(self.counter.wrapping_mul(GOLDEN)))
+    }
+
+    /// A point in [0, 1)^2: jittered within this sample's cell of the
+    /// pixel's stratification for the first draws, uniform after.
+    #[inline]
+    pub fn next_2d(&mut self) -> Vec2 {
+        let jitter = Vec2::new(self.next_f32(), self.next_f32());
+        if self.spp == 1 || self.pairs >= STRATIFIED_PAIRS {
+            return jitter;
+        }
+        // One shuffle of the cells per pixel and dimension, the same for
+        // all the pixel's samples (derived from the key, not the counter).
+        let shuffle = mix64(self.key ^ (self.pairs as u64 + 1).wrapping_mul(GOLDEN));
+        self.pairs += 1;
+        let n = (self.spp as f32).sqrt().round() as u32;
+        if n * n == self.spp {
+            let cell = permute(self.sample, self.spp, shuffle as u32);
+            Vec2::new(((cell % n) as f32 + jitter.x) / n as f32, ((cell / n) as f32 + jitter.y) / n as f32)
+        } else {
+            // Latin hypercube: a shuffled stratum per axis.
+            let cx = permute(self.sample, self.spp, shuffle as u32);
+            let cy = permute(self.sample, self.spp, (shuffle >> 32) as u32);
+            Vec2::new((cx as f32 + jitter.x) / self.spp as f32, (cy as f32 + jitter.y) / self.spp as f32)
+        }
+        .min(Vec2::splat(1.0 - f32::EPSILON / 2.0))
+    }
+}
+
+/// A pseudo-random permutation of `0..len` chosen by `key`: `i` maps to a
+/// distinct value below `len` (Kensler, "Correlated Multi-Jittered
+/// Sampling", 2013: invertible hashing on the next power of two, walked
+/// until it lands below `len`).
+pub fn permute(mut i: u32, len: u32, key: u32) -> u32 {
+    if len <= 1 {
+        return 0;
+    }
+    let mut w = len - 1;
+    w |= w >> 1;
+    w |= w >> 2;
+    w |= w >> 4;
+    w |= w >> 8;
+    w |= w >> 16;
+    let p = key;
+    loop {
+        i ^= p;
+        i = i.wrapping_mul(0xe170893d);
+        i ^= p >> 16;
+        i ^= (i & w) >> 4;
+        i ^= p >> 8;
+        i = i.wrapping_mul(0x0929eb3f);
+        i ^= p >> 23;
+        i ^= (i & w) >> 1;
+        i = i.wrapping_mul(1 | p >> 27);
+        i = i.wrapping_mul(0x6935fa69);
+        i ^= (i & w) >> 11;
+        i = i.wrapping_mul(0x74dcb303);
+        i ^= (i & w) >> 2;
+        i = i.wrapping_mul(0x9e501cc3);
+        i ^= (i & w) >> 2;
+        i = i.wrapping_mul(0xc860a3df);
+        i &= w;
+        i ^= i >> 5;
+        if i < len {
+            return (i.wrapping_add(p)) % len;
+        }
+    }
+}
+
+/// Two unit tangents completing `n` (unit) to a right-handed orthonormal
+/// basis, without a branch on a chosen axis (Duff et al., "Building an
+/// Orthonormal Basis, Revisited", 2017).
+#[inline]
+pub fn tangents(n: Vec3) -> (Vec3, Vec3) {
+    let sign = 1.0f32.copysign(n.z);
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    (Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x), Vec3::new(b, sign + n.y * n.y * a, -n.y))
+}
+
+/// `local` (z along `n`) in world space.
+#[inline]
+pub fn from_local(local: Vec3, n: Vec3) -> Vec3 {
+    let (t, b) = tangents(n);
+    t * local.x + b * local.y + n * local.z
+}
+
+/// A direction about the local z axis with density cos(theta) / pi: points
+/// spread uniformly on the unit disk, lifted onto the hemisphere (Malley).
+#[inline]
+pub fn cosine_hemisphere(u: Vec2) -> Vec3 {
+    let r = u.x.sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(r * phi.cos(), r * phi.sin(), (1.0 - u.x).max(0.0).sqrt())
+}
+
+#[inline]
+pub fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
+    cos_theta.max(0.0) * (1.0 / PI)
+}
+
+/// A half vector about the local z axis with density
+/// `(s + 1) / (2 pi) cos(theta_h)^s`, the distribution of the Blinn-Phong lobe.
+#[inline]
+pub fn blinn_phong_half(u: Vec2, sharpness: f32) -> Vec3 {
+    let cos_h = u.x.powf(1.0 / (sharpness + 1.0));
+    let sin_h = (1.0 - cos_h * cos_h).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(sin_h * phi.cos(), sin_h * phi.sin(), cos_h)
+}
+
+/// The density of `blinn_phong_half`'s half vector, as a density of the
+/// reflected direction: divided by the Jacobian `4 |w_o . h|` of reflection.
+#[inline]
+pub fn blinn_phong_pdf(n: Vec3, w_o: Vec3, w_i: Vec3, sharpness: f32) -> f32 {
+    let h = (w_i + w_o).normalize_or_zero();
+    let cos_h = n.dot(h);
+    let o_h = w_o.dot(h);
+    if cos_h <= 0.0 || o_h <= 0.0 {
+        return 0.0;
+    }
+    (sharpness + 1.0) / (2.0 * PI) * cos_h.powf(sharpness) / (4.0 * o_h)
+}
+
+/// The reflection of `w` (pointing away from the surface) about `h`.
+#[inline]
+pub fn reflect(w: Vec3, h: Vec3) -> Vec3 {
+    2.0 * w.dot(h) * h - w
+}
+
+/// Uniform on the unit sphere (photons leaving a point light).
+#[inline]
+pub fn uniform_sphere(u: Vec2) -> Vec3 {
+    let z = 1.0 - 2.0 * u.x;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// Uniform on the unit disk (photons of a directional light leave a disk).
+#[inline]
+pub fn uniform_disk(u: Vec2) -> Vec2 {
+    let r = u.x.sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec2::new(r * phi.cos(), r * phi.sin())
+}
+
+/// Luminance weights of linear sRGB (Rec. 709), for choosing between lobes
+/// and for Russian roulette.
+#[inline]
+pub fn luminance(c: Vec3) -> f32 {
+    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn streams_are_pure_functions_of_their_key() {
+        let draw = |mut r: SampleRng| (0..8).map(|_| r.next_f32().to_bits()).collect::<Vec<_>>();
+        assert_eq!(draw(SampleRng::for_pixel(7, 3, 1)), draw(SampleRng::for_pixel(7, 3, 1)));
+        assert_ne!(draw(SampleRng::for_pixel(7, 3, 1)), draw(SampleRng::for_pixel(7, 4, 1)));
+        assert_ne!(draw(SampleRng::for_pixel(7, 3, 1)), draw(SampleRng::for_pixel(8, 3, 1)));
+        assert_ne!(draw(SampleRng::for_pixel(7, 3, 1)), draw(SampleRng::for_pixel(7, 3, 2)));
+        assert_ne!(draw(SampleRng::for_pixel(0, 0, 0)), draw(SampleRng::for_index(1, 0, 0)));
+    }
+
+    #[test]
+    fn permute_is_a_permutation() {
+        for len in [1u32, 2, 3, 5, 16, 17, 64, 100, 1000] {
+            for key in [0u32, 1, 0xdead_beef, 12345] {
+                let mut seen: Vec<u32> = (0..len).map(|i| permute(i, len, key)).collect();
+                seen.sort();
+                assert_eq!(seen, (0..len).collect::<Vec<_>>(), "len {len} key {key}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_pixels_samples_take_one_cell_each() {
+        // The first 2D draw of each of a pixel's 16 samples lands in its own
+        // cell of the 4x4 grid; later draws of the same samples too.
+        for spp in [16u32, 5] {
+            for pair in 0..3 {
+                let mut cells: Vec<(u32, u32)> = (0..spp)
+                    .map(|s| {
+                        let mut r = SampleRng::stratified(99, s, spp, 7);
+                        let mut p = r.next_2d();
+                        for _ in 0..pair {
+                            p = r.next_2d();
+                        }
+                        let n = if spp == 16 { 4.0 } else { spp as f32 };
+                        ((p.x * n) as u32, if spp == 16 { (p.y * n) as u32 } else { 0 })
+                    })
+                    .collect();
+                if spp == 16 {
+                    cells.sort();
+                    cells.dedup();
+                    assert_eq!(cells.len(), 16, "pair {pair}");
+                } else {
+                    let mut xs: Vec<u32> = cells.iter().map(|c| c.0).collect();
+                    xs.sort();
+                    assert_eq!(xs, (0..spp).collect::<Vec<_>>(), "pair {pair}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn uniform_numbers_fill_the_unit_interval_evenly() {
+        // 64 bins, 64k draws over many streams: every bin within 5 sigma.
+        let mut bins = [0u32; 64];
+        for p in 0..4096 {
+            let mut r = SampleRng::for_pixel(p, p % 5, 42);
+            for _ in 0..16 {
+                let u = r.next_f32();
+                assert!((0.0..1.0).contains(&u));
+                bins[(u * 64.0) as usize] += 1;
+            }
+        }
+        let expect = 4096.0 * 16.0 / 64.0;
+        for (i, b) in bins.iter().enumerate() {
+            assert!((*b as f32 - expect).abs() < 5.0 * expect.sqrt(), "bin {i}: {b}");
+        }
+    }
+
+    #[test]
+    fn tangents_complete_an_orthonormal_basis() {
+        let mut r = SampleRng::for_index(9, 0, 0);
+        for _ in 0..1000 {
+            let n = uniform_sphere(r.next_2d());
+            let (t, b) = tangents(n);
+            for (x, y) in [(t, b), (t, n), (b, n)] {
+                assert!(x.dot(y).abs() < 1e-5);
+            }
+            for v in [t, b] {
+                assert!((v.length() - 1.0).abs() < 1e-5);
+            }
+            assert!((t.cross(b) - n).length() < 1e-4, "right-handed");
+        }
+        let (t, b) = tangents(-Vec3::Z);
+        assert!(t.is_finite() && b.is_finite());
+    }
+
+    /// Pearson's chi-square test of sampled directions against a density
+    /// over the hemisphere, binned in (cos theta, phi) with the expected
+    /// counts integrated numerically, bins of small expectation pooled (as
+    /// Mitsuba tests its BSDF sampling). Returns (statistic, threshold).
+    fn chi_square(sample: &mut dyn FnMut(Vec2) -> Option<Vec3>, pdf: &dyn Fn(Vec3) -> f32, n: usize) -> (f64, f64) {
+        const CT: usize = 16;
+        const PH: usize = 32;
+        let mut observed = vec![0f64; CT * PH];
+        let mut r = SampleRng::for_index(77, 0, 5);
+        for _ in 0..n {
+            if let Some(w) = sample(r.next_2d()) {
+                if w.z <= 0.0 {
+                    continue;
+                }
+                let ct = ((w.z * CT as f32) as usize).min(CT - 1);
+                let ph = (((w.y.atan2(w.x) / (2.0 * PI)).rem_euclid(1.0) * PH as f32) as usize).min(PH - 1);
+                observed[ct * PH + ph] += 1.0;
+            }
+        }
+        // Expected: integrate pdf over each bin (area element d(cos) d(phi)).
+        const SUB: usize = 12;
+        let mut expected = vec![0f64; CT * PH];
+        for ct in 0..CT {
+            for ph in 0..PH {
+                let mut sum = 0f64;
+                for i in 0..SUB {
+                    for j in 0..SUB {
+                        let c = (ct as f64 + (i as f64 + 0.5) / SUB as f64) / CT as f64;
+                        let p = (ph as f64 + (j as f64 + 0.5) / SUB as f64) / PH as f64 * 2.0 * std::f64::consts::PI;
+                        let s = (1.0 - c * c).max(0.0).sqrt();
+                        let w = Vec3::new((s * p.cos()) as f32, (s * p.sin()) as f32, c as f32);
+                        sum += pdf(w) as f64;
+                    }
+                }
+                let area = (1.0 / CT as f64) * (2.0 * std::f64::consts::PI / PH as f64);
+                expected[ct * PH + ph] = sum / (SUB * SUB) as f64 * area * n as f64;
+            }
+        }
+        // Pool bins expecting fewer than 5 samples into one.
+        let (mut stat, mut dof) = (0f64, 0i64);
+        let (mut pool_o, mut pool_e) = (0f64, 0f64);
+        for (o, e) in observed.iter().zip(&expected) {
+            if *e < 5.0 {
+                pool_o += o;
+                pool_e += e;
+            } else {
+                stat += (o - e) * (o - e) / e;
+                dof += 1;
+            }
+        }
+        if pool_e > 0.0 {
+            stat += (pool_o - pool_e) * (pool_o - pool_e) / pool_e.max(1.0);
+            dof += 1;
+        }
+        let k = (dof - 1).max(1) as f64;
+        // Wilson-Hilferty: the chi-square quantile at p = 1e-4 (z = 3.72).
+        let z = 3.72;
+        let threshold = k * (1.0 - 2.0 / (9.0 * k) + z * (2.0 / (9.0 * k)).sqrt()).powi(3);
+        (stat, threshold)
+    }
+
+    #[test]
+    fn cosine_sampling_matches_its_density() {
+        let (stat, threshold) = chi_square(&mut |u| Some(cosine_hemisphere(u)), &|w| cosine_hemisphere_pdf(w.z), 200_000);
+        assert!(stat < threshold, "chi-square {stat} >= {threshold}");
+        // A wrong density must fail the same test: uniform instead of cosine.
+        let (stat, threshold) = chi_square(&mut |u| Some(cosine_hemisphere(u)), &|_| 1.0 / (2.0 * PI), 200_000);
+        assert!(stat > threshold, "the test cannot tell cosine from uniform: {stat}");
+    }
+
+    #[test]
+    fn blinn_phong_sampling_matches_its_density() {
+        for sharpness in [1.0f32, 10.0, 100.0] {
+            for w_o in [Vec3::Z, Vec3::new(0.6, 0.0, 0.8), Vec3::new(-0.3, 0.9, 0.3).normalize()] {
+                let (stat, threshold) = chi_square(
+                    &mut |u| Some(reflect(w_o, blinn_phong_half(u, sharpness))),
+                    &|w_i| blinn_phong_pdf(Vec3::Z, w_o, w_i, sharpness),
+                    200_000,
+                );
+                assert!(stat < threshold, "s {sharpness}, w_o {w_o}: chi-square {stat} >= {threshold}");
+            }
+        }
+    }
+
+    #[test]
+    fn disk_and_sphere_samples_are_unit() {
+        let mut r = SampleRng::for_index(3, 0, 0);
+        let mut mean = Vec3::ZERO;
+        for _ in 0..20_000 {
+            let w = uniform_sphere(r.next_2d());
+            assert!((w.length() - 1.0).abs() < 1e-5);
+            mean += w;
+            assert!(uniform_disk(r.next_2d()).length() <= 1.0 + 1e-6);
+        }
+        assert!((mean / 20_000.0).length() < 0.03, "uniform: mean {mean}");
+    }
+}
