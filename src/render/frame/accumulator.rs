@@ -8,6 +8,7 @@ use crate::math::Radiance;
 use crate::render::debug::{self, View};
 use crate::render::raytrace::brute::BruteForce;
 use crate::render::{sample_offset, PassJob, PreparedScene, RayCounts, RenderSettings, Renderer};
+use rayon::prelude::*;
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -165,9 +166,13 @@ impl Accumulator {
                 }
             }
             if self.spp == 1 {
-                for s in &mut self.sum[span.clone()] {
-                    *s = admitted(*s);
-                }
+                // A read-only scan in parallel: writes only where a sample
+                // is not finite (rarely), so the frame costs one pass of loads.
+                self.sum[span.clone()].par_chunks_mut(8192).for_each(|chunk| {
+                    for s in chunk.iter_mut().filter(|s| !s.is_finite()) {
+                        *s = admitted(*s);
+                    }
+                });
             } else {
                 for (s, p) in self.sum[span.clone()].iter_mut().zip(&mine) {
                     add_sample(s, *p, self.spp);
