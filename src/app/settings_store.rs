@@ -25,6 +25,8 @@ pub struct ViewerSettings {
     pub max_depth: u32,
     pub view: View,
     pub interpolation: Interpolation,
+    /// Indirect light and its knobs.
+    pub gi: crate::render::gi::GiSettings,
     /// Image size over the scene's size.
     pub res_scale: f32,
     /// Encode the image as sRGB for display.
@@ -78,6 +80,7 @@ impl Default for ViewerSettings {
             max_depth: 4,
             view: View::Shaded,
             interpolation: Interpolation::Phong,
+            gi: Default::default(),
             res_scale: 1.0,
             gamma: true,
             panels: Panels::default(),
@@ -111,6 +114,7 @@ impl ViewerSettings {
             max_depth: self.max_depth,
             view: self.view,
             interpolation: self.interpolation,
+            gi: self.gi.clone(),
             shadow_map_size: k.shadow_map_size,
             shadow_map_bias: k.shadow_map_bias,
             msaa: k.msaa,

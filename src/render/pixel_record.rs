@@ -144,6 +144,18 @@ impl PixelTrace {
         PixelTrace::default()
     }
 
+    /// Adds `other`'s records after this one's (a rasterizer's layers, one
+    /// record each, become the pixel's record).
+    pub fn append(&mut self, other: PixelTrace) {
+        let PixelTrace { rays, lights, fragments, shaded, bounces, photon_estimates, .. } = other;
+        self.rays.extend(rays);
+        self.lights.extend(lights);
+        self.fragments.extend(fragments);
+        self.shaded.extend(shaded);
+        self.bounces.extend(bounces);
+        self.photon_estimates.extend(photon_estimates);
+    }
+
     fn current_ray(&mut self) -> Option<&mut RayRecord> {
         self.current.and_then(|i| self.rays.get_mut(i))
     }

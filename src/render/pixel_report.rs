@@ -80,11 +80,28 @@ fn fragment_json(f: &FragmentRecord) -> Value {
 }
 
 fn sample_json(scene: &Scene, t: &PixelTrace) -> Value {
-    json!({
+    let mut record = json!({
         "rays": t.rays.iter().map(|r| ray_json(scene, r)).collect::<Vec<_>>(),
         "lights": t.lights.iter().map(light_json).collect::<Vec<_>>(),
         "fragments": t.fragments.iter().map(fragment_json).collect::<Vec<_>>(),
-    })
+    });
+    // Indirect light's records appear only where a mode made them.
+    if !t.bounces.is_empty() {
+        record["bounces"] = t
+            .bounces
+            .iter()
+            .map(|b| {
+                json!({
+                    "depth": b.depth, "direction": v3(b.w_i), "pdf": b.pdf, "weight": v3(b.weight),
+                    "throughput": v3(b.throughput), "survival": b.survival,
+                })
+            })
+            .collect();
+    }
+    if !t.photon_estimates.is_empty() {
+        record["photon_estimates"] = t.photon_estimates.iter().map(|l| v3(*l)).collect();
+    }
+    record
 }
 
 /// The JSON record: `renderer`, `x`, `y`, `radiance` (the frame's value) and the samples.

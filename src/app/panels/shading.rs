@@ -5,6 +5,7 @@
 use eframe::egui;
 use super::{color_edit, section};
 use crate::app::settings_store::ViewerSettings;
+use crate::render::gi::{GiMode, GiSettings, MAX_BOUNCES};
 use crate::render::{Interpolation, ShadowMode};
 use crate::scene::RenderDefaults;
 
@@ -35,6 +36,7 @@ pub fn show(ui: &mut egui::Ui, settings: &mut ViewerSettings, look: &mut RenderD
                 ui.add(egui::Slider::new(&mut s.per_scene.shadow_map_bias, 0.0..=32.0)).labelled_by(l.id);
             });
         }
+        gi_knobs(ui, &mut s.gi);
         ui.horizontal(|ui| {
             let l = ui.label("samples per pixel");
             ui.add(egui::Slider::new(&mut s.spp, 1..=256).logarithmic(true)).labelled_by(l.id);
@@ -71,4 +73,57 @@ pub fn show(ui: &mut egui::Ui, settings: &mut ViewerSettings, look: &mut RenderD
         });
     });
     settings.panels.shading = open;
+}
+
+/// Indirect light: the mode and the knobs of the chosen one.
+fn gi_knobs(ui: &mut egui::Ui, gi: &mut GiSettings) {
+    ui.horizontal(|ui| {
+        ui.label("indirect light");
+        for m in GiMode::ALL {
+            ui.radio_value(&mut gi.mode, m, m.name());
+        }
+    });
+    match gi.mode {
+        GiMode::None => {}
+        GiMode::Ao => {
+            ui.horizontal(|ui| {
+                let l = ui.label("AO rays");
+                ui.add(egui::Slider::new(&mut gi.ao_samples, 1..=256).logarithmic(true)).labelled_by(l.id);
+            });
+            ui.horizontal(|ui| {
+                let l = ui.label("AO distance");
+                ui.add(egui::Slider::new(&mut gi.ao_distance, 0.01..=100.0).logarithmic(true)).labelled_by(l.id);
+            });
+        }
+        GiMode::Photons => {
+            ui.horizontal(|ui| {
+                let l = ui.label("photons");
+                ui.add(egui::Slider::new(&mut gi.photons, 1_000..=5_000_000).logarithmic(true)).labelled_by(l.id);
+            });
+            ui.horizontal(|ui| {
+                let l = ui.label("nearest photons k");
+                ui.add(egui::Slider::new(&mut gi.photon_k, 1..=1024).logarithmic(true)).labelled_by(l.id);
+            });
+            ui.horizontal(|ui| {
+                let l = ui.label("final gather rays");
+                ui.add(egui::Slider::new(&mut gi.final_gather, 0..=256)).labelled_by(l.id);
+            });
+        }
+        GiMode::Path => {
+            ui.horizontal(|ui| {
+                let mut unbounded = gi.bounces.is_none();
+                ui.checkbox(&mut unbounded, "unbounded (Russian roulette)");
+                let mut n = gi.bounces.unwrap_or(4);
+                if !unbounded {
+                    let l = ui.label("bounces");
+                    ui.add(egui::Slider::new(&mut n, 0..=MAX_BOUNCES)).labelled_by(l.id);
+                }
+                gi.bounces = (!unbounded).then_some(n);
+            });
+        }
+    }
+    ui.horizontal(|ui| {
+        let l = ui.label("seed");
+        ui.add(egui::DragValue::new(&mut gi.seed)).labelled_by(l.id);
+    });
 }

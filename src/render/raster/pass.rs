@@ -294,11 +294,7 @@ pub fn replay_pixel(method: Method, job: &PassJob, x: u32, y: u32, rec: &mut Pix
     let value = if vbs.len() == 1 { vbs[0].resolve(i, x, y) } else { msaa::resolve(&mut vbs, i, x, y) };
     // The layers' records in layer order: the pass's sample, then the coverage samples.
     for vb in vbs {
-        let t = vb.rec;
-        rec.fragments.extend(t.fragments);
-        rec.rays.extend(t.rays);
-        rec.lights.extend(t.lights);
-        rec.shaded.extend(t.shaded);
+        rec.append(vb.rec);
     }
     value
 }
