@@ -159,6 +159,10 @@ struct RenderOpts {
     /// Stochastic methods: the image depends on (scene, settings, seed) only.
     #[arg(long, default_value_t = 0)]
     seed: u64,
+    /// Adaptive sampling: pixels stop taking samples (of at most --spp) once
+    /// their estimated relative error is below TARGET (e.g. 0.05).
+    #[arg(long, value_name = "TARGET")]
+    adaptive: Option<f32>,
 }
 
 /// What is left to do once the command line ran: the viewer is not part of
@@ -270,6 +274,12 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
     settings.msaa = opts.msaa;
     settings.early_depth = opts.early_depth && !opts.forward;
     settings.gi = gi_settings(opts)?;
+    if let Some(t) = opts.adaptive {
+        if !(t > 0.0 && t.is_finite()) {
+            return Err(format!("--adaptive {t} must be a relative error > 0 (e.g. 0.05)"));
+        }
+        settings.adaptive = Some(t);
+    }
     let prepared = pool.install(|| PreparedScene::new(scene));
     Ok(Loaded { prepared, settings, renderer, pool, load_ms })
 }

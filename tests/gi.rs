@@ -179,3 +179,105 @@ fn photon_error_falls_with_more_photons() {
     let none = relative_rmse(&render("raytrace", &prepared, &RenderSettings { gi: Default::default(), ..s.clone() }), &truth);
     assert!(errors[2] < 0.5 * none, "photons {} vs direct only {none}", errors[2]);
 }
+
+/// A glass ball over a floor under a point light: the light it focuses
+/// makes a bright spot in the middle of its own shadow. Photon mapping
+/// stores the photons that came through the glass, so the spot appears;
+/// without indirect light, and with path tracing from the eye (which can
+/// never hit a point light through a refraction), the shadow stays dark there.
+#[test]
+fn photons_show_the_caustic_under_a_glass_ball() {
+    let text = r#"
+        [camera]
+        eye = [0.0, 2.0, 3.0]
+        target = [0.0, 0.0, 0.0]
+        fov_y_deg = 30.0
+        [render]
+        width = 96
+        height = 96
+        background = [0.0, 0.0, 0.0]
+        [[light]]
+        type = "point"
+        position = [0.0, 6.0, 0.0]
+        power = [400.0, 400.0, 400.0]
+        [materials.floor]
+        lambertian = [0.8, 0.8, 0.8]
+        [materials.glass]
+        transmission = [1.0, 1.0, 1.0]
+        ior = 1.5
+        [[object]]
+        type = "quad"
+        vertices = [[-3.0, 0.0, 3.0], [3.0, 0.0, 3.0], [3.0, 0.0, -3.0], [-3.0, 0.0, -3.0]]
+        material = "floor"
+        [[object]]
+        type = "sphere"
+        center = [0.0, 0.9, 0.0]
+        radius = 0.5
+        material = "glass"
+    "#;
+    let scene = pinhole::scene::file::parse_scene(text, "caustic test", std::path::Path::new("."), "caustic").unwrap();
+    let prepared = PreparedScene::new(scene);
+    let mut s = RenderSettings::for_scene(&prepared.scene);
+    s.gi.photons = 400_000;
+    s.gi.photon_k = 32;
+    // The camera looks past the ball at the floor beneath it.
+    let view = prepared.scene.camera.view(s.width, s.height);
+    let pixel_of = |p: pinhole::math::Vec3| {
+        let q = view.project_camera(view.to_camera(p));
+        (q.x as u32, q.y as u32)
+    };
+    let spot_and_ring = |img: &[Radiance]| {
+        let at = |p: pinhole::math::Vec3| {
+            let (x, y) = pixel_of(p);
+            img[(x + y * s.width) as usize].x as f64
+        };
+        use pinhole::math::Vec3;
+        let spot = at(Vec3::ZERO);
+        // Floor points inside the ball's shadow but outside the focused spot.
+        let ring = [Vec3::new(0.3, 0.0, 0.0), Vec3::new(-0.3, 0.0, 0.0), Vec3::new(0.0, 0.0, 0.3), Vec3::new(0.0, 0.0, -0.3)].iter().map(|p| at(*p)).sum::<f64>() / 4.0;
+        (spot, ring)
+    };
+    s.gi.mode = GiMode::Photons;
+    let (spot, ring) = spot_and_ring(&render("raytrace", &prepared, &s));
+    eprintln!("photons: spot {spot:.4}, ring {ring:.4}");
+    assert!(spot > 3.0 * ring + 1e-3, "no caustic: spot {spot}, ring {ring}");
+    s.gi.mode = GiMode::None;
+    let (spot_none, _) = spot_and_ring(&render("raytrace", &prepared, &s));
+    assert!(spot_none < 0.2 * spot, "the spot is there without photons: {spot_none}");
+    s.gi.mode = GiMode::Path;
+    s.spp = 16;
+    let (spot_path, ring_path) = spot_and_ring(&render("raytrace", &prepared, &s));
+    eprintln!("path: spot {spot_path:.4}, ring {ring_path:.4}");
+    assert!(spot_path < 0.2 * spot, "path tracing found the caustic of a point light: {spot_path}");
+}
+
+/// Adaptive sampling spends the budget where the noise is: pixels stop once
+/// their estimated relative error is below the target, so the frame takes
+/// far fewer samples than spp x pixels, noisy pixels take more than quiet
+/// ones, and a replayed pixel takes exactly the samples its frame took.
+#[test]
+fn adaptive_sampling_stops_settled_pixels() {
+    let (prepared, mut s) = small("cornell-gi", GiMode::Path, 128);
+    s.adaptive = Some(0.1);
+    let mut acc = render::frame::Accumulator::new(&s);
+    let r = render::renderer_by_name("raytrace").unwrap();
+    let cancel = std::sync::atomic::AtomicBool::new(false);
+    while !acc.is_complete() {
+        acc.render_band(r.as_ref(), &prepared, s.height, &cancel).unwrap();
+    }
+    let taken = acc.samples_taken();
+    let budget = (s.width * s.height * s.spp) as u64;
+    eprintln!("adaptive 10%: {taken} samples of a budget of {budget} ({:.0}%)", 100.0 * taken as f64 / budget as f64);
+    assert!(taken < budget * 3 / 4, "{taken} of {budget}");
+    assert!(taken >= (s.width * s.height * render::frame::ADAPTIVE_MIN_SAMPLES) as u64);
+    let frame = acc.finish().pixels;
+    let full = render("raytrace", &prepared, &s);
+    assert_eq!(bits(&frame), bits(&full), "render_frame takes the same adaptive samples");
+    let mut counts = Vec::new();
+    for (x, y) in pixels(3, 12, s.width, s.height) {
+        let replay = render::replay_pixel(r.as_ref(), &prepared, &s, x, y).unwrap();
+        assert_eq!(bits(&[replay.radiance]), bits(&frame[(x + y * s.width) as usize..][..1]), "({x}, {y})");
+        counts.push(replay.samples.len());
+    }
+    assert!(counts.iter().min() < counts.iter().max(), "every pixel took the same samples: {counts:?}");
+}

@@ -279,7 +279,7 @@ fn any_row_range_renders_the_same_rows() {
         let r = raster(m);
         let full = render(&r, &prepared, &settings);
         for rows in [0..H, 37..90, 3..4, 100..H] {
-            let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: sample_offset(0, 1), sample: 0, photons: None, rows: rows.clone(), cancel: &cancel };
+            let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: sample_offset(0, 1), sample: 0, photons: None, active: None, rows: rows.clone(), cancel: &cancel };
             let mut out = vec![Radiance::ZERO; (W * rows.len() as u32) as usize];
             let counts = r.render_pass(&job, &mut out);
             assert_eq!(counts.primary, out.len() as u64);

@@ -129,6 +129,8 @@ pub struct Stats {
     /// BVH build of the scene on show, ms.
     pub build_ms: f64,
     pub triangles: usize,
+    /// Estimated noise left in the image (rmse / mean), once two passes are in.
+    pub noise: Option<f32>,
 }
 
 /// The image the UI shows, as the worker last published it.
@@ -591,6 +593,7 @@ impl WorkerLoop {
         let first_image = !f.first_image;
         f.first_image = true;
         let passes = f.frame.passes_done();
+        let noise = if band.pass_done { f.frame.noise_estimate() } else { None };
         let (generation, scene_id) = (f.req.generation, f.req.scene_id);
         let (elapsed_ms, pass_counts) = (f.started.elapsed().as_secs_f64() * 1e3, f.pass_counts);
         // The finished frame replaces the running average whole (for the
@@ -632,6 +635,7 @@ impl WorkerLoop {
             out.preview = false;
             out.stats.pass_ms = pass_ms;
             out.stats.counts = pass_counts;
+            out.stats.noise = noise;
         }
         out.complete = complete;
         if let Some((result, rgb8)) = finished {

@@ -3,7 +3,7 @@
 
 mod accumulator;
 
-pub use accumulator::{add_sample, admitted, final_value, mean, Accumulator, Band};
+pub use accumulator::{add_sample, admitted, final_value, mean, relative_error, wants_more, Accumulator, Band, ADAPTIVE_MIN_SAMPLES};
 
 use super::{sample_offset, PassJob, PreparedScene, RayCounts, RenderSettings, Renderer};
 use crate::math::Radiance;
@@ -94,16 +94,26 @@ pub fn replay_pixel(renderer: &dyn Renderer, prepared: &PreparedScene, settings:
     let cancel = AtomicBool::new(false);
     let spp = settings.spp.max(1);
     let mut sum = Radiance::ZERO;
+    let mut sum_sq = 0.0f32;
     let mut samples = Vec::new();
+    // Adaptive sampling stops a pixel on its own samples alone, so the
+    // replay stops where the frame stopped.
+    let adaptive = settings.adaptive.filter(|_| spp > 1);
     for i in 0..spp {
+        if adaptive.is_some_and(|target| !accumulator::wants_more(sum, sum_sq, i, spp, target)) {
+            break;
+        }
         let offset = sample_offset(i, spp);
-        let job = PassJob { prepared, view: &view, settings, offset, sample: i, photons: photons.as_deref(), rows: y..y + 1, cancel: &cancel };
+        let job = PassJob { prepared, view: &view, settings, offset, sample: i, photons: photons.as_deref(), active: None, rows: y..y + 1, cancel: &cancel };
         let mut rec = super::pixel_record::PixelTrace::new();
         let value = renderer
             .trace_pixel(&job, x, y, &mut rec)
             .ok_or_else(|| format!("{} cannot replay pixels yet", renderer.name()))?;
         add_sample(&mut sum, value, spp);
+        let l = crate::render::sampling::luminance(admitted(value));
+        sum_sq += l * l;
         samples.push((offset, rec, value));
     }
-    Ok(PixelReplay { samples, radiance: final_value(sum, spp) })
+    let radiance = if adaptive.is_some() { mean(sum, samples.len() as u32) } else { final_value(sum, spp) };
+    Ok(PixelReplay { samples, radiance })
 }

@@ -96,6 +96,10 @@ pub struct RenderSettings {
     /// Indirect light and its knobs.
     #[serde(default)]
     pub gi: gi::GiSettings,
+    /// Adaptive sampling: after a few passes, only pixels whose estimated
+    /// relative error is above this keep taking samples (up to `spp`).
+    #[serde(default)]
+    pub adaptive: Option<f32>,
 }
 
 fn default_true() -> bool {
@@ -123,6 +127,7 @@ impl RenderSettings {
             early_depth: true,
             msaa: 1,
             gi: gi::GiSettings::default(),
+            adaptive: None,
         }
     }
 }
@@ -202,6 +207,9 @@ pub struct PassJob<'a> {
     pub sample: u32,
     /// `--gi photons`: the photon map, built before the passes.
     pub photons: Option<&'a photon_map::PhotonMap>,
+    /// Adaptive sampling: which pixels of `rows` (row-major, `width` per row)
+    /// still take samples; the others are left as they are in `out`.
+    pub active: Option<&'a [bool]>,
     /// Rows to render; `out` holds `width * rows.len()` pixels.
     pub rows: Range<u32>,
     pub cancel: &'a AtomicBool,
@@ -210,6 +218,12 @@ pub struct PassJob<'a> {
 impl PassJob<'_> {
     pub fn cancelled(&self) -> bool {
         self.cancel.load(std::sync::atomic::Ordering::Relaxed)
+    }
+
+    /// Whether pixel `(x, y)` (a row of `rows`) takes a sample in this pass.
+    #[inline]
+    pub fn is_active(&self, x: u32, y: u32) -> bool {
+        self.active.is_none_or(|a| a[((y - self.rows.start) * self.view.width + x) as usize])
     }
 
     /// The index of pixel `(x, y)` that keys its samples' random numbers.

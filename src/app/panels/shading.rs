@@ -77,10 +77,11 @@ pub fn show(ui: &mut egui::Ui, settings: &mut ViewerSettings, look: &mut RenderD
 
 /// Indirect light: the mode and the knobs of the chosen one.
 fn gi_knobs(ui: &mut egui::Ui, gi: &mut GiSettings) {
-    ui.horizontal(|ui| {
-        ui.label("indirect light");
+    // A combo box: its choices ("none", "path", ...) would otherwise share
+    // their names with other controls on screen.
+    egui::ComboBox::from_label("indirect light").selected_text(gi.mode.name()).show_ui(ui, |ui| {
         for m in GiMode::ALL {
-            ui.radio_value(&mut gi.mode, m, m.name());
+            ui.selectable_value(&mut gi.mode, m, m.name());
         }
     });
     match gi.mode {

@@ -53,11 +53,12 @@ pub fn status_text(app: &PinholeApp) -> String {
             "rendering".into()
         };
         format!(
-            "{renderer} | {}x{} | {}/{} spp | {:.1} ms/pass | {rate} | {triangles} triangles{} | first image {:.0} ms | {state}",
+            "{renderer} | {}x{} | {}/{} spp{} | {:.1} ms/pass | {rate} | {triangles} triangles{} | first image {:.0} ms | {state}",
             o.width,
             o.height,
             o.passes,
             o.spp,
+            s.noise.map_or(String::new(), |n| format!(" (noise ≈ {:.1}%)", n * 100.0)),
             s.pass_ms,
             if spheres > 0 { format!(", {spheres} spheres") } else { String::new() },
             s.first_image_ms,

@@ -5,6 +5,7 @@
 
 use super::FrameResult;
 use crate::math::Radiance;
+use crate::render::sampling::luminance;
 use crate::render::debug::{self, View};
 use crate::render::raytrace::brute::BruteForce;
 use crate::render::{sample_offset, PassJob, PreparedScene, RayCounts, RenderSettings, Renderer};
@@ -44,6 +45,42 @@ pub fn final_value(sum: Radiance, spp: u32) -> Radiance {
     if spp == 1 { sum } else { mean(sum, spp) }
 }
 
+/// Adaptive sampling looks at a pixel's error only after this many samples:
+/// fewer say too little about its variance.
+pub const ADAPTIVE_MIN_SAMPLES: u32 = 8;
+
+/// The estimated relative error of a pixel's mean after `n` samples whose
+/// luminances sum to `sum` and whose squares sum to `sum_sq`: the standard
+/// error over the mean (floored at 1e-3, so black pixels count as settled).
+#[inline]
+pub fn relative_error(sum: f32, sum_sq: f32, n: u32) -> f32 {
+    if n < 2 {
+        return f32::INFINITY;
+    }
+    let k = n as f32;
+    let mean = sum / k;
+    let variance = ((sum_sq / k - mean * mean) * k / (k - 1.0)).max(0.0);
+    (variance / k).sqrt() / mean.max(1e-3)
+}
+
+/// Whether adaptive sampling gives a pixel another sample: before
+/// `ADAPTIVE_MIN_SAMPLES`, and after while its relative error exceeds
+/// `target` and the budget `spp` is not spent. A function of the pixel's
+/// own samples only, so a replayed pixel takes exactly the frame's samples.
+#[inline]
+pub fn wants_more(sum: Radiance, sum_sq: f32, n: u32, spp: u32, target: f32) -> bool {
+    n < spp && (n < ADAPTIVE_MIN_SAMPLES || relative_error(luminance(sum), sum_sq, n) > target)
+}
+
+/// Adaptive sampling's bookkeeping: samples per pixel, and who still takes them.
+struct Adaptive {
+    target: f32,
+    samples: Vec<u32>,
+    active: Vec<bool>,
+    /// No pixel wants another sample: the frame is complete early.
+    settled: bool,
+}
+
 /// One band of one pass, as `Accumulator::render_band` rendered it.
 #[derive(Clone, Debug)]
 pub struct Band {
@@ -63,6 +100,9 @@ pub struct Accumulator {
     spp: u32,
     /// Sum of the samples per pixel, row-major, and per row how many passes it holds.
     sum: Vec<Radiance>,
+    /// With more than one sample: per pixel the sum of the squared sample
+    /// luminances, for the estimate of the noise left (`noise_estimate`).
+    sum_sq: Vec<f32>,
     row_passes: Vec<u32>,
     /// Diff view: the sum of the reference `raytrace:brute`'s samples, rendered
     /// band by band beside the renderer's; the frame is the difference image.
@@ -71,6 +111,8 @@ pub struct Accumulator {
     /// The next band starts at row `row` of pass `pass`.
     pass: u32,
     row: u32,
+    /// `--adaptive`: per-pixel sample counts and the pixels still sampling.
+    adaptive: Option<Adaptive>,
     /// The photon map every pass reads (`--gi photons`), built with the first band.
     photons: Option<std::sync::Arc<crate::render::photon_map::PhotonMap>>,
 }
@@ -85,12 +127,19 @@ impl Accumulator {
         Accumulator {
             spp: settings.spp.max(1),
             sum: vec![Radiance::ZERO; n],
+            sum_sq: if settings.spp > 1 { vec![0.0; n] } else { Vec::new() },
             row_passes: vec![0; settings.height as usize],
             reference: diff.then(|| vec![Radiance::ZERO; n]),
             counts: RayCounts::default(),
             pass: 0,
             row: 0,
             photons: None,
+            adaptive: settings.adaptive.filter(|_| settings.spp > 1).map(|target| Adaptive {
+                target,
+                samples: vec![0; n],
+                active: vec![true; n],
+                settled: false,
+            }),
             settings,
         }
     }
@@ -119,7 +168,21 @@ impl Accumulator {
 
     /// Every sample of every pixel is in.
     pub fn is_complete(&self) -> bool {
-        self.pass >= self.spp
+        self.pass >= self.spp || self.adaptive.as_ref().is_some_and(|a| a.settled)
+    }
+
+    /// Samples taken over the whole frame so far.
+    pub fn samples_taken(&self) -> u64 {
+        match &self.adaptive {
+            Some(a) => a.samples.iter().map(|n| *n as u64).sum(),
+            None => self.row_passes.iter().map(|p| *p as u64).sum::<u64>() * self.settings.width as u64,
+        }
+    }
+
+    /// How many samples pixel `i` (of row `y`) holds.
+    #[inline]
+    fn samples_of(&self, i: usize, y: usize) -> u32 {
+        self.adaptive.as_ref().map_or(self.row_passes[y], |a| a.samples[i])
     }
 
     /// Renders the next band of at most `max_rows` rows of the next pass and
@@ -136,6 +199,8 @@ impl Accumulator {
         let mut counts = RayCounts::default();
         if !rows.is_empty() && width > 0 {
             let view = prepared.scene.camera.view(width, height);
+            let w = width as usize;
+            let span = rows.start as usize * w..rows.end as usize * w;
             let job = PassJob {
                 prepared,
                 view: &view,
@@ -143,11 +208,10 @@ impl Accumulator {
                 offset: sample_offset(self.pass, self.spp),
                 sample: self.pass,
                 photons: self.photons.as_deref(),
+                active: self.adaptive.as_ref().map(|a| &a.active[span.clone()]),
                 rows: rows.clone(),
                 cancel,
             };
-            let w = width as usize;
-            let span = rows.start as usize * w..rows.end as usize * w;
             let cancelled = || cancel.load(Ordering::Relaxed);
             // With one sample the pass is the frame: render straight into it
             // (a cancelled band is rendered again or the frame dropped, and
@@ -174,8 +238,17 @@ impl Accumulator {
                     }
                 });
             } else {
-                for (s, p) in self.sum[span.clone()].iter_mut().zip(&mine) {
-                    add_sample(s, *p, self.spp);
+                for (k, p) in mine.iter().enumerate() {
+                    let i = span.start + k;
+                    if let Some(a) = self.adaptive.as_mut() {
+                        if !a.active[i] {
+                            continue;
+                        }
+                        a.samples[i] += 1;
+                    }
+                    add_sample(&mut self.sum[i], *p, self.spp);
+                    let l = luminance(admitted(*p));
+                    self.sum_sq[i] += l * l;
                 }
             }
             if let (Some(sum), Some(buf)) = (self.reference.as_mut(), theirs.as_ref()) {
@@ -194,6 +267,15 @@ impl Accumulator {
         if pass_done {
             self.row = 0;
             self.pass += 1;
+            let (sum, sum_sq, spp) = (&self.sum, &self.sum_sq, self.spp);
+            if let Some(a) = self.adaptive.as_mut() {
+                let mut any = false;
+                for i in 0..a.active.len() {
+                    a.active[i] = a.active[i] && wants_more(sum[i], sum_sq[i], a.samples[i], spp, a.target);
+                    any |= a.active[i];
+                }
+                a.settled = !any;
+            }
         }
         Some(Band { rows, pass, counts, pass_done })
     }
@@ -208,11 +290,41 @@ impl Accumulator {
             let row = &self.sum[y as usize * w..(y as usize + 1) * w];
             if passes == 0 {
                 out.extend(std::iter::repeat_n(Radiance::ZERO, w));
+            } else if let Some(a) = &self.adaptive {
+                let counts = &a.samples[y as usize * w..(y as usize + 1) * w];
+                out.extend(row.iter().zip(counts).map(|(s, n)| mean(*s, (*n).max(1))));
             } else {
                 out.extend(row.iter().map(|s| mean(*s, passes)));
             }
         }
         out
+    }
+
+    /// The noise left in the running average, as the estimated rmse over
+    /// the image divided by its mean luminance: per pixel the sample
+    /// variance of the luminance over the passes so far, divided by their
+    /// number. `None` before two passes, or with one sample per pixel.
+    pub fn noise_estimate(&self) -> Option<f32> {
+        if self.sum_sq.is_empty() {
+            return None;
+        }
+        let w = self.settings.width as usize;
+        let (mut error2, mut mean_sum, mut n) = (0f64, 0f64, 0usize);
+        for y in 0..self.row_passes.len() {
+            for i in y * w..(y + 1) * w {
+                let passes = self.samples_of(i, y);
+                if passes < 2 {
+                    continue;
+                }
+                let k = passes as f64;
+                let m = luminance(self.sum[i]) as f64 / k;
+                let variance = ((self.sum_sq[i] as f64 / k - m * m) * k / (k - 1.0)).max(0.0);
+                error2 += variance / k;
+                mean_sum += m;
+                n += 1;
+            }
+        }
+        (n > 0 && mean_sum > 0.0).then(|| ((error2 / n as f64).sqrt() / (mean_sum / n as f64)) as f32)
     }
 
     /// The finished frame: the average of the `spp` samples (one sample is
@@ -228,7 +340,10 @@ impl Accumulator {
             }
             sum
         };
-        let mine = average(self.sum);
+        let mine = match &self.adaptive {
+            Some(a) => self.sum.iter().zip(&a.samples).map(|(s, n)| mean(*s, (*n).max(1))).collect(),
+            None => average(self.sum),
+        };
         let (pixels, differing_pixels) = match self.reference {
             Some(reference) => {
                 let (image, count) = debug::diff_image(&mine, &average(reference));
@@ -282,6 +397,26 @@ mod tests {
             }
             counts
         }
+    }
+
+    /// The noise estimate falls like 1/sqrt(passes) on a path-traced frame
+    /// and is absent for deterministic single-sample frames.
+    #[test]
+    fn the_noise_estimate_falls_as_samples_add_up() {
+        let p = prepared("cornell-gi");
+        let mut s = settings(&p, 64, View::Shaded);
+        s.gi.mode = crate::render::gi::GiMode::Path;
+        let mut a = Accumulator::new(&s);
+        let mut at = Vec::new();
+        while !a.is_complete() {
+            a.render_band(&BvhRayTracer, &p, s.height, &AtomicBool::new(false)).unwrap();
+            if [4, 64].contains(&a.passes_done()) {
+                at.push(a.noise_estimate().unwrap());
+            }
+        }
+        let ratio = at[1] / at[0];
+        assert!((0.15..0.4).contains(&ratio), "4 -> 64 passes: {at:?}");
+        assert_eq!(Accumulator::new(&settings(&p, 1, View::Shaded)).noise_estimate(), None);
     }
 
     #[test]

@@ -344,6 +344,9 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
 
     /// Hands what pixel index `i` sees to the shared shading (recorded for the focus pixel).
     pub fn shade(&mut self, i: usize, x: u32, y: u32) -> Radiance {
+        if !self.job.is_active(x, y) {
+            return Radiance::ZERO;
+        }
         if self.id[i].is_none() && !self.is_focus(x, y) {
             if let Some(background) = miss_without_ray(self.job) {
                 return background;

@@ -29,7 +29,9 @@ pub fn cast_pass<Q: SceneQuery>(job: &PassJob, query: &Q, out: &mut [Radiance]) 
             }
             let y = job.rows.start + i as u32;
             for (x, px) in row.iter_mut().enumerate() {
-                *px = cast_pixel(job, query, x as u32, y, &mut counts, &mut NoRecord);
+                if job.is_active(x as u32, y) {
+                    *px = cast_pixel(job, query, x as u32, y, &mut counts, &mut NoRecord);
+                }
             }
             counts
         })

@@ -395,7 +395,7 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
                 let mut valid = 0u64;
                 for i in 0..P {
                     let (tx, ty) = lane_xy(i);
-                    if x0 + tx < width && ty < rows {
+                    if x0 + tx < width && ty < rows && job.is_active((x0 + tx) as u32, (y0 + ty) as u32) {
                         let p = job.sample_position((x0 + tx) as u32, (y0 + ty) as u32);
                         pk.rays[i] = job.view.eye_ray(p.x, p.y);
                         pk.t_max[i] = job.view.far_t(p.x, p.y);
