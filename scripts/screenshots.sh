@@ -35,6 +35,7 @@ shot panel-camera-materials spheres PINHOLE_PANELS=camera,materials
 shot view-barycentric one-triangle PINHOLE_VIEW=barycentric PINHOLE_PANELS=shading
 shot view-normal bunny PINHOLE_VIEW=normal PINHOLE_PANELS=lights
 # CGPP Figure 15.2: the gamma test pattern with gamma off and on.
+shot gi-path cornell-gi PINHOLE_GI=path PINHOLE_SPP=16 PINHOLE_PANELS=shading
 shot gamma-off test-pattern PINHOLE_GAMMA=off PINHOLE_PANELS=shading
 shot gamma-on test-pattern PINHOLE_GAMMA=on PINHOLE_PANELS=shading
 # Debug views with their legends.

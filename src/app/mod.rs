@@ -158,7 +158,8 @@ fn screenshot_frame(app: &mut PinholeApp, ctx: &egui::Context) {
 /// renderer, `PINHOLE_VIEW=NAME` the debug view, `PINHOLE_PANELS=camera,lights,
 /// materials,shading` (or `none`) which side-panel sections are open (the
 /// inspector shows whenever a pixel is selected),
-/// `PINHOLE_GAMMA=off` turns the sRGB encoding off.
+/// `PINHOLE_GAMMA=off` turns the sRGB encoding off, `PINHOLE_GI` and
+/// `PINHOLE_SPP` set the indirect light and the samples per pixel.
 fn apply_env_overrides(app: &mut PinholeApp) {
     if let Ok(name) = std::env::var("PINHOLE_RENDERER") {
         match crate::render::renderer_by_name(&name) {
@@ -174,6 +175,19 @@ fn apply_env_overrides(app: &mut PinholeApp) {
     }
     if let Ok(g) = std::env::var("PINHOLE_GAMMA") {
         app.settings.gamma = !matches!(g.as_str(), "0" | "off" | "false");
+    }
+    // PINHOLE_GI=MODE picks the indirect light, PINHOLE_SPP=N the samples.
+    if let Ok(m) = std::env::var("PINHOLE_GI") {
+        match crate::render::gi::GiMode::parse(&m) {
+            Ok(m) => app.settings.gi.mode = m,
+            Err(e) => eprintln!("pinhole: PINHOLE_GI: {e}"),
+        }
+    }
+    if let Ok(n) = std::env::var("PINHOLE_SPP") {
+        match n.parse::<u32>() {
+            Ok(n) if (1..=4096).contains(&n) => app.settings.spp = n,
+            _ => eprintln!("pinhole: PINHOLE_SPP: expected 1 to 4096, got \"{n}\""),
+        }
     }
     // PINHOLE_SELECT=X,Y selects a pixel for the inspector; PINHOLE_ZOOM=Z
     // magnifies the image (about the selected pixel, if any);
