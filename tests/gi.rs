@@ -281,3 +281,28 @@ fn adaptive_sampling_stops_settled_pixels() {
     }
     assert!(counts.iter().min() < counts.iter().max(), "every pixel took the same samples: {counts:?}");
 }
+
+/// `pinhole pixel` tells a path bounce by bounce, as text and as JSON, and
+/// the JSON's radiance is the frame's.
+#[test]
+fn the_pixel_command_replays_a_path() {
+    let bin = env!("CARGO_BIN_EXE_pinhole");
+    let args = ["pixel", "cornell-gi", "30", "40", "--gi", "path", "--spp", "2", "--width", "64", "--height", "64"];
+    let text = std::process::Command::new(bin).args(args).output().unwrap();
+    assert!(text.status.success());
+    let text = String::from_utf8_lossy(&text.stdout);
+    assert!(text.contains("sampled bounce(s)") && text.contains("pdf") && text.contains("throughput"), "{text}");
+    let json = std::process::Command::new(bin).args(args).arg("--json").output().unwrap();
+    let v: serde_json::Value = serde_json::from_slice(&json.stdout).unwrap();
+    let bounce = &v["samples"][0]["bounces"][0];
+    for key in ["depth", "direction", "pdf", "weight", "throughput", "survival"] {
+        assert!(!bounce[key].is_null(), "bounce lacks {key}: {bounce}");
+    }
+    let prepared = PreparedScene::new(builtin("cornell-gi"));
+    let mut s = RenderSettings::for_scene(&prepared.scene);
+    (s.width, s.height, s.spp, s.gi.mode) = (64, 64, 2, GiMode::Path);
+    let frame = render("raytrace", &prepared, &s);
+    let got: Vec<f32> = v["radiance"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap() as f32).collect();
+    let want = frame[(30 + 40 * 64) as usize];
+    assert!((got[0] - want.x).abs() <= 1e-6 * want.x.max(1.0), "{got:?} vs {want}");
+}

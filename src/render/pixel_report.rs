@@ -218,6 +218,28 @@ pub fn to_text(renderer: &str, scene: &Scene, x: u32, y: u32, replay: &PixelRepl
                 fmt3(l.contribution)
             );
         }
+        if !t.bounces.is_empty() {
+            let _ = writeln!(s, "  path ({} sampled bounce(s)):", t.bounces.len());
+        }
+        for b in &t.bounces {
+            let roulette = match b.survival {
+                p if p >= 1.0 => String::new(),
+                p if p > 0.0 => format!(", roulette: survived with p = {p:.3}"),
+                _ => ", roulette: path ended".into(),
+            };
+            let _ = writeln!(
+                s,
+                "    depth {}: w_i {} pdf {:.4}, weight f cos / pdf {}, throughput {}{roulette}",
+                b.depth,
+                fmt3(b.w_i),
+                b.pdf,
+                fmt3(b.weight),
+                fmt3(b.throughput)
+            );
+        }
+        for l in &t.photon_estimates {
+            let _ = writeln!(s, "  photon map estimate {}", fmt3(*l));
+        }
         let _ = writeln!(s, "  sample radiance {}", fmt3(*value));
     }
     let d = crate::image_io::display_pixel(replay.radiance, scene.render.exposure, true);

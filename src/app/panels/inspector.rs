@@ -141,6 +141,31 @@ fn sample(ui: &mut egui::Ui, names: &SceneNames, t: &PixelTrace, value: Radiance
             light(ui, names, l, traced, k);
         }
     }
+    if !t.bounces.is_empty() {
+        ui.label(RichText::new("path: sampled bounces").strong());
+        egui::Grid::new("bounces").striped(true).num_columns(5).spacing([10.0, 2.0]).show(ui, |ui| {
+            for h in ["depth", "direction", "pdf", "f cos / pdf", "throughput, roulette"] {
+                ui.label(RichText::new(h).color(DIM));
+            }
+            ui.end_row();
+            for b in &t.bounces {
+                ui.monospace(b.depth.to_string());
+                ui.monospace(fmt3(b.w_i));
+                ui.monospace(format!("{:.4}", b.pdf));
+                ui.monospace(fmt3(b.weight));
+                let roulette = match b.survival {
+                    p if p >= 1.0 => String::new(),
+                    p if p > 0.0 => format!(" (survived, p = {p:.2})"),
+                    _ => " (ended by roulette)".into(),
+                };
+                ui.monospace(format!("{}{roulette}", fmt3(b.throughput)));
+                ui.end_row();
+            }
+        });
+    }
+    for l in &t.photon_estimates {
+        ui.monospace(format!("photon map estimate {}", fmt3(*l)));
+    }
     if t.shaded.len() > 1 {
         ui.label(RichText::new("radiance returned per depth (innermost first)").small().color(DIM));
         for (d, rad) in &t.shaded {
