@@ -327,10 +327,11 @@ fn resolve_with<Q: SceneQuery, R: Recorder>(
     match (job.settings.view, hit) {
         (debug::View::Shaded, Some(h)) => {
             let mut path = gi::PathState::new(pixel, job.sample, job.settings.spp, &job.settings.gi, job.photons);
-            let shaded = with_shading_hit(job.settings.interpolation, h, |s| shade::shade(scene, query, job.settings, s, -ray.dir, 0, &mut path, counts, rec));
+            let mut sh = shade::Shading { scene, query, settings: job.settings, path: &mut path, counts, rec };
+            let shaded = with_shading_hit(job.settings.interpolation, h, |s| shade::shade(&mut sh, s, -ray.dir, 0));
             match shaded {
                 Some(radiance) => radiance,
-                None => shade::shade_gouraud(scene, query, job.settings, h, job.view.eye, &mut path, counts, rec),
+                None => shade::shade_gouraud(&mut sh, h, job.view.eye),
             }
         }
         (debug::View::Shaded, None) => {

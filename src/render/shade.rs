@@ -28,18 +28,27 @@ pub fn bsdf(material: &Material, albedo: Vec3, n: Vec3, w_i: Vec3, w_o: Vec3) ->
     f
 }
 
+/// What shading one sample reads and writes besides the surface: the scene
+/// and its query, the settings, the sample's path (random numbers,
+/// throughput, photon map), the counters and the recorder. Passed down
+/// whole through every step of `shade()` and the rays it follows.
+pub struct Shading<'a, 'p, Q, R> {
+    pub scene: &'a Scene,
+    pub query: &'a Q,
+    pub settings: &'a RenderSettings,
+    pub path: &'a mut PathState<'p>,
+    pub counts: &'a mut RayCounts,
+    pub rec: &'a mut R,
+}
+
 /// Outgoing radiance towards `w_o` (unit, pointing away from the surface) at `hit`.
 pub fn shade<Q: SceneQuery, R: Recorder>(
-    scene: &Scene,
-    query: &Q,
-    settings: &RenderSettings,
+    sh: &mut Shading<Q, R>,
     hit: &SurfaceHit,
     w_o: Vec3,
     depth: u32,
-    path: &mut PathState,
-    counts: &mut RayCounts,
-    rec: &mut R,
 ) -> Radiance {
+    let Shading { scene, query, settings, .. } = *sh;
     let material = &scene.materials[hit.material as usize];
     let n = hit.shading_normal;
     let p = hit.position;
@@ -48,7 +57,7 @@ pub fn shade<Q: SceneQuery, R: Recorder>(
         GiMode::None => albedo * scene.render.ambient,
         // The constant ambient term, dimmed where nearby geometry hides the sky.
         GiMode::Ao if scene.render.ambient != Vec3::ZERO && albedo != Vec3::ZERO => {
-            let open = gi::ambient_occlusion(query, hit, &settings.gi, settings.shadow_bump, &mut path.rng, counts, rec);
+            let open = gi::ambient_occlusion(query, hit, &settings.gi, settings.shadow_bump, &mut sh.path.rng, sh.counts, sh.rec);
             albedo * scene.render.ambient * open
         }
         // Traced or mapped indirect light replaces the constant.
@@ -60,7 +69,7 @@ pub fn shade<Q: SceneQuery, R: Recorder>(
         let Incidence { w_i, distance, incident, cos_theta } = incidence;
         if !incidence.illuminates() {
             if R::ENABLED {
-                rec.light(LightSample { light: index, w_i, distance, incident, cos_theta, shadow_ray: None, blocker: None, bsdf: Vec3::ZERO, contribution: Vec3::ZERO });
+                sh.rec.light(LightSample { light: index, w_i, distance, incident, cos_theta, shadow_ray: None, blocker: None, bsdf: Vec3::ZERO, contribution: Vec3::ZERO });
             }
             continue;
         }
@@ -68,11 +77,11 @@ pub fn shade<Q: SceneQuery, R: Recorder>(
         let mut blocker = None;
         if settings.shadows == ShadowMode::Ray {
             let (ray, t_max) = incidence.shadow_ray(scene, hit, settings.shadow_bump);
-            counts.shadow += 1;
-            rec.in_shadow_ray(true);
-            rec.ray(&ray, t_max, depth + 1);
-            blocker = query.occluder(&ray, t_max, counts, rec);
-            rec.in_shadow_ray(false);
+            sh.counts.shadow += 1;
+            sh.rec.in_shadow_ray(true);
+            sh.rec.ray(&ray, t_max, depth + 1);
+            blocker = query.occluder(&ray, t_max, sh.counts, sh.rec);
+            sh.rec.in_shadow_ray(false);
             shadow_ray = Some((ray, t_max));
         } else if settings.shadows == ShadowMode::Map {
             // CGPP 15.6.5: no ray; the light's depth map says whether something
@@ -85,104 +94,88 @@ pub fn shade<Q: SceneQuery, R: Recorder>(
         let contribution = if blocker.is_some() { Vec3::ZERO } else { incident * f * cos_theta };
         l_o += contribution;
         if R::ENABLED {
-            rec.light(LightSample { light: index, w_i, distance, incident, cos_theta, shadow_ray, blocker, bsdf: f, contribution });
+            sh.rec.light(LightSample { light: index, w_i, distance, incident, cos_theta, shadow_ray, blocker, bsdf: f, contribution });
         }
     }
 
     match settings.gi.mode {
         GiMode::Path if depth < settings.gi.max_path_depth() => {
-            l_o += indirect_path(scene, query, settings, hit, material, albedo, w_o, depth, path, counts, rec);
+            l_o += indirect_path(sh, hit, material, albedo, w_o, depth);
         }
-        GiMode::Photons => l_o += indirect_photons(scene, query, settings, hit, material, albedo, w_o, depth, path, counts, rec),
+        GiMode::Photons => l_o += indirect_photons(sh, hit, material, albedo, w_o, depth),
         _ => {}
     }
 
     if material.has_secondary() {
         if settings.gi.mode == GiMode::Path {
             if depth < settings.gi.max_path_depth() {
-                l_o += secondary_sampled(scene, query, settings, hit, material, w_o, depth, path, counts, rec);
+                l_o += secondary_sampled(sh, hit, material, w_o, depth);
             }
         } else if depth < settings.max_depth {
-            l_o += secondary(scene, query, settings, hit, material, w_o, depth, path, counts, rec);
+            l_o += secondary(sh, hit, material, w_o, depth);
         }
     }
-    rec.shaded(depth, l_o);
+    sh.rec.shaded(depth, l_o);
     l_o
 }
 
 /// Path tracing's indirect term: one direction sampled from the diffuse and
 /// glossy lobes, the radiance found along it weighted by `f cos / pdf`.
-#[allow(clippy::too_many_arguments)]
 fn indirect_path<Q: SceneQuery, R: Recorder>(
-    scene: &Scene,
-    query: &Q,
-    settings: &RenderSettings,
+    sh: &mut Shading<Q, R>,
     hit: &SurfaceHit,
     material: &Material,
     albedo: Vec3,
     w_o: Vec3,
     depth: u32,
-    path: &mut PathState,
-    counts: &mut RayCounts,
-    rec: &mut R,
 ) -> Radiance {
-    let Some((w_i, weight)) = gi::sample_bounce(material, albedo, hit, w_o, depth, path, rec) else {
+    let Shading { settings, .. } = *sh;
+    let Some((w_i, weight)) = gi::sample_bounce(material, albedo, hit, w_o, depth, sh.path, sh.rec) else {
         return Vec3::ZERO;
     };
     let ray = hit.spawn_ray_front(w_i, settings.shadow_bump);
-    weight * follow(scene, query, settings, &ray, depth, false, weight, path, counts, rec)
+    weight * follow(sh, &ray, depth, false, weight)
 }
 
 /// `radiance_along` with the path's throughput multiplied by `weight` for
 /// the rest of the path (Russian roulette reads it), restored afterwards.
-#[allow(clippy::too_many_arguments)]
 fn follow<Q: SceneQuery, R: Recorder>(
-    scene: &Scene,
-    query: &Q,
-    settings: &RenderSettings,
+    sh: &mut Shading<Q, R>,
     ray: &Ray,
     depth: u32,
     inside: bool,
     weight: Vec3,
-    path: &mut PathState,
-    counts: &mut RayCounts,
-    rec: &mut R,
 ) -> Radiance {
-    let before = path.throughput;
-    path.throughput *= weight;
-    let l = radiance_along(scene, query, settings, ray, depth + 1, inside, path, counts, rec);
-    path.throughput = before;
+    let before = sh.path.throughput;
+    sh.path.throughput *= weight;
+    let l = radiance_along(sh, ray, depth + 1, inside);
+    sh.path.throughput = before;
     l
 }
 
 /// Photon mapping's indirect term: the map's density estimate at diffuse
 /// surfaces, or at the first hit a final gather of sampled rays whose hits
 /// read the map.
-#[allow(clippy::too_many_arguments)]
 fn indirect_photons<Q: SceneQuery, R: Recorder>(
-    scene: &Scene,
-    query: &Q,
-    settings: &RenderSettings,
+    sh: &mut Shading<Q, R>,
     hit: &SurfaceHit,
     material: &Material,
     albedo: Vec3,
     w_o: Vec3,
     depth: u32,
-    path: &mut PathState,
-    counts: &mut RayCounts,
-    rec: &mut R,
 ) -> Radiance {
-    let Some(map) = path.photons else { return Vec3::ZERO };
+    let Shading { settings, .. } = *sh;
+    let Some(map) = sh.path.photons else { return Vec3::ZERO };
     let gather = settings.gi.final_gather;
     if depth == 0 && gather > 0 {
         let mut sum = Vec3::ZERO;
         for _ in 0..gather {
-            let choice = path.rng.next_f32();
-            let u = path.rng.next_2d();
+            let choice = sh.path.rng.next_f32();
+            let u = sh.path.rng.next_2d();
             if let Some(s) = super::bsdf_sampling::sample_bsdf(material, albedo, hit.shading_normal, w_o, choice, u) {
                 if s.w_i.dot(hit.geometric_normal) > 0.0 {
                     let ray = hit.spawn_ray_front(s.w_i, settings.shadow_bump);
-                    sum += s.weight * follow(scene, query, settings, &ray, depth, false, s.weight, path, counts, rec);
+                    sum += s.weight * follow(sh, &ray, depth, false, s.weight);
                 }
             }
         }
@@ -193,7 +186,7 @@ fn indirect_photons<Q: SceneQuery, R: Recorder>(
     }
     let l = map.radiance(hit, material, albedo, w_o, settings.gi.photon_k as usize);
     if R::ENABLED {
-        rec.photons(l);
+        sh.rec.photons(l);
     }
     l
 }
@@ -220,19 +213,14 @@ pub fn refraction(hit: &SurfaceHit, material: &Material, w_o: Vec3) -> (f32, Opt
 
 /// Path tracing's delta lobes: one of mirror reflection and refraction,
 /// chosen in proportion to its weight, instead of both.
-#[allow(clippy::too_many_arguments)]
 fn secondary_sampled<Q: SceneQuery, R: Recorder>(
-    scene: &Scene,
-    query: &Q,
-    settings: &RenderSettings,
+    sh: &mut Shading<Q, R>,
     hit: &SurfaceHit,
     material: &Material,
     w_o: Vec3,
     depth: u32,
-    path: &mut PathState,
-    counts: &mut RayCounts,
-    rec: &mut R,
 ) -> Radiance {
+    let Shading { settings, .. } = *sh;
     let n = hit.geometric_normal;
     let cos_o = w_o.dot(n).clamp(-1.0, 1.0);
     let mut reflect_weight = material.mirror;
@@ -243,7 +231,7 @@ fn secondary_sampled<Q: SceneQuery, R: Recorder>(
         refract = dir.map(|d| (d, material.transmission * (1.0 - fresnel)));
     }
     let refract_weight = refract.map_or(Vec3::ZERO, |r| r.1);
-    let (take_reflection, scale) = gi::choose_lobe(reflect_weight, refract_weight, &mut path.rng);
+    let (take_reflection, scale) = gi::choose_lobe(reflect_weight, refract_weight, &mut sh.path.rng);
     let (ray, weight, inside) = match refract {
         Some((dir, w)) if !take_reflection => (hit.spawn_ray_back(dir, settings.shadow_bump), w * scale, true),
         _ if reflect_weight != Vec3::ZERO => {
@@ -252,11 +240,11 @@ fn secondary_sampled<Q: SceneQuery, R: Recorder>(
         }
         _ => return Vec3::ZERO,
     };
-    let Some((survive, _)) = gi::roulette(depth, path.throughput * weight, &mut path.rng) else {
+    let Some((survive, _)) = gi::roulette(depth, sh.path.throughput * weight, &mut sh.path.rng) else {
         return Vec3::ZERO;
     };
     let weight = weight * survive;
-    weight * follow(scene, query, settings, &ray, depth, inside, weight, path, counts, rec)
+    weight * follow(sh, &ray, depth, inside, weight)
 }
 
 /// How one light arrives at a surface point: the first half of every light's
@@ -356,20 +344,15 @@ pub fn lifted_position(scene: &Scene, hit: &SurfaceHit) -> Vec3 {
 /// Gouraud shading: `shade()` at the triangle's three vertices (each seen
 /// from the eye), the results blended with the hit's barycentric weights.
 /// Spheres have no vertices and are shaded per sample.
-#[allow(clippy::too_many_arguments)]
 pub fn shade_gouraud<Q: SceneQuery, R: Recorder>(
-    scene: &Scene,
-    query: &Q,
-    settings: &RenderSettings,
+    sh: &mut Shading<Q, R>,
     hit: &SurfaceHit,
     eye: Vec3,
-    path: &mut PathState,
-    counts: &mut RayCounts,
-    rec: &mut R,
 ) -> Radiance {
+    let Shading { scene, .. } = *sh;
     if hit.kind != crate::scene::PrimitiveKind::Triangle {
         let w_o = (eye - hit.position).normalize_or_zero();
-        return shade(scene, query, settings, hit, w_o, 0, path, counts, rec);
+        return shade(sh, hit, w_o, 0);
     }
     let tri = &scene.triangles[hit.primitive as usize];
     let side = if hit.back_face { -1.0 } else { 1.0 };
@@ -385,25 +368,20 @@ pub fn shade_gouraud<Q: SceneQuery, R: Recorder>(
             ..*hit
         };
         let w_o = (eye - tri.v[k]).normalize_or_zero();
-        l_o += hit.barycentric[k] * shade(scene, query, settings, &vertex, w_o, 0, path, counts, rec);
+        l_o += hit.barycentric[k] * shade(sh, &vertex, w_o, 0);
     }
     l_o
 }
 
 /// Perfect mirror reflection and Fresnel-weighted refraction.
-#[allow(clippy::too_many_arguments)]
 fn secondary<Q: SceneQuery, R: Recorder>(
-    scene: &Scene,
-    query: &Q,
-    settings: &RenderSettings,
+    sh: &mut Shading<Q, R>,
     hit: &SurfaceHit,
     material: &Material,
     w_o: Vec3,
     depth: u32,
-    path: &mut PathState,
-    counts: &mut RayCounts,
-    rec: &mut R,
 ) -> Radiance {
+    let Shading { settings, .. } = *sh;
     let n = hit.geometric_normal;
     let cos_o = w_o.dot(n).clamp(-1.0, 1.0);
     let reflect_dir = (2.0 * cos_o * n - w_o).normalize();
@@ -414,37 +392,32 @@ fn secondary<Q: SceneQuery, R: Recorder>(
         reflect_weight += material.transmission * fresnel;
         if let Some(dir) = refracted {
             let ray = hit.spawn_ray_back(dir, settings.shadow_bump);
-            result += material.transmission * (1.0 - fresnel) * radiance_along(scene, query, settings, &ray, depth + 1, true, path, counts, rec);
+            result += material.transmission * (1.0 - fresnel) * radiance_along(sh, &ray, depth + 1, true);
         }
     }
     if reflect_weight != Vec3::ZERO {
         let ray = hit.spawn_ray_front(reflect_dir, settings.shadow_bump);
-        result += reflect_weight * radiance_along(scene, query, settings, &ray, depth + 1, false, path, counts, rec);
+        result += reflect_weight * radiance_along(sh, &ray, depth + 1, false);
     }
     result
 }
 
 /// Radiance along a secondary ray: closest hit, then `shade()`; the background on a miss.
-#[allow(clippy::too_many_arguments)]
 pub fn radiance_along<Q: SceneQuery, R: Recorder>(
-    scene: &Scene,
-    query: &Q,
-    settings: &RenderSettings,
+    sh: &mut Shading<Q, R>,
     ray: &Ray,
     depth: u32,
     inside: bool,
-    path: &mut PathState,
-    counts: &mut RayCounts,
-    rec: &mut R,
 ) -> Radiance {
-    counts.secondary += 1;
-    rec.ray(ray, f32::INFINITY, depth);
-    let hit = query.closest(ray, f32::INFINITY, inside, counts, rec);
-    rec.closest(hit.as_ref());
+    let Shading { scene, query, .. } = *sh;
+    sh.counts.secondary += 1;
+    sh.rec.ray(ray, f32::INFINITY, depth);
+    let hit = query.closest(ray, f32::INFINITY, inside, sh.counts, sh.rec);
+    sh.rec.closest(hit.as_ref());
     match hit {
-        Some(h) => shade(scene, query, settings, &h, -ray.dir, depth, path, counts, rec),
+        Some(h) => shade(sh, &h, -ray.dir, depth),
         None => {
-            rec.shaded(depth, scene.render.background);
+            sh.rec.shaded(depth, scene.render.background);
             scene.render.background
         }
     }

@@ -509,7 +509,11 @@ mod tests {
                     let Some(hit) = query.closest(&ray, view.far_t(x as f32 + 0.5, y as f32 + 0.5), false, &mut RayCounts::default(), &mut NoRecord) else { continue };
                     let expected = with_shading_hit(interpolation, &hit, |h| cast_shadow_ray(&prepared.scene, h, light, settings.shadow_bump)).flatten();
                     let mut trace = PixelTrace::new();
-                    with_shading_hit(interpolation, &hit, |h| shade(&prepared.scene, &query, &settings, h, -ray.dir, 0, &mut crate::render::gi::PathState::new(0, 0, 1, &settings.gi, None), &mut RayCounts::default(), &mut trace));
+                    with_shading_hit(interpolation, &hit, |h| {
+                        let mut path = crate::render::gi::PathState::new(0, 0, 1, &settings.gi, None);
+                        let mut sh = crate::render::shade::Shading { scene: &prepared.scene, query: &query, settings: &settings, path: &mut path, counts: &mut RayCounts::default(), rec: &mut trace };
+                        shade(&mut sh, h, -ray.dir, 0)
+                    });
                     let cast = trace.lights.iter().find(|l| l.light == 0).and_then(|l| l.shadow_ray);
                     assert_eq!(expected.map(bits), cast.map(bits), "{name} {interpolation:?} pixel ({x}, {y})");
                     compared += expected.is_some() as u32;
