@@ -50,5 +50,6 @@ shot view-vertices teapot PINHOLE_VERTICES=on PINHOLE_PANELS=none
 # level; the rasterizer's fragment history where the two-sided triangle's
 # front and back faces cover the same pixel.
 shot inspector-raytrace triangle-ground PINHOLE_SELECT=420,400 PINHOLE_PANELS=none
+shot inspector-path cornell-gi PINHOLE_GI=path PINHOLE_SPP=1 PINHOLE_SELECT=250,330 PINHOLE_PANELS=none
 shot inspector-zoom triangle-ground PINHOLE_SELECT=420,400 PINHOLE_ZOOM=12 PINHOLE_PANELS=none
 shot inspector-rasterize triangle-ground PINHOLE_RENDERER=rasterize PINHOLE_SELECT=500,380 PINHOLE_PANELS=none
