@@ -6,6 +6,7 @@ use crate::render::{self, debug::View, PreparedScene, RayCounts, RenderSettings,
 use crate::scene::Scene;
 use clap::{Args, Parser, Subcommand};
 use serde_json::json;
+use std::fmt::Write as _;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -196,10 +197,7 @@ pub fn run() -> Result<Outcome, String> {
         Some(Command::Chart { scene, output, renderers, spp_list, reference, reference_spp, opts }) => {
             cmd_chart(&scene, &output, &renderers, &spp_list, reference.as_deref(), reference_spp, &opts)
         }
-        Some(Command::List) => {
-            cmd_list();
-            Ok(())
-        }
+        Some(Command::List) => cmd_list(),
     };
     ran.map(|()| Outcome::Done)
 }
@@ -422,8 +420,7 @@ fn progress_loop(rows_done: &AtomicU64, total: u64, done: &AtomicBool) {
 fn write_json(dest: &str, j: &serde_json::Value) -> Result<(), String> {
     let text = serde_json::to_string_pretty(j).map_err(|e| e.to_string())? + "\n";
     if dest == "-" {
-        print!("{text}");
-        Ok(())
+        print_stdout(&text)
     } else {
         crate::image_io::write_atomic(Path::new(dest), text.as_bytes())
     }
@@ -466,8 +463,7 @@ fn cmd_pixel(scene_arg: &str, x: u32, y: u32, opts: &RenderOpts, as_json: bool) 
     if as_json {
         write_json("-", &crate::render::pixel_report::to_json(l.renderer.name(), scene, x, y, &replay))
     } else {
-        print!("{}", crate::render::pixel_report::to_text(l.renderer.name(), scene, x, y, &replay));
-        Ok(())
+        print_stdout(&crate::render::pixel_report::to_text(l.renderer.name(), scene, x, y, &replay))
     }
 }
 
@@ -533,31 +529,47 @@ fn cmd_compare(a: &Path, b: &Path, as_json: bool) -> Result<(), String> {
     if as_json {
         write_json("-", &serde_json::to_value(m).map_err(|e| e.to_string())?)
     } else {
-        println!("rmse      {:.6}  ({:.3}% of the mean {:.6} of {})", m.rmse, 100.0 * m.rmse / m.reference_mean.max(1e-12), m.reference_mean, b.display());
-        println!("rel_mse   {:.6}", m.rel_mse);
-        println!("max_abs   {:.6}", m.max_abs);
-        println!("flip      {:.6}", m.flip.unwrap_or(0.0));
-        println!("differing {} of {} pixels", m.differing_pixels, ia.pixels.len());
-        Ok(())
+        let mut t = String::new();
+        let _ = writeln!(t, "rmse      {:.6}  ({:.3}% of the mean {:.6} of {})", m.rmse, 100.0 * m.rmse / m.reference_mean.max(1e-12), m.reference_mean, b.display());
+        let _ = writeln!(t, "rel_mse   {:.6}", m.rel_mse);
+        let _ = writeln!(t, "max_abs   {:.6}", m.max_abs);
+        let _ = writeln!(t, "flip      {:.6}", m.flip.unwrap_or(0.0));
+        let _ = writeln!(t, "differing {} of {} pixels", m.differing_pixels, ia.pixels.len());
+        print_stdout(&t)
     }
 }
 
-fn cmd_list() {
-    println!("renderers:");
+fn cmd_list() -> Result<(), String> {
+    let mut t = String::new();
+    let _ = writeln!(t, "renderers:");
     for r in render::renderers() {
-        println!("  {:24} {}", r.name(), r.description());
+        let _ = writeln!(t, "  {:24} {}", r.name(), r.description());
     }
-    println!("  {:24} = {}", "raytrace", render::DEFAULT_RAYTRACE);
-    println!("  {:24} = {}", "rasterize", render::raster::DEFAULT_RASTERIZE);
-    println!("  (rasterizers only: --msaa 2|4|8 coverage samples, one shade per pixel per primitive;");
-    println!("   --forward shades every fragment that passes the depth test instead of early depth)");
-    println!("views:");
+    let _ = writeln!(t, "  {:24} = {}", "raytrace", render::DEFAULT_RAYTRACE);
+    let _ = writeln!(t, "  {:24} = {}", "rasterize", render::raster::DEFAULT_RASTERIZE);
+    let _ = writeln!(t, "  (rasterizers only: --msaa 2|4|8 coverage samples, one shade per pixel per primitive;");
+    let _ = writeln!(t, "   --forward shades every fragment that passes the depth test instead of early depth)");
+    let _ = writeln!(t, "views:");
     for v in View::ALL {
-        println!("  {}", v.name());
+        let _ = writeln!(t, "  {}", v.name());
     }
-    println!("shadows:\n  none\n  ray\n  map");
-    println!("built-in scenes:");
+    let _ = writeln!(t, "shadows:\n  none\n  ray\n  map");
+    let _ = writeln!(t, "built-in scenes:");
     for s in crate::scene::builtin::names() {
-        println!("  {s}");
+        let _ = writeln!(t, "  {s}");
+    }
+    print_stdout(&t)
+}
+
+/// Writes `text` to standard output. A reader that went away (`| head`)
+/// ends the program quietly, as Unix tools end; any other failure (a full
+/// disk) is an error sentence instead of a panic.
+fn print_stdout(text: &str) -> Result<(), String> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => std::process::exit(0),
+        Err(e) => Err(format!("cannot write to standard output: {e}")),
     }
 }

@@ -106,3 +106,32 @@ fn chart_writes_png_and_csv() {
     assert!(err(rows[2]) < err(rows[1]), "{csv}");
     assert_clean_error(&pinhole(&["chart", "spheres", "-o", png.to_str().unwrap(), "--spp-list", "1,x"]), "--spp-list");
 }
+
+/// A full disk behind standard output is one sentence and a non-zero exit,
+/// never a panic; a reader that goes away (`| head`) ends the program quietly.
+#[test]
+fn failed_standard_output_is_an_error_not_a_panic() {
+    let bin = env!("CARGO_BIN_EXE_pinhole");
+    if std::path::Path::new("/dev/full").exists() {
+        for args in [vec!["list"], vec!["pixel", "one-triangle", "5", "5", "--width", "16", "--height", "16", "--json"]] {
+            let full = std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap();
+            let out = std::process::Command::new(bin).args(&args).stdout(full).output().unwrap();
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+            assert!(err.contains("cannot write to standard output") && !err.contains("internal error"), "{args:?}: {err}");
+            assert_eq!(err.lines().count(), 1, "{err}");
+        }
+    }
+    // Megabytes of JSON into a pipe whose reader closed at once.
+    let mut child = std::process::Command::new(bin)
+        .args(["pixel", "spheres", "10", "10", "--json", "--spp", "256", "--width", "32", "--height", "32"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.is_empty(), "a closed pipe printed: {err}");
+}
