@@ -149,3 +149,23 @@ fn bare_obj_is_framed() {
     let pinhole::scene::Light::Point { position, .. } = s.lights[0] else { panic!() };
     assert!(position.y > s.camera.eye.y && position.z > 5.0, "light above and on the camera's side");
 }
+
+/// MTL colours: `Kd 0.5` means grey (the format allows one number), and a
+/// colour with two numbers or a word is an error naming the MTL file and
+/// line. tobj alone panics on both.
+#[test]
+fn mtl_colours_with_one_or_two_numbers() {
+    let dir = temp_dir("mtl");
+    write(&dir, "a.obj", "mtllib a.mtl\nusemtl a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    write(&dir, "a.mtl", "newmtl a\nKd 0.5\nKa 1\nKs 0.25\nKe 1\n");
+    let scene = load_scene(&dir.join("a.obj").to_string_lossy()).unwrap();
+    let m = scene.materials.iter().find(|m| m.name.ends_with("/a")).expect("material a");
+    assert_eq!(m.lambertian, pinhole::math::Vec3::splat(0.5));
+    assert_eq!(m.glossy, pinhole::math::Vec3::splat(0.25));
+    for (mtl, needle) in [("newmtl a\nKd 0.5 0.2\n", "a.mtl:2: Kd takes one or three numbers"), ("newmtl a\n\nKs 0.1 x 0.3\n", "a.mtl:3: Ks takes numbers")] {
+        write(&dir, "a.mtl", mtl);
+        let err = load_scene(&dir.join("a.obj").to_string_lossy()).err().expect("an error");
+        assert!(err.contains(needle), "{err}");
+        assert_eq!(err.lines().count(), 1, "{err}");
+    }
+}

@@ -35,11 +35,22 @@ pub fn load_obj(path: &Path, mode: NormalMode) -> Result<LoadedMesh, String> {
     let bytes = read_asset(path).map_err(|e| format!("cannot read OBJ {e}"))?;
     let base = path.parent().unwrap_or(Path::new("."));
     let options = tobj::LoadOptions { triangulate: true, single_index: false, ignore_points: true, ignore_lines: true };
+    // The first malformed MTL line, reported with its file and line: tobj's
+    // material loader can only say that it failed.
+    let mtl_error = std::cell::RefCell::new(None);
     let (models, mtl) = tobj::load_obj_buf(&mut std::io::Cursor::new(bytes), &options, |mtl_path| {
-        let data = read_asset(&base.join(mtl_path)).map_err(|_| tobj::LoadError::OpenFileFailed)?;
+        let mtl_file = base.join(mtl_path);
+        let data = read_asset(&mtl_file).map_err(|_| tobj::LoadError::OpenFileFailed)?;
+        let data = normalize_mtl_colours(&data).map_err(|e| {
+            *mtl_error.borrow_mut() = Some(format!("{}:{e}", mtl_file.display()));
+            tobj::LoadError::MaterialParseError
+        })?;
         tobj::load_mtl_buf(&mut std::io::Cursor::new(data))
     })
     .map_err(|e| format!("{name}: cannot read OBJ: {e}"))?;
+    if let Some(e) = mtl_error.into_inner() {
+        return Err(e);
+    }
     let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     let materials = match mtl {
         Ok(ms) => ms
@@ -194,4 +205,33 @@ pub fn frame_camera(scene: &mut Scene, lo: Vec3, hi: Vec3) {
     let d2 = (light_pos - center).length_squared();
     // About irradiance 3 W/m^2 at the object: a well-exposed grey at exposure 1.
     scene.lights.push(Light::Point { position: light_pos, power: Vec3::splat(3.0 * 4.0 * std::f32::consts::PI * d2) });
+}
+
+/// MTL colour statements (`Ka`, `Kd`, `Ks`, `Ke`, `Tf`) as tobj can read
+/// them: one number means grey (the format allows `Kd r` for `Kd r r r`)
+/// and is written out as three; any count but one or three, or a word that
+/// is not a number, is an error naming the line (`LINE: ...`), where tobj
+/// itself would panic or silently read part of it.
+pub fn normalize_mtl_colours(data: &[u8]) -> Result<Vec<u8>, String> {
+    let text = String::from_utf8_lossy(data);
+    let mut out = String::with_capacity(text.len() + 64);
+    for (i, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        let key = words.next().unwrap_or("");
+        if matches!(key, "Ka" | "Kd" | "Ks" | "Ke" | "Tf") {
+            let values: Vec<&str> = words.collect();
+            if let Some(bad) = values.iter().find(|v| v.parse::<f32>().is_err()) {
+                return Err(format!("{}: {key} takes numbers (r g b), not \"{}\"", i + 1, bad.chars().take(40).collect::<String>()));
+            }
+            match values.len() {
+                3 => out.push_str(line),
+                1 => out.push_str(&format!("{key} {0} {0} {0}", values[0])),
+                n => return Err(format!("{}: {key} takes one or three numbers (r g b), not {n}", i + 1)),
+            }
+        } else {
+            out.push_str(line);
+        }
+        out.push('\n');
+    }
+    Ok(out.into_bytes())
 }
