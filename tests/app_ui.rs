@@ -294,20 +294,7 @@ fn shadow_map_mode_never_crashes_the_viewer() {
 
 #[test]
 fn settings_persist_between_runs() {
-    #[derive(Default)]
-    struct Mem(std::collections::HashMap<String, String>);
-    impl eframe::Storage for Mem {
-        fn get_string(&self, key: &str) -> Option<String> {
-            self.0.get(key).cloned()
-        }
-        fn set_string(&mut self, key: &str, value: String) {
-            self.0.insert(key.into(), value);
-        }
-        fn remove_string(&mut self, key: &str) {
-            self.0.remove(key);
-        }
-        fn flush(&mut self) {}
-    }
+    use pinhole::app::settings_store::MemoryStorage as Mem;
     let mut app = PinholeApp::new_for_test(small_scene("one-triangle"));
     app.settings.renderer = "raytrace:brute".into();
     app.settings.spp = 9;

@@ -6,21 +6,7 @@ use pinhole::app::settings_store::ViewerSettings;
 use pinhole::render::debug::View;
 use pinhole::render::{Interpolation, ShadowMode};
 
-#[derive(Default)]
-struct Mem(std::collections::HashMap<String, String>);
-
-impl eframe::Storage for Mem {
-    fn get_string(&self, key: &str) -> Option<String> {
-        self.0.get(key).cloned()
-    }
-    fn set_string(&mut self, key: &str, value: String) {
-        self.0.insert(key.into(), value);
-    }
-    fn remove_string(&mut self, key: &str) {
-        self.0.remove(key);
-    }
-    fn flush(&mut self) {}
-}
+use pinhole::app::settings_store::MemoryStorage as Mem;
 
 fn stored(text: &str) -> Mem {
     let mut mem = Mem::default();
