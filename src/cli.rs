@@ -66,18 +66,27 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
-    /// Speed-versus-accuracy chart: error against frame time as spp grows (+ OUT.csv beside it).
+    /// Speed-versus-accuracy chart: error against frame time of every method
+    /// that matters for the scene (or of each renderer as spp grows), + OUT.csv beside it.
     Chart {
         scene: String,
         #[arg(short = 'o', long = "output", value_name = "OUT.png")]
         output: PathBuf,
-        /// Renderers to compare (comma-separated).
+        /// methods: renderers, samples, shadow maps, interpolation, indirect light;
+        /// spp: each of --renderers at each of --spp-list.
+        #[arg(long, default_value = "methods")]
+        sweep: String,
+        /// Error on the chart's vertical axis: rel-rmse | flip (the CSV has both).
+        #[arg(long, default_value = "rel-rmse")]
+        metric: String,
+        /// --sweep spp: renderers to compare (comma-separated).
         #[arg(long, default_value = "raytrace,rasterize")]
         renderers: String,
-        /// Samples per pixel to sweep (comma-separated).
+        /// --sweep spp: samples per pixel to sweep (comma-separated).
         #[arg(long = "spp-list", default_value = "1,4,16,64")]
         spp_list: String,
-        /// Reference image (linear .exr); default: raytrace:bvh at --reference-spp.
+        /// Reference image (linear .exr); default: the scene's [render] reference, else
+        /// (methods) a path-traced image at --reference-spp, cached, or (spp) raytrace:bvh.
         #[arg(long)]
         reference: Option<PathBuf>,
         #[arg(long = "reference-spp", default_value_t = 256)]
@@ -194,8 +203,10 @@ pub fn run() -> Result<Outcome, String> {
         Some(Command::Bench { scene, opts, frames }) => cmd_bench(&scene, &opts, frames),
         Some(Command::Compare { a, b, json }) => cmd_compare(&a, &b, json),
         Some(Command::Pixel { scene, x, y, opts, json }) => cmd_pixel(&scene, x, y, &opts, json),
-        Some(Command::Chart { scene, output, renderers, spp_list, reference, reference_spp, opts }) => {
-            cmd_chart(&scene, &output, &renderers, &spp_list, reference.as_deref(), reference_spp, &opts)
+        Some(Command::Chart { scene, output, sweep, metric, renderers, spp_list, reference, reference_spp, opts }) => match sweep.as_str() {
+            "methods" => cmd_chart_methods(&scene, &output, &metric, reference.as_deref(), reference_spp, &opts),
+            "spp" => cmd_chart(&scene, &output, &renderers, &spp_list, reference.as_deref(), reference_spp, &opts),
+            other => Err(format!("--sweep: \"{other}\" is not one of methods, spp")),
         }
         Some(Command::List) => cmd_list(),
     };
@@ -467,10 +478,53 @@ fn cmd_pixel(scene_arg: &str, x: u32, y: u32, opts: &RenderOpts, as_json: bool) 
     }
 }
 
-fn cmd_chart(scene_arg: &str, output: &Path, renderers: &str, spp_list: &str, reference: Option<&Path>, reference_spp: u32, opts: &RenderOpts) -> Result<(), String> {
+/// `chart --sweep methods`: every configuration of `chart::method_configurations`
+/// against the reference, as a scatter with its Pareto front, and the CSV.
+fn cmd_chart_methods(scene_arg: &str, output: &Path, metric: &str, reference: Option<&Path>, reference_spp: u32, opts: &RenderOpts) -> Result<(), String> {
+    check_png_output(output)?;
+    let metric = match metric {
+        "rel-rmse" | "rmse" => crate::chart::ErrorMetric::RelRmse,
+        "flip" => crate::chart::ErrorMetric::Flip,
+        other => return Err(format!("--metric: \"{other}\" is not one of rel-rmse, flip")),
+    };
+    if !(1..=65536).contains(&reference_spp) {
+        return Err(format!("--reference-spp {reference_spp} is not between 1 and 65536"));
+    }
+    let l = load(scene_arg, opts)?;
+    let (w, h) = (l.settings.width, l.settings.height);
+    let source = crate::chart::ReferenceSource::choose(reference, &l.prepared, reference_spp);
+    let cancel = AtomicBool::new(false);
+    let cache = crate::chart::reference::default_cache_dir();
+    let truth = l
+        .pool
+        .install(|| crate::chart::load_reference(&source, &l.prepared, w, h, cache.as_deref(), &cancel, None))?
+        .ok_or("cancelled")?;
+    eprintln!("reference: {}", truth.name);
+    let configs = crate::chart::method_configurations(&l.prepared.scene, &l.settings);
+    let mut points = Vec::new();
+    for (i, c) in configs.iter().enumerate() {
+        eprintln!("[{}/{}] {}", i + 1, configs.len(), c.label);
+        let m = l.pool.install(|| crate::chart::measure(&l.prepared, c, &truth, 3, &cancel))?.ok_or("cancelled")?;
+        points.push(m);
+    }
+    let title = format!("{}: error against time, {w}x{h}, {} threads; reference: {}", l.prepared.scene.name, l.pool.current_num_threads(), truth.name);
+    let png = crate::chart::plot::draw_methods_png(&points, metric, &title, 1100, 700)?;
+    let csv_path = output.with_extension("csv");
+    crate::image_io::write_atomic(&csv_path, crate::chart::methods_csv(&points).as_bytes())?;
+    crate::image_io::write_atomic(output, &png)?;
+    eprintln!("wrote {} and {}", output.display(), csv_path.display());
+    Ok(())
+}
+
+fn check_png_output(output: &Path) -> Result<(), String> {
     if output.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() != Some("png") {
         return Err(format!("{}: the chart is written as .png", output.display()));
     }
+    Ok(())
+}
+
+fn cmd_chart(scene_arg: &str, output: &Path, renderers: &str, spp_list: &str, reference: Option<&Path>, reference_spp: u32, opts: &RenderOpts) -> Result<(), String> {
+    check_png_output(output)?;
     let spps: Vec<u32> = spp_list
         .split(',')
         .map(|s| s.trim().parse::<u32>().ok().filter(|&n| (1..=65536).contains(&n)).ok_or(format!("--spp-list: \"{s}\" is not a sample count")))
@@ -481,7 +535,8 @@ fn cmd_chart(scene_arg: &str, output: &Path, renderers: &str, spp_list: &str, re
     }
     let l = load(scene_arg, opts)?;
     let (w, h) = (l.settings.width, l.settings.height);
-    let reference_pixels = match reference {
+    let reference = reference.map(Path::to_path_buf).or_else(|| l.prepared.scene.render.reference.clone());
+    let reference_pixels = match reference.as_deref() {
         Some(path) => {
             let img = crate::image_io::load_image(path)?;
             if (img.width, img.height) != (w, h) {
@@ -500,13 +555,13 @@ fn cmd_chart(scene_arg: &str, output: &Path, renderers: &str, spp_list: &str, re
         }
     };
     let points = l.pool.install(|| {
-        crate::chart::sweep(&l.prepared, &l.settings, &names, &spps, &reference_pixels, 3, |r, spp| eprintln!("measuring {r} at {spp} spp"))
+        crate::chart::spp_sweep::sweep(&l.prepared, &l.settings, &names, &spps, &reference_pixels, 3, |r, spp| eprintln!("measuring {r} at {spp} spp"))
     })?;
     let title = format!("{}: error against time, {w}x{h}, {} threads", l.prepared.scene.name, l.pool.current_num_threads());
-    let png = crate::chart::draw_png(&points, &title, 900, 600)?;
+    let png = crate::chart::plot::draw_spp_png(&points, &title, 900, 600)?;
     crate::image_io::write_atomic(output, &png)?;
     let csv_path = output.with_extension("csv");
-    crate::image_io::write_atomic(&csv_path, crate::chart::to_csv(&points).as_bytes())?;
+    crate::image_io::write_atomic(&csv_path, crate::chart::spp_sweep::to_csv(&points).as_bytes())?;
     eprintln!("wrote {} and {}", output.display(), csv_path.display());
     Ok(())
 }

@@ -93,7 +93,7 @@ fn errors_are_one_sentence() {
 fn chart_writes_png_and_csv() {
     let png = tmp("chart.png");
     let out = pinhole(&[
-        "chart", "spheres", "-o", png.to_str().unwrap(), "--width", "40", "--height", "25", "--spp-list", "1,4", "--reference-spp", "16",
+        "chart", "spheres", "-o", png.to_str().unwrap(), "--sweep", "spp", "--width", "40", "--height", "25", "--spp-list", "1,4", "--reference-spp", "16",
     ]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     assert!(image::open(&png).is_ok());
@@ -104,7 +104,7 @@ fn chart_writes_png_and_csv() {
     // More samples, less error (against a 16-spp reference with the same sample pattern family).
     let err = |row: &str| row.split(',').nth(3).unwrap().parse::<f64>().unwrap();
     assert!(err(rows[2]) < err(rows[1]), "{csv}");
-    assert_clean_error(&pinhole(&["chart", "spheres", "-o", png.to_str().unwrap(), "--spp-list", "1,x"]), "--spp-list");
+    assert_clean_error(&pinhole(&["chart", "spheres", "-o", png.to_str().unwrap(), "--sweep", "spp", "--spp-list", "1,x"]), "--spp-list");
 }
 
 /// A full disk behind standard output is one sentence and a non-zero exit,

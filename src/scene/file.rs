@@ -45,6 +45,7 @@ struct RenderDesc {
     background: Option<[f32; 3]>,
     ambient: Option<[f32; 3]>,
     exposure: Option<f32>,
+    reference: Option<String>,
 }
 
 #[derive(Deserialize)]
@@ -157,6 +158,7 @@ pub fn parse_scene(text: &str, origin: &str, base: &Path, name: &str) -> Result<
             background: color(r.background, d.background, &where_, "render.background")?,
             ambient: color(r.ambient, d.ambient, &where_, "render.ambient")?,
             exposure: r.exposure.unwrap_or(d.exposure),
+            reference: r.reference.as_ref().map(|f| base.join(f)),
         };
         if !(scene.render.exposure.is_finite() && scene.render.exposure >= 0.0) {
             return Err(format!("{where_}: render.exposure must be a finite number >= 0"));

@@ -145,6 +145,9 @@ pub struct RenderDefaults {
     pub background: Vec3,
     pub ambient: Vec3,
     pub exposure: f32,
+    /// A ground-truth image (linear EXR of this size) that charts measure
+    /// error against; the path is resolved against the scene file's folder.
+    pub reference: Option<std::path::PathBuf>,
 }
 
 impl Default for RenderDefaults {
@@ -155,6 +158,7 @@ impl Default for RenderDefaults {
             background: Vec3::new(0.0, 0.0, 0.1),
             ambient: Vec3::ZERO,
             exposure: 1.0,
+            reference: None,
         }
     }
 }

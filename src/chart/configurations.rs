@@ -1,0 +1,190 @@
+//! The configurations a methods chart measures: each approximation that
+//! matters for the scene, at a few settings of its knob, plus the samples
+//! that buy accuracy with time. Every configuration is a renderer and the
+//! `RenderSettings` it renders with, so the viewer can apply one as it is.
+
+use crate::render::gi::GiMode;
+use crate::render::{debug, shadow_map, Interpolation, RenderSettings, ShadowMode, DEFAULT_RAYTRACE};
+use crate::render::raster::DEFAULT_RASTERIZE;
+use crate::scene::Scene;
+
+/// One point of the methods sweep.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Configuration {
+    /// What it is, in the words of the command line (`describe`).
+    pub label: String,
+    /// The family of approximation it belongs to: the chart colours by it.
+    pub group: &'static str,
+    pub renderer: String,
+    pub settings: RenderSettings,
+}
+
+impl Configuration {
+    pub fn new(group: &'static str, renderer: &str, settings: RenderSettings) -> Configuration {
+        Configuration { label: describe(renderer, &settings), group, renderer: renderer.to_string(), settings }
+    }
+}
+
+/// The renderer and every knob that differs from the defaults, as the command
+/// line would set it: "rasterize:fixed --spp 4 --shadows map --shadow-map-size 256".
+/// Commas never appear, so a label is one CSV field.
+pub fn describe(renderer: &str, s: &RenderSettings) -> String {
+    let mut out = vec![renderer.to_string()];
+    let mut knob = |k: &str, v: String| out.push(format!("--{k} {v}"));
+    if s.spp != 1 {
+        knob("spp", s.spp.to_string());
+    }
+    if s.msaa > 1 {
+        knob("msaa", s.msaa.to_string());
+    }
+    if s.shadows != ShadowMode::Ray {
+        knob("shadows", s.shadows.name().to_string());
+    }
+    if s.shadows == ShadowMode::Map {
+        if s.shadow_map_size != shadow_map::DEFAULT_SIZE {
+            knob("shadow-map-size", s.shadow_map_size.to_string());
+        }
+        if s.shadow_map_bias != shadow_map::DEFAULT_BIAS {
+            knob("shadow-map-bias", format!("{}", s.shadow_map_bias));
+        }
+    }
+    if s.interpolation != Interpolation::Phong {
+        knob("interpolation", s.interpolation.name().to_string());
+    }
+    if s.affine {
+        out.push("--affine".into());
+    }
+    let gi = &s.gi;
+    if gi.mode != GiMode::None {
+        let mut knob = |k: &str, v: String| out.push(format!("--{k} {v}"));
+        knob("gi", gi.mode.name().to_string());
+        match gi.mode {
+            GiMode::Ao => knob("ao-samples", gi.ao_samples.to_string()),
+            GiMode::Photons => {
+                knob("photons", gi.photons.to_string());
+                if gi.final_gather > 0 {
+                    knob("final-gather", gi.final_gather.to_string());
+                }
+            }
+            GiMode::Path => {
+                if let Some(b) = gi.bounces {
+                    knob("bounces", b.to_string());
+                }
+            }
+            GiMode::None => {}
+        }
+    }
+    out.join(" ")
+}
+
+/// The configurations worth measuring on `scene`, all at `base`'s image size
+/// (and seed). Shadow-map settings only when something casts a shadow,
+/// interpolation only when the scene has triangles.
+pub fn method_configurations(scene: &Scene, base: &RenderSettings) -> Vec<Configuration> {
+    let plain = RenderSettings {
+        width: base.width,
+        height: base.height,
+        view: debug::View::Shaded,
+        gi: crate::render::gi::GiSettings { seed: base.gi.seed, ..Default::default() },
+        ..RenderSettings::for_scene(scene)
+    };
+    let with = |f: &dyn Fn(&mut RenderSettings)| {
+        let mut s = plain.clone();
+        f(&mut s);
+        s
+    };
+    let (ray, raster) = (DEFAULT_RAYTRACE, DEFAULT_RASTERIZE);
+    let mut out = Vec::new();
+    let mut add = |group, renderer: &str, s: RenderSettings| out.push(Configuration::new(group, renderer, s));
+
+    // Antialiasing: more samples per pixel, or coverage samples.
+    for spp in [1, 4, 16] {
+        add("samples", ray, with(&|s| s.spp = spp));
+    }
+    add("samples", raster, plain.clone());
+    add("samples", raster, with(&|s| s.msaa = 4));
+
+    // Shadows: none, traced (above), or looked up in maps of a few sizes and biases.
+    let casts_shadows = !scene.lights.is_empty() && scene.triangles.len() + scene.spheres.len() > 1;
+    if casts_shadows {
+        add("shadows", raster, with(&|s| s.shadows = ShadowMode::None));
+        for size in [256, 1024, 2048] {
+            add("shadows", raster, with(&|s| {
+                s.shadows = ShadowMode::Map;
+                s.shadow_map_size = size;
+            }));
+        }
+        for bias in [0.1, 8.0] {
+            add("shadows", raster, with(&|s| {
+                s.shadows = ShadowMode::Map;
+                s.shadow_map_bias = bias;
+            }));
+        }
+    }
+
+    // Shading interpolation across triangles.
+    if !scene.triangles.is_empty() {
+        for i in [Interpolation::Flat, Interpolation::Gouraud] {
+            add("interpolation", raster, with(&|s| s.interpolation = i));
+        }
+    }
+
+    // Indirect light: the cheap approximation (it darkens the ambient term,
+    // so only where there is one), photons, and paths (the truth's method).
+    let has_ambient = scene.render.ambient.max_element() > 0.0;
+    for (n, spp) in [(4, 1), (16, 4)].into_iter().filter(|_| has_ambient) {
+        add("indirect light", ray, with(&|s| {
+            s.gi.mode = GiMode::Ao;
+            s.gi.ao_samples = n;
+            s.spp = spp;
+        }));
+    }
+    for photons in [20_000, 200_000] {
+        add("indirect light", ray, with(&|s| {
+            s.gi.mode = GiMode::Photons;
+            s.gi.photons = photons;
+            s.spp = 4;
+        }));
+    }
+    for spp in [4, 16, 64] {
+        add("indirect light", ray, with(&|s| {
+            s.gi.mode = GiMode::Path;
+            s.spp = spp;
+        }));
+    }
+    add("indirect light", raster, with(&|s| {
+        s.gi.mode = GiMode::Path;
+        s.spp = 16;
+    }));
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn labels_name_the_knobs_that_differ_and_are_unique() {
+        let scene = crate::scene::builtin::load_builtin("teapot").unwrap().unwrap();
+        let base = RenderSettings { width: 40, height: 30, ..RenderSettings::for_scene(&scene) };
+        let configs = method_configurations(&scene, &base);
+        assert!(configs.len() >= 12);
+        let mut labels: Vec<&str> = configs.iter().map(|c| c.label.as_str()).collect();
+        labels.sort();
+        labels.dedup();
+        assert_eq!(labels.len(), configs.len(), "two configurations share a label");
+        assert!(labels.iter().all(|l| !l.contains(',')));
+        assert!(configs.iter().all(|c| (c.settings.width, c.settings.height) == (40, 30)));
+        let map = configs.iter().find(|c| c.settings.shadow_map_size == 256).unwrap();
+        assert_eq!(map.label, "rasterize:fixed --shadows map --shadow-map-size 256");
+        let path = configs.iter().find(|c| c.settings.gi.mode == GiMode::Path && c.settings.spp == 64).unwrap();
+        assert_eq!(path.label, "raytrace:bvh --spp 64 --gi path");
+    }
+
+    #[test]
+    fn a_scene_with_one_primitive_sweeps_no_shadow_maps() {
+        let scene = crate::scene::builtin::load_builtin("one-triangle").unwrap().unwrap();
+        let base = RenderSettings::for_scene(&scene);
+        assert!(method_configurations(&scene, &base).iter().all(|c| c.group != "shadows"));
+    }
+}

@@ -1,0 +1,151 @@
+//! Charts as PNG (plotters): error against frame time on log axes.
+
+use super::measure::{ErrorMetric, Measurement};
+use super::spp_sweep::SweepPoint;
+use plotters::prelude::*;
+
+/// Registering twice is harmless; the font is egui's own Ubuntu Light.
+fn register_font() {
+    let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, epaint_default_fonts::UBUNTU_LIGHT);
+}
+
+/// Draws error (log) against frame time (log), one line per renderer, each
+/// point labelled with its spp. Returns PNG bytes.
+pub fn draw_spp_png(points: &[SweepPoint], title: &str, width: u32, height: u32) -> Result<Vec<u8>, String> {
+    register_font();
+    let mut buf = vec![255u8; (width * height * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buf, (width, height)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        let (xmin, xmax) = bounds(points.iter().map(|p| p.ms));
+        let (ymin, ymax) = bounds(points.iter().map(|p| p.rel_rmse.max(1e-6)));
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 22))
+            .margin(16)
+            .x_label_area_size(44)
+            .y_label_area_size(70)
+            .build_cartesian_2d((xmin..xmax).log_scale(), (ymin..ymax).log_scale())
+            .map_err(|e| e.to_string())?;
+        chart
+            .configure_mesh()
+            .x_desc("frame time (ms, log)")
+            .y_desc("rmse / mean radiance (log)")
+            .label_style(("sans-serif", 14))
+            .draw()
+            .map_err(|e| e.to_string())?;
+        let mut names: Vec<&str> = points.iter().map(|p| p.renderer.as_str()).collect();
+        names.dedup();
+        for (i, name) in names.iter().enumerate() {
+            let color = Palette99::pick(i).to_rgba();
+            let series: Vec<(f64, f64)> = points.iter().filter(|p| p.renderer == *name).map(|p| (p.ms, p.rel_rmse.max(1e-6))).collect();
+            chart
+                .draw_series(LineSeries::new(series.clone(), color.stroke_width(2)))
+                .map_err(|e| e.to_string())?
+                .label(*name)
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
+            chart
+                .draw_series(points.iter().filter(|p| p.renderer == *name).map(|p| {
+                    EmptyElement::at((p.ms, p.rel_rmse.max(1e-6)))
+                        + Circle::new((0, 0), 4, color.filled())
+                        + Text::new(format!("{}", p.spp), (6, -14), ("sans-serif", 13))
+                }))
+                .map_err(|e| e.to_string())?;
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 15))
+            .draw()
+            .map_err(|e| e.to_string())?;
+        root.present().map_err(|e| e.to_string())?;
+    }
+    crate::image_io::encode_png(width, height, &buf)
+}
+
+/// Axis numbers with two significant digits (log axes otherwise print
+/// rounding noise such as 0.30000000000000004).
+fn short_number(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let digits = (1 - v.abs().log10().floor() as i32).max(0) as usize;
+    format!("{v:.digits$}")
+}
+
+/// A log-axis range around the values, with some room.
+fn bounds(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) = values.fold((f64::INFINITY, 0.0f64), |(lo, hi), v| (lo.min(v), hi.max(v)));
+    if !(lo.is_finite() && hi > 0.0) {
+        return (0.1, 1.0);
+    }
+    (lo / 1.5, hi * 1.5)
+}
+
+/// The methods chart: one dot per configuration, coloured by its group, the
+/// Pareto front as a line through the configurations worth choosing, each
+/// of those labelled. Returns PNG bytes.
+pub fn draw_methods_png(points: &[Measurement], metric: ErrorMetric, title: &str, width: u32, height: u32) -> Result<Vec<u8>, String> {
+    register_font();
+    let err = |p: &Measurement| metric.of(p).max(1e-6);
+    let front = super::measure::pareto_front(points, metric);
+    let mut buf = vec![255u8; (width * height * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buf, (width, height)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        let (xmin, xmax) = bounds(points.iter().map(|p| p.ms));
+        let (ymin, ymax) = bounds(points.iter().map(err));
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 20))
+            .margin(16)
+            .x_label_area_size(44)
+            .y_label_area_size(70)
+            .build_cartesian_2d((xmin..xmax).log_scale(), (ymin..ymax).log_scale())
+            .map_err(|e| e.to_string())?;
+        chart
+            .configure_mesh()
+            .x_desc("frame time (ms, log)")
+            .y_desc(format!("{} (log)", metric.axis_name()))
+            .x_label_formatter(&|v| short_number(*v))
+            .y_label_formatter(&|v| short_number(*v))
+            .label_style(("sans-serif", 14))
+            .draw()
+            .map_err(|e| e.to_string())?;
+        let front_line: Vec<(f64, f64)> = front.iter().map(|&i| (points[i].ms, err(&points[i]))).collect();
+        chart
+            .draw_series(LineSeries::new(front_line, BLACK.mix(0.5).stroke_width(1)))
+            .map_err(|e| e.to_string())?
+            .label("Pareto front")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.mix(0.5).stroke_width(1)));
+        let mut groups: Vec<&str> = Vec::new();
+        for p in points {
+            if !groups.contains(&p.group.as_str()) {
+                groups.push(&p.group);
+            }
+        }
+        for (gi, group) in groups.iter().enumerate() {
+            let color = Palette99::pick(gi).to_rgba();
+            chart
+                .draw_series(points.iter().filter(|p| p.group == *group).map(|p| Circle::new((p.ms, err(p)), 5, color.filled())))
+                .map_err(|e| e.to_string())?
+                .label(*group)
+                .legend(move |(x, y)| Circle::new((x + 10, y), 5, color.filled()));
+        }
+        chart
+            .draw_series(front.iter().map(|&i| {
+                let p = &points[i];
+                EmptyElement::at((p.ms, err(p))) + Text::new(p.label.clone(), (8, -6), ("sans-serif", 12))
+            }))
+            .map_err(|e| e.to_string())?;
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::LowerLeft)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 14))
+            .draw()
+            .map_err(|e| e.to_string())?;
+        root.present().map_err(|e| e.to_string())?;
+    }
+    crate::image_io::encode_png(width, height, &buf)
+}
