@@ -53,3 +53,5 @@ shot inspector-raytrace triangle-ground PINHOLE_SELECT=420,400 PINHOLE_PANELS=no
 shot inspector-path cornell-gi PINHOLE_GI=path PINHOLE_SPP=1 PINHOLE_SELECT=250,330 PINHOLE_PANELS=none
 shot inspector-zoom triangle-ground PINHOLE_SELECT=420,400 PINHOLE_ZOOM=12 PINHOLE_PANELS=none
 shot inspector-rasterize triangle-ground PINHOLE_RENDERER=rasterize PINHOLE_SELECT=500,380 PINHOLE_PANELS=none
+# The Compare window after measuring every method on the Cornell box.
+shot compare-cornell-gi cornell-gi PINHOLE_COMPARE=on PINHOLE_PANELS=none

@@ -4,6 +4,7 @@
 //! and `viewport` draw it.
 
 use eframe::egui;
+pub mod compare_lab;
 pub mod export;
 pub mod inspect;
 pub mod legend;
@@ -108,7 +109,8 @@ fn screenshot_frame(app: &mut PinholeApp, ctx: &egui::Context) {
     let ready = !app.loading()
         && app.with_output(|o| o.idle && o.complete && o.generation == generation && o.version == shown)
         && !app.bench.as_ref().is_some_and(|b| !b.done)
-        && !app.inspect.waiting(generation);
+        && !app.inspect.waiting(generation)
+        && !app.compare.running();
     let viewport_rect = app.viewport_rect;
     let Some(shot) = app.screenshot.as_mut() else { return };
     ctx.request_repaint_after(Duration::from_millis(30));
@@ -159,7 +161,8 @@ fn screenshot_frame(app: &mut PinholeApp, ctx: &egui::Context) {
 /// materials,shading` (or `none`) which side-panel sections are open (the
 /// inspector shows whenever a pixel is selected),
 /// `PINHOLE_GAMMA=off` turns the sRGB encoding off, `PINHOLE_GI` and
-/// `PINHOLE_SPP` set the indirect light and the samples per pixel.
+/// `PINHOLE_SPP` set the indirect light and the samples per pixel,
+/// `PINHOLE_COMPARE=on` opens the Compare window measuring.
 fn apply_env_overrides(app: &mut PinholeApp) {
     if let Ok(name) = std::env::var("PINHOLE_RENDERER") {
         match crate::render::renderer_by_name(&name) {
@@ -207,6 +210,11 @@ fn apply_env_overrides(app: &mut PinholeApp) {
             }
             Err(_) => eprintln!("pinhole: PINHOLE_ZOOM: expected a number, got \"{z}\""),
         }
+    }
+    // PINHOLE_COMPARE=on opens the Compare window and starts measuring.
+    if std::env::var("PINHOLE_COMPARE").is_ok_and(|v| !matches!(v.as_str(), "0" | "off" | "false")) {
+        app.compare.open = true;
+        app.start_compare();
     }
     if let Ok(v) = std::env::var("PINHOLE_VERTICES") {
         app.inspect.vertices = !matches!(v.as_str(), "0" | "off" | "false");

@@ -124,6 +124,25 @@ impl ViewerSettings {
         }
     }
 
+    /// Takes the renderer and every render knob of `settings` (a configuration
+    /// measured elsewhere), keeping the image size, the view and the display.
+    pub fn apply_configuration(&mut self, renderer: &str, settings: &RenderSettings) {
+        self.renderer = renderer.to_string();
+        self.spp = settings.spp;
+        self.shadows = settings.shadows;
+        self.shadow_bump = settings.shadow_bump;
+        self.max_depth = settings.max_depth;
+        self.interpolation = settings.interpolation;
+        self.gi = settings.gi.clone();
+        self.per_scene = SceneKnobs {
+            shadow_map_size: settings.shadow_map_size,
+            shadow_map_bias: settings.shadow_map_bias,
+            msaa: settings.msaa,
+            early_depth: settings.early_depth,
+            affine: settings.affine,
+        };
+    }
+
     pub fn load(storage: Option<&dyn eframe::Storage>) -> Option<ViewerSettings> {
         storage.and_then(|s| eframe::get_value(s, STORAGE_KEY))
     }

@@ -64,6 +64,8 @@ pub struct PinholeApp {
     pub bench: Option<super::UiBench>,
     /// Selected pixel and its replay, zoom, overlays (visual debugging).
     pub inspect: super::inspect::Inspect,
+    /// The Compare window's measurements.
+    pub compare: super::compare_lab::CompareLab,
 }
 
 impl PinholeApp {
@@ -109,6 +111,7 @@ impl PinholeApp {
             persist: false,
             bench: None,
             inspect: Default::default(),
+            compare: Default::default(),
         };
         app.install_scene(scene, scene_arg);
         app
@@ -292,8 +295,11 @@ impl PinholeApp {
 
     /// Carries out what the panels asked for this frame, in one place.
     pub fn apply(&mut self, requests: Requests, ctx: &egui::Context) {
-        let Requests { camera_moved, reset_camera, frame_all, open, reload, open_dialog, export, quit } = requests;
+        let Requests { camera_moved, reset_camera, frame_all, open, reload, open_dialog, export, toggle_compare, quit } = requests;
         self.camera_moving |= camera_moved;
+        if toggle_compare {
+            self.compare.open = !self.compare.open;
+        }
         if reset_camera {
             self.reset_camera();
         }
@@ -322,6 +328,47 @@ impl PinholeApp {
             }
             _ => 0.0,
         }
+    }
+
+    /// The Compare window and what it asks: measure the scene as edited,
+    /// apply a configuration, export the chart.
+    fn compare_window(&mut self, ctx: &egui::Context) {
+        if !self.compare.open {
+            // Closing the window (its button, the C key or the menu) stops the sweep.
+            if self.compare.running() {
+                self.compare.cancel();
+            }
+            return;
+        }
+        let current = crate::chart::describe(&self.settings.renderer, &self.effective_settings());
+        let req = super::panels::compare::show(ctx, &mut self.compare, &current);
+        if req.measure {
+            self.start_compare();
+        }
+        if let Some(c) = req.apply {
+            self.settings.apply_configuration(&c.renderer, &c.settings);
+            self.message = Some(format!("applied {}", c.label));
+        }
+        if req.export {
+            let title = format!("{}: error against time; reference: {}", self.scene.name, self.compare.progress.lock().unwrap().reference.clone().unwrap_or_default());
+            match self.compare.export(&title) {
+                Ok(m) => self.message = Some(m),
+                Err(e) => self.error_bar = Some(e),
+            }
+        }
+    }
+
+    /// Measures the scene as edited (camera, lights, materials) in the background.
+    pub fn start_compare(&mut self) {
+        let mut scene = (*self.scene).clone();
+        self.params.apply(&mut scene);
+        let rc = self.repaint_ctx.clone();
+        let repaint = std::sync::Arc::new(move || {
+            if let Some(ctx) = rc.lock().unwrap().as_ref() {
+                ctx.request_repaint();
+            }
+        });
+        self.compare.start(scene, self.settings.gi.seed, None, repaint);
     }
 
     /// Copies a newly published image into the texture.
@@ -356,6 +403,9 @@ impl PinholeApp {
             if ctx.input(|inp| inp.key_pressed(*k) && inp.modifiers.is_none()) {
                 self.select_renderer(i);
             }
+        }
+        if ctx.input(|i| i.key_pressed(Key::C) && i.modifiers.is_none()) {
+            self.compare.open = !self.compare.open;
         }
         if ctx.input(|i| i.key_pressed(Key::F) && i.modifiers.is_none()) {
             self.frame_all();
@@ -460,6 +510,7 @@ impl PinholeApp {
             self.open(path);
         }
         super::export::show_dialog(self, &ctx);
+        self.compare_window(&ctx);
 
         self.sync_worker();
         self.sync_inspector();

@@ -1,5 +1,5 @@
 //! The top bar: File (open, built-in scenes, reload, export), View (panels,
-//! debug view), the renderer and debug-view combo boxes, zoom and the
+//! debug view), the Compare window, the renderer and debug-view combo boxes, zoom and the
 //! vertex overlay.
 
 use eframe::egui;
@@ -48,6 +48,9 @@ pub fn show(ui: &mut egui::Ui, settings: &mut ViewerSettings, renderer_names: &[
                     ui.radio_value(&mut settings.view, v, v.name());
                 }
             });
+            if ui.button("Compare").on_hover_text("C: error against time of every method, against a reference").clicked() {
+                requests.toggle_compare = true;
+            }
             ui.separator();
             renderer_combo(ui, &mut settings.renderer, renderer_names);
             view_combo(ui, &mut settings.view);

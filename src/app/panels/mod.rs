@@ -6,6 +6,7 @@
 
 use eframe::egui;
 pub mod camera;
+pub mod compare;
 pub mod inspector;
 pub mod lights;
 pub mod materials;
@@ -28,6 +29,8 @@ pub struct Requests {
     pub reload: bool,
     pub open_dialog: bool,
     pub export: bool,
+    /// Open or close the Compare window.
+    pub toggle_compare: bool,
     pub quit: bool,
 }
 
@@ -40,6 +43,7 @@ impl std::ops::BitOrAssign for Requests {
         self.reload |= o.reload;
         self.open_dialog |= o.open_dialog;
         self.export |= o.export;
+        self.toggle_compare |= o.toggle_compare;
         self.quit |= o.quit;
     }
 }
