@@ -55,3 +55,5 @@ shot inspector-zoom triangle-ground PINHOLE_SELECT=420,400 PINHOLE_ZOOM=12 PINHO
 shot inspector-rasterize triangle-ground PINHOLE_RENDERER=rasterize PINHOLE_SELECT=500,380 PINHOLE_PANELS=none
 # The Compare window after measuring every method on the Cornell box.
 shot compare-cornell-gi cornell-gi PINHOLE_COMPARE=on PINHOLE_PANELS=none
+# A|B: path-traced indirect light (A) against the rasterizer's direct light (B).
+shot split-wipe cornell-gi PINHOLE_SPLIT=rasterize PINHOLE_GI=path PINHOLE_SPP=16 PINHOLE_PANELS=none

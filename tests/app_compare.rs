@@ -98,3 +98,90 @@ fn closing_the_window_cancels_a_sweep() {
     assert_eq!(p.stage, "cancelled");
     assert!(p.points.len() < p.total.max(1), "the sweep stopped early");
 }
+
+/// What `render_frame` gives for `renderer` and `settings` on the app's scene as edited.
+fn rendered(app: &PinholeApp, renderer: &str, settings: &pinhole::render::RenderSettings) -> Vec<pinhole::math::Radiance> {
+    let mut scene = (*app.scene).clone();
+    app.params.apply(&mut scene);
+    let prepared = pinhole::render::PreparedScene::new(scene);
+    let r = pinhole::render::renderer_by_name(renderer).unwrap();
+    pinhole::render::render_frame(r.as_ref(), &prepared, settings, &std::sync::atomic::AtomicBool::new(false), None).unwrap().pixels
+}
+
+fn press(h: &Harness<'static, PinholeApp>, pos: egui::Pos2, pressed: bool, modifiers: egui::Modifiers) {
+    h.event(egui::Event::PointerButton { pos, button: egui::PointerButton::Primary, pressed, modifiers });
+}
+
+fn drag(h: &mut Harness<'static, PinholeApp>, from: egui::Pos2, to: egui::Pos2, modifiers: egui::Modifiers) {
+    h.event(egui::Event::ModifiersChanged(modifiers));
+    h.hover_at(from);
+    h.step();
+    press(h, from, true, modifiers);
+    h.step();
+    for k in 1..=4 {
+        h.hover_at(from + (to - from) * (k as f32 / 4.0));
+        h.step();
+    }
+    press(h, to, false, modifiers);
+    h.step();
+    h.event(egui::Event::ModifiersChanged(egui::Modifiers::NONE));
+    h.step();
+}
+
+#[test]
+fn the_wipe_shows_two_renderers_and_measures_their_difference() {
+    let mut h = new_harness(small_scene("spheres"));
+    settle(&mut h);
+    h.key_press(egui::Key::B);
+    h.step();
+    assert!(h.state().split.enabled, "B shows two configurations");
+    // B: the rasterizer without shadows; A stays the ray tracer with shadow rays.
+    {
+        let app = h.state_mut();
+        app.split.b.renderer = "rasterize:fixed".into();
+        app.split.b.shadows = pinhole::render::ShadowMode::None;
+    }
+    settle(&mut h);
+    let app = h.state();
+    let (w, hgt) = app.image_size();
+    let b_settings = app.split.b_settings(&app.settings, &app.scene, w, hgt);
+    let (_, _, b_image) = app.split.b_linear().expect("B rendered");
+    assert_eq!(b_image, rendered(app, "rasterize:fixed", &b_settings), "B is the rasterizer's image");
+    let a_image = app.with_output(|o| o.linear.clone());
+    assert_eq!(a_image, rendered(app, &app.settings.renderer, &app.effective_settings()), "A is the live view");
+    let e = app.split.error.expect("the error of B against A");
+    assert!(e.whole > 0.01 && e.differing > 100, "shadows differ: {e:?}");
+
+    // The divider follows a drag and the camera does not orbit.
+    let rect = app.viewport_rect.unwrap();
+    let camera = app.params.camera.clone();
+    let at_divider = egui::pos2(rect.min.x + 0.5 * rect.width(), rect.center().y);
+    drag(&mut h, at_divider, egui::pos2(rect.min.x + 0.25 * rect.width(), rect.center().y), egui::Modifiers::NONE);
+    assert!((h.state().split.divider - 0.25).abs() < 0.02, "divider at {}", h.state().split.divider);
+    assert_eq!(h.state().params.camera, camera, "dragging the divider does not move the camera");
+
+    // Alt+drag measures a rectangle.
+    drag(&mut h, rect.min + rect.size() * 0.6, rect.min + rect.size() * 0.9, egui::Modifiers::ALT);
+    settle(&mut h);
+    let [x0, y0, x1, y1] = h.state().split.region.expect("a region");
+    assert!(x1 > x0 + 10 && y1 > y0 + 10, "{:?}", (x0, y0, x1, y1));
+    assert!(h.state().split.error.unwrap().region.is_some());
+    assert_eq!(h.state().params.camera, camera);
+
+    // X swaps A and B.
+    h.key_press(egui::Key::X);
+    settle(&mut h);
+    let app = h.state();
+    assert_eq!(app.settings.renderer, "rasterize:fixed");
+    assert_eq!(app.settings.shadows, pinhole::render::ShadowMode::None);
+    assert_eq!(app.split.b.shadows, pinhole::render::ShadowMode::Ray);
+    assert_eq!(app.with_output(|o| o.linear.clone()), b_image, "A now shows what B showed");
+
+    // The difference view and closing.
+    h.state_mut().split.mode = pinhole::app::split_view::SplitMode::Difference;
+    settle(&mut h);
+    assert!(h.state().split.diff_texture.is_some());
+    h.key_press(egui::Key::B);
+    h.step();
+    assert!(!h.state().split.enabled);
+}

@@ -12,6 +12,7 @@ pub mod overlay;
 pub mod open_dialog;
 pub mod panels;
 pub mod settings_store;
+pub mod split_view;
 pub mod state;
 pub mod viewport;
 pub mod worker;
@@ -110,7 +111,8 @@ fn screenshot_frame(app: &mut PinholeApp, ctx: &egui::Context) {
         && app.with_output(|o| o.idle && o.complete && o.generation == generation && o.version == shown)
         && !app.bench.as_ref().is_some_and(|b| !b.done)
         && !app.inspect.waiting(generation)
-        && !app.compare.running();
+        && !app.compare.running()
+        && app.split.idle();
     let viewport_rect = app.viewport_rect;
     let Some(shot) = app.screenshot.as_mut() else { return };
     ctx.request_repaint_after(Duration::from_millis(30));
@@ -162,12 +164,25 @@ fn screenshot_frame(app: &mut PinholeApp, ctx: &egui::Context) {
 /// inspector shows whenever a pixel is selected),
 /// `PINHOLE_GAMMA=off` turns the sRGB encoding off, `PINHOLE_GI` and
 /// `PINHOLE_SPP` set the indirect light and the samples per pixel,
-/// `PINHOLE_COMPARE=on` opens the Compare window measuring.
+/// `PINHOLE_COMPARE=on` opens the Compare window measuring,
+/// `PINHOLE_SPLIT=RENDERER` shows the view against RENDERER side by side.
 fn apply_env_overrides(app: &mut PinholeApp) {
     if let Ok(name) = std::env::var("PINHOLE_RENDERER") {
         match crate::render::renderer_by_name(&name) {
             Ok(r) => app.settings.renderer = r.name().to_string(),
             Err(e) => eprintln!("pinhole: PINHOLE_RENDERER: {e}"),
+        }
+    }
+    // PINHOLE_SPLIT=RENDERER shows the live view against RENDERER (A|B wipe);
+    // B keeps the settings as they are here, before the overrides below.
+    if let Ok(name) = std::env::var("PINHOLE_SPLIT") {
+        match crate::render::renderer_by_name(&name) {
+            Ok(r) => {
+                let mut b = app.settings.clone();
+                b.renderer = r.name().to_string();
+                app.split.set_b(b);
+            }
+            Err(e) => eprintln!("pinhole: PINHOLE_SPLIT: {e}"),
         }
     }
     if let Ok(v) = std::env::var("PINHOLE_VIEW") {

@@ -66,6 +66,8 @@ pub struct PinholeApp {
     pub inspect: super::inspect::Inspect,
     /// The Compare window's measurements.
     pub compare: super::compare_lab::CompareLab,
+    /// A second configuration shown beside the live one (A|B).
+    pub split: super::split_view::SplitView,
 }
 
 impl PinholeApp {
@@ -112,6 +114,7 @@ impl PinholeApp {
             bench: None,
             inspect: Default::default(),
             compare: Default::default(),
+            split: Default::default(),
         };
         app.install_scene(scene, scene_arg);
         app
@@ -139,6 +142,7 @@ impl PinholeApp {
         self.scene_arg = arg;
         self.scene = Arc::new(scene);
         self.worker.set_scene(self.scene_id, self.scene.clone());
+        self.split.scene_changed();
         self.error_bar = None;
         self.last_sent = None;
     }
@@ -265,7 +269,21 @@ impl PinholeApp {
             return false;
         }
         self.sync_worker();
+        self.sync_split();
         self.worker.wait_idle(self.generation, deadline.saturating_duration_since(Instant::now()))
+            && self.split.wait_idle(deadline.saturating_duration_since(Instant::now()))
+    }
+
+    /// Hands configuration B the live view's scene, camera and size.
+    pub fn sync_split(&mut self) {
+        let Some(a) = self.last_sent.clone() else { return };
+        let rc = self.repaint_ctx.clone();
+        let repaint = std::sync::Arc::new(move || {
+            if let Some(ctx) = rc.lock().unwrap().as_ref() {
+                ctx.request_repaint();
+            }
+        });
+        self.split.sync(&a, &self.settings, &self.scene, self.scene_id, repaint);
     }
 
     /// Runs `f` on the worker's latest output under its lock.
@@ -349,6 +367,11 @@ impl PinholeApp {
             self.settings.apply_configuration(&c.renderer, &c.settings);
             self.message = Some(format!("applied {}", c.label));
         }
+        if let Some(c) = req.set_b {
+            let mut b = self.settings.clone();
+            b.apply_configuration(&c.renderer, &c.settings);
+            self.split.set_b(b);
+        }
         if req.export {
             let title = format!("{}: error against time; reference: {}", self.scene.name, self.compare.progress.lock().unwrap().reference.clone().unwrap_or_default());
             match self.compare.export(&title) {
@@ -380,6 +403,20 @@ impl PinholeApp {
         let image = egui::ColorImage::from_rgb([out.width as usize, out.height as usize], &out.rgb8);
         self.shown_version = out.version;
         drop(out);
+        self.update_texture_of_a(ctx, image);
+    }
+
+    /// B's texture, and the difference and error of B against A.
+    fn update_split(&mut self, ctx: &egui::Context) {
+        if !self.split.enabled {
+            return;
+        }
+        let out = self.worker.shared.output.lock().unwrap();
+        let (exposure, gamma) = (self.params.render.exposure, self.settings.gamma);
+        self.split.update(ctx, (out.width, out.height, out.version, &out.linear), exposure, gamma);
+    }
+
+    fn update_texture_of_a(&mut self, ctx: &egui::Context, image: egui::ColorImage) {
         match &mut self.texture {
             Some(t) => t.set(image, egui::TextureOptions::NEAREST),
             None => self.texture = Some(ctx.load_texture("pinhole-frame", image, egui::TextureOptions::NEAREST)),
@@ -403,6 +440,13 @@ impl PinholeApp {
             if ctx.input(|inp| inp.key_pressed(*k) && inp.modifiers.is_none()) {
                 self.select_renderer(i);
             }
+        }
+        // B: two configurations side by side (B starts as the live one); X swaps them.
+        if ctx.input(|i| i.key_pressed(Key::B) && i.modifiers.is_none()) {
+            self.split.toggle(&self.settings);
+        }
+        if self.split.enabled && ctx.input(|i| i.key_pressed(Key::X) && i.modifiers.is_none()) {
+            self.split.swap(&mut self.settings);
         }
         if ctx.input(|i| i.key_pressed(Key::C) && i.modifiers.is_none()) {
             self.compare.open = !self.compare.open;
@@ -473,9 +517,24 @@ impl PinholeApp {
             ctx.request_repaint();
         }
         self.update_texture(&ctx);
+        self.update_split(&ctx);
 
         let mut requests = Requests::default();
         requests |= super::panels::menu::show(ui, &mut self.settings, &self.renderer_names, &mut self.inspect, &self.scene.name);
+        if self.split.enabled {
+            let a_label = crate::chart::describe(&self.settings.renderer, &self.effective_settings());
+            let b_label = self.split.b_label(&self.settings, &self.scene);
+            let r = super::panels::split_bar::show(ui, &mut self.split, &a_label, &b_label);
+            if r.swap {
+                self.split.swap(&mut self.settings);
+            }
+            if r.b_from_a {
+                self.split.set_b(self.settings.clone());
+            }
+            if r.close {
+                self.split.enabled = false;
+            }
+        }
         if let Some(err) = self.error_bar.clone() {
             egui::Panel::top("error-bar")
                 .frame(egui::Frame::new().fill(egui::Color32::from_rgb(110, 20, 20)).inner_margin(6.0))
@@ -513,6 +572,7 @@ impl PinholeApp {
         self.compare_window(&ctx);
 
         self.sync_worker();
+        self.sync_split();
         self.sync_inspector();
         super::screenshot_frame(self, &ctx);
     }

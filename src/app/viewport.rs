@@ -54,6 +54,7 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
         painter.image(t.id(), rect, Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0)), Color32::WHITE);
     }
     let map = ImageMap { rect, width: iw, height: ih };
+    let split_drag = split_view(app, ui, &response, &painter, &map);
     overlay::pixel_grid(&painter, &map, avail);
 
     // Image pixel of a screen point and back.
@@ -90,7 +91,7 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
     }
 
     // Dragging a point-light marker moves the light in the view plane.
-    if response.drag_started_by(egui::PointerButton::Primary) {
+    if response.drag_started_by(egui::PointerButton::Primary) && !split_drag {
         if let Some(p) = ui.input(|i| i.pointer.press_origin()) {
             app.dragging_light = markers
                 .iter()
@@ -113,7 +114,7 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
                 *position = view.eye + view.camera_to_world * (view.camera_dir(q.x, q.y) * depth);
             }
         }
-    } else if delta != egui::Vec2::ZERO {
+    } else if delta != egui::Vec2::ZERO && !split_drag {
         let cam = &mut app.params.camera;
         if response.dragged_by(egui::PointerButton::Middle) || (response.dragged_by(egui::PointerButton::Primary) && shift) {
             cc::pan(cam, delta.x, delta.y, settings.width, settings.height);
@@ -191,6 +192,71 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
     }
     hover_readout(app, &painter, avail, &view);
     super::legend::show(app, ui.ctx(), avail);
+}
+
+/// Configuration B over the image (right of the divider, or as the
+/// difference), the divider, B's label and the measured rectangle. Dragging
+/// the divider moves it; alt+drag measures a rectangle. Returns whether a
+/// drag of the primary button was taken here (so it does not orbit).
+fn split_view(app: &mut PinholeApp, ui: &egui::Ui, response: &egui::Response, painter: &egui::Painter, map: &ImageMap) -> bool {
+    use super::split_view::SplitMode;
+    let split = &mut app.split;
+    if !split.enabled {
+        return false;
+    }
+    let rect = map.rect;
+    let divider_x = rect.min.x + split.divider * rect.width();
+    if response.drag_started_by(egui::PointerButton::Primary) {
+        if let Some(p) = ui.input(|i| i.pointer.press_origin()) {
+            if ui.input(|i| i.modifiers.alt) {
+                split.region_start = map.pixel_at(p);
+            } else if split.mode == SplitMode::Wipe && (p.x - divider_x).abs() <= 8.0 {
+                split.dragging_divider = true;
+            }
+        }
+    }
+    let pointer = response.interact_pointer_pos();
+    let mut taken = split.dragging_divider || split.region_start.is_some();
+    if let (true, Some(p)) = (split.dragging_divider, pointer) {
+        split.divider = ((p.x - rect.min.x) / rect.width().max(1.0)).clamp(0.0, 1.0);
+    }
+    if let (Some((x0, y0)), Some(p)) = (split.region_start, pointer) {
+        let v = map.to_px(p);
+        let x1 = (v.x.max(0.0) as u32).min(map.width as u32 - 1);
+        let y1 = (v.y.max(0.0) as u32).min(map.height as u32 - 1);
+        split.region = Some([x0.min(x1), y0.min(y1), x0.max(x1) + 1, y0.max(y1) + 1]);
+    }
+    if response.drag_stopped() {
+        taken |= split.dragging_divider || split.region_start.is_some();
+        split.dragging_divider = false;
+        split.region_start = None;
+    }
+    let uv = |a: f32, b: f32| Rect::from_min_max(Pos2::new(a, 0.0), Pos2::new(b, 1.0));
+    match split.mode {
+        SplitMode::Wipe => {
+            if let Some(t) = &split.texture {
+                let right = Rect::from_min_max(Pos2::new(divider_x, rect.min.y), rect.max);
+                painter.image(t.id(), right, uv(split.divider, 1.0), Color32::WHITE);
+            }
+            painter.line_segment([Pos2::new(divider_x, rect.min.y), Pos2::new(divider_x, rect.max.y)], Stroke::new(2.0, Color32::WHITE));
+            painter.circle(Pos2::new(divider_x, rect.center().y), 6.0, Color32::WHITE, Stroke::new(1.0, Color32::BLACK));
+            let tag = |pos: Pos2, align, text: &str| {
+                painter.text(pos, align, text, egui::FontId::proportional(14.0), Color32::WHITE);
+            };
+            tag(Pos2::new(divider_x - 8.0, rect.min.y + 6.0), egui::Align2::RIGHT_TOP, "A");
+            tag(Pos2::new(divider_x + 8.0, rect.min.y + 6.0), egui::Align2::LEFT_TOP, "B");
+        }
+        SplitMode::Difference => {
+            if let Some(t) = &split.diff_texture {
+                painter.image(t.id(), rect, uv(0.0, 1.0), Color32::WHITE);
+            }
+        }
+    }
+    if let Some([x0, y0, x1, y1]) = split.region {
+        let r = Rect::from_min_max(map.to_screen(Vec2::new(x0 as f32, y0 as f32)), map.to_screen(Vec2::new(x1 as f32, y1 as f32)));
+        painter.rect_stroke(r, 0.0, Stroke::new(1.5, Color32::from_rgb(120, 255, 120)), egui::StrokeKind::Outside);
+    }
+    taken
 }
 
 /// The pixel under the cursor: coordinates, the value on show and what it

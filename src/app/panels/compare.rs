@@ -14,6 +14,8 @@ pub struct CompareRequests {
     pub measure: bool,
     /// Apply this configuration to the live view.
     pub apply: Option<Configuration>,
+    /// Show this configuration as B beside the live view.
+    pub set_b: Option<Configuration>,
     /// Write the chart and the CSV.
     pub export: bool,
 }
@@ -195,9 +197,14 @@ fn table(ui: &mut egui::Ui, metric: ErrorMetric, points: &[(Configuration, Measu
                     ui.label(&m.label);
                     ui.label(format!("{:.1}", m.ms));
                     ui.label(format!("{:.4}", metric.of(m)));
-                    if ui.small_button("apply").on_hover_text(format!("render the view as {}", c.label)).clicked() {
-                        req.apply = Some(c.clone());
-                    }
+                    ui.horizontal(|ui| {
+                        if ui.small_button("apply").on_hover_text(format!("render the view as {}", c.label)).clicked() {
+                            req.apply = Some(c.clone());
+                        }
+                        if ui.small_button("as B").on_hover_text("show it beside the view, A|B").clicked() {
+                            req.set_b = Some(c.clone());
+                        }
+                    });
                     ui.end_row();
                 }
             });

@@ -12,6 +12,7 @@ pub mod lights;
 pub mod materials;
 pub mod menu;
 pub mod shading;
+pub mod split_bar;
 pub mod status;
 
 use crate::math::Vec3;
