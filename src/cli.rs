@@ -510,8 +510,8 @@ fn cmd_chart_methods(scene_arg: &str, output: &Path, metric: &str, reference: Op
     let title = format!("{}: error against time, {w}x{h}, {} threads; reference: {}", l.prepared.scene.name, l.pool.current_num_threads(), truth.name);
     let png = crate::chart::plot::draw_methods_png(&points, metric, &title, 1100, 700)?;
     let csv_path = output.with_extension("csv");
-    crate::image_io::write_atomic(&csv_path, crate::chart::methods_csv(&points).as_bytes())?;
-    crate::image_io::write_atomic(output, &png)?;
+    let csv = crate::chart::methods_csv(&points);
+    crate::image_io::write_all_atomic(&[(output, &png), (&csv_path, csv.as_bytes())])?;
     eprintln!("wrote {} and {}", output.display(), csv_path.display());
     Ok(())
 }
@@ -559,9 +559,9 @@ fn cmd_chart(scene_arg: &str, output: &Path, renderers: &str, spp_list: &str, re
     })?;
     let title = format!("{}: error against time, {w}x{h}, {} threads", l.prepared.scene.name, l.pool.current_num_threads());
     let png = crate::chart::plot::draw_spp_png(&points, &title, 900, 600)?;
-    crate::image_io::write_atomic(output, &png)?;
     let csv_path = output.with_extension("csv");
-    crate::image_io::write_atomic(&csv_path, crate::chart::spp_sweep::to_csv(&points).as_bytes())?;
+    let csv = crate::chart::spp_sweep::to_csv(&points);
+    crate::image_io::write_all_atomic(&[(output, &png), (&csv_path, csv.as_bytes())])?;
     eprintln!("wrote {} and {}", output.display(), csv_path.display());
     Ok(())
 }

@@ -69,14 +69,39 @@ fn encode_ppm(width: u32, height: u32, rgb8: &[u8]) -> Vec<u8> {
 
 /// Writes a file so that readers never see it half-written.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), String> {
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let name = path.file_name().ok_or_else(|| format!("{}: not a file name", path.display()))?;
-    let tmp = dir.join(format!(".{}.{}.tmp", name.to_string_lossy(), std::process::id()));
-    std::fs::write(&tmp, bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        format!("cannot write {}: {e}", path.display())
-    })
+    write_all_atomic(&[(path, bytes)])
+}
+
+/// Writes several files, all or none: every file goes to a temporary name
+/// beside its target first, and only when all of them are written are they
+/// renamed into place. A failure removes the temporary files.
+pub fn write_all_atomic(files: &[(&Path, &[u8])]) -> Result<(), String> {
+    let mut temps = Vec::new();
+    let cleanup = |temps: &[std::path::PathBuf]| {
+        for t in temps {
+            let _ = std::fs::remove_file(t);
+        }
+    };
+    for (path, bytes) in files {
+        let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+        let Some(name) = path.file_name() else {
+            cleanup(&temps);
+            return Err(format!("{}: not a file name", path.display()));
+        };
+        let tmp = dir.join(format!(".{}.{}.tmp", name.to_string_lossy(), std::process::id()));
+        temps.push(tmp.clone());
+        if let Err(e) = std::fs::write(&tmp, bytes) {
+            cleanup(&temps);
+            return Err(format!("cannot write {}: {e}", path.display()));
+        }
+    }
+    for (i, ((path, _), tmp)) in files.iter().zip(&temps).enumerate() {
+        if let Err(e) = std::fs::rename(tmp, path) {
+            cleanup(&temps[i..]);
+            return Err(format!("cannot write {}: {e}", path.display()));
+        }
+    }
+    Ok(())
 }
 
 /// A loaded image in linear radiance, for `compare` and the reference tests.
@@ -98,6 +123,25 @@ pub fn load_image(path: &Path) -> Result<LinearImage, String> {
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn several_files_are_written_all_or_none() {
+        let d = std::env::temp_dir().join(format!("pinhole-all-or-none-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        let (a, b) = (d.join("a.png"), d.join("missing-dir").join("a.csv"));
+        std::fs::write(&a, b"old").unwrap();
+        let e = write_all_atomic(&[(&a, b"new png"), (&b, b"csv")]).unwrap_err();
+        assert!(e.contains("a.csv"), "{e}");
+        assert_eq!(std::fs::read(&a).unwrap(), b"old", "the first file stays as it was");
+        let left: Vec<_> = std::fs::read_dir(&d).unwrap().map(|e| e.unwrap().file_name()).collect();
+        assert_eq!(left.len(), 1, "temporary files are removed: {left:?}");
+        let c = d.join("a.csv");
+        write_all_atomic(&[(&a, b"new png"), (&c, b"csv")]).unwrap();
+        assert_eq!((std::fs::read(&a).unwrap(), std::fs::read(&c).unwrap()), (b"new png".to_vec(), b"csv".to_vec()));
+        let _ = std::fs::remove_dir_all(&d);
+    }
+
     use super::*;
 
     #[test]

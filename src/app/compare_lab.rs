@@ -130,8 +130,7 @@ impl CompareLab {
         }
         let png = chart::plot::draw_methods_png(&points, self.metric, title, 1100, 700)?;
         let csv = path.with_extension("csv");
-        crate::image_io::write_atomic(&csv, chart::methods_csv(&points).as_bytes())?;
-        crate::image_io::write_atomic(&path, &png)?;
+        crate::image_io::write_all_atomic(&[(&path, &png), (&csv, chart::methods_csv(&points).as_bytes())])?;
         Ok(format!("saved {} and {}", path.display(), csv.display()))
     }
 }

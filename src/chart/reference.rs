@@ -88,6 +88,10 @@ pub fn load_reference(
                     img.height
                 ));
             }
+            let bad = img.pixels.iter().filter(|p| !p.is_finite()).count();
+            if bad > 0 {
+                return Err(format!("the reference {} has {bad} pixels that are not finite numbers; error against it means nothing", path.display()));
+            }
             Ok(Some(Reference { pixels: img.pixels, width, height, name: source.describe() }))
         }
         ReferenceSource::PathTraced { spp } => {
@@ -190,8 +194,13 @@ mod tests {
         let f = dir.join("r.exr");
         crate::image_io::save_image(&f, 8, 4, &vec![glam::Vec3::ONE; 32], 1.0).unwrap();
         let p = prepared("spheres");
-        let e = load_reference(&ReferenceSource::File(f), &p, 16, 8, None, &AtomicBool::new(false), None).unwrap_err();
+        let e = load_reference(&ReferenceSource::File(f.clone()), &p, 16, 8, None, &AtomicBool::new(false), None).unwrap_err();
         assert!(e.contains("8x4") && e.contains("16x8"), "{e}");
+        let mut nan = vec![glam::Vec3::ONE; 32];
+        nan[5] = glam::Vec3::NAN;
+        crate::image_io::save_image(&f, 8, 4, &nan, 1.0).unwrap();
+        let e = load_reference(&ReferenceSource::File(f), &p, 8, 4, None, &AtomicBool::new(false), None).unwrap_err();
+        assert!(e.contains("1 pixels that are not finite"), "{e}");
         let _ = std::fs::remove_dir_all(&dir);
     }
 }
