@@ -25,9 +25,9 @@ fn one_triangle_shows_its_three_edges_over_the_shaded_image() {
     let s = settings(&scene, LineAlgorithm::Float);
     let view = scene.camera.view(s.width, s.height);
     let prepared = PreparedScene::new(scene);
-    let shaded = render("raytrace", &prepared, &RenderSettings { view: View::Shaded, ..s.clone() });
     for renderer in ["raytrace:bvh", "rasterize:fixed", "rasterize:painter"] {
         let img = render(renderer, &prepared, &s);
+        let shaded = render(renderer, &prepared, &RenderSettings { view: View::Shaded, ..s.clone() });
         // Points along each edge, by hand from the projected vertices: the
         // pixel holding each (or a neighbour, for the rounding of the end
         // points) is line-coloured.
