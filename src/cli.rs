@@ -110,7 +110,7 @@ struct RenderOpts {
     /// Samples per pixel (stratified; 1 = the pixel centre).
     #[arg(long, default_value_t = 1)]
     spp: u32,
-    /// shaded | barycentric | raydir | depth | zbuffer | normal | id | uv | cost | diff | shadowmap (see `pinhole list`)
+    /// shaded | barycentric | raydir | depth | zbuffer | normal | id | uv | cost | diff | shadowmap | wireframe (see `pinhole list`)
     #[arg(long, default_value = "shaded")]
     view: String,
     /// ray | map | none
@@ -173,6 +173,12 @@ struct RenderOpts {
     /// their estimated relative error is below TARGET (e.g. 0.05).
     #[arg(long, value_name = "TARGET")]
     adaptive: Option<f32>,
+    /// Rasterizers: what the depth buffer stores: f32 | unorm24 | unorm16 | reversed.
+    #[arg(long = "depth-buffer", default_value = "f32", value_name = "FORMAT")]
+    depth_buffer: String,
+    /// --view wireframe: the line algorithm, float (DDA) | integer (Bresenham).
+    #[arg(long, default_value = "float")]
+    lines: String,
 }
 
 /// What is left to do once the command line ran: the viewer is not part of
@@ -283,6 +289,8 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
     settings.msaa = opts.msaa;
     settings.early_depth = opts.early_depth && !opts.forward;
     settings.gi = gi_settings(opts)?;
+    settings.depth_buffer = render::raster::depth_format::DepthFormat::parse(&opts.depth_buffer).map_err(|e| format!("--depth-buffer: {e}"))?;
+    settings.lines = render::wireframe::LineAlgorithm::parse(&opts.lines).map_err(|e| format!("--lines: {e}"))?;
     if let Some(t) = opts.adaptive {
         if !(t > 0.0 && t.is_finite()) {
             return Err(format!("--adaptive {t} must be a relative error > 0 (e.g. 0.05)"));
@@ -609,6 +617,11 @@ fn cmd_list() -> Result<(), String> {
         let _ = writeln!(t, "  {}", v.name());
     }
     let _ = writeln!(t, "shadows:\n  none\n  ray\n  map");
+    let _ = writeln!(t, "depth buffers (rasterizers with a depth buffer: --depth-buffer):");
+    for f in render::raster::depth_format::DepthFormat::ALL {
+        let _ = writeln!(t, "  {:24} {}", f.name(), f.description());
+    }
+    let _ = writeln!(t, "line algorithms (--view wireframe: --lines):\n  float\n  integer");
     let _ = writeln!(t, "built-in scenes:");
     for s in crate::scene::builtin::names() {
         let _ = writeln!(t, "  {s}");

@@ -165,6 +165,9 @@ fn every_variant_agrees_with_the_ray_caster() {
         let prepared = PreparedScene::new(scene);
         let reference = render(brute().as_ref(), &prepared, &settings);
         for m in Method::ALL {
+            if m == Method::Painter {
+                continue; // wrong by design where primitives interpenetrate: tests/raster_painter.rs
+            }
             let image = render(&raster(m), &prepared, &settings);
             assert!(image.iter().all(|p| p.is_finite()), "{} on {name}: non-finite pixel", m.name());
             let a = agreement(&reference, &image, &edges, W as usize);

@@ -2,6 +2,8 @@
 //! `ViewerSettings`, that the viewer edits live and saves and loads whole.
 
 use crate::render::debug::View;
+use crate::render::raster::depth_format::DepthFormat;
+use crate::render::wireframe::LineAlgorithm;
 use crate::render::{shadow_map, Interpolation, RenderSettings, ShadowMode};
 use crate::scene::Scene;
 
@@ -44,11 +46,15 @@ pub struct SceneKnobs {
     pub msaa: u32,
     pub early_depth: bool,
     pub affine: bool,
+    /// What the depth buffer stores (rasterizers with one).
+    pub depth_buffer: DepthFormat,
+    /// The wireframe view's line algorithm.
+    pub lines: LineAlgorithm,
 }
 
 impl Default for SceneKnobs {
     fn default() -> Self {
-        SceneKnobs { shadow_map_size: shadow_map::DEFAULT_SIZE, shadow_map_bias: shadow_map::DEFAULT_BIAS, msaa: 1, early_depth: true, affine: false }
+        SceneKnobs { shadow_map_size: shadow_map::DEFAULT_SIZE, shadow_map_bias: shadow_map::DEFAULT_BIAS, msaa: 1, early_depth: true, affine: false, depth_buffer: DepthFormat::F32, lines: LineAlgorithm::Float }
     }
 }
 
@@ -120,6 +126,8 @@ impl ViewerSettings {
             msaa: k.msaa,
             early_depth: k.early_depth,
             affine: k.affine,
+            depth_buffer: k.depth_buffer,
+            lines: k.lines,
             ..RenderSettings::for_scene(scene)
         }
     }

@@ -50,6 +50,8 @@ named_enum! {
         /// The lights' shadow maps (CGPP Figure 15.14): depth from the light in
         /// grey, black near, white far; a point light's six faces in a 3 x 2 grid.
         Shadowmap = "shadowmap",
+        /// The shaded image with every triangle edge drawn over it (`wireframe`).
+        Wireframe = "wireframe",
     }
 }
 
@@ -68,7 +70,8 @@ pub fn view_color(view: View, camera: &CameraView, ray: &Ray, hit: Option<&Surfa
         // Cost is coloured by the renderer, which counted the work; diff is a
         // whole-frame comparison (`diff_image`).
         // The shadow map view is drawn by `shadow_map::view_sample`.
-        View::Shaded | View::Raydir | View::Cost | View::Diff | View::Shadowmap => Vec3::ZERO,
+        // The wireframe view is the shaded image with lines drawn after the frame.
+        View::Shaded | View::Raydir | View::Cost | View::Diff | View::Shadowmap | View::Wireframe => Vec3::ZERO,
         View::Barycentric => h.barycentric,
         View::Depth => Vec3::splat(depth_value(camera, (h.position - camera.eye).length())),
         View::Zbuffer => Vec3::splat(zbuffer_value(camera, camera.view_depth(h.position).max(camera.near))),

@@ -88,6 +88,11 @@ pub fn replay_pixel(renderer: &dyn Renderer, prepared: &PreparedScene, settings:
     if x >= settings.width || y >= settings.height {
         return Err(format!("pixel ({x}, {y}) is outside the {}x{} image", settings.width, settings.height));
     }
+    // The wireframe view is the shaded frame with lines over it: the samples
+    // are shaded, and a pixel under a line takes the line's colour.
+    let wireframe = settings.view == super::debug::View::Wireframe;
+    let shaded = RenderSettings { view: super::debug::View::Shaded, ..settings.clone() };
+    let settings = if wireframe { &shaded } else { settings };
     build_shadow_maps(prepared, settings);
     let photons = build_photon_map(prepared, settings);
     let view = prepared.scene.camera.view(settings.width, settings.height);
@@ -114,6 +119,9 @@ pub fn replay_pixel(renderer: &dyn Renderer, prepared: &PreparedScene, settings:
         sum_sq += l * l;
         samples.push((offset, rec, value));
     }
-    let radiance = if adaptive.is_some() { mean(sum, samples.len() as u32) } else { final_value(sum, spp) };
+    let mut radiance = if adaptive.is_some() { mean(sum, samples.len() as u32) } else { final_value(sum, spp) };
+    if wireframe && super::wireframe::line_mask(&prepared.scene, &view, settings.lines)[(x + y * settings.width) as usize] {
+        radiance = super::wireframe::LINE_COLOR;
+    }
     Ok(PixelReplay { samples, radiance })
 }

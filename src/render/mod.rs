@@ -19,6 +19,7 @@ pub mod shade;
 pub mod shadow_map;
 pub mod pixel_record;
 pub mod pixel_report;
+pub mod wireframe;
 
 pub use frame::{render_frame, render_frame_in_bands, replay_pixel, FrameResult, PixelReplay};
 pub use prepared::PreparedScene;
@@ -100,6 +101,13 @@ pub struct RenderSettings {
     /// relative error is above this keep taking samples (up to `spp`).
     #[serde(default)]
     pub adaptive: Option<f32>,
+    /// Rasterizers with a depth buffer: what it stores (`raster::depth_format`).
+    /// The ray casters, naive, bbox and the painter ignore it.
+    #[serde(default)]
+    pub depth_buffer: raster::depth_format::DepthFormat,
+    /// The wireframe view: the line algorithm (float DDA or integer Bresenham).
+    #[serde(default)]
+    pub lines: wireframe::LineAlgorithm,
 }
 
 fn default_true() -> bool {
@@ -128,6 +136,8 @@ impl RenderSettings {
             msaa: 1,
             gi: gi::GiSettings::default(),
             adaptive: None,
+            depth_buffer: raster::depth_format::DepthFormat::F32,
+            lines: wireframe::LineAlgorithm::Float,
         }
     }
 }

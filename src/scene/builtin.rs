@@ -15,6 +15,8 @@ const SCENES: &[(&str, &str)] = &[
     ("bunny", include_str!("../../assets/scenes/bunny.toml")),
     ("test-pattern", include_str!("../../assets/scenes/test-pattern.toml")),
     ("cornell-gi", include_str!("../../assets/scenes/cornell-gi.toml")),
+    ("stress-painter", include_str!("../../assets/scenes/stress-painter.toml")),
+    ("stress-zfight", include_str!("../../assets/scenes/stress-zfight.toml")),
 ];
 
 /// The scene the viewer opens when given none.

@@ -1,11 +1,14 @@
 //! Shading section (the debug view is in the top bar): shadows (none / ray / map) and the ray bump,
 //! samples per pixel, secondary depth, ambient, background, exposure and
-//! gamma on/off.
+//! gamma on/off; the rasterizers' knobs (MSAA, early depth, affine, depth
+//! buffer format) and the wireframe view's line algorithm.
 
 use eframe::egui;
 use super::{color_edit, section};
 use crate::app::settings_store::ViewerSettings;
 use crate::render::gi::{GiMode, GiSettings, MAX_BOUNCES};
+use crate::render::raster::depth_format::DepthFormat;
+use crate::render::wireframe::LineAlgorithm;
 use crate::render::{Interpolation, ShadowMode};
 use crate::scene::RenderDefaults;
 
@@ -70,6 +73,18 @@ pub fn show(ui: &mut egui::Ui, settings: &mut ViewerSettings, look: &mut RenderD
         ui.horizontal(|ui| {
             ui.checkbox(&mut s.early_depth, "early depth").on_hover_text("depth pass first, then shade once per pixel (CGPP 15.8.3)");
             ui.checkbox(&mut s.affine, "affine uv").on_hover_text("interpolate in screen space without the 1/z correction: try the uv view");
+        });
+        // A combo box: "f32" and friends would read oddly as a row of radios.
+        egui::ComboBox::from_label("rasterizer: depth buffer").selected_text(s.depth_buffer.name()).show_ui(ui, |ui| {
+            for f in DepthFormat::ALL {
+                ui.selectable_value(&mut s.depth_buffer, f, f.name()).on_hover_text(f.description());
+            }
+        });
+        ui.horizontal(|ui| {
+            ui.label("wireframe lines");
+            for a in LineAlgorithm::ALL {
+                ui.radio_value(&mut s.lines, a, a.name());
+            }
         });
     });
     settings.panels.shading = open;

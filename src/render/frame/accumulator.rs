@@ -1,6 +1,7 @@
 //! The progressive frame: the per-pixel sum of the sample passes, rendered
 //! band by band on request, with its running average, its final value and,
-//! for the diff view, the reference it is compared with. The command line's
+//! for the diff view, the reference it is compared with (the wireframe view,
+//! its lines, drawn over the average). The command line's
 //! `render_frame` and the viewer's worker both drive one of these.
 
 use super::FrameResult;
@@ -8,6 +9,7 @@ use crate::math::Radiance;
 use crate::render::sampling::luminance;
 use crate::render::debug::{self, View};
 use crate::render::raytrace::brute::BruteForce;
+use crate::render::wireframe::{self, LineAlgorithm};
 use crate::render::{sample_offset, PassJob, PreparedScene, RayCounts, RenderSettings, Renderer};
 use rayon::prelude::*;
 use std::ops::Range;
@@ -115,6 +117,10 @@ pub struct Accumulator {
     adaptive: Option<Adaptive>,
     /// The photon map every pass reads (`--gi photons`), built with the first band.
     photons: Option<std::sync::Arc<crate::render::photon_map::PhotonMap>>,
+    /// Wireframe view: the passes are shaded; the lines' pixels (made with
+    /// the first band) are painted over the average.
+    wireframe: Option<LineAlgorithm>,
+    lines: Option<Vec<bool>>,
 }
 
 impl Accumulator {
@@ -122,7 +128,9 @@ impl Accumulator {
     /// `settings.spp` samples (at least one).
     pub fn new(settings: &RenderSettings) -> Accumulator {
         let diff = settings.view == View::Diff;
-        let settings = if diff { RenderSettings { view: View::Shaded, ..settings.clone() } } else { settings.clone() };
+        let wireframe = (settings.view == View::Wireframe).then_some(settings.lines);
+        let shaded = diff || wireframe.is_some();
+        let settings = if shaded { RenderSettings { view: View::Shaded, ..settings.clone() } } else { settings.clone() };
         let n = settings.width as usize * settings.height as usize;
         Accumulator {
             spp: settings.spp.max(1),
@@ -134,6 +142,8 @@ impl Accumulator {
             pass: 0,
             row: 0,
             photons: None,
+            wireframe,
+            lines: None,
             adaptive: settings.adaptive.filter(|_| settings.spp > 1).map(|target| Adaptive {
                 target,
                 samples: vec![0; n],
@@ -194,6 +204,10 @@ impl Accumulator {
         if self.pass == 0 && self.row == 0 {
             super::build_shadow_maps(prepared, &self.settings);
             self.photons = super::build_photon_map(prepared, &self.settings);
+            if let Some(algorithm) = self.wireframe {
+                let view = prepared.scene.camera.view(width, height);
+                self.lines = Some(wireframe::line_mask(&prepared.scene, &view, algorithm));
+            }
         }
         let rows = self.row..(self.row + max_rows.max(1)).min(height);
         let mut counts = RayCounts::default();
@@ -296,6 +310,10 @@ impl Accumulator {
             } else {
                 out.extend(row.iter().map(|s| mean(*s, passes)));
             }
+            if let Some(lines) = &self.lines {
+                let at = out.len() - w;
+                wireframe::draw_over(&mut out[at..], &lines[y as usize * w..(y as usize + 1) * w]);
+            }
         }
         out
     }
@@ -340,10 +358,13 @@ impl Accumulator {
             }
             sum
         };
-        let mine = match &self.adaptive {
+        let mut mine: Vec<Radiance> = match &self.adaptive {
             Some(a) => self.sum.iter().zip(&a.samples).map(|(s, n)| mean(*s, (*n).max(1))).collect(),
             None => average(self.sum),
         };
+        if let Some(lines) = &self.lines {
+            wireframe::draw_over(&mut mine, lines);
+        }
         let (pixels, differing_pixels) = match self.reference {
             Some(reference) => {
                 let (image, count) = debug::diff_image(&mine, &average(reference));

@@ -26,7 +26,8 @@ pub fn coverage_counts(method: Method, width: u32, height: u32, offset: Vec2, tr
         Method::Incremental => sts.iter().for_each(|st| incremental::raster(st, full, offset, &mut tested, |x, y, _| hit(x, y))),
         Method::Barycentric => sts.iter().for_each(|st| barycentric::raster(st, full, offset, &mut tested, |x, y, _| hit(x, y))),
         Method::Scanline => sts.iter().for_each(|st| scanline::raster(st, full, offset, &mut tested, |x, y, _| hit(x, y))),
-        Method::Fixed => {
+        // The painter draws with fixed's coverage loop.
+        Method::Fixed | Method::Painter => {
             let off = snap_offset(offset);
             for ft in snap_triangles(&sts, offset, width, height) {
                 fixed::raster(&ft, full, off, &mut tested, |x, y, _| hit(x, y));

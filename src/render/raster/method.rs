@@ -14,6 +14,7 @@ named_enum! {
         Scanline = "rasterize:scanline",
         Fixed = "rasterize:fixed",
         Tiled = "rasterize:tiled",
+        Painter = "rasterize:painter",
     }
 }
 
@@ -28,6 +29,7 @@ impl Method {
             Method::Scanline => "span filling between the triangle's edges (Computer Graphics from Scratch)",
             Method::Fixed => "8-bit sub-pixel fixed-point edge functions, top-left rule: watertight",
             Method::Tiled => "fixed-point edge functions, 32x32 tiles in parallel, 8x8 block masks: watertight",
+            Method::Painter => "the painter's algorithm: no depth buffer, back to front with Newell's tests (CGFS ch. 12)",
         }
     }
 }

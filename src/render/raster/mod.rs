@@ -8,6 +8,8 @@
 //! - `rect`: pixel rectangles and sample spans; `subpixel`: the fixed-point grid;
 //! - coverage loops, one per file: `naive` and `bbox` (the 3D ray test),
 //!   `barycentric`, `incremental`, `scanline`, `fixed`, `tiled`;
+//! - `painter`: the painter's algorithm's draw order (no depth buffer);
+//! - `depth_format`: what the depth buffer stores (`--depth-buffer`);
 //! - `vis_buffer`: depth test, visibility buffer, forward or early-depth shading,
 //!   the pixel-history recorder and the cost view's counts;
 //! - `msaa`: coverage sample patterns and the one-shade-per-primitive resolve;
@@ -18,11 +20,13 @@ pub mod barycentric;
 pub mod bbox;
 pub mod clip;
 pub mod coverage;
+pub mod depth_format;
 pub mod fixed;
 pub mod incremental;
 pub mod method;
 pub mod msaa;
 pub mod naive;
+pub mod painter;
 pub mod pass;
 pub mod rect;
 pub mod scanline;

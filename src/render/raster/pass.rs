@@ -9,6 +9,10 @@
 //! pass's sample; with MSAA N there are N + 1: the pixel-centre layer that
 //! shading reads and the N coverage samples (`msaa.rs`).
 //!
+//! The painter (`painter.rs`) draws no band in scene order: every layer sorts
+//! all of the image's triangles and spheres back to front once, and each
+//! band draws its share of that order with the depth test off.
+//!
 //! `replay_pixel` replays one pixel through this very code: the same setup and
 //! coverage loops over the region holding the pixel (its row, or its tile),
 //! with a recording `VisBuffer` that keeps that pixel's fragment history.
@@ -18,7 +22,8 @@ use super::msaa;
 use super::naive::{ray_test_rect, region_rays};
 use super::rect::PixelRect;
 use super::setup::{bin_rows, setup_pass, ScreenTri};
-use super::sphere::{all_sphere_bounds, raster_spheres};
+use super::painter::{self, Paint};
+use super::sphere::{all_sphere_bounds, raster_sphere, raster_spheres};
 use super::subpixel::snap_offset;
 use super::tiled::{self, RectCoverage, TileGrid};
 use super::vis_buffer::{DepthKey, FragmentRecorder, VisBuffer};
@@ -54,6 +59,8 @@ enum Geometry {
     FixedTriangles { fts: Vec<FixedTri>, off: [i64; 2], bins: Vec<Vec<u32>> },
     /// tiled: fixed-point (snapped) triangles binned by tile, with their whole-tile coverage.
     FixedTriangleTiles { fts: Vec<FixedTri>, off: [i64; 2], bins: Vec<Vec<(u32, RectCoverage)>> },
+    /// painter: fixed-point triangles and spheres in draw order, the order binned by band.
+    Painted { fts: Vec<FixedTri>, off: [i64; 2], order: Vec<Paint>, bins: Vec<Vec<u32>> },
 }
 
 /// One sample position of a pass, set up.
@@ -77,6 +84,7 @@ impl<'a> Layer<'a> {
         let job = job_at_offset(job, offset, job.rows.clone());
         let (r0, r1) = (job.rows.start, job.rows.end);
         let (w, h) = (job.view.width, job.view.height);
+        let spheres = all_sphere_bounds(job.view, &job.prepared.scene.spheres, offset);
         let geometry = match method {
             Method::Naive => Geometry::AllTriangles,
             Method::BBox => {
@@ -100,8 +108,20 @@ impl<'a> Layer<'a> {
                 let bins = tiled::bin_tiles(&fts, grid, off);
                 Geometry::FixedTriangleTiles { fts, off, bins }
             }
+            Method::Painter => {
+                // The order is made over the whole image, whatever rows this
+                // job renders, so a band shows what the frame shows.
+                let frame = job_at_offset(&job, offset, 0..h);
+                let fts = snap_triangles(&setup_pass(&frame), offset, w, h);
+                let (order, _) = painter::draw_order(&frame, &fts, &spheres);
+                let rects = order.iter().map(|p| match *p {
+                    Paint::Triangle(t) => fts[t as usize].bbox,
+                    Paint::Sphere(s) => spheres[s as usize].unwrap_or(PixelRect::new(0, 0, 0, 0)),
+                });
+                let bins = bin_rows(rects, r0, r1, BAND_ROWS);
+                Geometry::Painted { fts, off: snap_offset(offset), order, bins }
+            }
         };
-        let spheres = all_sphere_bounds(job.view, &job.prepared.scene.spheres, offset);
         Layer { job, method, geometry, spheres, sample }
     }
 
@@ -156,6 +176,25 @@ impl<'a> Layer<'a> {
                 tiled::tile_fragments(fts, &bins[region], rect, *off, &mut tested, |ft, x, y, l| vb.triangle_fragment(&ft.st, x, y, l));
                 vb.end_tests(tested);
             }
+            Geometry::Painted { fts, off, order, bins } => {
+                for &i in &bins[region] {
+                    match order[i as usize] {
+                        Paint::Triangle(t) => {
+                            let ft = &fts[t as usize];
+                            let mut tested = vb.begin_tests();
+                            fixed::raster(ft, rect, *off, &mut tested, |x, y, l| vb.triangle_fragment(&ft.st, x, y, l));
+                            vb.end_tests(tested);
+                        }
+                        Paint::Sphere(s) => {
+                            if let Some(b) = self.spheres[s as usize] {
+                                raster_sphere(vb, s, b);
+                            }
+                        }
+                    }
+                }
+                // The spheres were drawn in the order.
+                return;
+            }
         }
         raster_spheres(vb, &self.spheres);
     }
@@ -193,6 +232,7 @@ fn layer_buffers<'j, 'a, Q: SceneQuery>(layers: &'j [Layer<'a>], query: &'j Q, r
         .map(|l| {
             let mut vb = VisBuffer::new(&l.job, query, rect, key, forward);
             vb.sample = l.sample;
+            vb.paint = l.method == Method::Painter;
             vb
         })
         .collect()
@@ -284,6 +324,7 @@ pub fn replay_pixel(method: Method, job: &PassJob, x: u32, y: u32, rec: &mut Pix
         .map(|l| {
             let mut vb = VisBuffer::with_recorder(&l.job, &query, rect, key, forward, PixelTrace::new(), (x, y));
             vb.sample = l.sample;
+            vb.paint = l.method == Method::Painter;
             vb
         })
         .collect();

@@ -52,28 +52,36 @@ pub fn all_sphere_bounds(view: &CameraView, spheres: &[Sphere], off: Vec2) -> Ve
 /// Draws every sphere (in scene order, after the triangles, as the ray caster
 /// tests them) into the region of `vb`.
 pub fn raster_spheres<Q: SceneQuery, R: FragmentRecorder>(vb: &mut VisBuffer<Q, R>, bounds: &[Option<PixelRect>]) {
+    for (si, b) in bounds.iter().enumerate() {
+        if let Some(b) = b {
+            raster_sphere(vb, si as u32, *b);
+        }
+    }
+}
+
+/// Draws sphere `si`, whose bounds are `bounds`, into the region of `vb`:
+/// every sample whose eye ray hits its front surface.
+pub fn raster_sphere<Q: SceneQuery, R: FragmentRecorder>(vb: &mut VisBuffer<Q, R>, si: u32, bounds: PixelRect) {
     let job = vb.job;
     let view = job.view;
-    for (si, (s, b)) in job.prepared.scene.spheres.iter().zip(bounds).enumerate() {
-        let Some(b) = b else { continue };
-        let r = b.intersect(&vb.rect);
-        if r.is_empty() {
-            continue;
-        }
-        vb.add_tested(r);
-        for y in r.y0..r.y1 {
-            for x in r.x0..r.x1 {
-                let p = job.sample_position(x, y);
-                let ray = view.eye_ray(p.x, p.y);
-                let t_max = view.far_t(p.x, p.y);
-                if let Ok(t) = intersect_sphere(&ray, s, t_max, false) {
-                    let key = match vb.key {
-                        DepthKey::RayT => t,
-                        // The eye ray starts on the near plane: depth = near + t / |d|.
-                        DepthKey::NegInvZ => -1.0 / (view.near + t / view.camera_dir(p.x, p.y).length()),
-                    };
-                    vb.sphere_fragment(x, y, si as u32, t, key);
-                }
+    let s = &job.prepared.scene.spheres[si as usize];
+    let r = bounds.intersect(&vb.rect);
+    if r.is_empty() {
+        return;
+    }
+    vb.add_tested(r);
+    for y in r.y0..r.y1 {
+        for x in r.x0..r.x1 {
+            let p = job.sample_position(x, y);
+            let ray = view.eye_ray(p.x, p.y);
+            let t_max = view.far_t(p.x, p.y);
+            if let Ok(t) = intersect_sphere(&ray, s, t_max, false) {
+                let key = match vb.key {
+                    DepthKey::RayT => t,
+                    // The eye ray starts on the near plane: depth = near + t / |d|.
+                    DepthKey::NegInvZ => vb.enc.key(1.0 / (view.near + t / view.camera_dir(p.x, p.y).length())),
+                };
+                vb.sphere_fragment(x, y, si, t, key);
             }
         }
     }

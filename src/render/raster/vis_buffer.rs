@@ -5,10 +5,16 @@
 //!
 //! Depth keys: smaller is nearer. Variants that cast 3D rays (naive, bbox)
 //! store the ray parameter t, exactly as the ray caster compares hits; the
-//! others store -1/z, which is affine in image space. Ties keep the earlier
-//! fragment (strict `<`), so the earlier triangle in scene order wins, as in
-//! the brute-force caster.
+//! others store -1/z, which is affine in image space, or what `--depth-buffer`
+//! turns it into (`depth_format`: quantized z/w, reversed z). Ties keep the
+//! earlier fragment (strict `<`), so the earlier triangle in scene order
+//! wins, as in the brute-force caster.
+//!
+//! The painter's algorithm (`paint`) keeps no depth test: every fragment
+//! overwrites the sample, so the last primitive drawn is the one seen. The
+//! keys are still written, for the fragment record.
 
+use super::depth_format::DepthEncoding;
 use super::rect::{PixelRect, TestCounter};
 use super::setup::ScreenTri;
 use crate::math::{Radiance, Ray, Vec3};
@@ -23,7 +29,7 @@ use crate::scene::{PrimitiveId, PrimitiveKind, SurfaceHit};
 pub enum DepthKey {
     /// Ray parameter along the eye ray (starts at far_t, the far plane).
     RayT,
-    /// -1 / view depth (starts at -1 / far).
+    /// -1 / view depth (starts at -1 / far), or its `--depth-buffer` encoding.
     NegInvZ,
 }
 
@@ -70,6 +76,10 @@ pub struct VisBuffer<'j, 'a, Q: SceneQuery, R: FragmentRecorder = NoRecord> {
     pub rect: PixelRect,
     stride: usize,
     pub key: DepthKey,
+    /// How `NegInvZ` keys are stored (`--depth-buffer`).
+    pub enc: DepthEncoding,
+    /// The painter's algorithm: no depth test, every fragment overwrites.
+    pub paint: bool,
     /// Shade every fragment that passes the depth test (forward) instead of
     /// once per pixel after visibility is known (early depth).
     pub forward: bool,
@@ -101,8 +111,9 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
     /// A buffer whose recorder `rec` takes the history of pixel `focus`.
     pub fn with_recorder(job: &'j PassJob<'a>, query: &'j Q, rect: PixelRect, key: DepthKey, forward: bool, rec: R, focus: (u32, u32)) -> Self {
         let n = rect.area() as usize;
+        let enc = DepthEncoding::new(job.settings.depth_buffer, job.view.near, job.view.far);
         let depth = match key {
-            DepthKey::NegInvZ => vec![-1.0 / job.view.far; n],
+            DepthKey::NegInvZ => vec![enc.clear_key(); n],
             DepthKey::RayT => {
                 let mut d = Vec::with_capacity(n);
                 for y in rect.y0..rect.y1 {
@@ -121,6 +132,8 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             rect,
             stride: rect.width() as usize,
             key,
+            enc,
+            paint: false,
             forward,
             depth,
             id: vec![PrimitiveId::NONE; n],
@@ -181,7 +194,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
     /// The view depth of a depth key at pixel `(x, y)` (for the record).
     fn view_depth_of_key(&self, key: f32, x: u32, y: u32) -> f32 {
         match self.key {
-            DepthKey::NegInvZ => -1.0 / key,
+            DepthKey::NegInvZ => self.enc.view_depth(key),
             DepthKey::RayT => {
                 let p = self.job.sample_position(x, y);
                 self.job.view.near + key / self.job.view.camera_dir(p.x, p.y).length()
@@ -197,9 +210,9 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         let i = self.index(x, y);
         self.count_work(i);
         let inv_z = st.inv_z_at(l);
-        let key = -inv_z;
+        let key = self.enc.key(inv_z);
         let stored = self.depth[i];
-        let passed = key < stored;
+        let passed = self.paint || key < stored;
         if passed {
             self.depth[i] = key;
             self.id[i] = PrimitiveId::triangle(st.tri);
@@ -273,7 +286,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
 
     /// The eye ray hits sphere `s` at `t`. Against another sphere the two ray
     /// parameters are compared (as the ray caster does); against a triangle the
-    /// depth keys.
+    /// depth keys. The painter overwrites whatever is there.
     #[inline]
     pub fn sphere_fragment(&mut self, x: u32, y: u32, s: u32, t: f32, key: f32) {
         self.counts.samples_covered += 1;
@@ -281,7 +294,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         self.count_work(i);
         let cur = self.id[i];
         let stored = self.depth[i];
-        let nearer = if cur.is_none() {
+        let nearer = if cur.is_none() || self.paint {
             true
         } else if cur.is_sphere() {
             t < self.payload[i][0]
@@ -422,7 +435,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         self.rect = rect;
         self.stride = rect.width() as usize;
         self.depth.clear();
-        self.depth.resize(n, -1.0 / self.job.view.far);
+        self.depth.resize(n, self.enc.clear_key());
         self.id.clear();
         self.id.resize(n, PrimitiveId::NONE);
         self.payload.clear();
