@@ -148,6 +148,8 @@ impl ViewerSettings {
             msaa: settings.msaa,
             early_depth: settings.early_depth,
             affine: settings.affine,
+            depth_buffer: settings.depth_buffer,
+            lines: settings.lines,
         };
     }
 

@@ -5,6 +5,7 @@
 
 use crate::render::gi::GiMode;
 use crate::render::{debug, shadow_map, Interpolation, RenderSettings, ShadowMode, DEFAULT_RAYTRACE};
+use crate::render::raster::depth_format::DepthFormat;
 use crate::render::raster::DEFAULT_RASTERIZE;
 use crate::scene::Scene;
 
@@ -47,6 +48,9 @@ pub fn describe(renderer: &str, s: &RenderSettings) -> String {
         if s.shadow_map_bias != shadow_map::DEFAULT_BIAS {
             knob("shadow-map-bias", format!("{}", s.shadow_map_bias));
         }
+    }
+    if s.depth_buffer != DepthFormat::F32 {
+        knob("depth-buffer", s.depth_buffer.name().to_string());
     }
     if s.interpolation != Interpolation::Phong {
         knob("interpolation", s.interpolation.name().to_string());
@@ -121,6 +125,12 @@ pub fn method_configurations(scene: &Scene, base: &RenderSettings) -> Vec<Config
             }));
         }
     }
+
+    // Visibility: depth buffers that store less, and no depth buffer at all.
+    for format in [DepthFormat::Unorm16, DepthFormat::Unorm24, DepthFormat::Reversed] {
+        add("visibility", raster, with(&|s| s.depth_buffer = format));
+    }
+    add("visibility", "rasterize:painter", plain.clone());
 
     // Shading interpolation across triangles.
     if !scene.triangles.is_empty() {
