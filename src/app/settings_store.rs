@@ -2,6 +2,7 @@
 //! `ViewerSettings`, that the viewer edits live and saves and loads whole.
 
 use crate::render::debug::View;
+use crate::render::shadow_volume::VolumeMode;
 use crate::render::{shadow_map, Interpolation, RenderSettings, ShadowMode};
 use crate::scene::Scene;
 
@@ -21,6 +22,8 @@ pub struct ViewerSettings {
     pub renderer: String,
     pub spp: u32,
     pub shadows: ShadowMode,
+    /// `--shadows volume`: z-pass or z-fail counting.
+    pub shadow_volume: VolumeMode,
     pub shadow_bump: f32,
     pub max_depth: u32,
     pub view: View,
@@ -76,6 +79,7 @@ impl Default for ViewerSettings {
             renderer: crate::render::DEFAULT_RAYTRACE.to_string(),
             spp: 1,
             shadows: ShadowMode::Ray,
+            shadow_volume: VolumeMode::ZFail,
             shadow_bump: 1e-4,
             max_depth: 4,
             view: View::Shaded,
@@ -110,6 +114,7 @@ impl ViewerSettings {
             height,
             spp: self.spp,
             shadows: self.shadows,
+            shadow_volume: self.shadow_volume,
             shadow_bump: self.shadow_bump,
             max_depth: self.max_depth,
             view: self.view,

@@ -19,6 +19,7 @@ use super::naive::{ray_test_rect, region_rays};
 use super::rect::PixelRect;
 use super::setup::{bin_rows, setup_pass, ScreenTri};
 use super::sphere::{all_sphere_bounds, raster_spheres};
+use super::stencil::StencilSetup;
 use super::subpixel::snap_offset;
 use super::tiled::{self, RectCoverage, TileGrid};
 use super::vis_buffer::{DepthKey, FragmentRecorder, VisBuffer};
@@ -27,7 +28,7 @@ use super::{barycentric, bbox, incremental, scanline};
 use crate::math::{Radiance, Vec2};
 use crate::render::raytrace::bvh::BvhQuery;
 use crate::render::pixel_record::PixelTrace;
-use crate::render::{PassJob, PreparedScene, RayCounts, SceneQuery};
+use crate::render::{debug, PassJob, PreparedScene, RayCounts, SceneQuery, ShadowMode};
 use rayon::prelude::*;
 use std::ops::Range;
 
@@ -64,6 +65,8 @@ pub struct Layer<'a> {
     spheres: Vec<Option<PixelRect>>,
     /// MSAA coverage sample index; `None` for the pass's own sample.
     pub sample: Option<u32>,
+    /// `--shadows volume`: the volume faces the stencil pass draws.
+    stencil: Option<StencilSetup>,
 }
 
 /// `job` with its sample at `offset` and its rows `rows`.
@@ -102,7 +105,8 @@ impl<'a> Layer<'a> {
             }
         };
         let spheres = all_sphere_bounds(job.view, &job.prepared.scene.spheres, offset);
-        Layer { job, method, geometry, spheres, sample }
+        let stencil = uses_stencil(&job).then(|| StencilSetup::new(&job));
+        Layer { job, method, geometry, spheres, sample, stencil }
     }
 
     /// Rasterizes this layer's triangles of region `region` (band or tile
@@ -158,7 +162,15 @@ impl<'a> Layer<'a> {
             }
         }
         raster_spheres(vb, &self.spheres);
+        if let Some(stencil) = &self.stencil {
+            vb.count_volumes(stencil);
+        }
     }
+}
+
+/// Shadow volumes are counted into a stencil for the shaded view only.
+fn uses_stencil(job: &PassJob) -> bool {
+    job.settings.shadows == ShadowMode::Volume && job.settings.view == debug::View::Shaded
 }
 
 fn depth_key(method: Method) -> DepthKey {
@@ -198,9 +210,12 @@ fn layer_buffers<'j, 'a, Q: SceneQuery>(layers: &'j [Layer<'a>], query: &'j Q, r
         .collect()
 }
 
-/// Forward shading applies without MSAA only (MSAA shades once per pixel per primitive).
+/// Forward shading applies without MSAA only (MSAA shades once per pixel per
+/// primitive), and not with shadow volumes: their stencil needs the whole
+/// depth pass before any light is added (an engine's depth pre-pass). The
+/// image is the same; early depth just shades fewer fragments.
 fn shades_forward(job: &PassJob) -> bool {
-    !job.settings.early_depth && job.settings.msaa <= 1
+    !job.settings.early_depth && job.settings.msaa <= 1 && !uses_stencil(job)
 }
 
 /// Renders `job.rows` of one pass of `method` into `out`.
