@@ -15,6 +15,7 @@ const SCENES: &[(&str, &str)] = &[
     ("bunny", include_str!("../../assets/scenes/bunny.toml")),
     ("test-pattern", include_str!("../../assets/scenes/test-pattern.toml")),
     ("cornell-gi", include_str!("../../assets/scenes/cornell-gi.toml")),
+    ("stress-zpass", include_str!("../../assets/scenes/stress-zpass.toml")),
 ];
 
 /// The scene the viewer opens when given none.
