@@ -142,3 +142,21 @@ fn replay_of_a_pixel_in_a_volume_shadow_equals_the_frame() {
         }
     }
 }
+
+#[test]
+fn the_command_line_takes_the_mode_and_names_a_bad_one() {
+    let run = |args: &[&str]| std::process::Command::new(env!("CARGO_BIN_EXE_pinhole")).args(args).output().unwrap();
+    let png = std::env::temp_dir().join(format!("pinhole-shadow-volume-{}.png", std::process::id()));
+    let o = png.to_str().unwrap();
+    let out = run(&["render", "stress-zpass", "--width", "40", "--height", "25", "--shadows", "volume", "--shadow-volume", "zpass", "-o", o, "--stats", "-"]);
+    let _ = std::fs::remove_file(&png);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(text.contains("\"shadow_volume\": \"zpass\""), "{text}");
+    let out = run(&["render", "stress-zpass", "--shadows", "volume", "--shadow-volume", "zmiddle", "-o", o]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(err.contains("--shadow-volume") && err.contains("zmiddle") && err.contains("zfail"), "{err}");
+    let list = String::from_utf8_lossy(&run(&["list"]).stdout).to_string();
+    assert!(list.contains("volume") && list.contains("zpass") && list.contains("zfail"), "{list}");
+}
