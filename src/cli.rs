@@ -113,7 +113,7 @@ struct RenderOpts {
     /// shaded | barycentric | raydir | depth | zbuffer | normal | id | uv | cost | diff | shadowmap | wireframe (see `pinhole list`)
     #[arg(long, default_value = "shaded")]
     view: String,
-    /// ray | map | none
+    /// ray | map | volume | none
     #[arg(long, default_value = "ray")]
     shadows: String,
     /// Rasterizers: interpolate attributes affinely in screen space (no 1/z correction).
@@ -134,6 +134,10 @@ struct RenderOpts {
     /// --shadows map: depth bias in texels, slope-scaled (too small: acne; too large: peter-panning).
     #[arg(long = "shadow-bias", value_name = "B")]
     shadow_bias: Option<f32>,
+    /// --shadows volume: count the volume faces in front of the visible
+    /// surface (zpass, wrong with the eye inside a shadow) or behind it (zfail).
+    #[arg(long = "shadow-volume", value_name = "zpass|zfail", default_value = "zfail")]
+    shadow_volume: String,
     /// Rasterizers: coverage samples per pixel with one shade per pixel per
     /// primitive: 1 (off), 2, 4 or 8. Ray casters ignore it (use --spp).
     #[arg(long, default_value_t = 1, value_name = "N")]
@@ -233,6 +237,7 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
     let view = View::parse(&opts.view)?;
     let shadows = ShadowMode::parse(&opts.shadows)?;
     let interpolation = render::Interpolation::parse(&opts.interpolation)?;
+    let shadow_volume = render::shadow_volume::VolumeMode::parse(&opts.shadow_volume).map_err(|e| format!("--shadow-volume: {e}"))?;
     if opts.spp == 0 || opts.spp > 65536 {
         return Err(format!("--spp {} is not between 1 and 65536", opts.spp));
     }
@@ -263,6 +268,7 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
     settings.spp = opts.spp;
     settings.view = view;
     settings.shadows = shadows;
+    settings.shadow_volume = shadow_volume;
     settings.interpolation = interpolation;
     settings.affine = opts.affine;
     if let Some(b) = opts.bump {
@@ -375,6 +381,8 @@ fn stats_json(l: &Loaded, render_ms: f64, counts: &RayCounts, spp: u32) -> serde
         "shadow_map_size": l.settings.shadow_map_size,
         "shadow_map_bias": l.settings.shadow_map_bias,
         "shadow_map_ms": (l.settings.shadows == ShadowMode::Map).then(|| l.prepared.shadow_maps(l.settings.shadow_map_size).build_ms),
+        "shadow_volume": l.settings.shadow_volume.name(),
+        "shadow_volume_ms": (l.settings.shadows == ShadowMode::Volume).then(|| l.prepared.shadow_volumes().build_ms),
         "gi": l.settings.gi.mode.name(),
         "seed": l.settings.gi.seed,
         "photons": (l.settings.gi.mode == render::gi::GiMode::Photons).then(|| l.prepared.photon_map(&l.settings.gi, l.settings.shadow_bump).len()),
@@ -616,7 +624,8 @@ fn cmd_list() -> Result<(), String> {
     for v in View::ALL {
         let _ = writeln!(t, "  {}", v.name());
     }
-    let _ = writeln!(t, "shadows:\n  none\n  ray\n  map");
+    let _ = writeln!(t, "shadows:\n  none\n  ray\n  map\n  volume");
+    let _ = writeln!(t, "shadow volumes (--shadow-volume, with --shadows volume):\n  zpass\n  zfail");
     let _ = writeln!(t, "depth buffers (rasterizers with a depth buffer: --depth-buffer):");
     for f in render::raster::depth_format::DepthFormat::ALL {
         let _ = writeln!(t, "  {:24} {}", f.name(), f.description());

@@ -4,6 +4,7 @@
 use crate::render::debug::View;
 use crate::render::raster::depth_format::DepthFormat;
 use crate::render::wireframe::LineAlgorithm;
+use crate::render::shadow_volume::VolumeMode;
 use crate::render::{shadow_map, Interpolation, RenderSettings, ShadowMode};
 use crate::scene::Scene;
 
@@ -23,6 +24,8 @@ pub struct ViewerSettings {
     pub renderer: String,
     pub spp: u32,
     pub shadows: ShadowMode,
+    /// `--shadows volume`: z-pass or z-fail counting.
+    pub shadow_volume: VolumeMode,
     pub shadow_bump: f32,
     pub max_depth: u32,
     pub view: View,
@@ -82,6 +85,7 @@ impl Default for ViewerSettings {
             renderer: crate::render::DEFAULT_RAYTRACE.to_string(),
             spp: 1,
             shadows: ShadowMode::Ray,
+            shadow_volume: VolumeMode::ZFail,
             shadow_bump: 1e-4,
             max_depth: 4,
             view: View::Shaded,
@@ -116,6 +120,7 @@ impl ViewerSettings {
             height,
             spp: self.spp,
             shadows: self.shadows,
+            shadow_volume: self.shadow_volume,
             shadow_bump: self.shadow_bump,
             max_depth: self.max_depth,
             view: self.view,
@@ -138,6 +143,7 @@ impl ViewerSettings {
         self.renderer = renderer.to_string();
         self.spp = settings.spp;
         self.shadows = settings.shadows;
+        self.shadow_volume = settings.shadow_volume;
         self.shadow_bump = settings.shadow_bump;
         self.max_depth = settings.max_depth;
         self.interpolation = settings.interpolation;

@@ -204,6 +204,7 @@ impl SplitView {
         a.renderer = b.renderer.clone();
         a.spp = b.spp;
         a.shadows = b.shadows;
+        a.shadow_volume = b.shadow_volume;
         a.shadow_bump = b.shadow_bump;
         a.max_depth = b.max_depth;
         a.interpolation = b.interpolation;

@@ -6,6 +6,7 @@
 use crate::render::gi::GiMode;
 use crate::render::{debug, shadow_map, Interpolation, RenderSettings, ShadowMode, DEFAULT_RAYTRACE};
 use crate::render::raster::depth_format::DepthFormat;
+use crate::render::shadow_volume::VolumeMode;
 use crate::render::raster::DEFAULT_RASTERIZE;
 use crate::scene::Scene;
 
@@ -40,6 +41,9 @@ pub fn describe(renderer: &str, s: &RenderSettings) -> String {
     }
     if s.shadows != ShadowMode::Ray {
         knob("shadows", s.shadows.name().to_string());
+    }
+    if s.shadows == ShadowMode::Volume && s.shadow_volume != VolumeMode::ZFail {
+        knob("shadow-volume", s.shadow_volume.name().to_string());
     }
     if s.shadows == ShadowMode::Map {
         if s.shadow_map_size != shadow_map::DEFAULT_SIZE {
@@ -116,6 +120,12 @@ pub fn method_configurations(scene: &Scene, base: &RenderSettings) -> Vec<Config
             add("shadows", raster, with(&|s| {
                 s.shadows = ShadowMode::Map;
                 s.shadow_map_size = size;
+            }));
+        }
+        for mode in [VolumeMode::ZFail, VolumeMode::ZPass] {
+            add("shadows", raster, with(&|s| {
+                s.shadows = ShadowMode::Volume;
+                s.shadow_volume = mode;
             }));
         }
         for bias in [0.1, 8.0] {

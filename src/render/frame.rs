@@ -61,10 +61,14 @@ pub fn render_frame_in_bands(
 
 /// Builds the shadow maps `settings` look up (`--shadows map`, the shadow-map
 /// view) once, in parallel, before the passes or a replay need them; samples
-/// would otherwise build them serially on first use.
+/// would otherwise build them serially on first use. The same for the shadow
+/// volumes (`--shadows volume`).
 pub fn build_shadow_maps(prepared: &PreparedScene, settings: &RenderSettings) {
     if settings.shadows == super::ShadowMode::Map || settings.view == super::debug::View::Shadowmap {
         prepared.shadow_maps(settings.shadow_map_size);
+    }
+    if settings.shadows == super::ShadowMode::Volume && settings.view == super::debug::View::Shaded {
+        prepared.shadow_volumes();
     }
 }
 

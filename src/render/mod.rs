@@ -17,6 +17,7 @@ pub mod raster;
 pub mod raytrace;
 pub mod shade;
 pub mod shadow_map;
+pub mod shadow_volume;
 pub mod pixel_record;
 pub mod pixel_report;
 pub mod wireframe;
@@ -38,6 +39,8 @@ named_enum! {
         None = "none",
         Ray = "ray",
         Map = "map",
+        /// Stencil shadow volumes for the surface the eye sees (`shadow_volume`).
+        Volume = "volume",
     }
 }
 
@@ -74,6 +77,10 @@ pub struct RenderSettings {
     /// than `bias * texel size * (1 + tan theta)` (see `shadow_map`).
     #[serde(default = "shadow_map::default_bias")]
     pub shadow_map_bias: f32,
+    /// `--shadows volume`: count the volume faces in front of the visible
+    /// surface (z-pass) or behind it (z-fail).
+    #[serde(default)]
+    pub shadow_volume: shadow_volume::VolumeMode,
     /// Maximum depth of mirror and refraction rays.
     pub max_depth: u32,
     pub view: debug::View,
@@ -128,6 +135,7 @@ impl RenderSettings {
             shadow_bump: 1e-4,
             shadow_map_size: shadow_map::DEFAULT_SIZE,
             shadow_map_bias: shadow_map::DEFAULT_BIAS,
+            shadow_volume: shadow_volume::VolumeMode::ZFail,
             max_depth: 4,
             view: debug::View::Shaded,
             interpolation: Interpolation::Phong,
@@ -201,6 +209,12 @@ pub trait SceneQuery: Sync {
     /// Shadow maps to look light visibility up in (`--shadows map`);
     /// `resolve_sample` wraps the query in a `shadow_map::MapQuery` that has them.
     fn shadow_maps(&self) -> Option<&shadow_map::ShadowMaps> {
+        None
+    }
+    /// The shadow volume count of light `light` at the primary surface
+    /// (`--shadows volume`, nonzero = shadow); `resolve_sample` wraps the
+    /// query in a `shadow_volume::VolumeQuery` that has the counts.
+    fn volume_count(&self, _light: usize) -> Option<i32> {
         None
     }
 }
@@ -320,7 +334,30 @@ pub fn resolve_sample<Q: SceneQuery, R: Recorder>(
             resolve_with(job, &shadow_map::MapQuery { inner: query, maps }, ray, hit, pixel, counts, rec)
         });
     }
+    if job.settings.shadows == ShadowMode::Volume && job.settings.view == debug::View::Shaded {
+        if let Some(h) = hit {
+            let volume = shadow_volume::ray_counts(job.prepared, job.settings, ray, h.t);
+            return resolve_counted(job, query, ray, hit, &volume, pixel, counts, rec);
+        }
+    }
     resolve_with(job, query, ray, hit, pixel, counts, rec)
+}
+
+/// `resolve_sample` for a sample whose shadow volume counts (one per light)
+/// are known already: a rasterizer's stencil (`--shadows volume`).
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub fn resolve_counted<Q: SceneQuery, R: Recorder>(
+    job: &PassJob,
+    query: &Q,
+    ray: &Ray,
+    hit: Option<&SurfaceHit>,
+    volume: &[i32],
+    pixel: u32,
+    counts: &mut RayCounts,
+    rec: &mut R,
+) -> Radiance {
+    resolve_with(job, &shadow_volume::VolumeQuery { inner: query, counts: volume }, ray, hit, pixel, counts, rec)
 }
 
 #[inline]

@@ -31,6 +31,9 @@ pub struct LightSample {
     pub shadow_ray: Option<(Ray, f32)>,
     /// What blocked the shadow ray (or, with shadow maps, the stored caster).
     pub blocker: Option<Occluder>,
+    /// With shadow volumes at the primary surface: the light's stencil count
+    /// (nonzero = in shadow), which replaced the shadow ray.
+    pub volume_count: Option<i32>,
     pub bsdf: Vec3,
     pub contribution: Radiance,
 }

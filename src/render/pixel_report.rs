@@ -63,12 +63,17 @@ fn finite_or_null(v: f32) -> Value {
 }
 
 fn light_json(l: &LightSample) -> Value {
-    json!({
+    let mut j = json!({
         "light": l.light, "w_i": v3(l.w_i), "distance": finite_or_null(l.distance), "incident": v3(l.incident),
         "cos_theta": l.cos_theta, "shadow_ray": l.shadow_ray.map(|(r, t)| json!({"origin": v3(r.origin), "direction": v3(r.dir), "t_max": t})),
         "blocked_by": l.blocker.map(|b| json!({"kind": kind(b.kind), "index": b.index, "t": b.t})),
         "bsdf": v3(l.bsdf), "contribution": v3(l.contribution),
-    })
+    });
+    // Only with shadow volumes, so other reports keep their exact form.
+    if let Some(c) = l.volume_count {
+        j["shadow_volume_count"] = json!(c);
+    }
+    j
 }
 
 fn fragment_json(f: &FragmentRecord) -> Value {
@@ -202,6 +207,8 @@ pub fn to_text(renderer: &str, scene: &Scene, x: u32, y: u32, replay: &PixelRepl
         }
         for l in &t.lights {
             let blocked = match l.blocker {
+                _ if l.volume_count.is_some_and(|c| c != 0) => format!("in shadow: shadow volume count {}", l.volume_count.unwrap_or(0)),
+                _ if l.volume_count.is_some() => "visible: shadow volume count 0".into(),
                 Some(b) => format!("blocked by {} {} at t = {:.5}", kind(b.kind), b.index, b.t),
                 None if l.shadow_ray.is_some() => "visible".into(),
                 None => "no shadow ray".into(),

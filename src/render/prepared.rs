@@ -18,6 +18,9 @@ pub struct PreparedScene {
     pub shadow_cache: super::shadow_map::ShadowMapCache,
     /// The last photon map built (`--gi photons`); see `PreparedScene::photon_map`.
     pub photon_cache: super::photon_map::PhotonMapCache,
+    /// The last shadow volumes built (`--shadows volume`), keyed by the
+    /// lights; see `PreparedScene::shadow_volumes`.
+    pub volume_cache: super::shadow_volume::ShadowVolumeCache,
 }
 
 impl PreparedScene {
@@ -26,7 +29,7 @@ impl PreparedScene {
         let start = Instant::now();
         let bvh = Bvh::build(&scene, &edges);
         let build_ms = start.elapsed().as_secs_f64() * 1e3;
-        PreparedScene { scene, edges, bvh, build_ms, shadow_cache: Default::default(), photon_cache: Default::default() }
+        PreparedScene { scene, edges, bvh, build_ms, shadow_cache: Default::default(), photon_cache: Default::default(), volume_cache: Default::default() }
     }
 
     /// The photon map for the scene's current lights and materials and the

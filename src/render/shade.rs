@@ -69,13 +69,16 @@ pub fn shade<Q: SceneQuery, R: Recorder>(
         let Incidence { w_i, distance, incident, cos_theta } = incidence;
         if !incidence.illuminates() {
             if R::ENABLED {
-                sh.rec.light(LightSample { light: index, w_i, distance, incident, cos_theta, shadow_ray: None, blocker: None, bsdf: Vec3::ZERO, contribution: Vec3::ZERO });
+                sh.rec.light(LightSample { light: index, w_i, distance, incident, cos_theta, shadow_ray: None, blocker: None, volume_count: None, bsdf: Vec3::ZERO, contribution: Vec3::ZERO });
             }
             continue;
         }
         let mut shadow_ray = None;
         let mut blocker = None;
-        if settings.shadows == ShadowMode::Ray {
+        // Shadow volumes answer for the surface the eye sees (its stencil
+        // count); every other surface falls back to a shadow ray.
+        let volume_count = if settings.shadows == ShadowMode::Volume && depth == 0 { query.volume_count(index) } else { None };
+        if volume_count.is_none() && matches!(settings.shadows, ShadowMode::Ray | ShadowMode::Volume) {
             let (ray, t_max) = incidence.shadow_ray(scene, hit, settings.shadow_bump);
             sh.counts.shadow += 1;
             sh.rec.in_shadow_ray(true);
@@ -91,10 +94,11 @@ pub fn shade<Q: SceneQuery, R: Recorder>(
             }
         }
         let f = bsdf(material, albedo, n, w_i, w_o);
-        let contribution = if blocker.is_some() { Vec3::ZERO } else { incident * f * cos_theta };
+        let shadowed = blocker.is_some() || volume_count.is_some_and(|c| c != 0);
+        let contribution = if shadowed { Vec3::ZERO } else { incident * f * cos_theta };
         l_o += contribution;
         if R::ENABLED {
-            sh.rec.light(LightSample { light: index, w_i, distance, incident, cos_theta, shadow_ray, blocker, bsdf: f, contribution });
+            sh.rec.light(LightSample { light: index, w_i, distance, incident, cos_theta, shadow_ray, blocker, volume_count, bsdf: f, contribution });
         }
     }
 

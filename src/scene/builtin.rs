@@ -17,6 +17,7 @@ const SCENES: &[(&str, &str)] = &[
     ("cornell-gi", include_str!("../../assets/scenes/cornell-gi.toml")),
     ("stress-painter", include_str!("../../assets/scenes/stress-painter.toml")),
     ("stress-zfight", include_str!("../../assets/scenes/stress-zfight.toml")),
+    ("stress-zpass", include_str!("../../assets/scenes/stress-zpass.toml")),
 ];
 
 /// The scene the viewer opens when given none.

@@ -272,6 +272,8 @@ fn light(ui: &mut egui::Ui, names: &SceneNames, l: &LightSample, traced: Option<
         None => "?",
     };
     let visibility = match (l.shadow_ray, l.blocker) {
+        _ if l.volume_count.is_some_and(|c| c != 0) => format!("in shadow: shadow volume count {}", l.volume_count.unwrap_or(0)),
+        _ if l.volume_count.is_some() => "visible: shadow volume count 0".into(),
         (_, Some(b)) => format!("blocked by {} {} {} at t = {:.5}", kind_name(b.kind), b.index, object_name(names.scene, b.kind, b.index), b.t),
         (Some(_), None) => "visible".into(),
         (None, None) => "no shadow ray".into(),
@@ -280,7 +282,7 @@ fn light(ui: &mut egui::Ui, names: &SceneNames, l: &LightSample, traced: Option<
         Some(b) => format!("blocked at t = {:.5}", b.t),
         None => visibility.clone(),
     };
-    let color = if l.blocker.is_some() { Color32::from_rgb(240, 110, 100) } else { Color32::from_rgb(110, 220, 120) };
+    let color = if l.blocker.is_some() || l.volume_count.is_some_and(|c| c != 0) { Color32::from_rgb(240, 110, 100) } else { Color32::from_rgb(110, 220, 120) };
     let title = RichText::new(format!("L{} ({kind}): {short}", l.light)).color(color);
     egui::CollapsingHeader::new(title).id_salt(("light", k)).default_open(true).show(ui, |ui| {
         egui::Grid::new(("light-grid", k)).num_columns(2).spacing([8.0, 2.0]).show(ui, |ui| {

@@ -1,4 +1,4 @@
-//! Shading section (the debug view is in the top bar): shadows (none / ray / map) and the ray bump,
+//! Shading section (the debug view is in the top bar): shadows (none / ray / map / volume) and the ray bump,
 //! samples per pixel, secondary depth, ambient, background, exposure and
 //! gamma on/off; the rasterizers' knobs (MSAA, early depth, affine, depth
 //! buffer format) and the wireframe view's line algorithm.
@@ -9,6 +9,7 @@ use crate::app::settings_store::ViewerSettings;
 use crate::render::gi::{GiMode, GiSettings, MAX_BOUNCES};
 use crate::render::raster::depth_format::DepthFormat;
 use crate::render::wireframe::LineAlgorithm;
+use crate::render::shadow_volume::VolumeMode;
 use crate::render::{Interpolation, ShadowMode};
 use crate::scene::RenderDefaults;
 
@@ -37,6 +38,15 @@ pub fn show(ui: &mut egui::Ui, settings: &mut ViewerSettings, look: &mut RenderD
             ui.horizontal(|ui| {
                 let l = ui.label("map bias (texels)");
                 ui.add(egui::Slider::new(&mut s.per_scene.shadow_map_bias, 0.0..=32.0)).labelled_by(l.id);
+            });
+        }
+        if s.shadows == ShadowMode::Volume {
+            // Where the stencil counts volume faces: z-pass fails with the eye in a shadow.
+            ui.horizontal(|ui| {
+                ui.label("volume count");
+                for m in VolumeMode::ALL {
+                    ui.radio_value(&mut s.shadow_volume, m, m.name());
+                }
             });
         }
         gi_knobs(ui, &mut s.gi);

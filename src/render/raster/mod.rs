@@ -14,6 +14,7 @@
 //!   the pixel-history recorder and the cost view's counts;
 //! - `msaa`: coverage sample patterns and the one-shade-per-primitive resolve;
 //! - `sphere`: analytic spheres through the ray tracer's sphere test;
+//! - `stencil`: the shadow volumes' stencil counts (`--shadows volume`);
 //! - `pass`: the parallel regions of a pass; `coverage`: coverage counts for tests.
 
 pub mod barycentric;
@@ -32,6 +33,7 @@ pub mod rect;
 pub mod scanline;
 pub mod setup;
 pub mod sphere;
+pub mod stencil;
 pub mod subpixel;
 pub mod tiled;
 pub mod vis_buffer;

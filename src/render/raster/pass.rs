@@ -24,6 +24,7 @@ use super::rect::PixelRect;
 use super::setup::{bin_rows, setup_pass, ScreenTri};
 use super::painter::{self, Paint};
 use super::sphere::{all_sphere_bounds, raster_sphere, raster_spheres};
+use super::stencil::StencilSetup;
 use super::subpixel::snap_offset;
 use super::tiled::{self, RectCoverage, TileGrid};
 use super::vis_buffer::{DepthKey, FragmentRecorder, VisBuffer};
@@ -32,7 +33,7 @@ use super::{barycentric, bbox, incremental, scanline};
 use crate::math::{Radiance, Vec2};
 use crate::render::raytrace::bvh::BvhQuery;
 use crate::render::pixel_record::PixelTrace;
-use crate::render::{PassJob, PreparedScene, RayCounts, SceneQuery};
+use crate::render::{debug, PassJob, PreparedScene, RayCounts, SceneQuery, ShadowMode};
 use rayon::prelude::*;
 use std::ops::Range;
 
@@ -71,6 +72,8 @@ pub struct Layer<'a> {
     spheres: Vec<Option<PixelRect>>,
     /// MSAA coverage sample index; `None` for the pass's own sample.
     pub sample: Option<u32>,
+    /// `--shadows volume`: the volume faces the stencil pass draws.
+    stencil: Option<StencilSetup>,
 }
 
 /// `job` with its sample at `offset` and its rows `rows`.
@@ -122,7 +125,8 @@ impl<'a> Layer<'a> {
                 Geometry::Painted { fts, off: snap_offset(offset), order, bins }
             }
         };
-        Layer { job, method, geometry, spheres, sample }
+        let stencil = uses_stencil(&job).then(|| StencilSetup::new(&job));
+        Layer { job, method, geometry, spheres, sample, stencil }
     }
 
     /// Rasterizes this layer's triangles of region `region` (band or tile
@@ -192,12 +196,21 @@ impl<'a> Layer<'a> {
                         }
                     }
                 }
-                // The spheres were drawn in the order.
-                return;
             }
         }
-        raster_spheres(vb, &self.spheres);
+        // The painter drew the spheres in its order.
+        if !matches!(self.geometry, Geometry::Painted { .. }) {
+            raster_spheres(vb, &self.spheres);
+        }
+        if let Some(stencil) = &self.stencil {
+            vb.count_volumes(stencil);
+        }
     }
+}
+
+/// Shadow volumes are counted into a stencil for the shaded view only.
+fn uses_stencil(job: &PassJob) -> bool {
+    job.settings.shadows == ShadowMode::Volume && job.settings.view == debug::View::Shaded
 }
 
 fn depth_key(method: Method) -> DepthKey {
@@ -238,9 +251,12 @@ fn layer_buffers<'j, 'a, Q: SceneQuery>(layers: &'j [Layer<'a>], query: &'j Q, r
         .collect()
 }
 
-/// Forward shading applies without MSAA only (MSAA shades once per pixel per primitive).
+/// Forward shading applies without MSAA only (MSAA shades once per pixel per
+/// primitive), and not with shadow volumes: their stencil needs the whole
+/// depth pass before any light is added (an engine's depth pre-pass). The
+/// image is the same; early depth just shades fewer fragments.
 fn shades_forward(job: &PassJob) -> bool {
-    !job.settings.early_depth && job.settings.msaa <= 1
+    !job.settings.early_depth && job.settings.msaa <= 1 && !uses_stencil(job)
 }
 
 /// Renders `job.rows` of one pass of `method` into `out`.

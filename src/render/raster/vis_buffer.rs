@@ -20,7 +20,9 @@ use super::setup::ScreenTri;
 use crate::math::{Radiance, Ray, Vec3};
 use crate::render::debug::{cost_color, View};
 use crate::render::pixel_record::{FragmentRecord, NoRecord, PixelTrace, Recorder};
-use crate::render::{miss_without_ray, resolve_sample, PassJob, RayCounts, SceneQuery};
+use crate::render::{miss_without_ray, resolve_counted, resolve_sample, PassJob, RayCounts, SceneQuery};
+use crate::render::shadow_volume::split_depth;
+use super::stencil::{PixelRay, StencilSetup};
 use crate::scene::{PrimitiveId, PrimitiveKind, SurfaceHit};
 
 
@@ -99,6 +101,10 @@ pub struct VisBuffer<'j, 'a, Q: SceneQuery, R: FragmentRecorder = NoRecord> {
     focus: (u32, u32),
     /// MSAA coverage sample of this buffer (recorded with its fragments).
     pub sample: Option<u32>,
+    /// `--shadows volume`: per pixel, one shadow-volume count per light
+    /// (`stencil_lights` of them), filled after the depth pass; empty otherwise.
+    stencil: Vec<i32>,
+    stencil_lights: usize,
 }
 
 impl<'j, 'a, Q: SceneQuery> VisBuffer<'j, 'a, Q, NoRecord> {
@@ -145,6 +151,8 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             rec,
             focus,
             sample: None,
+            stencil: Vec::new(),
+            stencil_lights: 0,
         }
     }
 
@@ -355,7 +363,31 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         self.job.view.far_t(p.x, p.y)
     }
 
-    /// Hands what pixel index `i` sees to the shared shading (recorded for the focus pixel).
+    /// The stencil pass of `--shadows volume`, after the depth pass: every
+    /// pixel that sees a surface gets its count per light (`stencil.rs`).
+    pub fn count_volumes(&mut self, setup: &StencilSetup) {
+        let r = self.rect;
+        let mut rays: Vec<PixelRay> = Vec::with_capacity(r.area() as usize);
+        let mut i = 0;
+        for y in r.y0..r.y1 {
+            for x in r.x0..r.x1 {
+                rays.push(if self.id[i].is_none() {
+                    None
+                } else {
+                    let (ray, hit) = self.eye_hit(i, x, y);
+                    hit.map(|h| (ray.origin, ray.dir, split_depth(h.t)))
+                });
+                i += 1;
+            }
+        }
+        self.stencil_lights = setup.lights;
+        self.stencil.clear();
+        self.stencil.resize(rays.len() * setup.lights, 0);
+        setup.count(r, &rays, &mut self.stencil);
+    }
+
+    /// Hands what pixel index `i` sees to the shared shading (recorded for the
+    /// focus pixel), with its stencil counts when there are any.
     pub fn shade(&mut self, i: usize, x: u32, y: u32) -> Radiance {
         if !self.job.is_active(x, y) {
             return Radiance::ZERO;
@@ -366,12 +398,25 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             }
         }
         let (ray, hit) = self.eye_hit(i, x, y);
-        if self.is_focus(x, y) {
+        let focus = self.is_focus(x, y);
+        if focus {
             self.rec.ray(&ray, self.far_t(x, y), 0);
             self.rec.closest(hit.as_ref());
-            return resolve_sample(self.job, self.query, &ray, hit.as_ref(), self.job.pixel_index(x, y), &mut self.counts, &mut self.rec);
         }
-        resolve_sample(self.job, self.query, &ray, hit.as_ref(), self.job.pixel_index(x, y), &mut self.counts, &mut NoRecord)
+        let pixel = self.job.pixel_index(x, y);
+        let l = self.stencil_lights;
+        if !self.stencil.is_empty() && hit.is_some() {
+            let volume = &self.stencil[i * l..(i + 1) * l];
+            return if focus {
+                resolve_counted(self.job, self.query, &ray, hit.as_ref(), volume, pixel, &mut self.counts, &mut self.rec)
+            } else {
+                resolve_counted(self.job, self.query, &ray, hit.as_ref(), volume, pixel, &mut self.counts, &mut NoRecord)
+            };
+        }
+        if focus {
+            return resolve_sample(self.job, self.query, &ray, hit.as_ref(), pixel, &mut self.counts, &mut self.rec);
+        }
+        resolve_sample(self.job, self.query, &ray, hit.as_ref(), pixel, &mut self.counts, &mut NoRecord)
     }
 
     /// True when the frame shows the cost view instead of shading.

@@ -444,6 +444,38 @@ impl Bvh {
         let id = self.prims[slot as usize].1;
         (id.kind(), id.index())
     }
+
+    /// Calls `visit` with the edges and id of every primitive in a leaf
+    /// whose box the ray meets before `t_max`, in no particular order: the
+    /// candidates for queries that need every crossing along a ray, not the
+    /// nearest one (shadow volume counts).
+    pub fn for_each_candidate(&self, ray: &Ray, t_max: f32, mut visit: impl FnMut(&TriangleEdges, PrimitiveId)) {
+        let r = PreparedRay::new(ray);
+        if self.prims.is_empty() || !r.slab1(self.root_bounds.min, self.root_bounds.max, t_max) {
+            return;
+        }
+        let mut stack: Vec<u32> = Vec::with_capacity(STACK);
+        let mut word = self.root;
+        loop {
+            if word & LEAF_BIT == 0 {
+                let node = &self.nodes[word as usize];
+                let (mut mask, _) = r.slab4(&node.planes, node.valid, t_max);
+                while mask != 0 {
+                    stack.push(node.child[mask.trailing_zeros() as usize]);
+                    mask &= mask - 1;
+                }
+            } else {
+                let (start, end) = leaf_range(word);
+                for (edges, id) in &self.prims[start..end] {
+                    visit(edges, *id);
+                }
+            }
+            match stack.pop() {
+                Some(next) => word = next,
+                None => break,
+            }
+        }
+    }
 }
 
 /// The traversal stack: on the machine stack for ordinary trees.
