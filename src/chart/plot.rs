@@ -132,9 +132,12 @@ pub fn draw_methods_png(points: &[Measurement], metric: ErrorMetric, title: &str
                 .legend(move |(x, y)| Circle::new((x + 10, y), 5, color.filled()));
         }
         chart
-            .draw_series(front.iter().map(|&i| {
+            .draw_series(front.iter().enumerate().map(|(k, &i)| {
+                // Neighbours on the front often sit close together: their
+                // labels step up in turn so they do not overprint.
                 let p = &points[i];
-                EmptyElement::at((p.ms, err(p))) + Text::new(p.label.clone(), (8, -6), ("sans-serif", 12))
+                let dy = -6 - 15 * (k % 3) as i32;
+                EmptyElement::at((p.ms, err(p))) + Text::new(p.label.clone(), (8, dy), ("sans-serif", 12))
             }))
             .map_err(|e| e.to_string())?;
         chart
