@@ -15,6 +15,8 @@ const SCENES: &[(&str, &str)] = &[
     ("bunny", include_str!("../../assets/scenes/bunny.toml")),
     ("test-pattern", include_str!("../../assets/scenes/test-pattern.toml")),
     ("cornell-gi", include_str!("../../assets/scenes/cornell-gi.toml")),
+    // The stress gallery's scenes (`gallery::cases`), each built to provoke one failure.
+    ("stress-shadow", include_str!("../../assets/scenes/stress-shadow.toml")),
 ];
 
 /// The scene the viewer opens when given none.

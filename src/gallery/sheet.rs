@@ -1,0 +1,79 @@
+//! The gallery's contact sheet: one row per case, the failing image beside
+//! the cured one, each captioned with its setting and wrong-pixel count.
+//! Text is drawn with plotters in egui's font, as the charts are.
+
+use super::measure::CaseResult;
+use plotters::prelude::*;
+
+/// Width of one image cell; images are enlarged by a whole factor to fill it.
+const CELL_W: u32 = 400;
+const PAD: u32 = 10;
+/// Height of a row's caption (case, explanation) above its images.
+const CAPTION_H: u32 = 46;
+/// Height of the line under each image (setting, wrong pixels).
+const LABEL_H: u32 = 22;
+const TITLE_H: u32 = 36;
+
+fn scale_of(r: &CaseResult) -> u32 {
+    (CELL_W / r.width.max(1)).max(1)
+}
+
+fn row_height(r: &CaseResult) -> u32 {
+    CAPTION_H + r.height * scale_of(r) + LABEL_H + PAD
+}
+
+/// Draws the sheet for `results` (with their explanations, by case) as PNG bytes.
+pub fn draw_png(results: &[(CaseResult, &str)]) -> Result<Vec<u8>, String> {
+    let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, epaint_default_fonts::UBUNTU_LIGHT);
+    // Images wider than a cell widen every cell.
+    let cell_w = results.iter().map(|(r, _)| r.width * scale_of(r)).fold(CELL_W, u32::max);
+    let width = PAD + 2 * (cell_w + PAD);
+    let height = TITLE_H + results.iter().map(|(r, _)| row_height(r)).sum::<u32>() + PAD;
+    let mut buf = vec![255u8; (width * height * 3) as usize];
+    // Images first (plain copies into the buffer), text over them after.
+    let mut y = TITLE_H;
+    for (r, _) in results {
+        let s = scale_of(r);
+        for (col, img) in [&r.failing.image, &r.cured.image].into_iter().enumerate() {
+            let rgb = crate::image_io::to_rgb8(img, r.exposure, true);
+            let x0 = PAD + col as u32 * (cell_w + PAD);
+            blit(&mut buf, width, &rgb, r.width, r.height, s, x0, y + CAPTION_H);
+        }
+        y += row_height(r);
+    }
+    {
+        let root = BitMapBackend::with_buffer(&mut buf, (width, height)).into_drawing_area();
+        let text = |s: &str, x: u32, y: u32, size: u32, color: RGBColor| {
+            root.draw(&Text::new(s.to_string(), (x as i32, y as i32), ("sans-serif", size).into_font().color(&color))).map_err(|e| e.to_string())
+        };
+        text("pinhole stress gallery: failing setting | cured setting, wrong pixels against the truth", PAD, 8, 20, BLACK)?;
+        let mut y = TITLE_H;
+        for (r, explanation) in results {
+            let verdict = if r.demonstrated() { "" } else { "  (NOT DEMONSTRATED)" };
+            text(&format!("{}  [{}, knob: {}]{verdict}", r.case, r.method, r.knob), PAD, y + 2, 18, BLACK)?;
+            text(explanation, PAD, y + 23, 14, RGBColor(60, 60, 60))?;
+            let label_y = y + CAPTION_H + r.height * scale_of(r) + 3;
+            for (col, s) in [&r.failing, &r.cured].into_iter().enumerate() {
+                let color = if s.wrong_pixels > r.threshold { RGBColor(180, 0, 0) } else { RGBColor(0, 120, 0) };
+                let x = PAD + col as u32 * (cell_w + PAD);
+                text(&format!("{}: {} wrong px", s.setting, s.wrong_pixels), x, label_y, 14, color)?;
+            }
+            y += row_height(r);
+        }
+        root.present().map_err(|e| e.to_string())?;
+    }
+    crate::image_io::encode_png(width, height, &buf)
+}
+
+/// Copies an RGB8 image of `w` x `h` into `buf` (`buf_w` wide) at `(x0, y0)`,
+/// each pixel as an `s` x `s` block (nearest: pixels stay visible).
+#[allow(clippy::too_many_arguments)]
+fn blit(buf: &mut [u8], buf_w: u32, rgb: &[u8], w: u32, h: u32, s: u32, x0: u32, y0: u32) {
+    for y in 0..h * s {
+        for x in 0..w * s {
+            let src = (((y / s) * w + x / s) * 3) as usize;
+            let dst = (((y0 + y) * buf_w + x0 + x) * 3) as usize;
+            buf[dst..dst + 3].copy_from_slice(&rgb[src..src + 3]);
+        }
+    }
+}
