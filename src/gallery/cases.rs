@@ -90,6 +90,98 @@ pub fn cases() -> Vec<GalleryCase> {
             truth: RAY_CAST_SHADOWS,
             threshold: 40,
         },
+        GalleryCase {
+            name: "grazing-light",
+            scene: "stress-grazing",
+            method: "shadow map",
+            knob: "shadow_map_slope_bias",
+            explanation: "light 6 degrees above the ground: one texel spans a long stretch of depth there, so a constant bias that suffices under steep light leaves acne",
+            failing: Setting::new("rasterize", "--shadows map, constant bias 1", |s| {
+                map(s);
+                s.shadow_map_slope_bias = false;
+            }),
+            cured: Setting::new("rasterize", "--shadows map, slope-scaled bias 1 (default)", map),
+            truth: RAY_CAST_SHADOWS,
+            threshold: 40,
+        },
+        GalleryCase {
+            name: "shadow-terminator",
+            scene: "stress-terminator",
+            method: "shadow rays",
+            knob: "terminator_lift",
+            explanation: "smooth normals face the light where the coarse facets do not: shadow rays leaving those facets hit the neighbouring ones, and the lit side ends in jagged black teeth",
+            failing: Setting::new("raytrace", "terminator_lift = false (from the hit point)", |s| s.terminator_lift = false),
+            cured: Setting::new("raytrace", "terminator_lift = true (default: Hanika 2021)", nothing),
+            truth: Setting::new("raytrace:brute", "raytrace:brute --shadows none (a convex object alone casts no shadow but its own)", |s| s.shadows = ShadowMode::None),
+            threshold: 40,
+        },
+        GalleryCase {
+            name: "self-intersection",
+            scene: "bunny",
+            method: "shadow rays",
+            knob: "bump",
+            explanation: "a shadow ray leaving exactly from a rounded hit point finds the surface it leaves about half the time: speckled self-shadowing (CGPP's rayBumpEpsilon cures it)",
+            failing: Setting::new("raytrace", "--bump 0", |s| {
+                s.width = 160;
+                s.height = 100;
+                s.shadow_bump = 0.0;
+            }),
+            cured: Setting::new("raytrace", "--bump 1e-4 (default)", |s| {
+                s.width = 160;
+                s.height = 100;
+            }),
+            truth: Setting::new("raytrace", "raytrace --bump 1e-3", |s| {
+                s.width = 160;
+                s.height = 100;
+                s.shadow_bump = 1e-3;
+            }),
+            threshold: 40,
+        },
+        GalleryCase {
+            name: "specular-aliasing",
+            scene: "stress-specular",
+            method: "sampling",
+            knob: "spp",
+            explanation: "each bump's highlight is smaller than a pixel: one sample per pixel hits it or misses it, and the field sparkles instead of glowing",
+            failing: Setting::new("rasterize", "--spp 1", nothing),
+            cured: Setting::new("rasterize", "--spp 64", |s| s.spp = 64),
+            truth: Setting::new("raytrace", "raytrace --spp 1024", |s| s.spp = 1024),
+            threshold: 400,
+        },
+        GalleryCase {
+            name: "near-plane",
+            scene: "stress-near",
+            method: "rasterize",
+            knob: "near_clip",
+            explanation: "the floor and the wall pass beside and behind the eye: without a clipper their triangles must be dropped whole, and they vanish",
+            failing: Setting::new("rasterize", "near_clip = false", |s| s.near_clip = false),
+            cured: Setting::new("rasterize", "near_clip = true (default)", nothing),
+            truth: Setting::new("raytrace:brute", "raytrace:brute", nothing),
+            threshold: 40,
+        },
+        GalleryCase {
+            name: "far-from-origin",
+            scene: "stress-far",
+            method: "ray casting",
+            knob: "camera-relative",
+            explanation: "100,000 units from the origin a float resolves 0.008: hit points land off their surfaces, beyond the 1e-4 bump, and shadow themselves",
+            failing: Setting::new("raytrace", "as placed (at 100000, 100000, 100000)", nothing),
+            cured: Setting {
+                renderer: "raytrace",
+                description: "re-centred at the camera",
+                scene: None,
+                apply: nothing,
+                transform: Some(crate::scene::recentre::recentre_at_camera),
+            },
+            truth: Setting {
+                renderer: "raytrace:brute",
+                description: "raytrace:brute on stress-shadow, the same scene at the origin",
+                scene: Some("stress-shadow"),
+                apply: nothing,
+                transform: None,
+            },
+            threshold: 40,
+        },
     ]
 }
 

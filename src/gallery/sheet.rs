@@ -9,7 +9,9 @@ use plotters::prelude::*;
 const CELL_W: u32 = 400;
 const PAD: u32 = 10;
 /// Height of a row's caption (case, explanation) above its images.
-const CAPTION_H: u32 = 46;
+const CAPTION_H: u32 = 62;
+/// Characters per line of a wrapped explanation.
+const WRAP: usize = 125;
 /// Height of the line under each image (setting, wrong pixels).
 const LABEL_H: u32 = 22;
 const TITLE_H: u32 = 36;
@@ -51,7 +53,9 @@ pub fn draw_png(results: &[(CaseResult, &str)]) -> Result<Vec<u8>, String> {
         for (r, explanation) in results {
             let verdict = if r.demonstrated() { "" } else { "  (NOT DEMONSTRATED)" };
             text(&format!("{}  [{}, knob: {}]{verdict}", r.case, r.method, r.knob), PAD, y + 2, 18, BLACK)?;
-            text(explanation, PAD, y + 23, 14, RGBColor(60, 60, 60))?;
+            for (k, line) in wrap(explanation, WRAP).iter().take(2).enumerate() {
+                text(line, PAD, y + 23 + 17 * k as u32, 14, RGBColor(60, 60, 60))?;
+            }
             let label_y = y + CAPTION_H + r.height * scale_of(r) + 3;
             for (col, s) in [&r.failing, &r.cured].into_iter().enumerate() {
                 let color = if s.wrong_pixels > r.threshold { RGBColor(180, 0, 0) } else { RGBColor(0, 120, 0) };
@@ -75,5 +79,33 @@ fn blit(buf: &mut [u8], buf_w: u32, rgb: &[u8], w: u32, h: u32, s: u32, x0: u32,
             let dst = (((y0 + y) * buf_w + x0 + x) * 3) as usize;
             buf[dst..dst + 3].copy_from_slice(&rgb[src..src + 3]);
         }
+    }
+}
+
+/// `text` broken at spaces into lines of at most `width` characters.
+fn wrap(text: &str, width: usize) -> Vec<String> {
+    let mut lines = vec![String::new()];
+    for word in text.split_whitespace() {
+        let line = lines.last_mut().expect("one line");
+        if !line.is_empty() && line.chars().count() + 1 + word.chars().count() > width {
+            lines.push(word.to_string());
+        } else {
+            if !line.is_empty() {
+                line.push(' ');
+            }
+            line.push_str(word);
+        }
+    }
+    lines
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn explanations_wrap_at_spaces() {
+        assert_eq!(wrap("aa bb cc", 5), vec!["aa bb", "cc"]);
+        assert_eq!(wrap("short", 80), vec!["short"]);
     }
 }

@@ -100,6 +100,26 @@ pub struct RenderSettings {
     /// relative error is above this keep taking samples (up to `spp`).
     #[serde(default)]
     pub adaptive: Option<f32>,
+    /// Rasterizers: cut triangles at the near plane (CGPP 15.6.3). A debug
+    /// knob to show why: false drops every triangle that reaches nearer than
+    /// the near plane whole, as a rasterizer without a clipper has to (its
+    /// vertices behind the eye would project through infinity), so floors
+    /// and walls that pass beside the camera lose their nearest triangles.
+    /// Ray casters and `rasterize:naive` ignore it (they test eye rays,
+    /// which start on the near plane).
+    #[serde(default = "default_true")]
+    pub near_clip: bool,
+    /// `--shadows map`: scale the bias with the slope of the surface to the
+    /// light (see `shadow_map`); false: a constant `shadow_map_bias` texels,
+    /// which at grazing light is too little (acne). A debug knob.
+    #[serde(default = "default_true")]
+    pub shadow_map_slope_bias: bool,
+    /// Shadow rays from smooth-normal triangles facing away from the light
+    /// leave from the surface the normals imply (`shade::shadow_origin`,
+    /// against the shadow terminator); false: from the hit point, as the book
+    /// does, to show the speckles. A debug knob.
+    #[serde(default = "default_true")]
+    pub terminator_lift: bool,
 }
 
 fn default_true() -> bool {
@@ -128,6 +148,9 @@ impl RenderSettings {
             msaa: 1,
             gi: gi::GiSettings::default(),
             adaptive: None,
+            near_clip: true,
+            shadow_map_slope_bias: true,
+            terminator_lift: true,
         }
     }
 }

@@ -12,6 +12,8 @@ const FILES: &[(&str, &[u8])] = &[
     ("models/stanford-bunny.obj", include_bytes!("../../assets/models/stanford-bunny.obj")),
     ("models/suzanne.obj", include_bytes!("../../assets/models/suzanne.obj")),
     ("models/spot.obj", include_bytes!("../../assets/models/spot.obj")),
+    ("models/stress-bumps.obj", include_bytes!("../../assets/models/stress-bumps.obj")),
+    ("models/stress-coarse-sphere.obj", include_bytes!("../../assets/models/stress-coarse-sphere.obj")),
     ("textures/test-pattern.exr", include_bytes!("../../assets/textures/test-pattern.exr")),
 ];
 

@@ -17,6 +17,11 @@ const SCENES: &[(&str, &str)] = &[
     ("cornell-gi", include_str!("../../assets/scenes/cornell-gi.toml")),
     // The stress gallery's scenes (`gallery::cases`), each built to provoke one failure.
     ("stress-shadow", include_str!("../../assets/scenes/stress-shadow.toml")),
+    ("stress-grazing", include_str!("../../assets/scenes/stress-grazing.toml")),
+    ("stress-far", include_str!("../../assets/scenes/stress-far.toml")),
+    ("stress-near", include_str!("../../assets/scenes/stress-near.toml")),
+    ("stress-specular", include_str!("../../assets/scenes/stress-specular.toml")),
+    ("stress-terminator", include_str!("../../assets/scenes/stress-terminator.toml")),
 ];
 
 /// The scene the viewer opens when given none.
