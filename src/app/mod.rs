@@ -5,6 +5,7 @@
 
 use eframe::egui;
 pub mod export;
+pub mod gallery;
 pub mod inspect;
 pub mod legend;
 pub mod overlay;

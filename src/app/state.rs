@@ -64,6 +64,8 @@ pub struct PinholeApp {
     pub bench: Option<super::UiBench>,
     /// Selected pixel and its replay, zoom, overlays (visual debugging).
     pub inspect: super::inspect::Inspect,
+    /// The stress-gallery case on show, whose setting overrides the knobs.
+    pub gallery: Option<super::gallery::GalleryView>,
 }
 
 impl PinholeApp {
@@ -109,6 +111,7 @@ impl PinholeApp {
             persist: false,
             bench: None,
             inspect: Default::default(),
+            gallery: None,
         };
         app.install_scene(scene, scene_arg);
         app
@@ -175,7 +178,11 @@ impl PinholeApp {
     fn apply_loaded(&mut self, (arg, result): (String, Result<Scene, String>)) {
         self.message = None;
         match result {
-            Ok(scene) => self.install_scene(scene, arg),
+            Ok(scene) => {
+                // Another scene (or the file reloaded): the gallery case is over.
+                self.gallery = None;
+                self.install_scene(scene, arg)
+            }
             Err(e) => self.error_bar = Some(e),
         }
     }
@@ -213,10 +220,12 @@ impl PinholeApp {
     }
 
     /// The settings the worker renders with: the scene's, with the user's
-    /// knobs, at the scaled resolution.
+    /// knobs (and a gallery case's over them), at the scaled resolution.
     pub fn effective_settings(&self) -> RenderSettings {
         let (width, height) = self.image_size();
-        self.settings.render_settings(&self.scene, width, height)
+        let mut settings = self.settings.render_settings(&self.scene, width, height);
+        self.apply_gallery(&mut settings);
+        settings
     }
 
     /// The image size: the scene's, times the resolution scale.
@@ -292,7 +301,10 @@ impl PinholeApp {
 
     /// Carries out what the panels asked for this frame, in one place.
     pub fn apply(&mut self, requests: Requests, ctx: &egui::Context) {
-        let Requests { camera_moved, reset_camera, frame_all, open, reload, open_dialog, export, quit } = requests;
+        let Requests { camera_moved, reset_camera, frame_all, open, reload, open_dialog, export, quit, gallery_case } = requests;
+        if let Some(name) = gallery_case {
+            self.open_gallery_case(name, false);
+        }
         self.camera_moving |= camera_moved;
         if reset_camera {
             self.reset_camera();
@@ -438,6 +450,7 @@ impl PinholeApp {
                     });
                 });
         }
+        super::gallery::show(self, ui);
         super::panels::status::show(self, ui);
         if self.settings.panels.side {
             egui::Panel::left("side-panel").default_size(300.0).resizable(true).show(ui, |ui| {

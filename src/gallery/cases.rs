@@ -48,6 +48,10 @@ pub struct GalleryCase {
     pub truth: Setting,
     /// A setting fails when more pixels than this are wrong, and passes otherwise.
     pub threshold: usize,
+    /// The size the gallery renders at, when not the scene's own (a big
+    /// scene measured small, so the gallery stays quick); the viewer keeps
+    /// the scene's size.
+    pub size: Option<(u32, u32)>,
 }
 
 fn map(s: &mut RenderSettings) {
@@ -55,6 +59,12 @@ fn map(s: &mut RenderSettings) {
 }
 
 fn nothing(_: &mut RenderSettings) {}
+
+/// Ray-cast shadows, as the scene defaults have them (spelled out for the
+/// viewer, where the user's own shadow mode would otherwise stay).
+fn rays(s: &mut RenderSettings) {
+    s.shadows = ShadowMode::Ray;
+}
 
 /// The truth of shadow-map cases: the same image with ray-cast shadows.
 const RAY_CAST_SHADOWS: Setting = Setting::new("raytrace:brute", "raytrace:brute, ray-cast shadows", nothing);
@@ -75,6 +85,7 @@ pub fn cases() -> Vec<GalleryCase> {
             cured: Setting::new("rasterize", "--shadows map --shadow-bias 1 (default)", map),
             truth: RAY_CAST_SHADOWS,
             threshold: 40,
+            size: None,
         },
         GalleryCase {
             name: "peter-panning",
@@ -89,6 +100,7 @@ pub fn cases() -> Vec<GalleryCase> {
             cured: Setting::new("rasterize", "--shadows map --shadow-bias 1 (default)", map),
             truth: RAY_CAST_SHADOWS,
             threshold: 40,
+            size: None,
         },
         GalleryCase {
             name: "grazing-light",
@@ -103,6 +115,7 @@ pub fn cases() -> Vec<GalleryCase> {
             cured: Setting::new("rasterize", "--shadows map, slope-scaled bias 1 (default)", map),
             truth: RAY_CAST_SHADOWS,
             threshold: 40,
+            size: None,
         },
         GalleryCase {
             name: "shadow-terminator",
@@ -110,10 +123,14 @@ pub fn cases() -> Vec<GalleryCase> {
             method: "shadow rays",
             knob: "terminator_lift",
             explanation: "smooth normals face the light where the coarse facets do not: shadow rays leaving those facets hit the neighbouring ones, and the lit side ends in jagged black teeth",
-            failing: Setting::new("raytrace", "terminator_lift = false (from the hit point)", |s| s.terminator_lift = false),
-            cured: Setting::new("raytrace", "terminator_lift = true (default: Hanika 2021)", nothing),
+            failing: Setting::new("raytrace", "terminator_lift = false (from the hit point)", |s| {
+                rays(s);
+                s.terminator_lift = false;
+            }),
+            cured: Setting::new("raytrace", "terminator_lift = true (default: Hanika 2021)", rays),
             truth: Setting::new("raytrace:brute", "raytrace:brute --shadows none (a convex object alone casts no shadow but its own)", |s| s.shadows = ShadowMode::None),
             threshold: 40,
+            size: None,
         },
         GalleryCase {
             name: "self-intersection",
@@ -122,20 +139,16 @@ pub fn cases() -> Vec<GalleryCase> {
             knob: "bump",
             explanation: "a shadow ray leaving exactly from a rounded hit point finds the surface it leaves about half the time: speckled self-shadowing (CGPP's rayBumpEpsilon cures it)",
             failing: Setting::new("raytrace", "--bump 0", |s| {
-                s.width = 160;
-                s.height = 100;
+                rays(s);
                 s.shadow_bump = 0.0;
             }),
             cured: Setting::new("raytrace", "--bump 1e-4 (default)", |s| {
-                s.width = 160;
-                s.height = 100;
+                rays(s);
+                s.shadow_bump = 1e-4;
             }),
-            truth: Setting::new("raytrace", "raytrace --bump 1e-3", |s| {
-                s.width = 160;
-                s.height = 100;
-                s.shadow_bump = 1e-3;
-            }),
+            truth: Setting::new("raytrace", "raytrace --bump 1e-3", |s| s.shadow_bump = 1e-3),
             threshold: 40,
+            size: Some((160, 100)),
         },
         GalleryCase {
             name: "specular-aliasing",
@@ -143,10 +156,11 @@ pub fn cases() -> Vec<GalleryCase> {
             method: "sampling",
             knob: "spp",
             explanation: "each bump's highlight is smaller than a pixel: one sample per pixel hits it or misses it, and the field sparkles instead of glowing",
-            failing: Setting::new("rasterize", "--spp 1", nothing),
+            failing: Setting::new("rasterize", "--spp 1", |s| s.spp = 1),
             cured: Setting::new("rasterize", "--spp 64", |s| s.spp = 64),
             truth: Setting::new("raytrace", "raytrace --spp 1024", |s| s.spp = 1024),
             threshold: 400,
+            size: None,
         },
         GalleryCase {
             name: "near-plane",
@@ -158,6 +172,7 @@ pub fn cases() -> Vec<GalleryCase> {
             cured: Setting::new("rasterize", "near_clip = true (default)", nothing),
             truth: Setting::new("raytrace:brute", "raytrace:brute", nothing),
             threshold: 40,
+            size: None,
         },
         GalleryCase {
             name: "far-from-origin",
@@ -165,12 +180,12 @@ pub fn cases() -> Vec<GalleryCase> {
             method: "ray casting",
             knob: "camera-relative",
             explanation: "100,000 units from the origin a float resolves 0.008: hit points land off their surfaces, beyond the 1e-4 bump, and shadow themselves",
-            failing: Setting::new("raytrace", "as placed (at 100000, 100000, 100000)", nothing),
+            failing: Setting::new("raytrace", "as placed (at 100000, 100000, 100000)", rays),
             cured: Setting {
                 renderer: "raytrace",
                 description: "re-centred at the camera",
                 scene: None,
-                apply: nothing,
+                apply: rays,
                 transform: Some(crate::scene::recentre::recentre_at_camera),
             },
             truth: Setting {
@@ -181,6 +196,7 @@ pub fn cases() -> Vec<GalleryCase> {
                 transform: None,
             },
             threshold: 40,
+            size: None,
         },
     ]
 }

@@ -34,17 +34,21 @@ fn pixel_wrong(a: Radiance, b: Radiance) -> bool {
 }
 
 /// Renders `setting` of `case`: loads the scene (the case's or the
-/// setting's own), transforms it, applies the knobs. Returns the image and
-/// its size.
+/// setting's own), transforms it, applies the knobs, at the case's size.
+/// Returns the image and its size.
 pub fn render_setting(case: &GalleryCase, setting: &Setting) -> Result<(Vec<Radiance>, u32, u32), String> {
-    let (scene, settings) = scene_and_settings(case, setting)?;
+    let (scene, mut settings) = scene_and_settings(case, setting)?;
+    if let Some((w, h)) = case.size {
+        (settings.width, settings.height) = (w, h);
+    }
     let renderer = render::renderer_by_name(setting.renderer)?;
     let prepared = PreparedScene::new(scene);
     let frame = render::render_frame(renderer.as_ref(), &prepared, &settings, &AtomicBool::new(false), None).ok_or("the render was cancelled")?;
     Ok((frame.pixels, settings.width, settings.height))
 }
 
-/// The scene and settings `setting` of `case` renders (the viewer opens the same).
+/// The scene and settings `setting` of `case` renders at the scene's size
+/// (the viewer opens the same).
 pub fn scene_and_settings(case: &GalleryCase, setting: &Setting) -> Result<(crate::scene::Scene, RenderSettings), String> {
     let name = setting.scene.unwrap_or(case.scene);
     let mut scene = crate::scene::builtin::load_builtin(name).ok_or_else(|| format!("gallery case {}: no built-in scene \"{name}\"", case.name))??;

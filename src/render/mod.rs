@@ -444,6 +444,19 @@ mod tests {
     }
 
     #[test]
+    fn settings_saved_before_the_debug_knobs_load_with_them_on() {
+        let scene = crate::scene::builtin::load_builtin("one-triangle").unwrap().unwrap();
+        let settings = RenderSettings::for_scene(&scene);
+        let mut old = serde_json::to_value(&settings).unwrap();
+        for key in ["near_clip", "shadow_map_slope_bias", "terminator_lift"] {
+            assert_eq!(old[key], true, "{key} is on by default");
+            old.as_object_mut().unwrap().remove(key);
+        }
+        let loaded: RenderSettings = serde_json::from_value(old).unwrap();
+        assert_eq!(loaded, settings);
+    }
+
+    #[test]
     fn every_name_resolves() {
         for n in renderer_names() {
             assert_eq!(renderer_by_name(n).unwrap().name(), n);

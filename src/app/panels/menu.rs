@@ -1,5 +1,5 @@
 //! The top bar: File (open, built-in scenes, reload, export), View (panels,
-//! debug view), the renderer and debug-view combo boxes, zoom and the
+//! debug view), Gallery (the stress cases: a failure and its cure), the renderer and debug-view combo boxes, zoom and the
 //! vertex overlay.
 
 use eframe::egui;
@@ -46,6 +46,14 @@ pub fn show(ui: &mut egui::Ui, settings: &mut ViewerSettings, renderer_names: &[
                 ui.separator();
                 for v in View::ALL {
                     ui.radio_value(&mut settings.view, v, v.name());
+                }
+            });
+            ui.menu_button("Gallery", |ui| {
+                for case in crate::gallery::cases() {
+                    if ui.button(case.name).on_hover_text(case.explanation).clicked() {
+                        requests.gallery_case = Some(case.name);
+                        ui.close();
+                    }
                 }
             });
             ui.separator();

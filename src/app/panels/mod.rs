@@ -29,6 +29,8 @@ pub struct Requests {
     pub open_dialog: bool,
     pub export: bool,
     pub quit: bool,
+    /// Open this stress-gallery case with its failing setting.
+    pub gallery_case: Option<&'static str>,
 }
 
 impl std::ops::BitOrAssign for Requests {
@@ -41,6 +43,7 @@ impl std::ops::BitOrAssign for Requests {
         self.open_dialog |= o.open_dialog;
         self.export |= o.export;
         self.quit |= o.quit;
+        self.gallery_case = o.gallery_case.or(self.gallery_case.take());
     }
 }
 
