@@ -23,7 +23,8 @@ pub fn wrong_pixels(image: &[Radiance], truth: &[Radiance], width: u32, height: 
     image.iter().zip(truth).filter(|(a, b)| pixel_wrong(**a, **b)).count()
 }
 
-fn pixel_wrong(a: Radiance, b: Radiance) -> bool {
+/// Whether `a` is wrong against the truth `b` (the rule above).
+pub fn pixel_wrong(a: Radiance, b: Radiance) -> bool {
     if !(a.is_finite() && b.is_finite()) {
         return true;
     }
@@ -74,9 +75,15 @@ pub struct SettingResult {
 pub struct CaseResult {
     pub case: String,
     pub method: String,
+    /// How the truth was made (the sheet shows it; not in the JSON).
+    #[serde(skip)]
+    pub truth_setting: String,
     pub knob: String,
     pub failing: SettingResult,
     pub cured: SettingResult,
+    /// The truth image, for the sheet's map of wrong pixels.
+    #[serde(skip)]
+    pub truth: Vec<Radiance>,
     #[serde(skip)]
     pub width: u32,
     #[serde(skip)]
@@ -111,10 +118,12 @@ pub fn measure_case(case: &GalleryCase) -> Result<CaseResult, String> {
     let exposure = crate::scene::builtin::load_builtin(case.scene).and_then(Result::ok).map_or(1.0, |s| s.render.exposure);
     Ok(CaseResult {
         case: case.name.to_string(),
+        truth_setting: case.truth.description.to_string(),
         method: case.method.to_string(),
         knob: case.knob.to_string(),
         failing,
         cured,
+        truth,
         width: w,
         height: h,
         threshold: case.threshold,
