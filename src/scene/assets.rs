@@ -14,6 +14,8 @@ const FILES: &[(&str, &[u8])] = &[
     ("models/spot.obj", include_bytes!("../../assets/models/spot.obj")),
     ("models/stress-bumps.obj", include_bytes!("../../assets/models/stress-bumps.obj")),
     ("models/stress-coarse-sphere.obj", include_bytes!("../../assets/models/stress-coarse-sphere.obj")),
+    ("models/stress-tjunction.obj", include_bytes!("../../assets/models/stress-tjunction.obj")),
+    ("models/stress-tjunction-shared.obj", include_bytes!("../../assets/models/stress-tjunction-shared.obj")),
     ("textures/test-pattern.exr", include_bytes!("../../assets/textures/test-pattern.exr")),
 ];
 
