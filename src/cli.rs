@@ -1,4 +1,4 @@
-//! The command line: `render`, `bench`, `compare`, `pixel`, `chart`, `list`;
+//! The command line: `render`, `bench`, `compare`, `pixel`, `chart`, `gallery`, `list`;
 //! without a subcommand it asks `main` to open the viewer. Errors are returned
 //! as one sentence; `main` prints them and exits non-zero.
 
@@ -93,6 +93,18 @@ enum Command {
         reference_spp: u32,
         #[command(flatten)]
         opts: RenderOpts,
+    },
+    /// The stress gallery: every case's failing and cured images against its
+    /// truth, as DIR/gallery.png (contact sheet) and DIR/gallery.json.
+    Gallery {
+        #[arg(short = 'o', long = "output", value_name = "DIR")]
+        output: PathBuf,
+        /// Run only this case (see the names in gallery.json or an error listing them).
+        #[arg(long, value_name = "NAME")]
+        case: Option<String>,
+        /// Worker threads (default: all cores).
+        #[arg(long)]
+        threads: Option<usize>,
     },
     /// List renderers, views and built-in scenes.
     List,
@@ -218,6 +230,7 @@ pub fn run() -> Result<Outcome, String> {
             "spp" => cmd_chart(&scene, &output, &renderers, &spp_list, reference.as_deref(), reference_spp, &opts),
             other => Err(format!("--sweep: \"{other}\" is not one of methods, spp")),
         }
+        Some(Command::Gallery { output, case, threads }) => cmd_gallery(&output, case.as_deref(), threads),
         Some(Command::List) => cmd_list(),
     };
     ran.map(|()| Outcome::Done)
@@ -610,6 +623,50 @@ fn cmd_compare(a: &Path, b: &Path, as_json: bool) -> Result<(), String> {
     }
 }
 
+fn cmd_gallery(dir: &Path, only: Option<&str>, threads: Option<usize>) -> Result<(), String> {
+    use crate::gallery;
+    let cases = match only {
+        Some(name) => vec![gallery::case_by_name(name)?],
+        None => gallery::cases(),
+    };
+    if threads == Some(0) {
+        return Err("--threads must be at least 1".into());
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build()
+        .map_err(|e| format!("cannot start worker threads: {e}"))?;
+    if dir.exists() && !dir.is_dir() {
+        return Err(format!("{}: exists and is not a directory", dir.display()));
+    }
+    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create the directory {}: {e}", dir.display()))?;
+    let start = Instant::now();
+    let mut results = Vec::new();
+    for (i, case) in cases.iter().enumerate() {
+        eprintln!("[{}/{}] {}: {} ...", i + 1, cases.len(), case.name, case.method);
+        let t = Instant::now();
+        let r = pool.install(|| gallery::measure_case(case))?;
+        eprintln!(
+            "    failing {}: {} wrong px; cured {}: {} wrong px (threshold {}){} in {:.1} s",
+            r.failing.setting,
+            r.failing.wrong_pixels,
+            r.cured.setting,
+            r.cured.wrong_pixels,
+            r.threshold,
+            if r.demonstrated() { "" } else { " NOT DEMONSTRATED" },
+            t.elapsed().as_secs_f64()
+        );
+        results.push((r, case.explanation));
+    }
+    let png = gallery::sheet::draw_png(&results)?;
+    let json = serde_json::to_value(results.iter().map(|(r, _)| r).collect::<Vec<_>>()).map_err(|e| e.to_string())?;
+    let text = serde_json::to_string_pretty(&json).map_err(|e| e.to_string())? + "\n";
+    crate::image_io::write_atomic(&dir.join("gallery.png"), &png)?;
+    crate::image_io::write_atomic(&dir.join("gallery.json"), text.as_bytes())?;
+    eprintln!("wrote {} and {} in {:.1} s", dir.join("gallery.png").display(), dir.join("gallery.json").display(), start.elapsed().as_secs_f64());
+    Ok(())
+}
+
 fn cmd_list() -> Result<(), String> {
     let mut t = String::new();
     let _ = writeln!(t, "renderers:");
@@ -633,6 +690,10 @@ fn cmd_list() -> Result<(), String> {
     let _ = writeln!(t, "line algorithms (--view wireframe: --lines):\n  float\n  integer");
     let _ = writeln!(t, "built-in scenes:");
     for s in crate::scene::builtin::names() {
+        let _ = writeln!(t, "  {s}");
+    }
+    let _ = writeln!(t, "stress scenes (pinhole gallery: each provokes one failure):");
+    for s in crate::scene::builtin::stress_names() {
         let _ = writeln!(t, "  {s}");
     }
     print_stdout(&t)

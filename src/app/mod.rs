@@ -6,6 +6,7 @@
 use eframe::egui;
 pub mod compare_lab;
 pub mod export;
+pub mod gallery;
 pub mod inspect;
 pub mod legend;
 pub mod overlay;

@@ -68,6 +68,8 @@ pub struct PinholeApp {
     pub compare: super::compare_lab::CompareLab,
     /// A second configuration shown beside the live one (A|B).
     pub split: super::split_view::SplitView,
+    /// The stress-gallery case on show, whose setting overrides the knobs.
+    pub gallery: Option<super::gallery::GalleryView>,
 }
 
 impl PinholeApp {
@@ -115,6 +117,7 @@ impl PinholeApp {
             inspect: Default::default(),
             compare: Default::default(),
             split: Default::default(),
+            gallery: None,
         };
         app.install_scene(scene, scene_arg);
         app
@@ -182,7 +185,11 @@ impl PinholeApp {
     fn apply_loaded(&mut self, (arg, result): (String, Result<Scene, String>)) {
         self.message = None;
         match result {
-            Ok(scene) => self.install_scene(scene, arg),
+            Ok(scene) => {
+                // Another scene (or the file reloaded): the gallery case is over.
+                self.gallery = None;
+                self.install_scene(scene, arg)
+            }
             Err(e) => self.error_bar = Some(e),
         }
     }
@@ -220,10 +227,12 @@ impl PinholeApp {
     }
 
     /// The settings the worker renders with: the scene's, with the user's
-    /// knobs, at the scaled resolution.
+    /// knobs (and a gallery case's over them), at the scaled resolution.
     pub fn effective_settings(&self) -> RenderSettings {
         let (width, height) = self.image_size();
-        self.settings.render_settings(&self.scene, width, height)
+        let mut settings = self.settings.render_settings(&self.scene, width, height);
+        self.apply_gallery(&mut settings);
+        settings
     }
 
     /// The image size: the scene's, times the resolution scale.
@@ -313,7 +322,10 @@ impl PinholeApp {
 
     /// Carries out what the panels asked for this frame, in one place.
     pub fn apply(&mut self, requests: Requests, ctx: &egui::Context) {
-        let Requests { camera_moved, reset_camera, frame_all, open, reload, open_dialog, export, toggle_compare, quit } = requests;
+        let Requests { camera_moved, reset_camera, frame_all, open, reload, open_dialog, export, toggle_compare, quit, gallery_case } = requests;
+        if let Some(name) = gallery_case {
+            self.open_gallery_case(name, false);
+        }
         self.camera_moving |= camera_moved;
         if toggle_compare {
             self.compare.open = !self.compare.open;
@@ -547,6 +559,7 @@ impl PinholeApp {
                     });
                 });
         }
+        super::gallery::show(self, ui);
         super::panels::status::show(self, ui);
         if self.settings.panels.side {
             egui::Panel::left("side-panel").default_size(300.0).resizable(true).show(ui, |ui| {

@@ -115,6 +115,26 @@ pub struct RenderSettings {
     /// The wireframe view: the line algorithm (float DDA or integer Bresenham).
     #[serde(default)]
     pub lines: wireframe::LineAlgorithm,
+    /// Rasterizers: cut triangles at the near plane (CGPP 15.6.3). A debug
+    /// knob to show why: false drops every triangle that reaches nearer than
+    /// the near plane whole, as a rasterizer without a clipper has to (its
+    /// vertices behind the eye would project through infinity), so floors
+    /// and walls that pass beside the camera lose their nearest triangles.
+    /// Ray casters and `rasterize:naive` ignore it (they test eye rays,
+    /// which start on the near plane).
+    #[serde(default = "default_true")]
+    pub near_clip: bool,
+    /// `--shadows map`: scale the bias with the slope of the surface to the
+    /// light (see `shadow_map`); false: a constant `shadow_map_bias` texels,
+    /// which at grazing light is too little (acne). A debug knob.
+    #[serde(default = "default_true")]
+    pub shadow_map_slope_bias: bool,
+    /// Shadow rays from smooth-normal triangles facing away from the light
+    /// leave from the surface the normals imply (`shade::shadow_origin`,
+    /// against the shadow terminator); false: from the hit point, as the book
+    /// does, to show the speckles. A debug knob.
+    #[serde(default = "default_true")]
+    pub terminator_lift: bool,
 }
 
 fn default_true() -> bool {
@@ -146,6 +166,9 @@ impl RenderSettings {
             adaptive: None,
             depth_buffer: raster::depth_format::DepthFormat::F32,
             lines: wireframe::LineAlgorithm::Float,
+            near_clip: true,
+            shadow_map_slope_bias: true,
+            terminator_lift: true,
         }
     }
 }
@@ -465,6 +488,19 @@ mod tests {
             let mean = pts.iter().copied().sum::<Vec2>() / spp as f32;
             assert!((mean - Vec2::splat(0.5)).length() < 0.5 / spp as f32 + 1e-6, "spp {spp}: {mean}");
         }
+    }
+
+    #[test]
+    fn settings_saved_before_the_debug_knobs_load_with_them_on() {
+        let scene = crate::scene::builtin::load_builtin("one-triangle").unwrap().unwrap();
+        let settings = RenderSettings::for_scene(&scene);
+        let mut old = serde_json::to_value(&settings).unwrap();
+        for key in ["near_clip", "shadow_map_slope_bias", "terminator_lift"] {
+            assert_eq!(old[key], true, "{key} is on by default");
+            old.as_object_mut().unwrap().remove(key);
+        }
+        let loaded: RenderSettings = serde_json::from_value(old).unwrap();
+        assert_eq!(loaded, settings);
     }
 
     #[test]

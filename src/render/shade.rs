@@ -79,7 +79,7 @@ pub fn shade<Q: SceneQuery, R: Recorder>(
         // count); every other surface falls back to a shadow ray.
         let volume_count = if settings.shadows == ShadowMode::Volume && depth == 0 { query.volume_count(index) } else { None };
         if volume_count.is_none() && matches!(settings.shadows, ShadowMode::Ray | ShadowMode::Volume) {
-            let (ray, t_max) = incidence.shadow_ray(scene, hit, settings.shadow_bump);
+            let (ray, t_max) = incidence.shadow_ray(scene, hit, settings.shadow_bump, settings.terminator_lift);
             sh.counts.shadow += 1;
             sh.rec.in_shadow_ray(true);
             sh.rec.ray(&ray, t_max, depth + 1);
@@ -90,7 +90,7 @@ pub fn shade<Q: SceneQuery, R: Recorder>(
             // CGPP 15.6.5: no ray; the light's depth map says whether something
             // nearer to the light covers P (blocker t = how far before P it lies).
             if let Some(maps) = query.shadow_maps() {
-                blocker = maps.occluder(scene, index, hit, w_i, settings.shadow_map_bias);
+                blocker = maps.occluder(scene, index, hit, w_i, settings.shadow_map_bias, settings.shadow_map_slope_bias, settings.terminator_lift);
             }
         }
         let f = bsdf(material, albedo, n, w_i, w_o);
@@ -296,9 +296,10 @@ impl Incidence {
     /// The shadow ray from `hit` towards the light, and its far end. It
     /// leaves from `shadow_origin` and starts `bump` along the ray so it does
     /// not hit P again (CGPP listing 15.20); it ends `bump` short of the light.
+    /// `lift`: `RenderSettings::terminator_lift`.
     #[inline]
-    pub fn shadow_ray(&self, scene: &Scene, hit: &SurfaceHit, bump: f32) -> (Ray, f32) {
-        let leaving = SurfaceHit { position: shadow_origin(scene, hit, self.w_i), ..*hit };
+    pub fn shadow_ray(&self, scene: &Scene, hit: &SurfaceHit, bump: f32, lift: bool) -> (Ray, f32) {
+        let leaving = SurfaceHit { position: shadow_origin(scene, hit, self.w_i, lift), ..*hit };
         (leaving.spawn_ray_along(self.w_i, bump), self.distance - bump)
     }
 }
@@ -308,9 +309,9 @@ impl Incidence {
 /// light (`Incidence::of`, `illuminates`, `shadow_ray`), for the BVH's
 /// packets, which trace these rays ahead of `shade()`.
 #[inline]
-pub fn cast_shadow_ray(scene: &Scene, hit: &SurfaceHit, light: &Light, bump: f32) -> Option<(Ray, f32)> {
+pub fn cast_shadow_ray(scene: &Scene, hit: &SurfaceHit, light: &Light, bump: f32, lift: bool) -> Option<(Ray, f32)> {
     let incidence = Incidence::of(light, hit.position, hit.shading_normal)?;
-    incidence.illuminates().then(|| incidence.shadow_ray(scene, hit, bump))
+    incidence.illuminates().then(|| incidence.shadow_ray(scene, hit, bump, lift))
 }
 
 /// Where a shadow ray towards `w_i` leaves a surface point. Normally the hit
@@ -322,8 +323,10 @@ pub fn cast_shadow_ray(scene: &Scene, hit: &SurfaceHit, light: &Light, bump: f32
 /// Ray Tracing Gems II, ch. 4), the origin is lifted onto the curved surface
 /// the vertex normals imply. Only there: elsewhere the lift would move the
 /// origin of a coarse, strongly bent triangle (the book's) far off its surface.
-pub fn shadow_origin(scene: &Scene, hit: &SurfaceHit, w_i: Vec3) -> Vec3 {
-    if hit.kind != crate::scene::PrimitiveKind::Triangle || hit.geometric_normal.dot(w_i) > 0.0 {
+/// Without `lift` (`RenderSettings::terminator_lift` off) always the hit point,
+/// to show the speckles it prevents.
+pub fn shadow_origin(scene: &Scene, hit: &SurfaceHit, w_i: Vec3, lift: bool) -> Vec3 {
+    if !lift || hit.kind != crate::scene::PrimitiveKind::Triangle || hit.geometric_normal.dot(w_i) > 0.0 {
         return hit.position;
     }
     lifted_position(scene, hit)
@@ -452,8 +455,9 @@ mod tests {
         let at_vertex = SurfaceHit { position: v[1], barycentric: Vec3::new(0.0, 1.0, 0.0), ..hit };
         assert!((lifted_position(&scene, &at_vertex) - v[1]).length() < 1e-6);
         // Only towards a light behind the facet: otherwise the book's plain bump.
-        assert_eq!(shadow_origin(&scene, &hit, Vec3::Z), p);
-        assert_eq!(shadow_origin(&scene, &hit, Vec3::new(0.0, 0.6, -0.8)), lifted);
+        assert_eq!(shadow_origin(&scene, &hit, Vec3::Z, true), p);
+        assert_eq!(shadow_origin(&scene, &hit, Vec3::new(0.0, 0.6, -0.8), true), lifted);
+        assert_eq!(shadow_origin(&scene, &hit, Vec3::new(0.0, 0.6, -0.8), false), p, "no lift when it is turned off");
         scene.triangles[0].n = [Vec3::Z; 3];
         assert!((lifted_position(&scene, &hit) - p).length() < 1e-7);
     }

@@ -167,11 +167,14 @@ impl ShadowMaps {
     /// The map's verdict for light `light` at `hit`: the primitive stored in
     /// the texel and how far before the point it lies (as a shadow ray's
     /// blocker, t being the distance from the point), or `None` when lit.
-    /// `bias` is in texels, slope-scaled (module documentation).
-    pub fn occluder(&self, scene: &Scene, light: usize, hit: &SurfaceHit, w_i: Vec3, bias: f32) -> Option<Occluder> {
+    /// `bias` is in texels, slope-scaled (module documentation) unless
+    /// `slope_scaled` is off (`RenderSettings::shadow_map_slope_bias`); `lift`
+    /// is `RenderSettings::terminator_lift`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn occluder(&self, scene: &Scene, light: usize, hit: &SurfaceHit, w_i: Vec3, bias: f32, slope_scaled: bool, lift: bool) -> Option<Occluder> {
         let map = self.maps.get(light).filter(|m| !m.faces.is_empty())?;
         // The same point a shadow ray would leave from (lifted on smooth triangles).
-        let p = super::shade::shadow_origin(scene, hit, w_i);
+        let p = super::shade::shadow_origin(scene, hit, w_i, lift);
         let n = self.size as f32;
         let (face, dist, texel_w) = match scene.lights[light] {
             Light::Point { position, .. } => {
@@ -191,7 +194,7 @@ impl ShadowMaps {
             return None;
         }
         let cos = hit.geometric_normal.dot(w_i).abs().clamp(1e-6, 1.0);
-        let tan = ((1.0 - cos * cos).max(0.0).sqrt() / cos).min(MAX_SLOPE);
+        let tan = if slope_scaled { ((1.0 - cos * cos).max(0.0).sqrt() / cos).min(MAX_SLOPE) } else { 0.0 };
         let gap = dist - face.depth[i];
         if gap > bias * texel_w * (1.0 + tan) {
             Some(Occluder::new(id, gap))
@@ -693,7 +696,7 @@ mod tests {
             position: Vec3::NEG_Y, geometric_normal: Vec3::Y, shading_normal: Vec3::Y, barycentric: Vec3::ZERO, uv: Vec2::ZERO, t: 1.0,
             kind: crate::scene::PrimitiveKind::Sphere, primitive: 0, object: 0, material: 0, back_face: false,
         };
-        assert_eq!(maps.occluder(&scene, 0, &hit, Vec3::Y, 1.0), None);
+        assert_eq!(maps.occluder(&scene, 0, &hit, Vec3::Y, 1.0, true, true), None);
         assert!(maps.view_color(Vec2::new(1.0, 1.0), 10, 10).is_finite());
     }
 }

@@ -12,6 +12,10 @@ const FILES: &[(&str, &[u8])] = &[
     ("models/stanford-bunny.obj", include_bytes!("../../assets/models/stanford-bunny.obj")),
     ("models/suzanne.obj", include_bytes!("../../assets/models/suzanne.obj")),
     ("models/spot.obj", include_bytes!("../../assets/models/spot.obj")),
+    ("models/stress-bumps.obj", include_bytes!("../../assets/models/stress-bumps.obj")),
+    ("models/stress-coarse-sphere.obj", include_bytes!("../../assets/models/stress-coarse-sphere.obj")),
+    ("models/stress-tjunction.obj", include_bytes!("../../assets/models/stress-tjunction.obj")),
+    ("models/stress-tjunction-shared.obj", include_bytes!("../../assets/models/stress-tjunction-shared.obj")),
     ("textures/test-pattern.exr", include_bytes!("../../assets/textures/test-pattern.exr")),
 ];
 

@@ -15,9 +15,24 @@ const SCENES: &[(&str, &str)] = &[
     ("bunny", include_str!("../../assets/scenes/bunny.toml")),
     ("test-pattern", include_str!("../../assets/scenes/test-pattern.toml")),
     ("cornell-gi", include_str!("../../assets/scenes/cornell-gi.toml")),
+];
+
+/// The stress gallery's scenes (`gallery::cases`), each built to provoke
+/// one failure. Loadable by name like the others, but listed apart: they are
+/// meant to break renderers, so what holds on every built-in scene (the
+/// renderers' agreement) does not hold on them.
+const STRESS_SCENES: &[(&str, &str)] = &[
     ("stress-painter", include_str!("../../assets/scenes/stress-painter.toml")),
     ("stress-zfight", include_str!("../../assets/scenes/stress-zfight.toml")),
     ("stress-zpass", include_str!("../../assets/scenes/stress-zpass.toml")),
+    ("stress-shadow", include_str!("../../assets/scenes/stress-shadow.toml")),
+    ("stress-grazing", include_str!("../../assets/scenes/stress-grazing.toml")),
+    ("stress-far", include_str!("../../assets/scenes/stress-far.toml")),
+    ("stress-near", include_str!("../../assets/scenes/stress-near.toml")),
+    ("stress-tjunction", include_str!("../../assets/scenes/stress-tjunction.toml")),
+    ("stress-tjunction-shared", include_str!("../../assets/scenes/stress-tjunction-shared.toml")),
+    ("stress-specular", include_str!("../../assets/scenes/stress-specular.toml")),
+    ("stress-terminator", include_str!("../../assets/scenes/stress-terminator.toml")),
 ];
 
 /// The scene the viewer opens when given none.
@@ -27,9 +42,14 @@ pub fn names() -> Vec<&'static str> {
     SCENES.iter().map(|(n, _)| *n).collect()
 }
 
-/// The TOML source of a built-in scene.
+/// The stress gallery's scenes, by name.
+pub fn stress_names() -> Vec<&'static str> {
+    STRESS_SCENES.iter().map(|(n, _)| *n).collect()
+}
+
+/// The TOML source of a built-in scene (stress scenes included).
 pub fn source(name: &str) -> Option<&'static str> {
-    SCENES.iter().find(|(n, _)| *n == name).map(|(_, s)| *s)
+    SCENES.iter().chain(STRESS_SCENES).find(|(n, _)| *n == name).map(|(_, s)| *s)
 }
 
 /// Parses a built-in scene; `None` when there is no such name.
@@ -46,6 +66,16 @@ mod tests {
     #[test]
     fn every_builtin_scene_loads() {
         for name in names() {
+            let scene = load_builtin(name).unwrap().unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert!(scene.triangles.len() + scene.spheres.len() > 0, "{name} is empty");
+            assert!(!scene.lights.is_empty(), "{name} has no light");
+        }
+    }
+
+    #[test]
+    fn every_stress_scene_loads_and_is_listed_apart() {
+        for name in stress_names() {
+            assert!(!names().contains(&name), "{name} is listed with the ordinary scenes");
             let scene = load_builtin(name).unwrap().unwrap_or_else(|e| panic!("{name}: {e}"));
             assert!(scene.triangles.len() + scene.spheres.len() > 0, "{name} is empty");
             assert!(!scene.lights.is_empty(), "{name} has no light");

@@ -9,6 +9,7 @@ pub mod file;
 pub mod load;
 pub mod material;
 pub mod obj;
+pub mod recentre;
 pub mod texture;
 
 pub use camera::{Camera, CameraView, Fov};

@@ -1,5 +1,5 @@
 //! The top bar: File (open, built-in scenes, reload, export), View (panels,
-//! debug view), the Compare window, the renderer and debug-view combo boxes, zoom and the
+//! debug view), the Compare window, Gallery (the stress cases: a failure and its cure), the renderer and debug-view combo boxes, zoom and the
 //! vertex overlay.
 
 use eframe::egui;
@@ -51,6 +51,14 @@ pub fn show(ui: &mut egui::Ui, settings: &mut ViewerSettings, renderer_names: &[
             if ui.button("Compare").on_hover_text("C: error against time of every method, against a reference").clicked() {
                 requests.toggle_compare = true;
             }
+            ui.menu_button("Gallery", |ui| {
+                for case in crate::gallery::cases() {
+                    if ui.button(case.name).on_hover_text(case.explanation).clicked() {
+                        requests.gallery_case = Some(case.name);
+                        ui.close();
+                    }
+                }
+            });
             ui.separator();
             renderer_combo(ui, &mut settings.renderer, renderer_names);
             view_combo(ui, &mut settings.view);

@@ -33,6 +33,8 @@ pub struct Requests {
     /// Open or close the Compare window.
     pub toggle_compare: bool,
     pub quit: bool,
+    /// Open this stress-gallery case with its failing setting.
+    pub gallery_case: Option<&'static str>,
 }
 
 impl std::ops::BitOrAssign for Requests {
@@ -46,6 +48,7 @@ impl std::ops::BitOrAssign for Requests {
         self.export |= o.export;
         self.toggle_compare |= o.toggle_compare;
         self.quit |= o.quit;
+        self.gallery_case = o.gallery_case.or(self.gallery_case.take());
     }
 }
 

@@ -132,12 +132,17 @@ pub fn is_back_face(view: &CameraView, t: &Triangle) -> bool {
 }
 
 /// Culls, clips and projects one scene triangle, appending 0, 1 or 2 pieces.
-pub fn setup_triangle(view: &CameraView, t: &Triangle, index: u32, off: Vec2, out: &mut Vec<ScreenTri>) {
+/// Without `near_clip` a triangle reaching nearer than the near plane is
+/// dropped instead of cut (the `near_clip` debug setting).
+pub fn setup_triangle(view: &CameraView, t: &Triangle, index: u32, off: Vec2, near_clip: bool, out: &mut Vec<ScreenTri>) {
     if is_back_face(view, t) {
         return;
     }
     let c = t.v.map(|v| view.to_camera(v));
     if c.iter().all(|c| -c.z >= view.far) {
+        return;
+    }
+    if !near_clip && c.iter().any(|c| -c.z < view.near) {
         return;
     }
     for piece in clip_near(triangle_vertices(c), view.near).as_slice() {
@@ -164,7 +169,7 @@ pub fn setup_pass(job: &PassJob) -> Vec<ScreenTri> {
         .map(|(ci, chunk)| {
             let mut out = Vec::with_capacity(chunk.len());
             for (j, t) in chunk.iter().enumerate() {
-                setup_triangle(view, t, (ci * CHUNK + j) as u32, job.offset, &mut out);
+                setup_triangle(view, t, (ci * CHUNK + j) as u32, job.offset, job.settings.near_clip, &mut out);
             }
             // Drop pieces outside the rows of this job.
             out.retain(|st| !st.bbox.intersect(&rows).is_empty());
@@ -248,7 +253,7 @@ mod tests {
             two_sided: true,
         };
         let mut out = Vec::new();
-        setup_triangle(&view, &t, 7, Vec2::splat(0.5), &mut out);
+        setup_triangle(&view, &t, 7, Vec2::splat(0.5), true, &mut out);
         assert_eq!(out.len(), 2);
         for st in &out {
             assert_eq!(st.tri, 7);
@@ -275,7 +280,7 @@ mod tests {
             two_sided: true,
         };
         let mut out = Vec::new();
-        setup_triangle(&view, &t, 0, Vec2::splat(0.5), &mut out);
+        setup_triangle(&view, &t, 0, Vec2::splat(0.5), true, &mut out);
         assert_eq!(out.len(), 1);
         let st = out[0];
         // Pixel (40, 55): its sample is inside the projection.

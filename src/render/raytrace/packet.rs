@@ -411,7 +411,7 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
                     m &= m - 1;
                     hits[i] = pk.hit(query, i);
                     if let (Some(light), Some(h)) = (shadow_light, &hits[i]) {
-                        let shadow_ray = with_shading_hit(settings.interpolation, h, |h| cast_shadow_ray(scene, h, light, settings.shadow_bump));
+                        let shadow_ray = with_shading_hit(settings.interpolation, h, |h| cast_shadow_ray(scene, h, light, settings.shadow_bump, settings.terminator_lift));
                         if let Some((ray, t_max)) = shadow_ray.flatten() {
                             shadow_pk.rays[i] = ray;
                             shadow_pk.t_max[i] = t_max;
@@ -507,7 +507,7 @@ mod tests {
                 for (x, y) in (0..w).flat_map(|x| (0..h).map(move |y| (x, y))) {
                     let ray = view.eye_ray(x as f32 + 0.5, y as f32 + 0.5);
                     let Some(hit) = query.closest(&ray, view.far_t(x as f32 + 0.5, y as f32 + 0.5), false, &mut RayCounts::default(), &mut NoRecord) else { continue };
-                    let expected = with_shading_hit(interpolation, &hit, |h| cast_shadow_ray(&prepared.scene, h, light, settings.shadow_bump)).flatten();
+                    let expected = with_shading_hit(interpolation, &hit, |h| cast_shadow_ray(&prepared.scene, h, light, settings.shadow_bump, settings.terminator_lift)).flatten();
                     let mut trace = PixelTrace::new();
                     with_shading_hit(interpolation, &hit, |h| {
                         let mut path = crate::render::gi::PathState::new(0, 0, 1, &settings.gi, None);

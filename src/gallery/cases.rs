@@ -1,0 +1,296 @@
+//! The gallery's cases, in one table. Each names a built-in scene, the method
+//! and knob under test, a failing and a cured `Setting`, and how the truth
+//! image is made. To add a case, add an entry to `cases()`.
+
+use crate::render::raster::depth_format::DepthFormat;
+use crate::render::shadow_volume::VolumeMode;
+use crate::render::{RenderSettings, ShadowMode};
+use crate::scene::Scene;
+
+/// One way of rendering a case: a renderer, the knobs changed from the
+/// scene's defaults (as a command-line-like description), and the functions
+/// that apply them.
+#[derive(Clone, Copy)]
+pub struct Setting {
+    /// A renderer name as `--renderer` takes it.
+    pub renderer: &'static str,
+    /// What is changed, e.g. "--shadows map --shadow-bias 0".
+    pub description: &'static str,
+    /// Another built-in scene to render instead of the case's own (a truth
+    /// made from an exact model of the same scene); `None`: the case's.
+    pub scene: Option<&'static str>,
+    /// Applies the knobs to the settings made for the scene (`RenderSettings::for_scene`).
+    pub apply: fn(&mut RenderSettings),
+    /// Changes the scene before it is prepared, when the knob lives there.
+    pub transform: Option<fn(&mut Scene)>,
+}
+
+impl Setting {
+    /// A setting that changes only render settings.
+    pub const fn new(renderer: &'static str, description: &'static str, apply: fn(&mut RenderSettings)) -> Setting {
+        Setting { renderer, description, scene: None, apply, transform: None }
+    }
+}
+
+/// One stress case.
+#[derive(Clone, Copy)]
+pub struct GalleryCase {
+    pub name: &'static str,
+    /// A built-in scene (`scene::builtin`).
+    pub scene: &'static str,
+    /// The method under test, e.g. "shadow map".
+    pub method: &'static str,
+    /// The knob whose value makes the difference.
+    pub knob: &'static str,
+    /// One line: what goes wrong and why.
+    pub explanation: &'static str,
+    pub failing: Setting,
+    pub cured: Setting,
+    /// How the truth is rendered.
+    pub truth: Setting,
+    /// A setting fails when more pixels than this are wrong, and passes otherwise.
+    pub threshold: usize,
+    /// The size the gallery renders at, when not the scene's own (a big
+    /// scene measured small, so the gallery stays quick); the viewer keeps
+    /// the scene's size.
+    pub size: Option<(u32, u32)>,
+}
+
+fn map(s: &mut RenderSettings) {
+    s.shadows = ShadowMode::Map;
+}
+
+fn nothing(_: &mut RenderSettings) {}
+
+/// Ray-cast shadows, as the scene defaults have them (spelled out for the
+/// viewer, where the user's own shadow mode would otherwise stay).
+fn rays(s: &mut RenderSettings) {
+    s.shadows = ShadowMode::Ray;
+}
+
+/// The truth of shadow-map cases: the same image with ray-cast shadows.
+const RAY_CAST_SHADOWS: Setting = Setting::new("raytrace:brute", "raytrace:brute, ray-cast shadows", nothing);
+
+/// Every case, in the order the gallery shows them.
+pub fn cases() -> Vec<GalleryCase> {
+    vec![
+        GalleryCase {
+            name: "shadow-acne",
+            scene: "stress-shadow",
+            method: "shadow map",
+            knob: "shadow-bias",
+            explanation: "with no depth bias a lit surface compares its depth against the map's own, rounded to texels, and shadows itself in stripes",
+            failing: Setting::new("rasterize", "--shadows map --shadow-bias 0", |s| {
+                map(s);
+                s.shadow_map_bias = 0.0;
+            }),
+            cured: Setting::new("rasterize", "--shadows map --shadow-bias 1 (default)", map),
+            truth: RAY_CAST_SHADOWS,
+            threshold: 40,
+            size: None,
+        },
+        GalleryCase {
+            name: "peter-panning",
+            scene: "stress-shadow",
+            method: "shadow map",
+            knob: "shadow-bias",
+            explanation: "a huge depth bias pushes shadows away from their casters: the contact shadows under the box and the ball come loose",
+            failing: Setting::new("rasterize", "--shadows map --shadow-bias 256", |s| {
+                map(s);
+                s.shadow_map_bias = 256.0;
+            }),
+            cured: Setting::new("rasterize", "--shadows map --shadow-bias 1 (default)", map),
+            truth: RAY_CAST_SHADOWS,
+            threshold: 40,
+            size: None,
+        },
+        GalleryCase {
+            name: "grazing-light",
+            scene: "stress-grazing",
+            method: "shadow map",
+            knob: "shadow_map_slope_bias",
+            explanation: "light 6 degrees above the ground: one texel spans a long stretch of depth there, so a constant bias that suffices under steep light leaves acne",
+            failing: Setting::new("rasterize", "--shadows map, constant bias 1", |s| {
+                map(s);
+                s.shadow_map_slope_bias = false;
+            }),
+            cured: Setting::new("rasterize", "--shadows map, slope-scaled bias 1 (default)", map),
+            truth: RAY_CAST_SHADOWS,
+            threshold: 40,
+            size: None,
+        },
+        GalleryCase {
+            name: "shadow-terminator",
+            scene: "stress-terminator",
+            method: "shadow rays",
+            knob: "terminator_lift",
+            explanation: "smooth normals face the light where the coarse facets do not: shadow rays leaving those facets hit the neighbouring ones, and the lit side ends in jagged black teeth",
+            failing: Setting::new("raytrace", "terminator_lift = false (from the hit point)", |s| {
+                rays(s);
+                s.terminator_lift = false;
+            }),
+            cured: Setting::new("raytrace", "terminator_lift = true (default: Hanika 2021)", rays),
+            truth: Setting::new("raytrace:brute", "raytrace:brute --shadows none (a convex object alone casts no shadow but its own)", |s| s.shadows = ShadowMode::None),
+            threshold: 40,
+            size: None,
+        },
+        GalleryCase {
+            name: "self-intersection",
+            scene: "bunny",
+            method: "shadow rays",
+            knob: "bump",
+            explanation: "a shadow ray leaving exactly from a rounded hit point finds the surface it leaves about half the time: speckled self-shadowing (CGPP's rayBumpEpsilon cures it)",
+            failing: Setting::new("raytrace", "--bump 0", |s| {
+                rays(s);
+                s.shadow_bump = 0.0;
+            }),
+            cured: Setting::new("raytrace", "--bump 1e-4 (default)", |s| {
+                rays(s);
+                s.shadow_bump = 1e-4;
+            }),
+            truth: Setting::new("raytrace", "raytrace --bump 1e-3", |s| s.shadow_bump = 1e-3),
+            threshold: 40,
+            size: Some((160, 100)),
+        },
+        GalleryCase {
+            name: "specular-aliasing",
+            scene: "stress-specular",
+            method: "sampling",
+            knob: "spp",
+            explanation: "each bump's highlight is smaller than a pixel: one sample per pixel hits it or misses it, and the field sparkles instead of glowing",
+            failing: Setting::new("rasterize", "--spp 1", |s| s.spp = 1),
+            cured: Setting::new("rasterize", "--spp 64", |s| s.spp = 64),
+            truth: Setting::new("raytrace", "raytrace --spp 1024", |s| s.spp = 1024),
+            threshold: 400,
+            size: None,
+        },
+        GalleryCase {
+            name: "near-plane",
+            scene: "stress-near",
+            method: "rasterize",
+            knob: "near_clip",
+            explanation: "the floor and the wall pass beside and behind the eye: without a clipper their triangles must be dropped whole, and they vanish",
+            failing: Setting::new("rasterize", "near_clip = false", |s| s.near_clip = false),
+            cured: Setting::new("rasterize", "near_clip = true (default)", nothing),
+            truth: Setting::new("raytrace:brute", "raytrace:brute", nothing),
+            threshold: 40,
+            size: None,
+        },
+        GalleryCase {
+            name: "t-junction-cracks",
+            scene: "stress-tjunction",
+            method: "meshes",
+            knob: "shared vertices",
+            explanation: "a vertex lying on its neighbour's edge stays on it only in exact arithmetic: rounded (here 100,000 units out) it moves off, and the background shows through",
+            failing: Setting::new("raytrace", "T-junctions (stress-tjunction)", rays),
+            cured: Setting {
+                renderer: "raytrace",
+                description: "every edge shared whole (stress-tjunction-shared)",
+                scene: Some("stress-tjunction-shared"),
+                apply: rays,
+                transform: None,
+            },
+            truth: Setting {
+                renderer: "raytrace:brute",
+                description: "raytrace:brute on stress-tjunction-shared re-centred at the camera",
+                scene: Some("stress-tjunction-shared"),
+                apply: nothing,
+                transform: Some(crate::scene::recentre::recentre_at_camera),
+            },
+            threshold: 20,
+            size: None,
+        },
+        GalleryCase {
+            name: "far-from-origin",
+            scene: "stress-far",
+            method: "ray casting",
+            knob: "camera-relative",
+            explanation: "100,000 units from the origin a float resolves 0.008: hit points land off their surfaces, beyond the 1e-4 bump, and shadow themselves",
+            failing: Setting::new("raytrace", "as placed (at 100000, 100000, 100000)", rays),
+            cured: Setting {
+                renderer: "raytrace",
+                description: "re-centred at the camera",
+                scene: None,
+                apply: rays,
+                transform: Some(crate::scene::recentre::recentre_at_camera),
+            },
+            truth: Setting {
+                renderer: "raytrace:brute",
+                description: "raytrace:brute on stress-shadow, the same scene at the origin",
+                scene: Some("stress-shadow"),
+                apply: nothing,
+                transform: None,
+            },
+            threshold: 40,
+            size: None,
+        },
+        GalleryCase {
+            name: "zpass-eye-in-shadow",
+            scene: "stress-zpass",
+            method: "shadow volumes",
+            knob: "shadow-volume",
+            explanation: "z-pass counts the volume faces in front of each visible point, assuming the eye is in no volume: standing in the roof's shadow, every count is off by one and shadow and light swap",
+            failing: Setting::new("rasterize", "--shadows volume --shadow-volume zpass", |s| {
+                s.shadows = ShadowMode::Volume;
+                s.shadow_volume = VolumeMode::ZPass;
+            }),
+            cured: Setting::new("rasterize", "--shadows volume --shadow-volume zfail (default)", |s| {
+                s.shadows = ShadowMode::Volume;
+                s.shadow_volume = VolumeMode::ZFail;
+            }),
+            truth: RAY_CAST_SHADOWS,
+            threshold: 40,
+            size: Some((160, 100)),
+        },
+        GalleryCase {
+            name: "painter-cycles",
+            scene: "stress-painter",
+            method: "visibility",
+            knob: "renderer",
+            explanation: "three bars overlap in a cycle and two triangles pass through each other: no back-to-front order of whole triangles exists, so the painter must draw some of them wrongly on top",
+            failing: Setting::new("rasterize:painter", "--renderer rasterize:painter", nothing),
+            cured: Setting::new("rasterize:fixed", "--renderer rasterize:fixed (a depth buffer)", nothing),
+            truth: Setting::new("raytrace:brute", "raytrace:brute", nothing),
+            threshold: 40,
+            size: Some((160, 100)),
+        },
+        GalleryCase {
+            name: "z-fighting",
+            scene: "stress-zfight",
+            method: "depth buffer",
+            knob: "depth-buffer",
+            explanation: "a decal 2 cm above the ground, 30-90 m away, near plane 1 cm: 16 fixed-point bits of z/w cannot tell the two surfaces apart there, and the ground wins where they round equal",
+            failing: Setting::new("rasterize", "--depth-buffer unorm16", |s| s.depth_buffer = DepthFormat::Unorm16),
+            cured: Setting::new("rasterize", "--depth-buffer unorm24", |s| s.depth_buffer = DepthFormat::Unorm24),
+            truth: Setting::new("raytrace:brute", "raytrace:brute", nothing),
+            threshold: 40,
+            size: Some((160, 100)),
+        },
+        GalleryCase {
+            name: "z-fighting-near-plane",
+            scene: "stress-zfight",
+            method: "depth buffer",
+            knob: "camera.near",
+            explanation: "z/w spends most of its steps just beyond the near plane: moving the near plane from 1 cm to 1 m gives the 16-bit buffer the precision the far decal needs",
+            failing: Setting::new("rasterize", "--depth-buffer unorm16, camera.near = 0.01", |s| s.depth_buffer = DepthFormat::Unorm16),
+            cured: Setting {
+                renderer: "rasterize",
+                description: "--depth-buffer unorm16, camera.near = 1",
+                scene: None,
+                apply: |s| s.depth_buffer = DepthFormat::Unorm16,
+                transform: Some(|scene| scene.camera.near = 1.0),
+            },
+            truth: Setting::new("raytrace:brute", "raytrace:brute", nothing),
+            threshold: 40,
+            size: Some((160, 100)),
+        },
+    ]
+}
+
+/// The case called `name`.
+pub fn case_by_name(name: &str) -> Result<GalleryCase, String> {
+    let all = cases();
+    all.iter().find(|c| c.name == name).copied().ok_or_else(|| {
+        format!("no gallery case \"{name}\" (choose from {})", all.iter().map(|c| c.name).collect::<Vec<_>>().join(", "))
+    })
+}
