@@ -57,3 +57,7 @@ shot inspector-rasterize triangle-ground PINHOLE_RENDERER=rasterize PINHOLE_SELE
 shot compare-cornell-gi cornell-gi PINHOLE_COMPARE=on PINHOLE_PANELS=none
 # A|B: path-traced indirect light (A) against the rasterizer's direct light (B).
 shot split-wipe cornell-gi PINHOLE_SPLIT=rasterize PINHOLE_GI=path PINHOLE_SPP=16 PINHOLE_PANELS=none
+# The gallery in the viewer: z-pass counting with the eye inside a shadow volume.
+shot gallery-zpass stress-zpass PINHOLE_GALLERY=zpass-eye-in-shadow PINHOLE_PANELS=shading
+# The wireframe view (DDA lines over the shaded image) and stencil shadow volumes.
+shot view-wireframe teapot PINHOLE_VIEW=wireframe PINHOLE_PANELS=shading

@@ -166,7 +166,8 @@ fn screenshot_frame(app: &mut PinholeApp, ctx: &egui::Context) {
 /// `PINHOLE_GAMMA=off` turns the sRGB encoding off, `PINHOLE_GI` and
 /// `PINHOLE_SPP` set the indirect light and the samples per pixel,
 /// `PINHOLE_COMPARE=on` opens the Compare window measuring,
-/// `PINHOLE_SPLIT=RENDERER` shows the view against RENDERER side by side.
+/// `PINHOLE_SPLIT=RENDERER` shows the view against RENDERER side by side,
+/// `PINHOLE_GALLERY=CASE` opens a stress-gallery case.
 fn apply_env_overrides(app: &mut PinholeApp) {
     if let Ok(name) = std::env::var("PINHOLE_RENDERER") {
         match crate::render::renderer_by_name(&name) {
@@ -226,6 +227,10 @@ fn apply_env_overrides(app: &mut PinholeApp) {
             }
             Err(_) => eprintln!("pinhole: PINHOLE_ZOOM: expected a number, got \"{z}\""),
         }
+    }
+    // PINHOLE_GALLERY=CASE opens a stress-gallery case at its failing setting.
+    if let Ok(name) = std::env::var("PINHOLE_GALLERY") {
+        app.open_gallery_case(&name, false);
     }
     // PINHOLE_COMPARE=on opens the Compare window and starts measuring.
     if std::env::var("PINHOLE_COMPARE").is_ok_and(|v| !matches!(v.as_str(), "0" | "off" | "false")) {

@@ -111,6 +111,10 @@ pub fn method_configurations(scene: &Scene, base: &RenderSettings) -> Vec<Config
     }
     add("samples", raster, plain.clone());
     add("samples", raster, with(&|s| s.msaa = 4));
+    // The same image by other visibility algorithms: they differ in time only.
+    for variant in ["rasterize:tiled", "rasterize:scanline"] {
+        add("samples", variant, plain.clone());
+    }
 
     // Shadows: none, traced (above), or looked up in maps of a few sizes and biases.
     let casts_shadows = !scene.lights.is_empty() && scene.triangles.len() + scene.spheres.len() > 1;
