@@ -23,7 +23,7 @@ shot() { # NAME SCENE [VAR=VALUE...]
 }
 
 # Each built-in scene with the default renderer and panels.
-for scene in $("$bin" list | sed -n '/^built-in scenes:/,$p' | tail -n +2); do
+for scene in $("$bin" list | awk '/^built-in scenes:/ {s = 1; next} /^[^ ]/ {s = 0} s && NF {print $1}'); do
     shot "scene-$scene" "$scene"
 done
 # Each renderer family on the same scene.
