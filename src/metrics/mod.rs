@@ -41,6 +41,14 @@ pub fn compare(test: &[Radiance], reference: &[Radiance]) -> Result<ErrorMetrics
     if test.is_empty() {
         return Err("the images are empty".into());
     }
+    // A NaN difference compares false with everything, so it would count as
+    // no difference at all: non-finite input is refused instead.
+    for (img, which) in [(test, "test"), (reference, "reference")] {
+        let bad = count_non_finite(img);
+        if bad > 0 {
+            return Err(format!("the {which} image has {bad} pixels that are NaN or infinite; error metrics need finite values"));
+        }
+    }
     let (mut se, mut rel, mut max_abs, mut mean) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
     let mut differing = 0u64;
     for (a, b) in test.iter().zip(reference) {
@@ -69,10 +77,23 @@ pub fn compare(test: &[Radiance], reference: &[Radiance]) -> Result<ErrorMetrics
     })
 }
 
+/// How many pixels have a NaN or infinite channel.
+pub fn count_non_finite(img: &[Radiance]) -> usize {
+    img.iter().filter(|c| !(c.x.is_finite() && c.y.is_finite() && c.z.is_finite())).count()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use glam::Vec3;
+
+    #[test]
+    fn non_finite_input_is_refused_not_measured_as_zero() {
+        let good = vec![Vec3::ONE; 2];
+        let nan = vec![Vec3::new(f32::NAN, 0.0, 0.0), Vec3::ONE];
+        assert!(compare(&nan, &good).unwrap_err().contains("test image has 1 pixels"));
+        assert!(compare(&good, &[Vec3::ONE, Vec3::splat(f32::INFINITY)]).unwrap_err().contains("reference image"));
+    }
 
     #[test]
     fn by_hand() {
