@@ -117,6 +117,22 @@ pub fn decode_image(bytes: &[u8], name: &str) -> Result<image::DynamicImage, Str
     r.decode().map_err(|e| format!("cannot decode {name}: {e}"))
 }
 
+/// Longest error message about an input, in characters.
+pub const MAX_MESSAGE_CHARS: usize = 600;
+
+/// A message cut to `MAX_MESSAGE_CHARS` when it quotes something huge from
+/// the input: the start (file and line) and the end (usually the valid
+/// range) are kept, the middle is elided.
+pub fn bounded_message(msg: &str) -> String {
+    let n = msg.chars().count();
+    if n <= MAX_MESSAGE_CHARS {
+        return msg.to_string();
+    }
+    let head: String = msg.chars().take(300).collect();
+    let tail: String = msg.chars().skip(n - 250).collect();
+    format!("{head} ... {tail}")
+}
+
 fn size_text(bytes: u64) -> String {
     format!("{} MiB", bytes >> 20)
 }
@@ -145,6 +161,14 @@ mod tests {
         std::fs::write(&p, b"x = 1").unwrap();
         assert_eq!(read_file(&p, InputKind::Scene).unwrap(), b"x = 1");
         let _ = std::fs::remove_dir_all(&d);
+    }
+
+    #[test]
+    fn long_messages_keep_their_start_and_end() {
+        let m = format!("a.toml:3: material \"{}\" is bad; allowed: 0 to 1", "x".repeat(10_000));
+        let b = bounded_message(&m);
+        assert!(b.chars().count() <= MAX_MESSAGE_CHARS && b.starts_with("a.toml:3:") && b.ends_with("allowed: 0 to 1"), "{b}");
+        assert_eq!(bounded_message("short"), "short");
     }
 
     #[test]

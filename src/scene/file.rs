@@ -155,6 +155,12 @@ pub fn load_scene_file(path: &Path) -> Result<Scene, String> {
 /// Parses scene TOML. `origin` names the source in messages; `base` resolves
 /// relative paths.
 pub fn parse_scene(text: &str, origin: &str, base: &Path, name: &str) -> Result<Scene, String> {
+    parse_scene_unbounded(text, origin, base, name).map_err(|e| crate::input::bounded_message(&e))
+}
+
+/// `parse_scene` before its message is bounded: messages quote names from
+/// the file (materials, types, paths), which can be of any length.
+fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str) -> Result<Scene, String> {
     let desc: SceneDesc = toml::from_str(text).map_err(|e| toml_error(origin, text, &e))?;
     let at = |span: std::ops::Range<usize>| format!("{origin}:{}", line_of(text, span.start));
     let mut scene = Scene { name: name.to_string(), ..Scene::default() };

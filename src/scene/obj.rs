@@ -44,6 +44,11 @@ pub enum MtlTextures {
 }
 
 pub fn load_obj(path: &Path, mode: NormalMode, textures: MtlTextures) -> Result<LoadedMesh, String> {
+    load_obj_unbounded(path, mode, textures).map_err(|e| crate::input::bounded_message(&e))
+}
+
+/// `load_obj` before its message is bounded (MTL material names are echoed).
+fn load_obj_unbounded(path: &Path, mode: NormalMode, textures: MtlTextures) -> Result<LoadedMesh, String> {
     let name = path.display();
     let bytes = read_asset(path, InputKind::Mesh).map_err(|e| format!("cannot read OBJ {e}"))?;
     let base = path.parent().unwrap_or(Path::new("."));
@@ -105,15 +110,17 @@ pub fn load_obj(path: &Path, mode: NormalMode, textures: MtlTextures) -> Result<
     let mut degenerate = 0;
     for model in &models {
         let m = &model.mesh;
+        // The object's name as messages echo it: a file's name line can be any length.
+        let model_name: String = model.name.chars().take(60).collect();
         let pos: Vec<Vec3> = m.positions.chunks_exact(3).map(|p| Vec3::new(p[0], p[1], p[2])).collect();
         if let Some(i) = pos.iter().position(|p| !crate::math::is_finite(*p)) {
-            return Err(format!("{name}: vertex {} of \"{}\" is not finite", i + 1, model.name));
+            return Err(format!("{name}: vertex {} of \"{}\" is not finite", i + 1, model_name));
         }
         if let Some(i) = pos.iter().position(|p| p.abs().max_element() > MAX_COORDINATE) {
             return Err(format!(
                 "{name}: vertex {} of \"{}\" is {}; coordinates must be between -{MAX_COORDINATE:e} and {MAX_COORDINATE:e}",
                 i + 1,
-                model.name,
+                model_name,
                 pos[i]
             ));
         }
@@ -121,7 +128,7 @@ pub fn load_obj(path: &Path, mode: NormalMode, textures: MtlTextures) -> Result<
         let uvs: Vec<Vec2> = m.texcoords.chunks_exact(2).map(|p| Vec2::new(p[0], p[1])).collect();
         let check = |idx: &[u32], len: usize, what: &str| -> Result<(), String> {
             match idx.iter().find(|&&i| i as usize >= len) {
-                Some(i) => Err(format!("{name}: a face of \"{}\" uses {what} {} but the file has only {len}", model.name, i + 1)),
+                Some(i) => Err(format!("{name}: a face of \"{model_name}\" uses {what} {} but the file has only {len}", i + 1)),
                 None => Ok(()),
             }
         };
