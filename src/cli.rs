@@ -525,6 +525,9 @@ fn cmd_chart_methods(scene_arg: &str, output: &Path, metric: &str, reference: Op
     // Some configurations draw shadow maps whatever --shadows says.
     render::shadow_map::check_memory(&l.prepared.scene, l.settings.shadow_map_size)?;
     let (w, h) = (l.settings.width, l.settings.height);
+    if metric == crate::chart::ErrorMetric::Flip && (w * h) as usize > crate::metrics::MAX_FLIP_PIXELS {
+        return Err(format!("--metric flip: {w}x{h} is more than the {} pixels FLIP is computed for", crate::metrics::MAX_FLIP_PIXELS));
+    }
     let source = crate::chart::ReferenceSource::choose(reference, &l.prepared, reference_spp);
     let cancel = AtomicBool::new(false);
     let cache = crate::chart::reference::default_cache_dir();
@@ -633,7 +636,11 @@ fn cmd_compare(a: &Path, b: &Path, as_json: bool) -> Result<(), String> {
         let _ = writeln!(t, "rmse      {:.6}  ({:.3}% of the mean {:.6} of {})", m.rmse, 100.0 * m.rmse / m.reference_mean.max(1e-12), m.reference_mean, b.display());
         let _ = writeln!(t, "rel_mse   {:.6}", m.rel_mse);
         let _ = writeln!(t, "max_abs   {:.6}", m.max_abs);
-        let _ = writeln!(t, "flip      {:.6}", m.flip.unwrap_or(0.0));
+        match m.flip {
+            Some(f) => writeln!(t, "flip      {f:.6}"),
+            None => writeln!(t, "flip      not computed (more than {} pixels)", crate::metrics::MAX_FLIP_PIXELS),
+        }
+        .ok();
         let _ = writeln!(t, "differing {} of {} pixels", m.differing_pixels, ia.pixels.len());
         print_stdout(&t)
     }

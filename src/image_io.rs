@@ -201,10 +201,12 @@ pub fn load_image(path: &Path) -> Result<LinearImage, String> {
     let img = crate::input::decode_image(&bytes, &path.display().to_string()).map_err(|e| format!("cannot read image {e}"))?;
     drop(bytes);
     let is_float = matches!(img, image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_));
-    let rgb = img.to_rgb32f();
+    // Consumed, not copied: a float RGB image is taken over as it is.
+    let rgb = img.into_rgb32f();
+    let (width, height) = rgb.dimensions();
     let decode = |v: f32| if is_float { v } else if v <= 0.04045 { v / 12.92 } else { ((v + 0.055) / 1.055).powf(2.4) };
-    let pixels = rgb.pixels().map(|p| Vec3::new(decode(p[0]), decode(p[1]), decode(p[2]))).collect();
-    Ok(LinearImage { width: rgb.width(), height: rgb.height(), pixels })
+    let pixels = rgb.into_raw().chunks_exact(3).map(|p| Vec3::new(decode(p[0]), decode(p[1]), decode(p[2]))).collect();
+    Ok(LinearImage { width, height, pixels })
 }
 
 #[cfg(test)]

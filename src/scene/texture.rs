@@ -40,8 +40,7 @@ pub fn load_texture(path: &Path) -> Result<Texture, String> {
     let img = decode_image(&bytes, &path.display().to_string())?;
     drop(bytes);
     let is_float = matches!(img, image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_));
-    let rgb = img.to_rgb32f();
-    drop(img);
+    let rgb = img.into_rgb32f();
     let mut texels = Vec::with_capacity(rgb.width() as usize * rgb.height() as usize);
     for (x, y, p) in rgb.enumerate_pixels() {
         let c = Vec3::new(p[0], p[1], p[2]);
