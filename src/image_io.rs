@@ -141,21 +141,32 @@ enum OutputTarget {
 /// Follows symlinks (even one pointing at a file not made yet) and tells a
 /// regular destination from a special file; a directory is an error.
 fn output_target(path: &Path) -> Result<OutputTarget, String> {
-    let mut target = path.to_path_buf();
-    // A bounded number of links, as the kernel bounds them (a loop is an error).
-    for _ in 0..40 {
-        match std::fs::symlink_metadata(&target) {
-            Ok(m) if m.file_type().is_symlink() => {
-                let link = std::fs::read_link(&target).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-                let base = target.parent().map(Path::to_path_buf).unwrap_or_default();
-                target = base.join(link);
+    match std::fs::metadata(path) {
+        Ok(m) if m.is_dir() => Err(format!("cannot write {}: it is a directory", path.display())),
+        // Opening follows every link, including /proc's (`/dev/stdout`).
+        Ok(m) if !m.is_file() => Ok(OutputTarget::Special(path.to_path_buf())),
+        // `/dev/stdout` redirected to a file: written into, so the shell's
+        // open file gets the bytes (a rename would leave it empty).
+        Ok(_) if path.starts_with("/dev") || path.starts_with("/proc") => Ok(OutputTarget::Special(path.to_path_buf())),
+        Ok(_) => Ok(OutputTarget::Regular(std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf()))),
+        Err(_) => {
+            // Nothing there yet, or a link to a file not made yet: the file is
+            // created where the last link points. Links are followed a bounded
+            // number of times, as the kernel bounds them.
+            let mut target = path.to_path_buf();
+            for _ in 0..40 {
+                match std::fs::symlink_metadata(&target) {
+                    Ok(m) if m.file_type().is_symlink() => {
+                        let link = std::fs::read_link(&target).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+                        let base = target.parent().map(Path::to_path_buf).unwrap_or_default();
+                        target = base.join(link);
+                    }
+                    _ => return Ok(OutputTarget::Regular(target)),
+                }
             }
-            Ok(m) if m.is_dir() => return Err(format!("cannot write {}: it is a directory", path.display())),
-            Ok(m) if !m.is_file() => return Ok(OutputTarget::Special(target)),
-            _ => return Ok(OutputTarget::Regular(target)),
+            Err(format!("cannot write {}: too many levels of symbolic links", path.display()))
         }
     }
-    Err(format!("cannot write {}: too many levels of symbolic links", path.display()))
 }
 
 /// Checks, before any work, that `path` can be written: it is not a
@@ -166,7 +177,7 @@ pub fn check_writable(path: &Path) -> Result<(), String> {
     match output_target(path)? {
         OutputTarget::Special(t) => {
             use std::os::unix::fs::FileTypeExt;
-            let fifo = std::fs::metadata(&t).map(|m| m.file_type().is_fifo()).unwrap_or(false);
+            let fifo = std::fs::metadata(&t).map(|m| m.file_type().is_fifo() || m.file_type().is_socket()).unwrap_or(false);
             if !fifo {
                 std::fs::OpenOptions::new().write(true).open(&t).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
             }
@@ -243,6 +254,12 @@ mod tests {
         write_atomic(&link, b"new").unwrap();
         assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink(), "the link stays a link");
         assert_eq!(std::fs::read(&real).unwrap(), b"new");
+        // A link to a file not made yet makes the file where it points.
+        let (dangling, later) = (d.join("dangling.json"), d.join("later.json"));
+        std::os::unix::fs::symlink("later.json", &dangling).unwrap();
+        write_atomic(&dangling, b"made").unwrap();
+        assert!(std::fs::symlink_metadata(&dangling).unwrap().file_type().is_symlink());
+        assert_eq!(std::fs::read(&later).unwrap(), b"made");
         // A character device is written into, not replaced by a regular file.
         write_atomic(Path::new("/dev/null"), b"x").unwrap();
         assert!(!std::fs::metadata("/dev/null").unwrap().is_file());
@@ -254,7 +271,7 @@ mod tests {
         assert!(check_writable(&d.join("missing").join("a.png")).is_err());
         assert!(check_writable(&d.join("a.png")).is_ok());
         let left: Vec<_> = std::fs::read_dir(&d).unwrap().map(|e| e.unwrap().file_name()).collect();
-        assert_eq!(left.len(), 2, "no probe or temporary files left: {left:?}");
+        assert_eq!(left.len(), 4, "no probe or temporary files left: {left:?}");
         let _ = std::fs::remove_dir_all(&d);
     }
 
