@@ -245,6 +245,9 @@ struct Loaded {
     load_ms: f64,
 }
 
+/// Most worker threads `--threads` starts: more only cost memory and start-up time.
+const MAX_THREADS: usize = 256;
+
 fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
     let renderer = render::renderer_by_name(&opts.renderer)?;
     let view = View::parse(&opts.view)?;
@@ -254,9 +257,13 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
     if opts.spp == 0 || opts.spp > 65536 {
         return Err(format!("--spp {} is not between 1 and 65536", opts.spp));
     }
-    let threads = opts.threads.unwrap_or(0);
+    let mut threads = opts.threads.unwrap_or(0);
     if opts.threads == Some(0) {
         return Err("--threads must be at least 1".into());
+    }
+    if threads > MAX_THREADS {
+        eprintln!("warning: --threads {threads} is more than {MAX_THREADS}; using {MAX_THREADS}");
+        threads = MAX_THREADS;
     }
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
@@ -278,6 +285,7 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
     }
     settings.width = opts.width.unwrap_or(settings.width);
     settings.height = opts.height.unwrap_or(settings.height);
+    crate::input::check_image_size(settings.width, settings.height).map_err(|e| format!("the image size {e}"))?;
     settings.spp = opts.spp;
     settings.view = view;
     settings.shadows = shadows;
@@ -315,6 +323,9 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
             return Err(format!("--adaptive {t} must be a relative error > 0 (e.g. 0.05)"));
         }
         settings.adaptive = Some(t);
+    }
+    if settings.shadows == ShadowMode::Map {
+        render::shadow_map::check_memory(&scene, settings.shadow_map_size)?;
     }
     let prepared = pool.install(|| PreparedScene::new(scene));
     Ok(Loaded { prepared, settings, renderer, pool, load_ms })
@@ -406,6 +417,10 @@ fn cmd_render(scene_arg: &str, output: &Path, opts: &RenderOpts, stats: Option<&
     let ext = output.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).unwrap_or_default();
     if !["png", "exr", "ppm"].contains(&ext.as_str()) {
         return Err(format!("{}: unknown image type (use .png, .exr or .ppm)", output.display()));
+    }
+    crate::image_io::check_writable(output)?;
+    if let Some(dest) = stats.filter(|d| *d != "-") {
+        crate::image_io::check_writable(Path::new(dest))?;
     }
     let l = load(scene_arg, opts)?;
     let cancel = AtomicBool::new(false);
@@ -520,7 +535,12 @@ fn cmd_chart_methods(scene_arg: &str, output: &Path, metric: &str, reference: Op
         return Err(format!("--reference-spp {reference_spp} is not between 1 and 65536"));
     }
     let l = load(scene_arg, opts)?;
+    // Some configurations draw shadow maps whatever --shadows says.
+    render::shadow_map::check_memory(&l.prepared.scene, l.settings.shadow_map_size)?;
     let (w, h) = (l.settings.width, l.settings.height);
+    if metric == crate::chart::ErrorMetric::Flip && (w * h) as usize > crate::metrics::MAX_FLIP_PIXELS {
+        return Err(format!("--metric flip: {w}x{h} is more than the {} pixels FLIP is computed for", crate::metrics::MAX_FLIP_PIXELS));
+    }
     let source = crate::chart::ReferenceSource::choose(reference, &l.prepared, reference_spp);
     let cancel = AtomicBool::new(false);
     let cache = crate::chart::reference::default_cache_dir();
@@ -545,15 +565,21 @@ fn cmd_chart_methods(scene_arg: &str, output: &Path, metric: &str, reference: Op
     Ok(())
 }
 
+/// The chart's PNG name, and that it and the CSV beside it can be written
+/// (checked before minutes of measuring).
 fn check_png_output(output: &Path) -> Result<(), String> {
     if output.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() != Some("png") {
         return Err(format!("{}: the chart is written as .png", output.display()));
     }
-    Ok(())
+    crate::image_io::check_writable(output)?;
+    crate::image_io::check_writable(&output.with_extension("csv"))
 }
 
 fn cmd_chart(scene_arg: &str, output: &Path, renderers: &str, spp_list: &str, reference: Option<&Path>, reference_spp: u32, opts: &RenderOpts) -> Result<(), String> {
     check_png_output(output)?;
+    if !(1..=65536).contains(&reference_spp) {
+        return Err(format!("--reference-spp {reference_spp} is not between 1 and 65536"));
+    }
     let spps: Vec<u32> = spp_list
         .split(',')
         .map(|s| s.trim().parse::<u32>().ok().filter(|&n| (1..=65536).contains(&n)).ok_or(format!("--spp-list: \"{s}\" is not a sample count")))
@@ -598,6 +624,12 @@ fn cmd_chart(scene_arg: &str, output: &Path, renderers: &str, spp_list: &str, re
 fn cmd_compare(a: &Path, b: &Path, as_json: bool) -> Result<(), String> {
     let ia = crate::image_io::load_image(a)?;
     let ib = crate::image_io::load_image(b)?;
+    for (img, path) in [(&ia, a), (&ib, b)] {
+        let bad = crate::metrics::count_non_finite(&img.pixels);
+        if bad > 0 {
+            return Err(format!("{}: {bad} pixels are NaN or infinite; compare needs finite images", path.display()));
+        }
+    }
     if (ia.width, ia.height) != (ib.width, ib.height) {
         return Err(format!(
             "{} is {}x{} but {} is {}x{}; compare needs images of the same size",
@@ -617,7 +649,11 @@ fn cmd_compare(a: &Path, b: &Path, as_json: bool) -> Result<(), String> {
         let _ = writeln!(t, "rmse      {:.6}  ({:.3}% of the mean {:.6} of {})", m.rmse, 100.0 * m.rmse / m.reference_mean.max(1e-12), m.reference_mean, b.display());
         let _ = writeln!(t, "rel_mse   {:.6}", m.rel_mse);
         let _ = writeln!(t, "max_abs   {:.6}", m.max_abs);
-        let _ = writeln!(t, "flip      {:.6}", m.flip.unwrap_or(0.0));
+        match m.flip {
+            Some(f) => writeln!(t, "flip      {f:.6}"),
+            None => writeln!(t, "flip      not computed (more than {} pixels)", crate::metrics::MAX_FLIP_PIXELS),
+        }
+        .ok();
         let _ = writeln!(t, "differing {} of {} pixels", m.differing_pixels, ia.pixels.len());
         print_stdout(&t)
     }

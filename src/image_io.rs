@@ -3,7 +3,7 @@
 //! (a temporary file in the same directory, then a rename).
 
 use crate::math::{Radiance, Vec3};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// sRGB transfer function (IEC 61966-2-1) of a linear value in [0, 1].
 pub fn linear_to_srgb(c: f32) -> f32 {
@@ -75,16 +75,34 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), String> {
 /// Writes several files, all or none: every file goes to a temporary name
 /// beside its target first, and only when all of them are written are they
 /// renamed into place. A failure removes the temporary files.
+///
+/// A symlink is written through: its target is replaced and the link stays.
+/// A special file (`/dev/null`, a terminal, a FIFO) is written into
+/// directly, never replaced by a regular file.
 pub fn write_all_atomic(files: &[(&Path, &[u8])]) -> Result<(), String> {
     let mut temps = Vec::new();
-    let cleanup = |temps: &[std::path::PathBuf]| {
+    let cleanup = |temps: &[PathBuf]| {
         for t in temps {
             let _ = std::fs::remove_file(t);
         }
     };
+    let mut renames = Vec::new();
+    let mut direct = Vec::new();
     for (path, bytes) in files {
-        let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-        let Some(name) = path.file_name() else {
+        let target = match output_target(path) {
+            Ok(t) => t,
+            Err(e) => {
+                cleanup(&temps);
+                return Err(e);
+            }
+        };
+        if let OutputTarget::Special(t) = target {
+            direct.push((*path, t, *bytes));
+            continue;
+        }
+        let OutputTarget::Regular(target) = target else { unreachable!() };
+        let dir = target.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+        let Some(name) = target.file_name() else {
             cleanup(&temps);
             return Err(format!("{}: not a file name", path.display()));
         };
@@ -94,14 +112,90 @@ pub fn write_all_atomic(files: &[(&Path, &[u8])]) -> Result<(), String> {
             cleanup(&temps);
             return Err(format!("cannot write {}: {e}", path.display()));
         }
+        renames.push((*path, target));
     }
-    for (i, ((path, _), tmp)) in files.iter().zip(&temps).enumerate() {
-        if let Err(e) = std::fs::rename(tmp, path) {
+    for (i, ((path, target), tmp)) in renames.iter().zip(&temps).enumerate() {
+        if let Err(e) = std::fs::rename(tmp, target) {
             cleanup(&temps[i..]);
             return Err(format!("cannot write {}: {e}", path.display()));
         }
     }
+    for (path, target, bytes) in direct {
+        use std::io::Write;
+        let written = std::fs::OpenOptions::new().write(true).open(&target).and_then(|mut f| f.write_all(bytes));
+        if let Err(e) = written {
+            return Err(format!("cannot write {}: {e}", path.display()));
+        }
+    }
     Ok(())
+}
+
+/// Where writing `path` really goes.
+enum OutputTarget {
+    /// A regular file (or nothing yet) at this path: replaced by rename.
+    Regular(PathBuf),
+    /// A device or FIFO at this path: written into.
+    Special(PathBuf),
+}
+
+/// Follows symlinks (even one pointing at a file not made yet) and tells a
+/// regular destination from a special file; a directory is an error.
+fn output_target(path: &Path) -> Result<OutputTarget, String> {
+    match std::fs::metadata(path) {
+        Ok(m) if m.is_dir() => Err(format!("cannot write {}: it is a directory", path.display())),
+        // Opening follows every link, including /proc's (`/dev/stdout`).
+        Ok(m) if !m.is_file() => Ok(OutputTarget::Special(path.to_path_buf())),
+        // `/dev/stdout` redirected to a file: written into, so the shell's
+        // open file gets the bytes (a rename would leave it empty).
+        Ok(_) if path.starts_with("/dev") || path.starts_with("/proc") => Ok(OutputTarget::Special(path.to_path_buf())),
+        Ok(_) => Ok(OutputTarget::Regular(std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf()))),
+        Err(_) => {
+            // Nothing there yet, or a link to a file not made yet: the file is
+            // created where the last link points. Links are followed a bounded
+            // number of times, as the kernel bounds them.
+            let mut target = path.to_path_buf();
+            for _ in 0..40 {
+                match std::fs::symlink_metadata(&target) {
+                    Ok(m) if m.file_type().is_symlink() => {
+                        let link = std::fs::read_link(&target).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+                        let base = target.parent().map(Path::to_path_buf).unwrap_or_default();
+                        target = base.join(link);
+                    }
+                    _ => return Ok(OutputTarget::Regular(target)),
+                }
+            }
+            Err(format!("cannot write {}: too many levels of symbolic links", path.display()))
+        }
+    }
+}
+
+/// Checks, before any work, that `path` can be written: it is not a
+/// directory, and its directory exists and lets us create a file (tried
+/// with a temporary file that is removed at once). A special file is
+/// checked by opening it for writing, except a FIFO, which would block.
+pub fn check_writable(path: &Path) -> Result<(), String> {
+    match output_target(path)? {
+        OutputTarget::Special(t) => {
+            use std::os::unix::fs::FileTypeExt;
+            let fifo = std::fs::metadata(&t).map(|m| m.file_type().is_fifo() || m.file_type().is_socket()).unwrap_or(false);
+            if !fifo {
+                std::fs::OpenOptions::new().write(true).open(&t).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+            }
+            Ok(())
+        }
+        OutputTarget::Regular(t) => {
+            let dir = t.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+            let name = t.file_name().ok_or(format!("{}: not a file name", path.display()))?;
+            let probe = dir.join(format!(".{}.{}.check", name.to_string_lossy(), std::process::id()));
+            match std::fs::OpenOptions::new().write(true).create_new(true).open(&probe) {
+                Ok(_) => {
+                    let _ = std::fs::remove_file(&probe);
+                    Ok(())
+                }
+                Err(e) => Err(format!("cannot write {}: {e}", path.display())),
+            }
+        }
+    }
 }
 
 /// A loaded image in linear radiance, for `compare` and the reference tests.
@@ -111,14 +205,19 @@ pub struct LinearImage {
     pub pixels: Vec<Radiance>,
 }
 
-/// Reads `.exr` as linear values and `.png`/`.ppm` as sRGB-encoded 8-bit (decoded to linear).
+/// Reads `.exr` as linear values and `.png`/`.ppm` as sRGB-encoded 8-bit (decoded
+/// to linear), through the bounded reader and with the declared size checked first.
 pub fn load_image(path: &Path) -> Result<LinearImage, String> {
-    let img = image::open(path).map_err(|e| format!("cannot read image {}: {e}", path.display()))?;
+    let bytes = crate::input::read_file(path, crate::input::InputKind::Image).map_err(|e| format!("cannot read image {e}"))?;
+    let img = crate::input::decode_image(&bytes, &path.display().to_string()).map_err(|e| format!("cannot read image {e}"))?;
+    drop(bytes);
     let is_float = matches!(img, image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_));
-    let rgb = img.to_rgb32f();
+    // Consumed, not copied: a float RGB image is taken over as it is.
+    let rgb = img.into_rgb32f();
+    let (width, height) = rgb.dimensions();
     let decode = |v: f32| if is_float { v } else if v <= 0.04045 { v / 12.92 } else { ((v + 0.055) / 1.055).powf(2.4) };
-    let pixels = rgb.pixels().map(|p| Vec3::new(decode(p[0]), decode(p[1]), decode(p[2]))).collect();
-    Ok(LinearImage { width: rgb.width(), height: rgb.height(), pixels })
+    let pixels = rgb.into_raw().chunks_exact(3).map(|p| Vec3::new(decode(p[0]), decode(p[1]), decode(p[2]))).collect();
+    Ok(LinearImage { width, height, pixels })
 }
 
 #[cfg(test)]
@@ -143,6 +242,38 @@ mod tests {
     }
 
     use super::*;
+
+    #[test]
+    fn symlinks_and_special_files_are_written_through() {
+        let d = std::env::temp_dir().join(format!("pinhole-through-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        let (real, link) = (d.join("real.json"), d.join("link.json"));
+        std::fs::write(&real, b"old").unwrap();
+        std::os::unix::fs::symlink("real.json", &link).unwrap();
+        write_atomic(&link, b"new").unwrap();
+        assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink(), "the link stays a link");
+        assert_eq!(std::fs::read(&real).unwrap(), b"new");
+        // A link to a file not made yet makes the file where it points.
+        let (dangling, later) = (d.join("dangling.json"), d.join("later.json"));
+        std::os::unix::fs::symlink("later.json", &dangling).unwrap();
+        write_atomic(&dangling, b"made").unwrap();
+        assert!(std::fs::symlink_metadata(&dangling).unwrap().file_type().is_symlink());
+        assert_eq!(std::fs::read(&later).unwrap(), b"made");
+        // A character device is written into, not replaced by a regular file.
+        write_atomic(Path::new("/dev/null"), b"x").unwrap();
+        assert!(!std::fs::metadata("/dev/null").unwrap().is_file());
+        check_writable(Path::new("/dev/null")).unwrap();
+        // A full device fails with a sentence naming it.
+        let e = write_atomic(Path::new("/dev/full"), b"x").unwrap_err();
+        assert!(e.contains("/dev/full"), "{e}");
+        assert!(check_writable(&d).unwrap_err().contains("directory"));
+        assert!(check_writable(&d.join("missing").join("a.png")).is_err());
+        assert!(check_writable(&d.join("a.png")).is_ok());
+        let left: Vec<_> = std::fs::read_dir(&d).unwrap().map(|e| e.unwrap().file_name()).collect();
+        assert_eq!(left.len(), 4, "no probe or temporary files left: {left:?}");
+        let _ = std::fs::remove_dir_all(&d);
+    }
 
     #[test]
     fn srgb_known_values() {

@@ -8,6 +8,7 @@ pub mod chart;
 pub mod cli;
 pub mod gallery;
 pub mod image_io;
+pub mod input;
 pub mod math;
 pub mod metrics;
 pub mod named;

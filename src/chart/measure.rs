@@ -81,7 +81,7 @@ pub fn measure(prepared: &PreparedScene, config: &Configuration, reference: &Ref
         renderer: config.renderer.clone(),
         ms: best,
         rel_rmse: m.rmse / m.reference_mean.max(1e-12),
-        flip: m.flip.unwrap_or(0.0),
+        flip: m.flip.unwrap_or(f64::NAN),
     }))
 }
 

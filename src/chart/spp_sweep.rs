@@ -50,7 +50,7 @@ pub fn sweep(
                 spp,
                 ms: best,
                 rel_rmse: m.rmse / m.reference_mean.max(1e-12),
-                flip: m.flip.unwrap_or(0.0),
+                flip: m.flip.unwrap_or(f64::NAN),
             });
         }
     }

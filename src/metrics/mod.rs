@@ -21,6 +21,11 @@ pub struct ErrorMetrics {
 }
 
 /// All metrics, FLIP included, for two images of `width` x `height`.
+/// Largest image FLIP is computed for (4 Mi pixels, e.g. 2048 x 2048): its
+/// filtered copies would otherwise take gigabytes.
+pub const MAX_FLIP_PIXELS: usize = 1 << 22;
+
+/// The metrics of `compare`, with FLIP when the image has at most `MAX_FLIP_PIXELS`.
 pub fn compare_images(test: &[Radiance], reference: &[Radiance], width: usize, height: usize) -> Result<ErrorMetrics, String> {
     let mut m = compare(test, reference)?;
     let encode = |img: &[Radiance]| -> Vec<glam::Vec3> {
@@ -29,7 +34,10 @@ pub fn compare_images(test: &[Radiance], reference: &[Radiance], width: usize, h
             glam::Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32) / 255.0
         }).collect()
     };
-    m.flip = Some(flip::mean_flip(&encode(test), &encode(reference), width, height));
+    // FLIP holds a dozen full-size buffers: above the limit it is left out.
+    if width * height <= MAX_FLIP_PIXELS {
+        m.flip = Some(flip::mean_flip(&encode(test), &encode(reference), width, height));
+    }
     Ok(m)
 }
 
@@ -40,6 +48,14 @@ pub fn compare(test: &[Radiance], reference: &[Radiance]) -> Result<ErrorMetrics
     }
     if test.is_empty() {
         return Err("the images are empty".into());
+    }
+    // A NaN difference compares false with everything, so it would count as
+    // no difference at all: non-finite input is refused instead.
+    for (img, which) in [(test, "test"), (reference, "reference")] {
+        let bad = count_non_finite(img);
+        if bad > 0 {
+            return Err(format!("the {which} image has {bad} pixels that are NaN or infinite; error metrics need finite values"));
+        }
     }
     let (mut se, mut rel, mut max_abs, mut mean) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
     let mut differing = 0u64;
@@ -69,10 +85,32 @@ pub fn compare(test: &[Radiance], reference: &[Radiance]) -> Result<ErrorMetrics
     })
 }
 
+/// How many pixels have a NaN or infinite channel.
+pub fn count_non_finite(img: &[Radiance]) -> usize {
+    img.iter().filter(|c| !(c.x.is_finite() && c.y.is_finite() && c.z.is_finite())).count()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use glam::Vec3;
+
+    #[test]
+    fn non_finite_input_is_refused_not_measured_as_zero() {
+        let good = vec![Vec3::ONE; 2];
+        let nan = vec![Vec3::new(f32::NAN, 0.0, 0.0), Vec3::ONE];
+        assert!(compare(&nan, &good).unwrap_err().contains("test image has 1 pixels"));
+        assert!(compare(&good, &[Vec3::ONE, Vec3::splat(f32::INFINITY)]).unwrap_err().contains("reference image"));
+    }
+
+    #[test]
+    fn flip_is_left_out_above_its_pixel_limit() {
+        let (w, h) = (2049, 2048);
+        let img = vec![Vec3::splat(0.5); w * h];
+        assert!(w * h > MAX_FLIP_PIXELS);
+        assert_eq!(compare_images(&img, &img, w, h).unwrap().flip, None);
+        assert_eq!(compare_images(&img[..64], &img[..64], 8, 8).unwrap().flip, Some(0.0));
+    }
 
     #[test]
     fn by_hand() {

@@ -109,19 +109,28 @@ fn sample_json(scene: &Scene, t: &PixelTrace) -> Value {
     record
 }
 
-/// The JSON record: `renderer`, `x`, `y`, `radiance` (the frame's value) and the samples.
+/// Most samples the JSON record lists in full: every sample's record can
+/// hold hundreds of rays, and 65536 of them would be hundreds of megabytes.
+pub const MAX_LISTED_SAMPLES: usize = 256;
+
+/// The JSON record: `renderer`, `x`, `y`, `radiance` (the frame's value) and
+/// the samples (the first `MAX_LISTED_SAMPLES`; `samples_omitted` counts the rest).
 pub fn to_json(renderer: &str, scene: &Scene, x: u32, y: u32, replay: &PixelReplay) -> Value {
     let display = crate::image_io::display_pixel(replay.radiance, scene.render.exposure, true);
-    json!({
+    let mut record = json!({
         "renderer": renderer, "x": x, "y": y, "radiance": v3(replay.radiance), "display_srgb8": display,
         "exposure": scene.render.exposure, "spp": replay.samples.len(),
-        "samples": replay.samples.iter().map(|(o, t, v)| {
+        "samples": replay.samples.iter().take(MAX_LISTED_SAMPLES).map(|(o, t, v)| {
             let mut s = sample_json(scene, t);
             s["offset"] = json!([o.x, o.y]);
             s["radiance"] = v3(*v);
             s
         }).collect::<Vec<_>>(),
-    })
+    });
+    if replay.samples.len() > MAX_LISTED_SAMPLES {
+        record["samples_omitted"] = json!(replay.samples.len() - MAX_LISTED_SAMPLES);
+    }
+    record
 }
 
 fn fmt3(v: Vec3) -> String {

@@ -68,6 +68,32 @@ pub const DEFAULT_BIAS: f32 = 1.0;
 /// The slope factor tan(theta) of the bias is clamped here (about 84 degrees).
 pub const MAX_SLOPE: f32 = 10.0;
 
+/// Most memory all of a scene's shadow maps together may take: 1 GiB.
+pub const MAX_BYTES: u64 = 1 << 30;
+
+/// Memory the maps of every light of `scene` take at `size` texels per side:
+/// a depth and a primitive id per texel, six faces per point light.
+pub fn memory_bytes(scene: &Scene, size: u32) -> u64 {
+    let faces: u64 = scene.lights.iter().map(|l| if matches!(l, Light::Point { .. }) { 6 } else { 1 }).sum();
+    let texel = (std::mem::size_of::<f32>() + std::mem::size_of::<PrimitiveId>()) as u64;
+    let side = size.clamp(1, MAX_SIZE) as u64;
+    side * side * faces * texel
+}
+
+/// Refuses, before anything is allocated, maps that would take more than `MAX_BYTES`.
+pub fn check_memory(scene: &Scene, size: u32) -> Result<(), String> {
+    let bytes = memory_bytes(scene, size);
+    if bytes > MAX_BYTES {
+        return Err(format!(
+            "shadow maps of {} lights at {size}x{size} texels would take {} MiB, more than the limit of {} MiB; use a smaller --shadow-map-size",
+            scene.lights.len(),
+            bytes >> 20,
+            MAX_BYTES >> 20
+        ));
+    }
+    Ok(())
+}
+
 pub fn default_size() -> u32 {
     DEFAULT_SIZE
 }
@@ -672,6 +698,19 @@ mod tests {
         assert_eq!(sphere_entry(Vec3::new(1.5, 0.0, 0.0), Vec3::NEG_Z, c, 1.0, false), None);
         // Behind a perspective ray's origin: not seen.
         assert_eq!(sphere_entry(Vec3::ZERO, Vec3::Z, c, 1.0, false), None);
+    }
+
+    #[test]
+    fn shadow_map_memory_is_bounded_over_all_lights() {
+        let point = Light::Point { position: Vec3::Y, power: Vec3::ONE };
+        let mut scene = Scene::default();
+        scene.lights = vec![point.clone()];
+        // One point light at the largest size: 6 * 4096^2 texels of 4 + 4 bytes.
+        assert_eq!(memory_bytes(&scene, MAX_SIZE), 6 * 4096 * 4096 * 8);
+        assert!(check_memory(&scene, MAX_SIZE).is_ok());
+        scene.lights = vec![point; 200];
+        let e = check_memory(&scene, DEFAULT_SIZE).unwrap_err();
+        assert!(e.contains("200 lights") && e.contains("limit of 1024 MiB"), "{e}");
     }
 
     #[test]

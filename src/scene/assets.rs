@@ -1,6 +1,7 @@
 //! Files a scene refers to: compiled-in assets (the built-in scenes' models
 //! and textures, under `BUILTIN_ROOT`) or real paths on disk.
 
+use crate::input::{read_file, InputKind};
 use std::path::{Component, Path, PathBuf};
 
 /// The root that built-in scenes' relative paths resolve under.
@@ -20,8 +21,8 @@ const FILES: &[(&str, &[u8])] = &[
 ];
 
 /// Reads a file a scene refers to: from the compiled-in assets for paths under
-/// `BUILTIN_ROOT`, otherwise from disk.
-pub fn read_asset(path: &Path) -> Result<Vec<u8>, String> {
+/// `BUILTIN_ROOT`, otherwise from disk through the bounded reader.
+pub fn read_asset(path: &Path, kind: InputKind) -> Result<Vec<u8>, String> {
     let clean = lexical_normalize(path);
     if let Ok(rest) = clean.strip_prefix(BUILTIN_ROOT) {
         let key = rest.to_string_lossy().replace('\\', "/");
@@ -31,7 +32,7 @@ pub fn read_asset(path: &Path) -> Result<Vec<u8>, String> {
             .map(|(_, bytes)| bytes.to_vec())
             .ok_or_else(|| format!("{}: no such built-in asset", path.display()));
     }
-    std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))
+    read_file(path, kind)
 }
 
 /// Resolves `.` and `..` without touching the file system.
@@ -57,7 +58,7 @@ mod tests {
 
     #[test]
     fn builtin_paths_resolve() {
-        assert!(read_asset(Path::new("<builtin>/scenes/../models/teapot.obj")).is_ok());
-        assert!(read_asset(Path::new("<builtin>/scenes/../models/nope.obj")).is_err());
+        assert!(read_asset(Path::new("<builtin>/scenes/../models/teapot.obj"), InputKind::Mesh).is_ok());
+        assert!(read_asset(Path::new("<builtin>/scenes/../models/nope.obj"), InputKind::Mesh).is_err());
     }
 }

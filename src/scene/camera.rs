@@ -9,6 +9,11 @@ pub mod control;
 
 use crate::math::{Mat3, Ray, Vec2, Vec3};
 
+/// The field of view a camera may have, in degrees: narrower than this the
+/// image plane is smaller than f32 can resolve, wider the projection blows up.
+pub const MIN_FOV_DEG: f32 = 0.001;
+pub const MAX_FOV_DEG: f32 = 179.9;
+
 /// Which image edges the field of view spans.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Fov {
@@ -44,23 +49,29 @@ impl Default for Camera {
 impl Camera {
     /// Checks the camera can form an image; the message names the field at fault.
     pub fn validate(&self) -> Result<(), String> {
+        use crate::input::MAX_COORDINATE;
         for (name, v) in [("eye", self.eye), ("target", self.target), ("up", self.up)] {
             if !crate::math::is_finite(v) {
                 return Err(format!("camera.{name} is not finite"));
+            }
+        }
+        for (name, v) in [("eye", self.eye), ("target", self.target)] {
+            if v.abs().max_element() > MAX_COORDINATE {
+                return Err(format!("camera.{name} is {v}; coordinates must be between -{MAX_COORDINATE:e} and {MAX_COORDINATE:e}"));
             }
         }
         let forward = self.target - self.eye;
         if forward.length_squared() < 1e-20 {
             return Err("camera.eye and camera.target are the same point".into());
         }
-        if forward.normalize().cross(self.up).length_squared() < 1e-12 {
-            return Err("camera.up is parallel to the view direction".into());
+        if forward.normalize().cross(crate::math::rescale_direction(self.up)).length_squared() < 1e-12 {
+            return Err("camera.up is parallel to the view direction (or zero)".into());
         }
         let deg = match self.fov {
             Fov::X(d) | Fov::Y(d) => d,
         };
-        if !(deg > 0.0 && deg < 180.0) {
-            return Err(format!("camera field of view {deg} is not between 0 and 180 degrees"));
+        if !((MIN_FOV_DEG..=MAX_FOV_DEG).contains(&deg)) {
+            return Err(format!("camera field of view {deg} is not between {MIN_FOV_DEG} and {MAX_FOV_DEG} degrees"));
         }
         if !(self.near > 0.0 && self.near < self.far && self.far.is_finite()) {
             return Err(format!(
@@ -96,7 +107,7 @@ pub struct CameraView {
 impl CameraView {
     pub fn new(camera: &Camera, width: u32, height: u32) -> CameraView {
         let forward = (camera.target - camera.eye).normalize();
-        let right = forward.cross(camera.up).normalize();
+        let right = forward.cross(crate::math::rescale_direction(camera.up)).normalize();
         let up = right.cross(forward);
         let camera_to_world = Mat3::from_cols(right, up, -forward);
         let aspect = width as f32 / height as f32;
@@ -277,5 +288,16 @@ mod tests {
         let mut c = Camera::default();
         c.eye.x = f32::NAN;
         assert!(c.validate().unwrap_err().contains("eye"));
+        let mut c = Camera::default();
+        c.fov = Fov::Y(1e-45);
+        assert!(c.validate().unwrap_err().contains("between 0.001 and 179.9"));
+        let mut c = Camera::default();
+        c.eye.z = 1e20;
+        assert!(c.validate().unwrap_err().contains("between -1e6 and 1e6"));
+        // A huge up vector is a direction like any other.
+        let mut c = Camera::default();
+        c.up = Vec3::new(0.0, 1e20, 0.0);
+        assert!(c.validate().is_ok());
+        assert_eq!(c.view(8, 6).eye_ray(4.0, 3.0).dir, Camera::default().view(8, 6).eye_ray(4.0, 3.0).dir);
     }
 }

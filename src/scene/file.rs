@@ -5,7 +5,14 @@
 use super::obj::{self, NormalMode};
 use super::texture::load_texture;
 use super::{Camera, Fov, Light, Material, ObjectInfo, RenderDefaults, Scene, Sphere, Triangle};
+use crate::input::{MAX_COORDINATE, MAX_LIGHT, MAX_VALUE};
 use crate::math::{Vec2, Vec3};
+
+/// Largest index of refraction.
+const MAX_IOR: f32 = 100.0;
+/// Smallest and largest size of a scale factor.
+const MIN_SCALE: f32 = 1e-6;
+const MAX_SCALE: f32 = 1e6;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -28,9 +35,9 @@ struct SceneDesc {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct CameraDesc {
-    eye: Option<[f32; 3]>,
-    target: Option<[f32; 3]>,
-    up: Option<[f32; 3]>,
+    eye: Option<F3>,
+    target: Option<F3>,
+    up: Option<F3>,
     fov_y_deg: Option<f32>,
     fov_x_deg: Option<f32>,
     near: Option<f32>,
@@ -42,8 +49,8 @@ struct CameraDesc {
 struct RenderDesc {
     width: Option<i64>,
     height: Option<i64>,
-    background: Option<[f32; 3]>,
-    ambient: Option<[f32; 3]>,
+    background: Option<F3>,
+    ambient: Option<F3>,
     exposure: Option<f32>,
     reference: Option<String>,
 }
@@ -53,29 +60,29 @@ struct RenderDesc {
 struct LightDesc {
     #[serde(rename = "type")]
     kind: String,
-    position: Option<[f32; 3]>,
-    power: Option<[f32; 3]>,
-    direction: Option<[f32; 3]>,
-    irradiance: Option<[f32; 3]>,
+    position: Option<F3>,
+    power: Option<F3>,
+    direction: Option<F3>,
+    irradiance: Option<F3>,
 }
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct MaterialDesc {
-    lambertian: Option<[f32; 3]>,
-    glossy: Option<[f32; 3]>,
+    lambertian: Option<F3>,
+    glossy: Option<F3>,
     sharpness: Option<f32>,
-    mirror: Option<[f32; 3]>,
-    transmission: Option<[f32; 3]>,
+    mirror: Option<F3>,
+    transmission: Option<F3>,
     ior: Option<f32>,
     texture: Option<String>,
 }
 
 #[derive(Deserialize)]
-#[serde(untagged)]
+#[serde(untagged, expecting = "`scale` must be one number or an array of three numbers [x, y, z]")]
 enum ScaleDesc {
     Uniform(f32),
-    PerAxis([f32; 3]),
+    PerAxis(F3),
 }
 
 #[derive(Deserialize)]
@@ -87,27 +94,59 @@ struct ObjectDesc {
     normals: Option<Normals>,
     material: Option<String>,
     two_sided: Option<bool>,
-    translate: Option<[f32; 3]>,
-    rotate_deg: Option<[f32; 3]>,
+    translate: Option<F3>,
+    rotate_deg: Option<F3>,
     scale: Option<ScaleDesc>,
-    vertices: Option<Vec<[f32; 3]>>,
-    uvs: Option<Vec<[f32; 2]>>,
-    center: Option<[f32; 3]>,
+    vertices: Option<Vec<F3>>,
+    uvs: Option<Vec<F2>>,
+    center: Option<F3>,
     radius: Option<f32>,
     // `normals` for triangles is a list of vectors; meshes use the mode string.
 }
 
 /// `normals` is a mode string on meshes and a list of three vectors on triangles.
 #[derive(Deserialize)]
-#[serde(untagged)]
+#[serde(
+    untagged,
+    expecting = "`normals` must be \"auto\", \"smooth\" or \"flat\" on a mesh, or one [x, y, z] per vertex on a triangle or quad"
+)]
 enum Normals {
     Mode(NormalMode),
-    PerVertex(Vec<[f32; 3]>),
+    PerVertex(Vec<F3>),
+}
+
+/// N numbers, exactly: serde's fixed arrays would silently drop extra
+/// elements (`eye = [0, 0, 3, 99]`).
+#[derive(Deserialize, Clone, Copy)]
+#[serde(try_from = "Vec<f32>")]
+struct Numbers<const N: usize>([f32; N]);
+type F3 = Numbers<3>;
+type F2 = Numbers<2>;
+
+impl<const N: usize> TryFrom<Vec<f32>> for Numbers<N> {
+    type Error = String;
+    fn try_from(v: Vec<f32>) -> Result<Self, String> {
+        let n = v.len();
+        v.try_into().map(Numbers).map_err(|_| format!("expected an array of {N} numbers, found {n}"))
+    }
+}
+
+impl From<Numbers<3>> for Vec3 {
+    fn from(n: Numbers<3>) -> Vec3 {
+        Vec3::from(n.0)
+    }
+}
+
+impl From<Numbers<2>> for Vec2 {
+    fn from(n: Numbers<2>) -> Vec2 {
+        Vec2::from(n.0)
+    }
 }
 
 /// Reads and parses a scene file from disk.
 pub fn load_scene_file(path: &Path) -> Result<Scene, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: cannot read scene file: {e}", path.display()))?;
+    let bytes = crate::input::read_file(path, crate::input::InputKind::Scene)?;
+    let text = String::from_utf8(bytes).map_err(|_| format!("{}: cannot read scene file: it is not UTF-8 text", path.display()))?;
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
     parse_scene(&text, &path.display().to_string(), &base, &name)
@@ -116,6 +155,12 @@ pub fn load_scene_file(path: &Path) -> Result<Scene, String> {
 /// Parses scene TOML. `origin` names the source in messages; `base` resolves
 /// relative paths.
 pub fn parse_scene(text: &str, origin: &str, base: &Path, name: &str) -> Result<Scene, String> {
+    parse_scene_unbounded(text, origin, base, name).map_err(|e| crate::input::bounded_message(&e))
+}
+
+/// `parse_scene` before its message is bounded: messages quote names from
+/// the file (materials, types, paths), which can be of any length.
+fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str) -> Result<Scene, String> {
     let desc: SceneDesc = toml::from_str(text).map_err(|e| toml_error(origin, text, &e))?;
     let at = |span: std::ops::Range<usize>| format!("{origin}:{}", line_of(text, span.start));
     let mut scene = Scene { name: name.to_string(), ..Scene::default() };
@@ -155,13 +200,13 @@ pub fn parse_scene(text: &str, origin: &str, base: &Path, name: &str) -> Result<
         scene.render = RenderDefaults {
             width: dim(r.width, "width", d.width)?,
             height: dim(r.height, "height", d.height)?,
-            background: color(r.background, d.background, &where_, "render.background")?,
-            ambient: color(r.ambient, d.ambient, &where_, "render.ambient")?,
+            background: color(r.background, d.background, MAX_VALUE, &where_, "render.background")?,
+            ambient: color(r.ambient, d.ambient, MAX_VALUE, &where_, "render.ambient")?,
             exposure: r.exposure.unwrap_or(d.exposure),
             reference: r.reference.as_ref().map(|f| base.join(f)),
         };
-        if !(scene.render.exposure.is_finite() && scene.render.exposure >= 0.0) {
-            return Err(format!("{where_}: render.exposure must be a finite number >= 0"));
+        if !(scene.render.exposure.is_finite() && scene.render.exposure >= 0.0 && scene.render.exposure <= MAX_VALUE) {
+            return Err(format!("{where_}: render.exposure must be a finite number >= 0 (at most {MAX_VALUE:e})"));
         }
     }
 
@@ -172,42 +217,48 @@ pub fn parse_scene(text: &str, origin: &str, base: &Path, name: &str) -> Result<
             "point" => {
                 reject(&where_, "point light", &[("direction", l.direction.is_some()), ("irradiance", l.irradiance.is_some())])?;
                 Light::Point {
-                    position: finite(l.position, &where_, "position")?.ok_or(format!("{where_}: a point light needs `position`"))?,
-                    power: color(l.power, Vec3::ZERO, &where_, "power")?,
+                    position: position(l.position, &where_, "position")?.ok_or(format!("{where_}: a point light needs `position`"))?,
+                    power: color(l.power, Vec3::ZERO, MAX_LIGHT, &where_, "power")?,
                 }
             }
             "directional" => {
                 reject(&where_, "directional light", &[("position", l.position.is_some()), ("power", l.power.is_some())])?;
                 let dir = finite(l.direction, &where_, "direction")?.ok_or(format!("{where_}: a directional light needs `direction`"))?;
+                // Only the direction matters: a huge or tiny vector is scaled
+                // (exactly, by a power of two) so that normalizing it cannot overflow.
+                let dir = crate::math::rescale_direction(dir);
                 if dir.length_squared() < 1e-20 {
                     return Err(format!("{where_}: direction must not be zero"));
                 }
-                Light::Directional { direction: dir.normalize(), irradiance: color(l.irradiance, Vec3::ZERO, &where_, "irradiance")? }
+                Light::Directional { direction: dir.normalize(), irradiance: color(l.irradiance, Vec3::ZERO, MAX_LIGHT, &where_, "irradiance")? }
             }
             other => return Err(format!("{where_}: unknown light type \"{other}\" (expected \"point\" or \"directional\")")),
         };
         scene.lights.push(light);
     }
 
+    // Textures are decoded after the objects are known, and only for
+    // materials something is drawn with.
+    let mut textures = Vec::new();
     for (mat_name, m) in &desc.materials {
         let where_ = format!("{}: material \"{mat_name}\"", at(m.span()));
         let m = m.get_ref();
         let mut mat = Material::black();
         mat.name = mat_name.clone();
-        mat.lambertian = color(m.lambertian, Vec3::ZERO, &where_, "lambertian")?;
-        mat.glossy = color(m.glossy, Vec3::ZERO, &where_, "glossy")?;
-        mat.mirror = color(m.mirror, Vec3::ZERO, &where_, "mirror")?;
-        mat.transmission = color(m.transmission, Vec3::ZERO, &where_, "transmission")?;
+        mat.lambertian = color(m.lambertian, Vec3::ZERO, MAX_VALUE, &where_, "lambertian")?;
+        mat.glossy = color(m.glossy, Vec3::ZERO, MAX_VALUE, &where_, "glossy")?;
+        mat.mirror = color(m.mirror, Vec3::ZERO, MAX_VALUE, &where_, "mirror")?;
+        mat.transmission = color(m.transmission, Vec3::ZERO, MAX_VALUE, &where_, "transmission")?;
         mat.sharpness = m.sharpness.unwrap_or(100.0);
-        if !(mat.sharpness.is_finite() && mat.sharpness >= 0.0) {
-            return Err(format!("{where_}: sharpness must be a finite number >= 0"));
+        if !(mat.sharpness.is_finite() && mat.sharpness >= 0.0 && mat.sharpness <= MAX_VALUE) {
+            return Err(format!("{where_}: sharpness must be a finite number >= 0 (at most {MAX_VALUE:e})"));
         }
         mat.ior = m.ior.unwrap_or(1.5);
-        if !(mat.ior.is_finite() && mat.ior > 0.0) {
-            return Err(format!("{where_}: ior must be a finite number > 0"));
+        if !(mat.ior.is_finite() && mat.ior > 0.0 && mat.ior <= MAX_IOR) {
+            return Err(format!("{where_}: ior must be a finite number > 0 (at most {MAX_IOR})"));
         }
         if let Some(tex) = &m.texture {
-            mat.texture = Some(Arc::new(load_texture(&base.join(tex)).map_err(|e| format!("{where_}: texture: {e}"))?));
+            textures.push((scene.materials.len(), base.join(tex), where_));
         }
         scene.materials.push(mat);
     }
@@ -215,6 +266,12 @@ pub fn parse_scene(text: &str, origin: &str, base: &Path, name: &str) -> Result<
     for (i, o) in desc.object.iter().enumerate() {
         let where_ = format!("{}: object {}", at(o.span()), i + 1);
         add_object(&mut scene, o.get_ref(), i as u32, &where_, base)?;
+    }
+    for (index, path, where_) in textures {
+        let drawn = scene.triangles.iter().any(|t| t.material as usize == index) || scene.spheres.iter().any(|s| s.material as usize == index);
+        if drawn {
+            scene.materials[index].texture = Some(Arc::new(load_texture(&path).map_err(|e| format!("{where_}: texture: {e}"))?));
+        }
     }
     Ok(scene)
 }
@@ -260,7 +317,9 @@ fn add_object(scene: &mut Scene, o: &ObjectDesc, object: u32, where_: &str, base
                 Some(Normals::PerVertex(_)) => return Err(format!("{where_}: mesh `normals` must be \"auto\", \"smooth\" or \"flat\"")),
             };
             let path = base.join(file);
-            let loaded = obj::load_obj(&path, mode).map_err(|e| format!("{where_}: {e}"))?;
+            let textures = if explicit_material.is_some() { obj::MtlTextures::None } else { obj::MtlTextures::Used };
+            let loaded = obj::load_obj(&path, mode, textures).map_err(|e| format!("{where_}: {e}"))?;
+            scene.warnings.extend(loaded.warnings);
             if loaded.degenerate > 0 {
                 scene.warnings.push(format!("{}: skipped {} triangles with zero area", path.display(), loaded.degenerate));
             }
@@ -296,10 +355,13 @@ fn add_object(scene: &mut Scene, o: &ObjectDesc, object: u32, where_: &str, base
             if vs.iter().any(|v| !crate::math::is_finite(*v)) {
                 return Err(format!("{where_}: vertices must be finite numbers"));
             }
+            if let Some(v) = vs.iter().find(|v| v.abs().max_element() > MAX_COORDINATE) {
+                return Err(format!("{where_}: vertex {v} is out of range; coordinates must be between -{MAX_COORDINATE:e} and {MAX_COORDINATE:e}"));
+            }
             let ns: Option<Vec<Vec3>> = match &o.normals {
                 None => None,
                 Some(Normals::PerVertex(ns)) if ns.len() == count => {
-                    let ns: Vec<Vec3> = ns.iter().map(|n| Vec3::from(*n)).collect();
+                    let ns: Vec<Vec3> = ns.iter().map(|n| crate::math::rescale_direction(Vec3::from(*n))).collect();
                     if ns.iter().any(|n| !crate::math::is_finite(*n) || n.length_squared() < 1e-20) {
                         return Err(format!("{where_}: normals must be finite, non-zero vectors"));
                     }
@@ -337,10 +399,10 @@ fn add_object(scene: &mut Scene, o: &ObjectDesc, object: u32, where_: &str, base
         }
         "sphere" => {
             only(&["center", "radius"])?;
-            let center = finite(o.center, where_, "center")?.ok_or(format!("{where_}: a sphere needs `center`"))?;
+            let center = position(o.center, where_, "center")?.ok_or(format!("{where_}: a sphere needs `center`"))?;
             let radius = o.radius.ok_or(format!("{where_}: a sphere needs `radius`"))?;
-            if !(radius.is_finite() && radius > 0.0) {
-                return Err(format!("{where_}: radius must be a finite number > 0, found {radius}"));
+            if !(radius.is_finite() && radius > 0.0 && radius <= MAX_COORDINATE) {
+                return Err(format!("{where_}: radius must be a finite number > 0 and at most {MAX_COORDINATE:e}, found {radius}"));
             }
             let material = match explicit_material {
                 Some(m) => m,
@@ -348,9 +410,19 @@ fn add_object(scene: &mut Scene, o: &ObjectDesc, object: u32, where_: &str, base
             };
             // A sphere stays analytic, so only uniform scale keeps it a sphere.
             let (center, radius) = placement.apply_sphere(center, radius).map_err(|e| format!("{where_}: {e}"))?;
+            if center.abs().max_element() > MAX_COORDINATE || radius > MAX_COORDINATE {
+                return Err(format!(
+                    "{where_}: placed, the sphere has centre {center} and radius {radius}; coordinates must be between -{MAX_COORDINATE:e} and {MAX_COORDINATE:e}"
+                ));
+            }
             scene.spheres.push(Sphere { center, radius, material, object });
         }
         other => return Err(format!("{where_}: unknown object type \"{other}\" (expected mesh, triangle, quad or sphere)")),
+    }
+    // Placement (scale, translate) can carry in-range vertices out of range.
+    if let Some(t) = scene.triangles[first..].iter().find(|t| t.v.iter().any(|v| !(v.abs().max_element() <= MAX_COORDINATE))) {
+        let v = t.v.into_iter().find(|v| !(v.abs().max_element() <= MAX_COORDINATE)).unwrap_or_default();
+        return Err(format!("{where_}: placed, a vertex lands at {v}; coordinates must be between -{MAX_COORDINATE:e} and {MAX_COORDINATE:e}"));
     }
     let name = match (&o.file, kind) {
         (Some(f), _) => Path::new(f).file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default(),
@@ -407,7 +479,7 @@ impl Placement {
 }
 
 fn placement(o: &ObjectDesc, where_: &str) -> Result<Placement, String> {
-    let translate = finite(o.translate, where_, "translate")?.unwrap_or(Vec3::ZERO);
+    let translate = position(o.translate, where_, "translate")?.unwrap_or(Vec3::ZERO);
     let rotate = finite(o.rotate_deg, where_, "rotate_deg")?.unwrap_or(Vec3::ZERO);
     let scale = match &o.scale {
         None => Vec3::ONE,
@@ -416,6 +488,14 @@ fn placement(o: &ObjectDesc, where_: &str) -> Result<Placement, String> {
     };
     if !crate::math::is_finite(scale) || scale.x * scale.y * scale.z == 0.0 {
         return Err(format!("{where_}: scale must be finite and non-zero"));
+    }
+    let size = scale.abs();
+    if size.min_element() < MIN_SCALE || size.max_element() > MAX_SCALE {
+        return Err(format!("{where_}: scale {scale} is out of range; each factor's size must be from {MIN_SCALE:e} to {MAX_SCALE:e}"));
+    }
+    let rotate_size = rotate.abs().max_element();
+    if rotate_size > 1e6 {
+        return Err(format!("{where_}: rotate_deg {rotate} is out of range (at most 1e6 degrees)"));
     }
     Ok(Placement::new(translate, rotate, scale))
 }
@@ -427,7 +507,7 @@ fn reject(where_: &str, what: &str, keys: &[(&str, bool)]) -> Result<(), String>
     }
 }
 
-fn finite(v: Option<[f32; 3]>, where_: &str, key: &str) -> Result<Option<Vec3>, String> {
+fn finite(v: Option<F3>, where_: &str, key: &str) -> Result<Option<Vec3>, String> {
     match v.map(Vec3::from) {
         Some(v) if !crate::math::is_finite(v) => Err(format!("{where_}: `{key}` must be finite numbers, found {v}")),
         other => Ok(other),
@@ -435,12 +515,22 @@ fn finite(v: Option<[f32; 3]>, where_: &str, key: &str) -> Result<Option<Vec3>, 
 }
 
 /// A radiance, power or reflectance: finite and not negative.
-fn color(v: Option<[f32; 3]>, default: Vec3, where_: &str, key: &str) -> Result<Vec3, String> {
+fn color(v: Option<F3>, default: Vec3, max: f32, where_: &str, key: &str) -> Result<Vec3, String> {
     let v = v.map(Vec3::from).unwrap_or(default);
-    if !crate::math::is_finite(v) || v.min_element() < 0.0 {
-        return Err(format!("{where_}: `{key}` must be finite and not negative, found {v}"));
+    if !crate::math::is_finite(v) || v.min_element() < 0.0 || v.max_element() > max {
+        return Err(format!("{where_}: `{key}` must be finite and not negative (at most {max:e}), found {v}"));
     }
     Ok(v)
+}
+
+/// A point in the scene: finite and within `MAX_COORDINATE` on every axis.
+fn position(v: Option<F3>, where_: &str, key: &str) -> Result<Option<Vec3>, String> {
+    match finite(v, where_, key)? {
+        Some(p) if p.abs().max_element() > MAX_COORDINATE => Err(format!(
+            "{where_}: `{key}` is {p}; coordinates must be between -{MAX_COORDINATE:e} and {MAX_COORDINATE:e}"
+        )),
+        other => Ok(other),
+    }
 }
 
 /// 1-based line of a byte offset.
@@ -449,13 +539,24 @@ fn line_of(text: &str, offset: usize) -> usize {
 }
 
 fn toml_error(origin: &str, text: &str, e: &toml::de::Error) -> String {
-    let msg = e.message().trim().replace('\n', " ");
+    let msg = shorten(&e.message().trim().replace('\n', " "), MAX_ECHO_CHARS);
     match e.span() {
         Some(span) => {
             let line = line_of(text, span.start);
-            let snippet = text.lines().nth(line - 1).unwrap_or("").trim();
+            let snippet = shorten(text.lines().nth(line - 1).unwrap_or("").trim(), MAX_ECHO_CHARS);
             format!("{origin}:{line}: {msg} (in `{snippet}`)")
         }
         None => format!("{origin}: {msg}"),
+    }
+}
+
+/// Most characters of the scene file a message echoes: a 5 MB line must
+/// not make a 5 MB message.
+const MAX_ECHO_CHARS: usize = 200;
+
+fn shorten(s: &str, max: usize) -> String {
+    match s.char_indices().nth(max) {
+        Some((cut, _)) => format!("{}...", &s[..cut]),
+        None => s.to_string(),
     }
 }

@@ -5,6 +5,7 @@
 //! `map_Kd` -> texture. Other MTL terms are ignored.
 
 use super::assets::read_asset;
+use crate::input::{InputKind, MAX_COORDINATE, MAX_VALUE};
 use super::texture::load_texture;
 use super::{Camera, Fov, Light, Material, ObjectInfo, Scene, Triangle};
 use crate::math::{Vec2, Vec3};
@@ -28,65 +29,106 @@ pub struct LoadedMesh {
     pub materials: Vec<Material>,
     /// Triangles dropped because they have no area.
     pub degenerate: usize,
+    /// Things that load but are probably not what the file meant: a missing
+    /// or broken MTL file, a `usemtl` naming no material.
+    pub warnings: Vec<String>,
 }
 
-pub fn load_obj(path: &Path, mode: NormalMode) -> Result<LoadedMesh, String> {
+/// Which of the file's MTL materials to load textures for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MtlTextures {
+    /// Those of materials a face uses.
+    Used,
+    /// None: the mesh is drawn with a material of the scene instead.
+    None,
+}
+
+pub fn load_obj(path: &Path, mode: NormalMode, textures: MtlTextures) -> Result<LoadedMesh, String> {
+    load_obj_unbounded(path, mode, textures).map_err(|e| crate::input::bounded_message(&e))
+}
+
+/// `load_obj` before its message is bounded (MTL material names are echoed).
+fn load_obj_unbounded(path: &Path, mode: NormalMode, textures: MtlTextures) -> Result<LoadedMesh, String> {
     let name = path.display();
-    let bytes = read_asset(path).map_err(|e| format!("cannot read OBJ {e}"))?;
+    let bytes = read_asset(path, InputKind::Mesh).map_err(|e| format!("cannot read OBJ {e}"))?;
     let base = path.parent().unwrap_or(Path::new("."));
     let options = tobj::LoadOptions { triangulate: true, single_index: false, ignore_points: true, ignore_lines: true };
     // The first malformed MTL line, reported with its file and line: tobj's
     // material loader can only say that it failed.
     let mtl_error = std::cell::RefCell::new(None);
-    let (models, mtl) = tobj::load_obj_buf(&mut std::io::Cursor::new(bytes), &options, |mtl_path| {
+    let warnings = std::cell::RefCell::new(Vec::new());
+    let (models, mtl) = tobj::load_obj_buf(&mut std::io::Cursor::new(&bytes), &options, |mtl_path| {
         let mtl_file = base.join(mtl_path);
-        let data = read_asset(&mtl_file).map_err(|_| tobj::LoadError::OpenFileFailed)?;
+        let data = read_asset(&mtl_file, InputKind::Mtl).map_err(|e| {
+            warnings.borrow_mut().push(format!("{name}: cannot read its MTL file ({e}); its faces use the default material"));
+            tobj::LoadError::OpenFileFailed
+        })?;
         let data = normalize_mtl_colours(&data).map_err(|e| {
             *mtl_error.borrow_mut() = Some(format!("{}:{e}", mtl_file.display()));
             tobj::LoadError::MaterialParseError
         })?;
-        tobj::load_mtl_buf(&mut std::io::Cursor::new(data))
+        tobj::load_mtl_buf(&mut std::io::Cursor::new(data)).inspect_err(|e| {
+            warnings.borrow_mut().push(format!("{}: cannot parse the MTL file ({e}); its faces use the default material", mtl_file.display()));
+        })
     })
     .map_err(|e| format!("{name}: cannot read OBJ: {e}"))?;
     if let Some(e) = mtl_error.into_inner() {
         return Err(e);
     }
+    let mut warnings = warnings.into_inner();
+    let used: std::collections::HashSet<usize> = models.iter().filter_map(|m| m.mesh.material_id).collect();
     let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     let materials = match mtl {
-        Ok(ms) => ms
-            .iter()
-            .map(|m| {
-                let mut mat = Material::black();
-                mat.name = format!("{stem}/{}", m.name);
-                mat.lambertian = m.diffuse.map(Vec3::from).unwrap_or(Vec3::splat(0.8));
-                mat.glossy = m.specular.map(Vec3::from).unwrap_or(Vec3::ZERO);
-                mat.sharpness = m.shininess.unwrap_or(100.0);
-                if let Some(tex) = &m.diffuse_texture {
-                    mat.texture = Some(Arc::new(load_texture(&base.join(tex)).map_err(|e| format!("{name}: MTL {}: {e}", m.name))?));
-                }
-                if !crate::math::is_finite(mat.lambertian) || !crate::math::is_finite(mat.glossy) || !mat.sharpness.is_finite() {
-                    return Err(format!("{name}: MTL material {} has values that are not finite", m.name));
-                }
-                Ok(mat)
-            })
-            .collect::<Result<Vec<_>, String>>()?,
-        // A missing or broken MTL is not fatal: the mesh falls back to the default material.
-        Err(_) => Vec::new(),
+        Ok(ms) => {
+            if let Some(undefined) = undefined_usemtl(&bytes, &ms) {
+                warnings.push(format!("{name}: `usemtl {undefined}` names no material of its MTL files; those faces use the default material"));
+            }
+            ms.iter()
+                .enumerate()
+                .map(|(i, m)| {
+                    let mut mat = mtl_material(m).map_err(|e| format!("{name}: MTL material \"{}\": {e}", m.name))?;
+                    mat.name = format!("{stem}/{}", m.name);
+                    // A texture is decoded only when a face is drawn with it.
+                    if let (Some(tex), MtlTextures::Used, true) = (&m.diffuse_texture, textures, used.contains(&i)) {
+                        mat.texture = Some(Arc::new(load_texture(&base.join(tex)).map_err(|e| format!("{name}: MTL {}: {e}", m.name))?));
+                    }
+                    Ok(mat)
+                })
+                .collect::<Result<Vec<_>, String>>()?
+        }
+        // A missing or broken MTL is not fatal: the mesh falls back to the
+        // default material (the loader above has said why).
+        Err(e) => {
+            if warnings.is_empty() {
+                warnings.push(format!("{name}: cannot load its MTL file ({e}); its faces use the default material"));
+            }
+            Vec::new()
+        }
     };
 
     let mut triangles = Vec::new();
     let mut degenerate = 0;
     for model in &models {
         let m = &model.mesh;
+        // The object's name as messages echo it: a file's name line can be any length.
+        let model_name: String = model.name.chars().take(60).collect();
         let pos: Vec<Vec3> = m.positions.chunks_exact(3).map(|p| Vec3::new(p[0], p[1], p[2])).collect();
         if let Some(i) = pos.iter().position(|p| !crate::math::is_finite(*p)) {
-            return Err(format!("{name}: vertex {} of \"{}\" is not finite", i + 1, model.name));
+            return Err(format!("{name}: vertex {} of \"{}\" is not finite", i + 1, model_name));
+        }
+        if let Some(i) = pos.iter().position(|p| p.abs().max_element() > MAX_COORDINATE) {
+            return Err(format!(
+                "{name}: vertex {} of \"{}\" is {}; coordinates must be between -{MAX_COORDINATE:e} and {MAX_COORDINATE:e}",
+                i + 1,
+                model_name,
+                pos[i]
+            ));
         }
         let normals: Vec<Vec3> = m.normals.chunks_exact(3).map(|p| Vec3::new(p[0], p[1], p[2])).collect();
         let uvs: Vec<Vec2> = m.texcoords.chunks_exact(2).map(|p| Vec2::new(p[0], p[1])).collect();
         let check = |idx: &[u32], len: usize, what: &str| -> Result<(), String> {
             match idx.iter().find(|&&i| i as usize >= len) {
-                Some(i) => Err(format!("{name}: a face of \"{}\" uses {what} {} but the file has only {len}", model.name, i + 1)),
+                Some(i) => Err(format!("{name}: a face of \"{model_name}\" uses {what} {} but the file has only {len}", i + 1)),
                 None => Ok(()),
             }
         };
@@ -139,7 +181,7 @@ pub fn load_obj(path: &Path, mode: NormalMode) -> Result<LoadedMesh, String> {
     if triangles.is_empty() {
         return Err(format!("{name}: the OBJ has no triangles with area"));
     }
-    Ok(LoadedMesh { triangles, materials, degenerate })
+    Ok(LoadedMesh { triangles, materials, degenerate, warnings })
 }
 
 /// Area-weighted vertex normals (the un-normalized face normal is already
@@ -161,11 +203,15 @@ fn smooth_normals(pos: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
 /// A scene around a bare `.obj`: camera on +z looking at the bounding-box
 /// centre with the whole box in view, one point light above and behind it.
 pub fn frame_bare_obj(path: &Path) -> Result<Scene, String> {
-    let mesh = load_obj(path, NormalMode::Auto)?;
+    let mesh = load_obj(path, NormalMode::Auto, MtlTextures::Used)?;
     let mut scene = Scene {
         name: path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "mesh".into()),
         ..Scene::default()
     };
+    scene.warnings = mesh.warnings;
+    if mesh.degenerate > 0 {
+        scene.warnings.push(format!("{}: skipped {} triangles with zero area", path.display(), mesh.degenerate));
+    }
     scene.materials = mesh.materials;
     let fallback = scene.default_material_index();
     scene.triangles = mesh
@@ -205,6 +251,36 @@ pub fn frame_camera(scene: &mut Scene, lo: Vec3, hi: Vec3) {
     let d2 = (light_pos - center).length_squared();
     // About irradiance 3 W/m^2 at the object: a well-exposed grey at exposure 1.
     scene.lights.push(Light::Point { position: light_pos, power: Vec3::splat(3.0 * 4.0 * std::f32::consts::PI * d2) });
+}
+
+/// The MTL terms pinhole uses, checked as the scene file's materials are:
+/// colours finite and from 0 to `MAX_VALUE`, `Ns` from 0 to `MAX_VALUE`.
+fn mtl_material(m: &tobj::Material) -> Result<Material, String> {
+    let colour = |v: Option<[f32; 3]>, default: Vec3, key: &str| -> Result<Vec3, String> {
+        let c = v.map(Vec3::from).unwrap_or(default);
+        if !crate::math::is_finite(c) || c.min_element() < 0.0 || c.max_element() > MAX_VALUE {
+            return Err(format!("{key} must be finite numbers from 0 to {MAX_VALUE:e}, found {c}"));
+        }
+        Ok(c)
+    };
+    let mut mat = Material::black();
+    mat.lambertian = colour(m.diffuse, Vec3::splat(0.8), "Kd")?;
+    mat.glossy = colour(m.specular, Vec3::ZERO, "Ks")?;
+    mat.sharpness = m.shininess.unwrap_or(100.0);
+    if !(mat.sharpness.is_finite() && (0.0..=MAX_VALUE).contains(&mat.sharpness)) {
+        return Err(format!("Ns must be a finite number from 0 to {MAX_VALUE:e}, found {}", mat.sharpness));
+    }
+    Ok(mat)
+}
+
+/// The first name a `usemtl` line gives that no loaded material has.
+fn undefined_usemtl(obj: &[u8], materials: &[tobj::Material]) -> Option<String> {
+    String::from_utf8_lossy(obj).lines().find_map(|line| {
+        let rest = line.trim_start().strip_prefix("usemtl")?;
+        let wanted = rest.trim();
+        let defined = wanted.is_empty() || !rest.starts_with(char::is_whitespace) || materials.iter().any(|m| m.name == wanted);
+        (!defined).then(|| wanted.chars().take(60).collect())
+    })
 }
 
 /// MTL colour statements (`Ka`, `Kd`, `Ks`, `Ke`, `Tf`) as tobj can read

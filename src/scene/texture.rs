@@ -1,6 +1,7 @@
 //! Textures: image files decoded into linear RGB, sampled bilinearly.
 
 use super::assets::read_asset;
+use crate::input::{decode_image, InputKind, MAX_VALUE};
 use crate::math::{Vec2, Vec3};
 use std::path::Path;
 
@@ -31,19 +32,30 @@ impl Texture {
     }
 }
 
-/// Loads an 8-bit sRGB image (or a float EXR) into a linear texture.
+/// Loads an 8-bit sRGB image (or a float EXR) into a linear texture. A float
+/// texel that is NaN, infinite, negative or above `MAX_VALUE` is an error
+/// naming the texel: such a value would reach pixels through every sample.
 pub fn load_texture(path: &Path) -> Result<Texture, String> {
-    let bytes = read_asset(path).map_err(|e| format!("cannot read {e}"))?;
-    let img = image::load_from_memory(&bytes).map_err(|e| format!("cannot decode {}: {e}", path.display()))?;
+    let bytes = read_asset(path, InputKind::Image).map_err(|e| format!("cannot read {e}"))?;
+    let img = decode_image(&bytes, &path.display().to_string())?;
+    drop(bytes);
     let is_float = matches!(img, image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_));
-    let rgb = img.to_rgb32f();
-    let texels = rgb
-        .pixels()
-        .map(|p| {
-            let c = Vec3::new(p[0], p[1], p[2]);
-            if is_float { c } else { Vec3::new(srgb_to_linear(c.x), srgb_to_linear(c.y), srgb_to_linear(c.z)) }
-        })
-        .collect();
+    let rgb = img.into_rgb32f();
+    let mut texels = Vec::with_capacity(rgb.width() as usize * rgb.height() as usize);
+    for (x, y, p) in rgb.enumerate_pixels() {
+        let c = Vec3::new(p[0], p[1], p[2]);
+        if is_float {
+            if let Some(bad) = c.to_array().into_iter().find(|v| !(v.is_finite() && (0.0..=MAX_VALUE).contains(v))) {
+                return Err(format!(
+                    "{}: texel ({x}, {y}) is {bad}; texels must be finite numbers from 0 to {MAX_VALUE:e}",
+                    path.display()
+                ));
+            }
+            texels.push(c);
+        } else {
+            texels.push(Vec3::new(srgb_to_linear(c.x), srgb_to_linear(c.y), srgb_to_linear(c.z)));
+        }
+    }
     Ok(Texture { width: rgb.width(), height: rgb.height(), texels })
 }
 
