@@ -120,7 +120,9 @@ pub fn method_configurations(scene: &Scene, base: &RenderSettings) -> Vec<Config
     let casts_shadows = !scene.lights.is_empty() && scene.triangles.len() + scene.spheres.len() > 1;
     if casts_shadows {
         add("shadows", raster, with(&|s| s.shadows = ShadowMode::None));
-        for size in [256, 1024, 2048] {
+        // Sizes whose maps for all the scene's lights would not fit in memory are left out.
+        let fits = |size| crate::render::shadow_map::check_memory(scene, size).is_ok();
+        for size in [256, 1024, 2048].into_iter().filter(|&n| fits(n)) {
             add("shadows", raster, with(&|s| {
                 s.shadows = ShadowMode::Map;
                 s.shadow_map_size = size;
@@ -132,7 +134,7 @@ pub fn method_configurations(scene: &Scene, base: &RenderSettings) -> Vec<Config
                 s.shadow_volume = mode;
             }));
         }
-        for bias in [0.1, 8.0] {
+        for bias in [0.1, 8.0].into_iter().filter(|_| fits(shadow_map::DEFAULT_SIZE)) {
             add("shadows", raster, with(&|s| {
                 s.shadows = ShadowMode::Map;
                 s.shadow_map_bias = bias;
@@ -203,6 +205,20 @@ mod tests {
         assert_eq!(map.label, "rasterize:fixed --shadows map --shadow-map-size 256");
         let path = configs.iter().find(|c| c.settings.gi.mode == GiMode::Path && c.settings.spp == 64).unwrap();
         assert_eq!(path.label, "raytrace:bvh --spp 64 --gi path");
+    }
+
+    #[test]
+    fn shadow_maps_that_would_not_fit_in_memory_are_left_out() {
+        let mut scene = crate::scene::builtin::load_builtin("spheres").unwrap().unwrap();
+        let light = scene.lights[0].clone();
+        // 2048^2 texels x 6 faces x 8 bytes = 192 MiB per point light: 6 lights pass 1 GiB.
+        scene.lights = vec![light; 6];
+        let sizes: Vec<u32> = method_configurations(&scene, &RenderSettings::for_scene(&scene))
+            .iter()
+            .filter(|c| c.settings.shadows == ShadowMode::Map)
+            .map(|c| c.settings.shadow_map_size)
+            .collect();
+        assert!(sizes.contains(&1024) && !sizes.contains(&2048), "{sizes:?}");
     }
 
     #[test]
