@@ -292,6 +292,27 @@ fn shadow_map_mode_never_crashes_the_viewer() {
     assert_eq!(shown(h.state()), reference(h.state()));
 }
 
+/// Shadow maps too big for memory (many lights at a large size) are an
+/// error in the viewer, not an abort; a smaller size renders again.
+#[test]
+fn shadow_maps_over_the_memory_limit_are_an_error_not_a_crash() {
+    let mut scene = small_scene("triangle-ground");
+    let light = scene.lights[0].clone();
+    scene.lights = vec![light; 40];
+    let mut h = harness(scene);
+    {
+        let app = h.state_mut();
+        app.settings.shadows = render::ShadowMode::Map;
+        app.settings.per_scene.shadow_map_size = 4096;
+    }
+    settle(&mut h);
+    let error = h.state().with_output(|o| o.error.clone()).expect("an error");
+    assert!(error.contains("shadow maps") && error.contains("MiB"), "{error}");
+    h.state_mut().settings.per_scene.shadow_map_size = 64;
+    settle(&mut h);
+    assert!(h.state().with_output(|o| o.error.is_none() && o.complete));
+}
+
 #[test]
 fn settings_persist_between_runs() {
     use pinhole::app::settings_store::MemoryStorage as Mem;

@@ -427,6 +427,15 @@ impl WorkerLoop {
         };
         let settings = RenderSettings { width: req.settings.width.max(1), height: req.settings.height.max(1), ..req.settings.clone() };
         let (width, height) = (settings.width, settings.height);
+        // What input can make too big is refused here, as on the command
+        // line, rather than aborting the viewer when it is allocated.
+        let maps = settings.shadows == render::ShadowMode::Map || settings.view == View::Shadowmap;
+        let too_big = crate::input::check_image_size(width, height)
+            .and_then(|_| if maps { render::shadow_map::check_memory(&prepared.scene, settings.shadow_map_size) } else { Ok(()) });
+        if let Err(e) = too_big {
+            self.fail(&req, e);
+            return;
+        }
         if self.timed != (req.renderer.clone(), req.scene_id) {
             // Another renderer or scene: old timings mean nothing.
             self.timed = (req.renderer.clone(), req.scene_id);
