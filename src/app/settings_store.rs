@@ -159,6 +159,14 @@ impl ViewerSettings {
         };
     }
 
+    /// Takes `other`'s renderer and render knobs, keeping this one's view,
+    /// display, panels and scene.
+    pub fn take_configuration(&mut self, other: &ViewerSettings) {
+        let keep = (self.scene.take(), self.view, self.res_scale, self.gamma, self.panels);
+        *self = other.clone();
+        (self.scene, self.view, self.res_scale, self.gamma, self.panels) = keep;
+    }
+
     pub fn load(storage: Option<&dyn eframe::Storage>) -> Option<ViewerSettings> {
         storage.and_then(|s| eframe::get_value(s, STORAGE_KEY))
     }

@@ -199,18 +199,9 @@ impl SplitView {
 
     /// Swaps A and B: the live view takes B's configuration and B takes A's.
     pub fn swap(&mut self, a: &mut ViewerSettings) {
-        let (a_renderer, a_knobs) = (a.renderer.clone(), a.clone());
-        let b = std::mem::replace(&mut self.b, a_knobs);
-        a.renderer = b.renderer.clone();
-        a.spp = b.spp;
-        a.shadows = b.shadows;
-        a.shadow_volume = b.shadow_volume;
-        a.shadow_bump = b.shadow_bump;
-        a.max_depth = b.max_depth;
-        a.interpolation = b.interpolation;
-        a.gi = b.gi.clone();
-        a.per_scene = b.per_scene;
-        self.b.renderer = a_renderer;
+        let old_a = a.clone();
+        a.take_configuration(&self.b);
+        self.b = old_a;
     }
 }
 
