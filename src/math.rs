@@ -1,5 +1,7 @@
 //! Small math vocabulary shared by the whole core: rays, radiance, glam re-exports.
 
+pub mod lanes;
+
 pub use glam::{Mat3, Vec2, Vec3};
 
 /// Linear RGB radiance in W/(m²·sr). Never gamma-encoded inside the core.

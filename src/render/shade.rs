@@ -3,29 +3,35 @@
 //! here and nowhere else.
 
 use super::gi::{self, GiMode, PathState};
+use super::lighting::{self, IncidenceLanes, LightVisibility, SurfaceLanes};
 use super::pixel_record::{LightSample, Recorder};
 use super::{RayCounts, RenderSettings, SceneQuery, ShadowMode};
+use crate::math::lanes::V3;
 use crate::math::{Radiance, Ray, Vec3};
 use crate::scene::{Light, Material, Scene, SurfaceHit};
+#[cfg(test)]
 use std::f32::consts::PI;
 
-/// The BSDF of CGPP listing 15.19: Lambertian plus normalized Blinn-Phong,
-/// `f = k_L / pi + k_G (s + 8) / (8 pi) max(0, n.h)^s`. The glossy lobe is
-/// skipped when k_G = 0.
+/// The BSDF of CGPP listing 15.19 for one sample (`lighting::bsdf`, one lane
+/// wide): Lambertian plus normalized Blinn-Phong,
+/// `f = k_L / pi + k_G (s + 8) / (8 pi) max(0, n.h)^s`.
 #[inline]
 pub fn bsdf(material: &Material, albedo: Vec3, n: Vec3, w_i: Vec3, w_o: Vec3) -> Vec3 {
-    let mut f = albedo * (1.0 / PI);
-    if material.has_glossy() {
-        let w_h = (w_i + w_o).normalize_or_zero();
-        let s = material.sharpness;
-        let c = n.dot(w_h).max(0.0);
-        // c^s <= exp(-s (1 - c)) since ln c <= c - 1: when that bound is below
-        // 1e-9 the lobe adds nothing visible, and the costly powf is skipped.
-        if s * (1.0 - c) < 20.7 {
-            f += material.glossy * ((s + 8.0) / (8.0 * PI) * c.powf(s));
-        }
+    let surface = surface_lane(material, albedo, Vec3::ZERO, n, w_o);
+    lighting::bsdf(&surface, w_i.into()).into()
+}
+
+/// One sample's surface as the lane-generic lighting code reads it.
+#[inline(always)]
+fn surface_lane(material: &Material, albedo: Vec3, position: Vec3, n: Vec3, w_o: Vec3) -> SurfaceLanes<f32> {
+    SurfaceLanes {
+        position: position.into(),
+        normal: n.into(),
+        w_o: w_o.into(),
+        albedo: albedo.into(),
+        glossy: material.glossy.into(),
+        sharpness: material.sharpness,
     }
-    f
 }
 
 /// What shading one sample reads and writes besides the surface: the scene
@@ -48,12 +54,23 @@ pub fn shade<Q: SceneQuery, R: Recorder>(
     w_o: Vec3,
     depth: u32,
 ) -> Radiance {
-    let Shading { scene, query, settings, .. } = *sh;
+    let Shading { scene, .. } = *sh;
     let material = &scene.materials[hit.material as usize];
-    let n = hit.shading_normal;
-    let p = hit.position;
     let albedo = material.albedo(hit.uv);
-    let mut l_o = match settings.gi.mode {
+    let ambient = ambient_term(sh, hit, albedo);
+    let surface = surface_lane(material, albedo, hit.position, hit.shading_normal, w_o);
+    let mut visibility = ShadowQueries { sh: &mut *sh, hit, depth, pending: PendingShadow::default() };
+    let direct: Vec3 = lighting::direct_light(&scene.lights, &surface, ambient.into(), &mut visibility).into();
+    after_direct(sh, hit, material, albedo, w_o, depth, direct)
+}
+
+/// The term `shade()` starts from, before the lights: the constant ambient,
+/// dimmed by ambient occlusion with `--gi ao`; zero when indirect light is
+/// traced or mapped instead.
+#[inline]
+pub fn ambient_term<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &SurfaceHit, albedo: Vec3) -> Radiance {
+    let Shading { scene, query, settings, .. } = *sh;
+    match settings.gi.mode {
         GiMode::None => albedo * scene.render.ambient,
         // The constant ambient term, dimmed where nearby geometry hides the sky.
         GiMode::Ao if scene.render.ambient != Vec3::ZERO && albedo != Vec3::ZERO => {
@@ -62,46 +79,23 @@ pub fn shade<Q: SceneQuery, R: Recorder>(
         }
         // Traced or mapped indirect light replaces the constant.
         GiMode::Ao | GiMode::Photons | GiMode::Path => Vec3::ZERO,
-    };
-
-    for (index, light) in scene.lights.iter().enumerate() {
-        let Some(incidence) = Incidence::of(light, p, n) else { continue };
-        let Incidence { w_i, distance, incident, cos_theta } = incidence;
-        if !incidence.illuminates() {
-            if R::ENABLED {
-                sh.rec.light(LightSample { light: index, w_i, distance, incident, cos_theta, shadow_ray: None, blocker: None, volume_count: None, bsdf: Vec3::ZERO, contribution: Vec3::ZERO });
-            }
-            continue;
-        }
-        let mut shadow_ray = None;
-        let mut blocker = None;
-        // Shadow volumes answer for the surface the eye sees (its stencil
-        // count); every other surface falls back to a shadow ray.
-        let volume_count = if settings.shadows == ShadowMode::Volume && depth == 0 { query.volume_count(index) } else { None };
-        if volume_count.is_none() && matches!(settings.shadows, ShadowMode::Ray | ShadowMode::Volume) {
-            let (ray, t_max) = incidence.shadow_ray(scene, hit, settings.shadow_bump, settings.terminator_lift);
-            sh.counts.shadow += 1;
-            sh.rec.in_shadow_ray(true);
-            sh.rec.ray(&ray, t_max, depth + 1);
-            blocker = query.occluder(&ray, t_max, sh.counts, sh.rec);
-            sh.rec.in_shadow_ray(false);
-            shadow_ray = Some((ray, t_max));
-        } else if settings.shadows == ShadowMode::Map {
-            // CGPP 15.6.5: no ray; the light's depth map says whether something
-            // nearer to the light covers P (blocker t = how far before P it lies).
-            if let Some(maps) = query.shadow_maps() {
-                blocker = maps.occluder(scene, index, hit, w_i, settings.shadow_map_bias, settings.shadow_map_slope_bias, settings.terminator_lift);
-            }
-        }
-        let f = bsdf(material, albedo, n, w_i, w_o);
-        let shadowed = blocker.is_some() || volume_count.is_some_and(|c| c != 0);
-        let contribution = if shadowed { Vec3::ZERO } else { incident * f * cos_theta };
-        l_o += contribution;
-        if R::ENABLED {
-            sh.rec.light(LightSample { light: index, w_i, distance, incident, cos_theta, shadow_ray, blocker, volume_count, bsdf: f, contribution });
-        }
     }
+}
 
+/// What `shade()` adds after direct light, in this order: traced or mapped
+/// indirect light, then mirror reflection and refraction. `l_o` is the
+/// ambient term plus direct light.
+#[inline]
+pub fn after_direct<Q: SceneQuery, R: Recorder>(
+    sh: &mut Shading<Q, R>,
+    hit: &SurfaceHit,
+    material: &Material,
+    albedo: Vec3,
+    w_o: Vec3,
+    depth: u32,
+    mut l_o: Radiance,
+) -> Radiance {
+    let Shading { settings, .. } = *sh;
     match settings.gi.mode {
         GiMode::Path if depth < settings.gi.max_path_depth() => {
             l_o += indirect_path(sh, hit, material, albedo, w_o, depth);
@@ -121,6 +115,65 @@ pub fn shade<Q: SceneQuery, R: Recorder>(
     }
     sh.rec.shaded(depth, l_o);
     l_o
+}
+
+/// What one light's visibility test found, kept for the recorder.
+#[derive(Default)]
+struct PendingShadow {
+    shadow_ray: Option<(Ray, f32)>,
+    blocker: Option<super::Occluder>,
+    volume_count: Option<i32>,
+}
+
+/// Visibility for one sample as `shade()` asks it: the shadow volume count
+/// at the surface the eye sees, a shadow ray, or the light's shadow map;
+/// every step recorded.
+struct ShadowQueries<'s, 'a, 'p, Q, R> {
+    sh: &'s mut Shading<'a, 'p, Q, R>,
+    hit: &'s SurfaceHit,
+    depth: u32,
+    pending: PendingShadow,
+}
+
+impl<Q: SceneQuery, R: Recorder> LightVisibility<f32> for ShadowQueries<'_, '_, '_, Q, R> {
+    #[inline]
+    fn visible(&mut self, index: usize, inc: &IncidenceLanes<f32>, _lit: bool) -> bool {
+        let Shading { scene, query, settings, .. } = *self.sh;
+        let incidence = Incidence::from_lane(inc);
+        let (hit, depth) = (self.hit, self.depth);
+        let mut blocker = None;
+        // Shadow volumes answer for the surface the eye sees (its stencil
+        // count); every other surface falls back to a shadow ray.
+        let volume_count = if settings.shadows == ShadowMode::Volume && depth == 0 { query.volume_count(index) } else { None };
+        if volume_count.is_none() && matches!(settings.shadows, ShadowMode::Ray | ShadowMode::Volume) {
+            let (ray, t_max) = incidence.shadow_ray(scene, hit, settings.shadow_bump, settings.terminator_lift);
+            let sh = &mut *self.sh;
+            sh.counts.shadow += 1;
+            sh.rec.in_shadow_ray(true);
+            sh.rec.ray(&ray, t_max, depth + 1);
+            blocker = query.occluder(&ray, t_max, sh.counts, sh.rec);
+            sh.rec.in_shadow_ray(false);
+            self.pending.shadow_ray = Some((ray, t_max));
+        } else if settings.shadows == ShadowMode::Map {
+            // CGPP 15.6.5: no ray; the light's depth map says whether something
+            // nearer to the light covers P (blocker t = how far before P it lies).
+            if let Some(maps) = query.shadow_maps() {
+                blocker = maps.occluder(scene, index, hit, incidence.w_i, settings.shadow_map_bias, settings.shadow_map_slope_bias, settings.terminator_lift);
+            }
+        }
+        self.pending.blocker = blocker;
+        self.pending.volume_count = volume_count;
+        !(blocker.is_some() || volume_count.is_some_and(|c| c != 0))
+    }
+
+    #[inline]
+    fn reflected(&mut self, index: usize, inc: &IncidenceLanes<f32>, _lit: bool, f: V3<f32>, contribution: V3<f32>) {
+        let PendingShadow { shadow_ray, blocker, volume_count } = std::mem::take(&mut self.pending);
+        if R::ENABLED {
+            let Incidence { w_i, distance, incident, cos_theta } = Incidence::from_lane(inc);
+            self.sh.rec.light(LightSample { light: index, w_i, distance, incident, cos_theta, shadow_ray, blocker, volume_count, bsdf: f.into(), contribution: contribution.into() });
+        }
+    }
 }
 
 /// Path tracing's indirect term: one direction sampled from the diffuse and
@@ -272,18 +325,14 @@ impl Incidence {
     /// contributes nothing).
     #[inline]
     pub fn of(light: &Light, p: Vec3, n: Vec3) -> Option<Incidence> {
-        let (w_i, distance, incident) = match *light {
-            Light::Point { position, power } => {
-                let offset = position - p;
-                let d = offset.length();
-                if d <= 0.0 {
-                    return None;
-                }
-                (offset / d, d, power / (4.0 * PI * d * d))
-            }
-            Light::Directional { direction, irradiance } => (-direction, f32::INFINITY, irradiance),
-        };
-        Some(Incidence { w_i, distance, incident, cos_theta: w_i.dot(n) })
+        let lane = lighting::incidence::<f32>(light, p.into(), n.into());
+        lane.exists.then(|| Incidence::from_lane(&lane))
+    }
+
+    /// One lane's incidence as this struct.
+    #[inline(always)]
+    pub fn from_lane(lane: &IncidenceLanes<f32>) -> Incidence {
+        Incidence { w_i: lane.w_i.into(), distance: lane.distance, incident: lane.incident.into(), cos_theta: lane.cos_theta }
     }
 
     /// Whether the light reaches the surface's lit side with some radiance:

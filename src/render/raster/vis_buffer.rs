@@ -21,6 +21,7 @@ use crate::math::{Radiance, Ray, Vec3};
 use crate::render::debug::{cost_color, View};
 use crate::render::pixel_record::{FragmentRecord, NoRecord, PixelTrace, Recorder};
 use crate::render::{miss_without_ray, resolve_counted, resolve_sample, PassJob, RayCounts, SceneQuery};
+use crate::render::shade_batch::{self, Batch};
 use crate::render::shadow_volume::split_depth;
 use super::stencil::{PixelRay, StencilSetup};
 use crate::scene::{PrimitiveId, PrimitiveKind, SurfaceHit};
@@ -461,6 +462,9 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
     /// visible surface once here; forward mode already shaded it. Counts one
     /// primary sample per pixel.
     pub fn resolve_into(&mut self, out: &mut [Radiance], out_stride: usize, x_offset: usize) -> RayCounts {
+        if !self.forward && !self.cost_view() && self.stencil.is_empty() && shade_batch::batchable(self.job) {
+            return self.resolve_batched(out, out_stride, x_offset);
+        }
         let r = self.rect;
         let mut i = 0;
         for (row, y) in (r.y0..r.y1).enumerate() {
@@ -471,6 +475,52 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             }
         }
         std::mem::take(&mut self.counts)
+    }
+
+    /// `resolve_into` in early-depth mode, the visible surfaces shaded eight
+    /// at a time (`shade_batch`); empty, inactive and recorded pixels one by
+    /// one, as `resolve` does them.
+    fn resolve_batched(&mut self, out: &mut [Radiance], out_stride: usize, x_offset: usize) -> RayCounts {
+        let r = self.rect;
+        let interpolation = self.job.settings.interpolation;
+        let mut batch = Batch::new();
+        let mut i = 0;
+        for (row, y) in (r.y0..r.y1).enumerate() {
+            let line = row * out_stride + x_offset;
+            for (col, x) in (r.x0..r.x1).enumerate() {
+                let slot = line + col;
+                if self.id[i].is_none() || self.is_focus(x, y) || !self.job.is_active(x, y) {
+                    out[slot] = self.resolve(i, x, y);
+                } else {
+                    self.counts.primary += 1;
+                    self.counts.fragments_shaded += 1;
+                    match self.eye_hit(i, x, y) {
+                        (ray, Some(hit)) => {
+                            batch.push(interpolation, &hit, ray.dir, self.job.pixel_index(x, y), slot);
+                            if batch.is_full() {
+                                self.shade_batch_into(&mut batch, out);
+                            }
+                        }
+                        (_, None) => out[slot] = self.shade(i, x, y),
+                    }
+                }
+                i += 1;
+            }
+        }
+        self.shade_batch_into(&mut batch, out);
+        std::mem::take(&mut self.counts)
+    }
+
+    /// Shades the batch's samples into their slots of `out` and empties it.
+    fn shade_batch_into(&mut self, batch: &mut Batch, out: &mut [Radiance]) {
+        if batch.is_empty() {
+            return;
+        }
+        let values = shade_batch::shade_batch(self.job, self.query, batch, None, &mut self.counts);
+        for (j, value) in values.iter().enumerate().take(batch.len()) {
+            out[batch.slots[j]] = *value;
+        }
+        batch.clear();
     }
 
     /// Empties the buffers for another region of at most the same size (the tiles of a row).

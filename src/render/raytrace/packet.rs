@@ -13,8 +13,9 @@
 //!   change any ray's winner; the padded boxes guarantee no true hit is
 //!   culled by a box test in either traversal.
 //!
-//! After the eye rays, the tile's shadow rays towards the first light go as
-//! one packet too (`cast_pass_packets`), and `shade()` is answered from it.
+//! After the eye rays, the tile's shadow rays towards each light go as one
+//! packet too, and the tile is shaded eight samples at a time from those
+//! answers (`shade_tile_batched`, `shade_batch`).
 
 use super::bvh::{leaf_range, BvhQuery, Node4, LEAF_BIT, STACK};
 use super::cast_pass;
@@ -22,8 +23,9 @@ use super::traverse::{slab_test, test_leaf, BestHit, ChildOrder, PreparedRay, SL
 use crate::math::{Radiance, Ray};
 use crate::render::debug::View;
 use crate::render::shade::cast_shadow_ray;
-use crate::render::pixel_record::{NoRecord, Recorder};
-use crate::render::{resolve_sample, with_shading_hit, Interpolation, Occluder, PassJob, RayCounts, SceneQuery, ShadowMode};
+use crate::render::pixel_record::NoRecord;
+use crate::render::shade_batch::{self, Batch};
+use crate::render::{resolve_sample, with_shading_hit, Occluder, PassJob, RayCounts, ShadowMode};
 use crate::scene::{PrimitiveId, SurfaceHit};
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
@@ -324,61 +326,18 @@ impl BvhQuery<'_> {
     }
 }
 
-/// The query `shade()` gets for one pixel of a tile: the shadow ray towards
-/// the first light was traced with the tile's packet and is answered from
-/// it; everything else goes to the BVH.
-///
-/// The answer is keyed by the question itself: it is given only when
-/// `shade()` asks for exactly the packet's ray (same bits of origin,
-/// direction and t_max). Both rays are made by `shade::Incidence` (the
-/// packet's through `shade::cast_shadow_ray`), so they agree by
-/// construction, and the comparison costs seven integer compares per pixel.
-/// Handing `shade()` "light 0's answer" instead would need to know which of
-/// its questions that is: `shade()` also asks for light 0's shadow ray from
-/// every mirror or refraction hit further down the path, and only the ray
-/// tells them apart without this query knowing depths, light indices or
-/// interpolation modes. Should the two sides ever drift apart, the ray is
-/// traced alone: slower, never different. Recorded queries always trace, so
-/// a record lists the traversal (pixel replays do not use this query at all,
-/// see `BvhRayTracer::trace_pixel`).
-struct PixelQuery<'q, 'a> {
-    bvh: &'q BvhQuery<'a>,
-    shadow: Option<(Ray, f32, Option<Occluder>)>,
-}
-
-impl SceneQuery for PixelQuery<'_, '_> {
-    #[inline]
-    fn closest<R: Recorder>(&self, ray: &Ray, t_max: f32, inside: bool, counts: &mut RayCounts, rec: &mut R) -> Option<SurfaceHit> {
-        self.bvh.closest(ray, t_max, inside, counts, rec)
-    }
-
-    #[inline]
-    fn occluder<R: Recorder>(&self, ray: &Ray, t_max: f32, counts: &mut RayCounts, rec: &mut R) -> Option<Occluder> {
-        if let Some((r, t, answer)) = &self.shadow {
-            let bits = |r: &Ray| (r.origin.to_array().map(f32::to_bits), r.dir.to_array().map(f32::to_bits));
-            if !R::ENABLED && t.to_bits() == t_max.to_bits() && bits(r) == bits(ray) {
-                return *answer;
-            }
-        }
-        self.bvh.occluder(ray, t_max, counts, rec)
-    }
-}
-
 /// `cast_pass` for the BVH: the same pixels, eye rays traced a tile at a
-/// time, then the tile's shadow rays towards the first light as one packet.
-/// Bands of TILE_H rows run in parallel. The cost view (per-ray work) and
-/// very deep trees take the single-ray path.
+/// time; where frames are shaded in batches, the tile's shadow rays go as
+/// one packet per light and its surfaces are shaded eight at a time
+/// (`shade_tile_batched`). Bands of TILE_H rows run in parallel. The cost
+/// view (per-ray work) and very deep trees take the single-ray path.
 pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) -> RayCounts {
     if query.prepared.bvh.deep || job.settings.view == View::Cost {
         return cast_pass(job, query, out);
     }
     let scene = &query.prepared.scene;
-    let settings = job.settings;
-    let shadow_light = match (settings.view, settings.shadows, settings.interpolation) {
-        (View::Shaded, ShadowMode::Ray, Interpolation::Phong | Interpolation::Flat) => scene.lights.first(),
-        _ => None,
-    };
     let width = job.view.width as usize;
+    let batched = shade_batch::batchable(job);
     out.par_chunks_mut(width * TILE_H)
         .enumerate()
         .map(|(b, band)| {
@@ -391,6 +350,7 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
             let mut pk = Packet::new();
             let mut shadow_pk = Packet::new();
             let mut hits = [None; P];
+            let mut blocked = vec![0u64; scene.lights.len()];
             for x0 in (0..width).step_by(TILE_W) {
                 let mut valid = 0u64;
                 for i in 0..P {
@@ -404,32 +364,17 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
                 }
                 counts.primary += valid.count_ones() as u64;
                 query.closest_packet(&mut pk, valid, &mut counts);
-                let mut shadow_valid = 0u64;
-                let mut m = valid;
-                while m != 0 {
-                    let i = m.trailing_zeros() as usize;
-                    m &= m - 1;
-                    hits[i] = pk.hit(query, i);
-                    if let (Some(light), Some(h)) = (shadow_light, &hits[i]) {
-                        let shadow_ray = with_shading_hit(settings.interpolation, h, |h| cast_shadow_ray(scene, h, light, settings.shadow_bump, settings.terminator_lift));
-                        if let Some((ray, t_max)) = shadow_ray.flatten() {
-                            shadow_pk.rays[i] = ray;
-                            shadow_pk.t_max[i] = t_max;
-                            shadow_valid |= 1 << i;
-                        }
-                    }
-                }
-                if shadow_valid != 0 {
-                    query.occluded_packet(&mut shadow_pk, shadow_valid, &mut counts);
+                if batched {
+                    shade_tile_batched(job, query, &pk, valid, &mut shadow_pk, &mut blocked, &mut hits, band, (x0, y0), width, &mut counts);
+                    continue;
                 }
                 let mut m = valid;
                 while m != 0 {
                     let i = m.trailing_zeros() as usize;
                     m &= m - 1;
                     let (tx, ty) = lane_xy(i);
-                    let shadow = (shadow_valid & 1 << i != 0).then(|| (shadow_pk.rays[i], shadow_pk.t_max[i], shadow_pk.occluder(i)));
-                    let pixel_query = PixelQuery { bvh: query, shadow };
-                    band[ty * width + x0 + tx] = resolve_sample(job, &pixel_query, &pk.rays[i], hits[i].as_ref(), job.pixel_index((x0 + tx) as u32, (y0 + ty) as u32), &mut counts, &mut NoRecord);
+                    let hit = pk.hit(query, i);
+                    band[ty * width + x0 + tx] = resolve_sample(job, query, &pk.rays[i], hit.as_ref(), job.pixel_index((x0 + tx) as u32, (y0 + ty) as u32), &mut counts, &mut NoRecord);
                 }
             }
             counts
@@ -440,12 +385,106 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
         })
 }
 
+/// Shades one traced tile in batches of eight (`shade_batch`): first the
+/// tile's shadow rays towards every light go as one packet per light, then
+/// the lanes that see a surface are shaded eight at a time, each light's
+/// visibility read from its packet.
+#[allow(clippy::too_many_arguments)]
+fn shade_tile_batched(
+    job: &PassJob,
+    query: &BvhQuery,
+    pk: &Packet,
+    valid: u64,
+    shadow_pk: &mut Packet,
+    blocked: &mut [u64],
+    hits: &mut [Option<SurfaceHit>; P],
+    band: &mut [Radiance],
+    (x0, y0): (usize, usize),
+    width: usize,
+    counts: &mut RayCounts,
+) {
+    let scene = &query.prepared.scene;
+    let settings = job.settings;
+    let mut seen = 0u64;
+    let mut m = valid;
+    while m != 0 {
+        let i = m.trailing_zeros() as usize;
+        m &= m - 1;
+        hits[i] = pk.hit(query, i);
+        seen |= (hits[i].is_some() as u64) << i;
+    }
+    let shadows = settings.shadows == ShadowMode::Ray;
+    if shadows {
+        for (k, light) in scene.lights.iter().enumerate() {
+            let mut cast = 0u64;
+            let mut m = seen;
+            while m != 0 {
+                let i = m.trailing_zeros() as usize;
+                m &= m - 1;
+                let Some(h) = &hits[i] else { continue };
+                let shadow_ray = with_shading_hit(settings.interpolation, h, |h| cast_shadow_ray(scene, h, light, settings.shadow_bump, settings.terminator_lift));
+                if let Some((ray, t_max)) = shadow_ray.flatten() {
+                    shadow_pk.rays[i] = ray;
+                    shadow_pk.t_max[i] = t_max;
+                    cast |= 1 << i;
+                }
+            }
+            blocked[k] = 0;
+            if cast != 0 {
+                query.occluded_packet(shadow_pk, cast, counts);
+                let mut m = cast;
+                while m != 0 {
+                    let i = m.trailing_zeros() as usize;
+                    m &= m - 1;
+                    blocked[k] |= (shadow_pk.occluder(i).is_some() as u64) << i;
+                }
+            }
+        }
+    }
+    let write = |band: &mut [Radiance], i: usize, value: Radiance| {
+        let (tx, ty) = lane_xy(i);
+        band[ty * width + x0 + tx] = value;
+    };
+    let mut batch = Batch::new();
+    let mut lane_blocked = vec![0u8; blocked.len()];
+    let mut flush = |batch: &mut Batch, band: &mut [Radiance], counts: &mut RayCounts| {
+        if batch.is_empty() {
+            return;
+        }
+        for (k, bits) in lane_blocked.iter_mut().enumerate() {
+            *bits = (0..batch.len()).fold(0u8, |acc, j| acc | (((blocked[k] >> batch.slots[j]) & 1) as u8) << j);
+        }
+        let values = shade_batch::shade_batch(job, query, batch, shadows.then_some(&lane_blocked[..]), counts);
+        for j in 0..batch.len() {
+            write(band, batch.slots[j], values[j]);
+        }
+        batch.clear();
+    };
+    let mut m = valid;
+    while m != 0 {
+        let i = m.trailing_zeros() as usize;
+        m &= m - 1;
+        let (tx, ty) = lane_xy(i);
+        let pixel = job.pixel_index((x0 + tx) as u32, (y0 + ty) as u32);
+        match &hits[i] {
+            Some(h) => {
+                batch.push(settings.interpolation, h, pk.rays[i].dir, pixel, i);
+                if batch.is_full() {
+                    flush(&mut batch, band, counts);
+                }
+            }
+            None => band[ty * width + x0 + tx] = resolve_sample(job, query, &pk.rays[i], None, pixel, counts, &mut NoRecord),
+        }
+    }
+    flush(&mut batch, band, counts);
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::math::Vec2;
     use crate::render::pixel_record::NoRecord;
-    use crate::render::{PreparedScene, SceneQuery};
+    use crate::render::{Interpolation, PreparedScene, SceneQuery};
     use crate::scene::builtin;
 
     /// Every lane's hit is bit for bit the single-ray hit, on every builtin

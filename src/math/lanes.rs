@@ -1,0 +1,400 @@
+//! Arithmetic written once over a lane type: `f32` (one sample, for replays
+//! and the scalar paths) or `f32x8` (eight samples, for frames). Code generic
+//! over [`Lane`] runs the same IEEE operations in the same order in either
+//! width, so a frame's eight-wide result equals the one-wide replay bit for
+//! bit. That is why the trait offers only exactly rounded operations (add,
+//! sub, mul, div, sqrt, compare, select, floor, bit moves) and builds
+//! everything else (`pow`) from them: a library `powf` and a vector
+//! approximation would round differently.
+//!
+//! No fused multiply-add anywhere: a CPU without FMA could not match it.
+
+use fearless_simd::{f32x8, mask32x8, u32x8, Select, Simd, SimdBase, SimdFloat, SimdFrom, SimdInt};
+use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
+
+/// Lanes of `f32` computed together.
+pub trait Lane:
+    Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Div<Output = Self> + Neg<Output = Self>
+{
+    /// One boolean per lane.
+    type Mask: Copy + BitAnd<Output = Self::Mask> + BitOr<Output = Self::Mask> + Not<Output = Self::Mask>;
+
+    /// `x` in every lane (the SIMD context is taken from `self`).
+    fn splat(self, x: f32) -> Self;
+    fn sqrt(self) -> Self;
+    fn floor(self) -> Self;
+    fn gt(self, other: Self) -> Self::Mask;
+    fn ge(self, other: Self) -> Self::Mask;
+    fn lt(self, other: Self) -> Self::Mask;
+    fn le(self, other: Self) -> Self::Mask;
+    fn eq(self, other: Self) -> Self::Mask;
+    /// Per lane `if mask { a } else { b }`.
+    fn select(mask: Self::Mask, a: Self, b: Self) -> Self;
+    /// Whether any lane of `mask` is set.
+    fn any(mask: Self::Mask) -> bool;
+    /// Splits a positive normal number into `(e, m)` with `self = 2^e m`,
+    /// `m` in [1, 2) and `e` an integer (as a float). Exact.
+    fn exponent_mantissa(self) -> (Self, Self);
+    /// `2^self` for integer-valued lanes in [-126, 127]. Exact.
+    fn exp2_integer(self) -> Self;
+
+    /// `a > b ? a : b`, the x86 `maxps` rule: the second operand when
+    /// either is NaN (`f32::max` would pick the number, so it is not used).
+    #[inline(always)]
+    fn max(self, other: Self) -> Self {
+        Self::select(self.gt(other), self, other)
+    }
+
+    #[inline(always)]
+    fn min(self, other: Self) -> Self {
+        Self::select(self.lt(other), self, other)
+    }
+}
+
+impl Lane for f32 {
+    type Mask = bool;
+
+    #[inline(always)]
+    fn splat(self, x: f32) -> f32 {
+        x
+    }
+    #[inline(always)]
+    fn sqrt(self) -> f32 {
+        f32::sqrt(self)
+    }
+    #[inline(always)]
+    fn floor(self) -> f32 {
+        f32::floor(self)
+    }
+    #[inline(always)]
+    fn gt(self, other: f32) -> bool {
+        self > other
+    }
+    #[inline(always)]
+    fn ge(self, other: f32) -> bool {
+        self >= other
+    }
+    #[inline(always)]
+    fn lt(self, other: f32) -> bool {
+        self < other
+    }
+    #[inline(always)]
+    fn le(self, other: f32) -> bool {
+        self <= other
+    }
+    #[inline(always)]
+    fn eq(self, other: f32) -> bool {
+        self == other
+    }
+    #[inline(always)]
+    fn select(mask: bool, a: f32, b: f32) -> f32 {
+        if mask { a } else { b }
+    }
+    #[inline(always)]
+    fn any(mask: bool) -> bool {
+        mask
+    }
+    #[inline(always)]
+    fn exponent_mantissa(self) -> (f32, f32) {
+        let bits = self.to_bits();
+        let e = ((bits >> 23) & 0xff) as f32 - 127.0;
+        (e, f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000))
+    }
+    #[inline(always)]
+    fn exp2_integer(self) -> f32 {
+        f32::from_bits(((self + 127.0) as u32) << 23)
+    }
+}
+
+impl<S: Simd> Lane for f32x8<S> {
+    type Mask = mask32x8<S>;
+
+    #[inline(always)]
+    fn splat(self, x: f32) -> Self {
+        <f32x8<S> as SimdBase<S>>::splat(self.simd, x)
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        SimdFloat::sqrt(self)
+    }
+    #[inline(always)]
+    fn floor(self) -> Self {
+        SimdFloat::floor(self)
+    }
+    #[inline(always)]
+    fn gt(self, other: Self) -> Self::Mask {
+        self.simd_gt(other)
+    }
+    #[inline(always)]
+    fn ge(self, other: Self) -> Self::Mask {
+        self.simd_ge(other)
+    }
+    #[inline(always)]
+    fn lt(self, other: Self) -> Self::Mask {
+        self.simd_lt(other)
+    }
+    #[inline(always)]
+    fn le(self, other: Self) -> Self::Mask {
+        self.simd_le(other)
+    }
+    #[inline(always)]
+    fn eq(self, other: Self) -> Self::Mask {
+        self.simd_eq(other)
+    }
+    #[inline(always)]
+    fn select(mask: Self::Mask, a: Self, b: Self) -> Self {
+        mask.select(a, b)
+    }
+    #[inline(always)]
+    fn any(mask: Self::Mask) -> bool {
+        fearless_simd::SimdMask::to_bitmask(mask) != 0
+    }
+    #[inline(always)]
+    fn exponent_mantissa(self) -> (Self, Self) {
+        let bits: u32x8<S> = self.to_bits();
+        let biased: u32x8<S> = (bits >> 23) & 0xff;
+        let e: f32x8<S> = biased.to_float::<f32x8<S>>() - 127.0;
+        let m_bits: u32x8<S> = (bits & 0x007f_ffff) | 0x3f80_0000;
+        (e, f32x8::from_bits(m_bits))
+    }
+    #[inline(always)]
+    fn exp2_integer(self) -> Self {
+        let biased: u32x8<S> = (self + 127.0).to_int::<u32x8<S>>();
+        f32x8::from_bits(biased << 23)
+    }
+}
+
+/// `c^s` for `c >= 0` and `s > 0`, as `2^(s log2 c)`, with the same
+/// operations in every width. Relative error below 5e-6 where the result
+/// is above 1e-9 (the BSDF leaves smaller values out), growing with
+/// `|s log2 c|` below that; 0 for `c` zero or below the normal range.
+#[inline(always)]
+pub fn pow<L: Lane>(c: L, s: L) -> L {
+    let x = s * log2(c);
+    let x = x.max(c.splat(-126.0)).min(c.splat(126.0));
+    let result = exp2(x);
+    L::select(c.ge(c.splat(f32::MIN_POSITIVE)), result, c.splat(0.0))
+}
+
+/// `log2 c` for positive normal `c`: `c = 2^e m`, with `m` moved into
+/// [sqrt(1/2), sqrt(2)) and `ln m = 2 atanh((m - 1) / (m + 1))` summed to
+/// the t^9 term (|t| <= 0.172, so the next term is below 1e-9).
+#[inline(always)]
+fn log2<L: Lane>(c: L) -> L {
+    let (e, m) = c.exponent_mantissa();
+    let high = m.gt(c.splat(std::f32::consts::SQRT_2));
+    let m = L::select(high, m * c.splat(0.5), m);
+    let e = L::select(high, e + c.splat(1.0), e);
+    let t = (m - c.splat(1.0)) / (m + c.splat(1.0));
+    let t2 = t * t;
+    let series = c.splat(1.0 / 9.0);
+    let series = series * t2 + c.splat(1.0 / 7.0);
+    let series = series * t2 + c.splat(1.0 / 5.0);
+    let series = series * t2 + c.splat(1.0 / 3.0);
+    let series = series * t2 + c.splat(1.0);
+    e + t * series * c.splat(2.0 * std::f32::consts::LOG2_E)
+}
+
+/// `2^x` for x in [-126, 126]: `2^n 2^f` with `n = round(x)`, `|f| <= 1/2`
+/// and `2^f = e^(f ln 2)` by its Taylor series to the 7th power (error
+/// below 1e-8).
+#[inline(always)]
+fn exp2<L: Lane>(x: L) -> L {
+    let n = (x + x.splat(0.5)).floor();
+    let g = (x - n) * x.splat(std::f32::consts::LN_2);
+    let mut p = x.splat(1.0 / 5040.0);
+    for k in [720.0f32, 120.0, 24.0, 6.0, 2.0, 1.0, 1.0] {
+        p = p * g + x.splat(1.0 / k);
+    }
+    p * n.exp2_integer()
+}
+
+/// A 3-vector of lanes: eight points, normals or colours at once with
+/// `f32x8`, one with `f32`. Operations keep glam's order of arithmetic
+/// (`dot` is `(x x' + y y') + z z'`), so the one-lane form equals glam's
+/// `Vec3` results bit for bit.
+#[derive(Clone, Copy, Debug)]
+pub struct V3<L> {
+    pub x: L,
+    pub y: L,
+    pub z: L,
+}
+
+impl<L: Lane> V3<L> {
+    #[inline(always)]
+    pub fn new(x: L, y: L, z: L) -> Self {
+        V3 { x, y, z }
+    }
+    /// The constant `v` in every lane (the SIMD context taken from `like`).
+    #[inline(always)]
+    pub fn splat(like: L, v: glam::Vec3) -> Self {
+        V3 { x: like.splat(v.x), y: like.splat(v.y), z: like.splat(v.z) }
+    }
+    #[inline(always)]
+    pub fn dot(self, o: Self) -> L {
+        self.x * o.x + self.y * o.y + self.z * o.z
+    }
+    #[inline(always)]
+    pub fn length(self) -> L {
+        self.dot(self).sqrt()
+    }
+    #[inline(always)]
+    pub fn scale(self, s: L) -> Self {
+        V3 { x: self.x * s, y: self.y * s, z: self.z * s }
+    }
+    #[inline(always)]
+    pub fn div(self, s: L) -> Self {
+        V3 { x: self.x / s, y: self.y / s, z: self.z / s }
+    }
+    /// glam's `normalize_or_zero`: times `1 / length`, zero where that is
+    /// not a positive finite number.
+    #[inline(always)]
+    pub fn normalize_or_zero(self) -> Self {
+        let rcp = self.x.splat(1.0) / self.length();
+        let ok = rcp.gt(self.x.splat(0.0)) & rcp.lt(self.x.splat(f32::INFINITY));
+        let n = self.scale(rcp);
+        let zero = self.x.splat(0.0);
+        V3 { x: L::select(ok, n.x, zero), y: L::select(ok, n.y, zero), z: L::select(ok, n.z, zero) }
+    }
+    /// Per lane `if mask { a } else { b }`.
+    #[inline(always)]
+    pub fn select(mask: L::Mask, a: Self, b: Self) -> Self {
+        V3 { x: L::select(mask, a.x, b.x), y: L::select(mask, a.y, b.y), z: L::select(mask, a.z, b.z) }
+    }
+    /// Whether every component is zero, per lane.
+    #[inline(always)]
+    pub fn is_zero(self) -> L::Mask {
+        let zero = self.x.splat(0.0);
+        self.x.eq(zero) & self.y.eq(zero) & self.z.eq(zero)
+    }
+}
+
+impl<L: Lane> Add for V3<L> {
+    type Output = Self;
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        V3 { x: self.x + o.x, y: self.y + o.y, z: self.z + o.z }
+    }
+}
+
+impl<L: Lane> Sub for V3<L> {
+    type Output = Self;
+    #[inline(always)]
+    fn sub(self, o: Self) -> Self {
+        V3 { x: self.x - o.x, y: self.y - o.y, z: self.z - o.z }
+    }
+}
+
+/// Component by component, as glam's `Vec3 * Vec3`.
+impl<L: Lane> Mul for V3<L> {
+    type Output = Self;
+    #[inline(always)]
+    fn mul(self, o: Self) -> Self {
+        V3 { x: self.x * o.x, y: self.y * o.y, z: self.z * o.z }
+    }
+}
+
+impl<L: Lane> Neg for V3<L> {
+    type Output = Self;
+    #[inline(always)]
+    fn neg(self) -> Self {
+        V3 { x: -self.x, y: -self.y, z: -self.z }
+    }
+}
+
+impl From<glam::Vec3> for V3<f32> {
+    #[inline(always)]
+    fn from(v: glam::Vec3) -> Self {
+        V3 { x: v.x, y: v.y, z: v.z }
+    }
+}
+
+impl From<V3<f32>> for glam::Vec3 {
+    #[inline(always)]
+    fn from(v: V3<f32>) -> Self {
+        glam::Vec3::new(v.x, v.y, v.z)
+    }
+}
+
+impl<S: Simd> V3<f32x8<S>> {
+    /// Eight vectors gathered into lanes.
+    #[inline(always)]
+    pub fn gather(simd: S, v: &[glam::Vec3; 8]) -> Self {
+        V3 {
+            x: f32x8::simd_from(simd, v.map(|v| v.x)),
+            y: f32x8::simd_from(simd, v.map(|v| v.y)),
+            z: f32x8::simd_from(simd, v.map(|v| v.z)),
+        }
+    }
+    /// The eight vectors back out of the lanes.
+    #[inline(always)]
+    pub fn scatter(self) -> [glam::Vec3; 8] {
+        let (x, y, z): ([f32; 8], [f32; 8], [f32; 8]) = (self.x.into(), self.y.into(), self.z.into());
+        std::array::from_fn(|i| glam::Vec3::new(x[i], y[i], z[i]))
+    }
+}
+
+/// Lane `i` of a mask as a bool.
+#[inline(always)]
+pub fn mask_bits<S: Simd>(mask: mask32x8<S>) -> u8 {
+    fearless_simd::SimdMask::to_bitmask(mask) as u8
+}
+
+/// A mask from 8 bits (bit i = lane i).
+#[inline(always)]
+pub fn mask_from_bits<S: Simd>(simd: S, bits: u8) -> mask32x8<S> {
+    fearless_simd::SimdMask::from_bitmask(simd, bits as u64)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use fearless_simd::{dispatch, Level};
+
+    fn pow8(c: [f32; 8], s: [f32; 8]) -> [f32; 8] {
+        let level = Level::new();
+        dispatch!(level, simd => pow(f32x8::simd_from(simd, c), f32x8::simd_from(simd, s)).into())
+    }
+
+    #[test]
+    fn pow_is_close_to_libm() {
+        let mut worst = 0.0f64;
+        for i in 0..20_000 {
+            let c = (i as f32 + 0.5) / 20_000.0;
+            for s in [0.5f32, 1.0, 3.0, 10.0, 100.0, 1000.0, 5000.0] {
+                let want = (c as f64).powf(s as f64);
+                if want < 1e-9 {
+                    continue;
+                }
+                let got = pow(c, s) as f64;
+                worst = worst.max((got - want).abs() / want);
+            }
+        }
+        assert!(worst < 5e-6, "worst relative error {worst}");
+        assert_eq!(pow(0.0f32, 2.0), 0.0);
+        assert_eq!(pow(1.0f32, 100.0), 1.0);
+    }
+
+    /// The eight-wide and one-wide results agree bit for bit, whatever SIMD
+    /// level the CPU gives.
+    #[test]
+    fn pow_lanes_match_scalar_bits() {
+        for k in 0..2_000 {
+            let c: [f32; 8] = std::array::from_fn(|i| ((k * 8 + i) as f32 * 0.618_034).fract());
+            let s: [f32; 8] = std::array::from_fn(|i| 1.0 + ((k * 8 + i) as f32 * 0.414_214).fract() * 500.0);
+            let wide = pow8(c, s);
+            for i in 0..8 {
+                assert_eq!(wide[i].to_bits(), pow(c[i], s[i]).to_bits(), "c {} s {}", c[i], s[i]);
+            }
+        }
+    }
+
+    #[test]
+    fn normalize_or_zero_matches_glam() {
+        for v in [glam::Vec3::new(1.0, 2.0, 3.0), glam::Vec3::ZERO, glam::Vec3::new(1e-30, 0.0, 0.0), glam::Vec3::new(-0.3, 0.7, 1e5)] {
+            let ours: glam::Vec3 = V3::from(v).normalize_or_zero().into();
+            assert_eq!(ours.to_array().map(f32::to_bits), v.normalize_or_zero().to_array().map(f32::to_bits), "{v}");
+            assert_eq!(V3::from(v).dot(V3::from(v * 2.0)).to_bits(), v.dot(v * 2.0).to_bits());
+        }
+    }
+}
