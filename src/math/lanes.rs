@@ -164,6 +164,13 @@ impl<S: Simd> Lane for f32x8<S> {
     }
 }
 
+/// The SIMD level of this CPU, detected once; `dispatch!` runs code
+/// generic over `Simd` at it.
+pub fn simd_level() -> fearless_simd::Level {
+    static LEVEL: std::sync::OnceLock<fearless_simd::Level> = std::sync::OnceLock::new();
+    *LEVEL.get_or_init(fearless_simd::Level::new)
+}
+
 /// `c^s` for `c >= 0` and `s > 0`, as `2^(s log2 c)`, with the same
 /// operations in every width. Relative error below 5e-6 where the result
 /// is above 1e-9 (the BSDF leaves smaller values out), growing with
@@ -233,6 +240,11 @@ impl<L: Lane> V3<L> {
     #[inline(always)]
     pub fn dot(self, o: Self) -> L {
         self.x * o.x + self.y * o.y + self.z * o.z
+    }
+    /// glam's `cross`, term for term.
+    #[inline(always)]
+    pub fn cross(self, o: Self) -> Self {
+        V3 { x: self.y * o.z - o.y * self.z, y: self.z * o.x - o.z * self.x, z: self.x * o.y - o.x * self.y }
     }
     #[inline(always)]
     pub fn length(self) -> L {
@@ -317,6 +329,15 @@ impl From<V3<f32>> for glam::Vec3 {
 }
 
 impl<S: Simd> V3<f32x8<S>> {
+    /// Lanes `start..start + 8` of three coordinate arrays.
+    #[inline(always)]
+    pub fn load(simd: S, xyz: [&[f32]; 3], start: usize) -> Self {
+        V3 {
+            x: f32x8::from_slice(simd, &xyz[0][start..start + 8]),
+            y: f32x8::from_slice(simd, &xyz[1][start..start + 8]),
+            z: f32x8::from_slice(simd, &xyz[2][start..start + 8]),
+        }
+    }
     /// Eight vectors gathered into lanes.
     #[inline(always)]
     pub fn gather(simd: S, v: &[glam::Vec3; 8]) -> Self {

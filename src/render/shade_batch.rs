@@ -11,20 +11,13 @@ use super::lighting::{self, IncidenceLanes, LightVisibility, SurfaceLanes};
 use super::pixel_record::NoRecord;
 use super::shade::{self, Incidence, Shading};
 use super::{debug::View, gi::PathState, Interpolation, PassJob, RayCounts, SceneQuery, ShadowMode};
-use crate::math::lanes::{mask_bits, mask_from_bits, V3};
+use crate::math::lanes::{mask_bits, mask_from_bits, simd_level, V3};
 use crate::math::{Radiance, Vec3};
 use crate::scene::SurfaceHit;
-use fearless_simd::{dispatch, f32x8, Level, Simd, SimdFrom};
-use std::sync::OnceLock;
+use fearless_simd::{dispatch, f32x8, Simd, SimdFrom};
 
 /// Samples per batch.
 pub const LANES: usize = 8;
-
-/// The SIMD level of this CPU, detected once.
-fn level() -> Level {
-    static LEVEL: OnceLock<Level> = OnceLock::new();
-    *LEVEL.get_or_init(Level::new)
-}
 
 /// Whether frames of `job` are shaded in batches. Otherwise (debug views,
 /// Gouraud's per-vertex shading, shadow maps and volumes, whose lookups
@@ -140,7 +133,7 @@ pub fn shade_batch<Q: SceneQuery>(job: &PassJob, query: &Q, batch: &Batch, block
     }
     let inputs = DirectInputs { position, normal, w_o, albedo, glossy, sharpness, ambient };
     let mut visibility = BatchVisibility { job, query, hits: &batch.hits, live: ((1u32 << n) - 1) as u8, blocked, counts: &mut *counts };
-    let direct = dispatch!(level(), simd => direct_light8(simd, job, &inputs, &mut visibility));
+    let direct = dispatch!(simd_level(), simd => direct_light8(simd, job, &inputs, &mut visibility));
 
     let mut out = [Radiance::ZERO; LANES];
     for i in 0..n {

@@ -1,6 +1,7 @@
 //! Ray-primitive intersection, shared by every method that casts rays (and by
 //! the rasterizer's analytic spheres), so all of them agree bit for bit.
 
+use crate::math::lanes::{Lane, V3};
 use crate::math::{Ray, Vec3};
 use crate::scene::{Sphere, Triangle};
 
@@ -79,6 +80,32 @@ pub fn intersect_triangle(ray: &Ray, tri: &TriangleEdges, t_max: f32) -> Triangl
     Ok((t, b1, b2))
 }
 
+/// `intersect_triangle` for lanes of rays against one triangle, with the
+/// same arithmetic in the same order, so each lane's `(t, b1, b2)` is bit
+/// for bit the single ray's. Returns the lanes that hit (`0 < t < limit`)
+/// and the values (meaningless in the other lanes).
+#[inline(always)]
+pub fn intersect_triangle_lanes<L: Lane>(origin: V3<L>, dir: V3<L>, tri: &TriangleEdges, limit: L) -> (L::Mask, L, L, L) {
+    let (zero, one) = (limit.splat(0.0), limit.splat(1.0));
+    let e1 = V3::splat(limit, tri.e1);
+    let e2 = V3::splat(limit, tri.e2);
+    let p = dir.cross(e2);
+    let det = e1.dot(p);
+    let epsilon = limit.splat(tri.det_epsilon);
+    let front = det.gt(epsilon);
+    let facing = if tri.two_sided { front | (-det).gt(epsilon) } else { front };
+    let inv = one / det;
+    let s = origin - V3::splat(limit, tri.v0);
+    let b1 = s.dot(p) * inv;
+    let inside1 = zero.le(b1) & b1.le(one);
+    let q = s.cross(e1);
+    let b2 = dir.dot(q) * inv;
+    let inside2 = !(b2.lt(zero) | (b1 + b2).gt(one));
+    let t = e2.dot(q) * inv;
+    let ahead = !(t.le(zero) | t.ge(limit));
+    (facing & inside1 & inside2 & ahead, t, b1, b2)
+}
+
 /// Ray-sphere test. Spheres are closed and hit from outside only: a ray that
 /// starts inside (or on) the sphere does not hit it, which also keeps shadow
 /// rays from re-hitting the sphere they leave. Refracted rays travelling inside
@@ -113,6 +140,47 @@ pub fn intersect_sphere(ray: &Ray, s: &Sphere, t_max: f32, allow_inside: bool) -
 mod tests {
     use super::*;
     use glam::Vec2;
+
+    /// The lane form gives each ray the single test's outcome and, on a hit,
+    /// its very bits, at one lane and at eight (whatever SIMD level runs).
+    #[test]
+    fn lanes_match_the_single_ray_test() {
+        use fearless_simd::{dispatch, f32x8, SimdFrom};
+        let mut seed = 12345u32;
+        let mut next = move || {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (seed >> 8) as f32 / (1 << 24) as f32 * 2.0 - 1.0
+        };
+        let mut hits = 0;
+        for round in 0..4000 {
+            let v = [Vec3::new(next(), next(), next()), Vec3::new(next(), next(), next()), Vec3::new(next(), next(), next())];
+            let t = tri(v, round % 3 == 0);
+            let rays: [Ray; 8] = std::array::from_fn(|_| {
+                let origin = Vec3::new(next(), next(), next() + 2.0);
+                let target = (v[0] + v[1] + v[2]) / 3.0 + Vec3::new(next(), next(), next()) * 0.5;
+                Ray::new(origin, (target - origin).normalize())
+            });
+            let limit: [f32; 8] = std::array::from_fn(|i| if i == 7 { 1.5 } else { f32::INFINITY });
+            let want: [TriangleTest; 8] = std::array::from_fn(|i| intersect_triangle(&rays[i], &t, limit[i]));
+            let wide: (u8, [f32; 8], [f32; 8], [f32; 8]) = dispatch!(crate::math::lanes::simd_level(), simd => {
+                let origin = V3::gather(simd, &rays.map(|r| r.origin));
+                let dir = V3::gather(simd, &rays.map(|r| r.dir));
+                let (hit, t8, b1, b2) = intersect_triangle_lanes(origin, dir, &t, f32x8::simd_from(simd, limit));
+                (crate::math::lanes::mask_bits(hit), t8.into(), b1.into(), b2.into())
+            });
+            for i in 0..8 {
+                let (one_hit, t1, b11, b21) = intersect_triangle_lanes(rays[i].origin.into(), rays[i].dir.into(), &t, limit[i]);
+                assert_eq!(want[i].is_ok(), one_hit, "round {round} ray {i}");
+                assert_eq!(want[i].is_ok(), wide.0 & 1 << i != 0, "round {round} ray {i}");
+                if let Ok((tt, bb1, bb2)) = want[i] {
+                    hits += 1;
+                    assert_eq!([tt, bb1, bb2].map(f32::to_bits), [t1, b11, b21].map(f32::to_bits));
+                    assert_eq!([tt, bb1, bb2].map(f32::to_bits), [wide.1[i], wide.2[i], wide.3[i]].map(f32::to_bits));
+                }
+            }
+        }
+        assert!(hits > 5000, "only {hits} hits compared");
+    }
 
     fn tri(v: [Vec3; 3], two_sided: bool) -> TriangleEdges {
         TriangleEdges::new(&Triangle { v, n: [Vec3::Z; 3], uv: [Vec2::ZERO; 3], material: 0, object: 0, two_sided })

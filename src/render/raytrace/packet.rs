@@ -19,7 +19,11 @@
 
 use super::bvh::{leaf_range, BvhQuery, Node4, LEAF_BIT, STACK};
 use super::cast_pass;
+use super::intersect::{intersect_triangle_lanes, TriangleEdges};
 use super::traverse::{slab_test, test_leaf, BestHit, ChildOrder, PreparedRay, SLAB_WIDEN};
+use crate::math::lanes::{mask_bits, simd_level, V3};
+use crate::scene::Sphere;
+use fearless_simd::{dispatch, f32x8, Simd, SimdBase};
 use crate::math::{Radiance, Ray};
 use crate::render::debug::View;
 use crate::render::shade::cast_shadow_ray;
@@ -82,6 +86,7 @@ pub struct Packet {
     pub rays: [Ray; P],
     pub t_max: [f32; P],
     origin: [Lanes; 3],
+    dir: [Lanes; 3],
     inv: [Lanes; 3],
     /// The closest hit so far (t_max until one is found): the far end of the box tests.
     best_t: Lanes,
@@ -100,6 +105,7 @@ impl Packet {
             rays: [ray; P],
             t_max: [0.0; P],
             origin: [zero; 3],
+            dir: [zero; 3],
             inv: [zero; 3],
             best_t: zero,
             limit: [0.0; P],
@@ -198,7 +204,7 @@ impl BvhQuery<'_> {
     /// Closest hits of the packet's rays whose bit is set in `valid`. The
     /// tree must not be `deep` (the stack is fixed).
     pub fn closest_packet(&self, pk: &mut Packet, valid: u64, counts: &mut RayCounts) {
-        self.trace_packet::<false>(pk, valid, counts);
+        dispatch!(simd_level(), simd => self.trace_packet::<_, false>(simd, pk, valid, counts));
     }
 
     /// Shadow rays: for each ray in `valid`, whether `occluder` finds
@@ -207,11 +213,12 @@ impl BvhQuery<'_> {
     /// first found); whether there is one cannot: with the far end fixed at
     /// t_max, a ray meets exactly the leaves it meets alone.
     pub fn occluded_packet(&self, pk: &mut Packet, valid: u64, counts: &mut RayCounts) {
-        self.trace_packet::<true>(pk, valid, counts);
+        dispatch!(simd_level(), simd => self.trace_packet::<_, true>(simd, pk, valid, counts));
     }
 
+    /// The packet traversal, compiled for the SIMD level `simd` proves.
     #[inline(always)]
-    fn trace_packet<const ANY: bool>(&self, pk: &mut Packet, valid: u64, counts: &mut RayCounts) {
+    fn trace_packet<S: Simd, const ANY: bool>(&self, simd: S, pk: &mut Packet, valid: u64, counts: &mut RayCounts) {
         let bvh = &self.prepared.bvh;
         debug_assert!(!bvh.deep);
         let spheres = &self.prepared.scene.spheres;
@@ -224,6 +231,7 @@ impl BvhQuery<'_> {
             let r = PreparedRay::new(&pk.rays[i]);
             for a in 0..3 {
                 pk.origin[a].0[i] = r.origin[a].x;
+                pk.dir[a].0[i] = pk.rays[i].dir[a];
                 pk.inv[a].0[i] = r.inv[a].x;
             }
             let t_max = pk.t_max[i];
@@ -299,20 +307,7 @@ impl BvhQuery<'_> {
                 }
             } else {
                 let (start, end) = leaf_range(word);
-                let prims = &bvh.prims[start..end];
-                let mut m = mask;
-                while m != 0 {
-                    let i = m.trailing_zeros() as usize;
-                    m &= m - 1;
-                    let mut best = BestHit { t: pk.best_t.0[i], limit: pk.limit[i], id: pk.best_id[i], bary: pk.bary[i] };
-                    if test_leaf::<ANY, _>(prims, spheres, &pk.rays[i], false, &mut best, &mut tests, &mut NoRecord) {
-                        done |= 1 << i;
-                    }
-                    pk.best_t.0[i] = best.t;
-                    pk.limit[i] = best.limit;
-                    pk.best_id[i] = best.id;
-                    pk.bary[i] = best.bary;
-                }
+                test_leaf_packet::<S, ANY>(simd, &bvh.prims[start..end], spheres, pk, mask, &mut done, &mut tests);
             }
             if len == 0 {
                 break;
@@ -323,6 +318,81 @@ impl BvhQuery<'_> {
         }
         counts.nodes += visits;
         counts.tests += tests;
+    }
+}
+
+/// The leaf loop of `traverse::test_leaf` for the rays of `mask`, each
+/// triangle tested against eight rays at a time (`intersect_triangle_lanes`,
+/// the single test's arithmetic lane by lane) with each lane's own limit,
+/// and the same tie rule applied per ray in the same primitive order: every
+/// ray ends with the hit it finds alone. Spheres are tested ray by ray.
+/// With `ANY`, a ray stops at its first hit (its bit set in `done`).
+#[inline(always)]
+fn test_leaf_packet<S: Simd, const ANY: bool>(
+    simd: S,
+    prims: &[(TriangleEdges, PrimitiveId)],
+    spheres: &[Sphere],
+    pk: &mut Packet,
+    mask: u64,
+    done: &mut u64,
+    tests: &mut u64,
+) {
+    let mut active = mask;
+    for prim in prims {
+        let (tri, id) = (&prim.0, prim.1);
+        *tests += active.count_ones() as u64;
+        if id.is_sphere() {
+            let mut m = active;
+            while m != 0 {
+                let i = m.trailing_zeros() as usize;
+                m &= m - 1;
+                let mut best = BestHit { t: pk.best_t.0[i], limit: pk.limit[i], id: pk.best_id[i], bary: pk.bary[i] };
+                let mut sphere_tests = 0;
+                if test_leaf::<ANY, _>(std::slice::from_ref(prim), spheres, &pk.rays[i], false, &mut best, &mut sphere_tests, &mut NoRecord) {
+                    *done |= 1 << i;
+                    active &= !(1 << i);
+                }
+                pk.best_t.0[i] = best.t;
+                pk.limit[i] = best.limit;
+                pk.best_id[i] = best.id;
+                pk.bary[i] = best.bary;
+            }
+            continue;
+        }
+        for g in 0..P / 8 {
+            let lanes = (active >> (8 * g)) as u8;
+            if lanes == 0 {
+                continue;
+            }
+            let base = 8 * g;
+            let origin = V3::load(simd, [&pk.origin[0].0, &pk.origin[1].0, &pk.origin[2].0], base);
+            let dir = V3::load(simd, [&pk.dir[0].0, &pk.dir[1].0, &pk.dir[2].0], base);
+            let limit = f32x8::from_slice(simd, &pk.limit[base..base + 8]);
+            let (hit, t, b1, b2) = intersect_triangle_lanes(origin, dir, tri, limit);
+            let mut found = mask_bits(hit) & lanes;
+            if found == 0 {
+                continue;
+            }
+            let (t, b1, b2): ([f32; 8], [f32; 8], [f32; 8]) = (t.into(), b1.into(), b2.into());
+            while found != 0 {
+                let j = found.trailing_zeros() as usize;
+                found &= found - 1;
+                let i = base + j;
+                if ANY {
+                    pk.best_t.0[i] = t[j];
+                    pk.best_id[i] = id;
+                    pk.bary[i] = (b1[j], b2[j]);
+                    *done |= 1 << i;
+                    active &= !(1 << i);
+                } else if t[j] < pk.best_t.0[i] || id < pk.best_id[i] {
+                    // As `test_leaf`: t <= best here; on a tie the lower id wins.
+                    pk.best_t.0[i] = t[j];
+                    pk.best_id[i] = id;
+                    pk.bary[i] = (b1[j], b2[j]);
+                    pk.limit[i] = f32::from_bits(t[j].to_bits() + 1);
+                }
+            }
+        }
     }
 }
 
