@@ -1,17 +1,18 @@
 //! Eye rays traced as packets: the rays of a TILE_W x TILE_H pixel tile walk
 //! the 4-wide BVH together. Each node is fetched once per packet and its four
-//! child boxes are tested against four rays at a time (one SIMD lane per
-//! ray), so the per-ray latency chain of single-ray traversal becomes
-//! independent work the CPU overlaps.
+//! child boxes are tested against eight rays at a time, and each leaf
+//! triangle against eight rays at a time (one SIMD lane per ray, at the
+//! widest level the CPU has: `math::lanes::simd_level`), so the per-ray
+//! latency chain of single-ray traversal becomes independent work.
 //!
 //! Every ray ends with exactly the hit `BvhQuery::closest` finds for it alone:
-//! - a ray enters a node only when its own slab test (`traverse::slab_test`,
-//!   the single-ray test's arithmetic, lane by lane) accepts the box;
-//! - leaves test only those rays, with the same leaf loop
-//!   (`traverse::test_leaf`) and so the same tie rule (on equal t the lower
-//!   primitive id wins): the order in which the packet visits nodes cannot
-//!   change any ray's winner; the padded boxes guarantee no true hit is
-//!   culled by a box test in either traversal.
+//! - a ray enters a node only when its own slab test (`slab_test8`, the
+//!   single-ray test's arithmetic, lane by lane) accepts the box;
+//! - leaves test only those rays, with the single test's arithmetic
+//!   (`intersect_triangle_lanes`) and the same tie rule in the same order
+//!   (on equal t the lower primitive id wins): the order in which the
+//!   packet visits nodes cannot change any ray's winner; the padded boxes
+//!   guarantee no true hit is culled by a box test in either traversal.
 //!
 //! After the eye rays, the tile's shadow rays towards each light go as one
 //! packet too, and the tile is shaded eight samples at a time from those
@@ -20,61 +21,33 @@
 use super::bvh::{leaf_range, BvhQuery, Node4, LEAF_BIT, STACK};
 use super::cast_pass;
 use super::intersect::{intersect_triangle_lanes, TriangleEdges};
-use super::traverse::{slab_test, test_leaf, BestHit, ChildOrder, PreparedRay, SLAB_WIDEN};
-use crate::math::lanes::{mask_bits, simd_level, V3};
-use crate::scene::Sphere;
-use fearless_simd::{dispatch, f32x8, Simd, SimdBase};
+use super::traverse::{test_leaf, BestHit, ChildOrder, PreparedRay, SLAB_WIDEN};
+use crate::math::lanes::{mask_bits, mask_from_bits, simd_level, V3};
 use crate::math::{Radiance, Ray};
 use crate::render::debug::View;
 use crate::render::shade::cast_shadow_ray;
 use crate::render::pixel_record::NoRecord;
 use crate::render::shade_batch::{self, Batch};
 use crate::render::{resolve_sample, with_shading_hit, Occluder, PassJob, RayCounts, ShadowMode};
-use crate::scene::{PrimitiveId, SurfaceHit};
+use crate::scene::{PrimitiveId, Sphere, SurfaceHit};
+use fearless_simd::{dispatch, f32x8, mask32x8, Select, Simd, SimdBase};
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 use std::mem::MaybeUninit;
 
 pub const TILE_W: usize = 8;
 pub const TILE_H: usize = 8;
-/// Rays per packet, and groups of four (one SIMD register) per packet.
+/// Rays per packet: eight groups of eight (one SIMD register of lanes).
 const P: usize = TILE_W * TILE_H;
-const _: () = assert!(P <= 64 && TILE_W % 2 == 0 && TILE_H % 2 == 0);
-
-/// Per lane: +inf where the lane is active, -inf where not. `min` with a
-/// ray's far distance keeps it for active rays and makes every box test
-/// fail for the others.
-const LANE_FAR: [Vec4; 16] = {
-    let mut t = [Vec4::ZERO; 16];
-    let mut m = 0;
-    while m < 16 {
-        let mut l = [f32::NEG_INFINITY; 4];
-        let mut bit = 0;
-        while bit < 4 {
-            if m & (1 << bit) != 0 {
-                l[bit] = f32::INFINITY;
-            }
-            bit += 1;
-        }
-        t[m] = Vec4::new(l[0], l[1], l[2], l[3]);
-        m += 1;
-    }
-    t
-};
+const _: () = assert!(P == 64 && TILE_W % 4 == 0 && TILE_H % 2 == 0);
 
 #[derive(Clone, Copy)]
 #[repr(C, align(16))]
 struct Lanes([f32; P]);
 
-impl Lanes {
-    #[inline(always)]
-    fn group(&self, g: usize) -> Vec4 {
-        Vec4::from_slice(&self.0[g * 4..g * 4 + 4])
-    }
-}
-
 /// Image position within the tile of lane `i`: each group of four lanes is a
-/// 2x2 quad, so a group's rays are as close together as they can be.
+/// 2x2 quad, and each group of eight two quads side by side (a 4x2 block),
+/// so a group's rays are as close together as they can be.
 #[inline(always)]
 pub fn lane_xy(i: usize) -> (usize, usize) {
     let (g, q) = (i / 4, i % 4);
@@ -262,33 +235,39 @@ impl BvhQuery<'_> {
                 let node = &bvh.nodes[word as usize];
                 let mut child_mask = [0u64; 4];
                 let mut child_near = [f32::INFINITY; 4];
-                // The groups with an active ray, and their lanes' far ends.
-                let mut groups = [(0usize, Vec4::ZERO); P / 4];
+                // The groups of eight lanes with an active ray, and their lanes'
+                // far ends (-inf in inactive lanes, so their box tests fail).
+                let mut groups = [(0usize, f32x8::splat(simd, 0.0)); P / 8];
                 let mut n_groups = 0;
-                for g in 0..P / 4 {
-                    let gmask = (mask >> (4 * g)) as usize & 15;
-                    groups[n_groups] = (g, pk.best_t.group(g).min(LANE_FAR[gmask]));
-                    n_groups += (gmask != 0) as usize;
+                let mut far_max = f32::NEG_INFINITY;
+                for g in 0..P / 8 {
+                    let gmask = (mask >> (8 * g)) as u8;
+                    if gmask == 0 {
+                        continue;
+                    }
+                    let active = mask_from_bits(simd, gmask);
+                    let best = f32x8::from_slice(simd, &pk.best_t.0[8 * g..8 * g + 8]);
+                    let far = active.select(best, f32x8::splat(simd, f32::NEG_INFINITY));
+                    far_max = far_max.max(horizontal_max(far));
+                    groups[n_groups] = (g, far);
+                    n_groups += 1;
                 }
                 // Interval test: the children no ray of the packet can meet.
-                let far_max = groups[..n_groups].iter().fold(Vec4::NEG_INFINITY, |m, g| m.max(g.1)).max_element();
                 let mut valid_children = bounds.children_possible(node, far_max);
                 while valid_children != 0 {
                     let c = valid_children.trailing_zeros() as usize;
                     valid_children &= valid_children - 1;
-                    // Child c's box in every lane, against four rays at a time.
-                    let planes: [Vec4; 6] = std::array::from_fn(|k| Vec4::splat(node.planes[k].as_ref()[c]));
-                    let mut near = Vec4::INFINITY;
+                    // Child c's box in every lane, against eight rays at a time.
+                    let planes: [f32x8<S>; 6] = std::array::from_fn(|k| f32x8::splat(simd, node.planes[k].as_ref()[c]));
+                    let mut near = f32x8::splat(simd, f32::INFINITY);
                     let mut bits_all = 0u64;
                     for &(g, t_far) in &groups[..n_groups] {
-                        let origin = [pk.origin[0].group(g), pk.origin[1].group(g), pk.origin[2].group(g)];
-                        let inv = [pk.inv[0].group(g), pk.inv[1].group(g), pk.inv[2].group(g)];
-                        let (hit, tn) = slab_test(&planes, &origin, &inv, t_far);
-                        bits_all |= (hit.bitmask() as u64) << (4 * g);
-                        near = near.min(Vec4::select(hit, tn, Vec4::INFINITY));
+                        let (hit, tn) = slab_test8(simd, &planes, pk, 8 * g, t_far);
+                        bits_all |= (mask_bits(hit) as u64) << (8 * g);
+                        near = near.min(hit.select(tn, f32x8::splat(simd, f32::INFINITY)));
                     }
                     child_mask[c] = bits_all;
-                    child_near[c] = near.min_element();
+                    child_near[c] = horizontal_min(near);
                 }
                 // Nearest child next (its nearest ray's entry); the others pushed farthest first.
                 let mut order = ChildOrder::new();
@@ -319,6 +298,36 @@ impl BvhQuery<'_> {
         counts.nodes += visits;
         counts.tests += tests;
     }
+}
+
+/// `traverse::slab_test` for the eight rays of lanes `start..start + 8`
+/// against one box: the same arithmetic, eight wide. (The box tests only
+/// prune: the padded boxes and `SLAB_WIDEN` keep every true hit, so they
+/// need not match the single ray's bit for bit, but they do.)
+#[inline(always)]
+fn slab_test8<S: Simd>(simd: S, p: &[f32x8<S>; 6], pk: &Packet, start: usize, t_far: f32x8<S>) -> (mask32x8<S>, f32x8<S>) {
+    let o = |a: usize| f32x8::from_slice(simd, &pk.origin[a].0[start..start + 8]);
+    let inv = |a: usize| f32x8::from_slice(simd, &pk.inv[a].0[start..start + 8]);
+    let (ox, oy, oz) = (o(0), o(1), o(2));
+    let (ix, iy, iz) = (inv(0), inv(1), inv(2));
+    let (x0, x1) = ((p[0] - ox) * ix, (p[1] - ox) * ix);
+    let (y0, y1) = ((p[2] - oy) * iy, (p[3] - oy) * iy);
+    let (z0, z1) = ((p[4] - oz) * iz, (p[5] - oz) * iz);
+    let tn = x0.min(x1).max(y0.min(y1)).max(z0.min(z1)).max(0.0) * (1.0 - SLAB_WIDEN);
+    let tf = (x0.max(x1).min(y0.max(y1)).min(z0.max(z1)) * (1.0 + SLAB_WIDEN)).min(t_far);
+    (tn.simd_le(tf), tn)
+}
+
+#[inline(always)]
+fn horizontal_min<S: Simd>(v: f32x8<S>) -> f32 {
+    let a: [f32; 8] = v.into();
+    a.into_iter().fold(f32::INFINITY, f32::min)
+}
+
+#[inline(always)]
+fn horizontal_max<S: Simd>(v: f32x8<S>) -> f32 {
+    let a: [f32; 8] = v.into();
+    a.into_iter().fold(f32::NEG_INFINITY, f32::max)
 }
 
 /// The leaf loop of `traverse::test_leaf` for the rays of `mask`, each
