@@ -123,27 +123,33 @@ struct PacketBounds {
 }
 
 impl PacketBounds {
-    fn new(pk: &Packet, mask: u64) -> PacketBounds {
-        let mut lo = [f32::INFINITY; 6];
-        let mut hi = [f32::NEG_INFINITY; 6];
-        let mut m = mask;
-        while m != 0 {
-            let i = m.trailing_zeros() as usize;
-            m &= m - 1;
+    /// The bounds over the lanes of `mask`, eight lanes at a time.
+    #[inline(always)]
+    fn new<S: Simd>(simd: S, pk: &Packet, mask: u64) -> PacketBounds {
+        let (inf, neg_inf) = (f32x8::splat(simd, f32::INFINITY), f32x8::splat(simd, f32::NEG_INFINITY));
+        let mut lo = [inf; 6];
+        let mut hi = [neg_inf; 6];
+        for g in 0..P / 8 {
+            let gmask = (mask >> (8 * g)) as u8;
+            if gmask == 0 {
+                continue;
+            }
+            let active = mask_from_bits(simd, gmask);
             for a in 0..3 {
-                let (o, v) = (pk.origin[a].0[i], pk.inv[a].0[i]);
-                lo[a] = lo[a].min(o);
-                hi[a] = hi[a].max(o);
-                lo[3 + a] = lo[3 + a].min(v);
-                hi[3 + a] = hi[3 + a].max(v);
+                for (k, lanes) in [(a, &pk.origin[a]), (3 + a, &pk.inv[a])] {
+                    let v = f32x8::from_slice(simd, &lanes.0[8 * g..8 * g + 8]);
+                    lo[k] = lo[k].min(active.select(v, inf));
+                    hi[k] = hi[k].max(active.select(v, neg_inf));
+                }
             }
         }
-        let s = |v: &[f32; 6], k: usize| Vec4::splat(v[k]);
+        let s = |v: f32| Vec4::splat(v);
+        let (lo, hi) = (lo.map(horizontal_min), hi.map(horizontal_max));
         PacketBounds {
-            o_lo: [s(&lo, 0), s(&lo, 1), s(&lo, 2)],
-            o_hi: [s(&hi, 0), s(&hi, 1), s(&hi, 2)],
-            inv_lo: [s(&lo, 3), s(&lo, 4), s(&lo, 5)],
-            inv_hi: [s(&hi, 3), s(&hi, 4), s(&hi, 5)],
+            o_lo: [s(lo[0]), s(lo[1]), s(lo[2])],
+            o_hi: [s(hi[0]), s(hi[1]), s(hi[2])],
+            inv_lo: [s(lo[3]), s(lo[4]), s(lo[5])],
+            inv_hi: [s(hi[3]), s(hi[4]), s(hi[5])],
         }
     }
 
@@ -217,7 +223,7 @@ impl BvhQuery<'_> {
         if mask == 0 {
             return;
         }
-        let bounds = PacketBounds::new(pk, mask);
+        let bounds = PacketBounds::new(simd, pk, mask);
         let mut stack: [MaybeUninit<(u32, u64)>; STACK] = [const { MaybeUninit::uninit() }; STACK];
         let mut len = 0usize;
         let mut word = bvh.root;
