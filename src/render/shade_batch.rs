@@ -221,3 +221,68 @@ impl<Q: SceneQuery> BatchVisibility<'_, '_, Q> {
         visible
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::pixel_record::NoRecord;
+    use crate::render::raytrace::bvh::BvhQuery;
+    use crate::render::gi::GiMode;
+    use crate::render::{PreparedScene, RenderSettings};
+    use crate::scene::builtin;
+    use std::sync::atomic::AtomicBool;
+
+    /// Eight (or fewer) samples shaded together give each sample's
+    /// one-wide `shade()` value bit for bit: on every built-in scene (glossy,
+    /// mirror, glass, several lights), with flat and Phong normals, with and
+    /// without shadow rays, and with ambient occlusion's random rays.
+    #[test]
+    fn batches_equal_one_sample_shading() {
+        let mut compared = 0;
+        for name in builtin::names() {
+            let prepared = PreparedScene::new(builtin::load_builtin(name).unwrap().unwrap());
+            let query = BvhQuery::new(&prepared);
+            let (w, h) = (29u32, 19u32);
+            let view = prepared.scene.camera.view(w, h);
+            let cancel = AtomicBool::new(false);
+            for (interpolation, shadows, gi) in [
+                (Interpolation::Phong, ShadowMode::Ray, GiMode::None),
+                (Interpolation::Flat, ShadowMode::None, GiMode::None),
+                (Interpolation::Phong, ShadowMode::Ray, GiMode::Ao),
+            ] {
+                let mut settings = RenderSettings { interpolation, shadows, ..RenderSettings::for_scene(&prepared.scene) };
+                settings.gi.mode = gi;
+                let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: glam::Vec2::splat(0.5), sample: 0, photons: None, active: None, rows: 0..h, cancel: &cancel };
+                assert!(batchable(&job));
+                let mut batch = Batch::new();
+                let mut expected = Vec::new();
+                let mut check = |batch: &mut Batch, expected: &mut Vec<Radiance>| {
+                    let got = shade_batch(&job, &query, batch, None, &mut RayCounts::default());
+                    for j in 0..batch.len() {
+                        assert_eq!(got[j].to_array().map(f32::to_bits), expected[j].to_array().map(f32::to_bits), "{name} {interpolation:?} {shadows:?} {gi:?} lane {j} of {}", batch.len());
+                    }
+                    compared += batch.len();
+                    batch.clear();
+                    expected.clear();
+                };
+                for (x, y) in (0..h).flat_map(|y| (0..w).map(move |x| (x, y))) {
+                    let p = job.sample_position(x, y);
+                    let ray = view.eye_ray(p.x, p.y);
+                    let Some(hit) = query.closest(&ray, view.far_t(p.x, p.y), false, &mut RayCounts::default(), &mut NoRecord) else { continue };
+                    let pixel = job.pixel_index(x, y);
+                    let one = crate::render::resolve_sample(&job, &query, &ray, Some(&hit), pixel, &mut RayCounts::default(), &mut NoRecord);
+                    batch.push(interpolation, &hit, ray.dir, pixel, 0);
+                    expected.push(one);
+                    // Odd-sized batches too: flush after five when the pixel index says so.
+                    if batch.is_full() || (pixel % 7 == 0 && batch.len() == 5) {
+                        check(&mut batch, &mut expected);
+                    }
+                }
+                if !batch.is_empty() {
+                    check(&mut batch, &mut expected);
+                }
+            }
+        }
+        assert!(compared > 3000, "only {compared} samples compared");
+    }
+}
