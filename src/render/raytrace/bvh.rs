@@ -395,6 +395,13 @@ impl Bvh {
         self.nodes.len() + self.leaf_bounds.len()
     }
 
+    /// Bytes the hierarchy holds: its nodes, its primitive slots and the
+    /// debugger's bounds, each as length times element size.
+    pub fn memory_bytes(&self) -> usize {
+        use std::mem::size_of_val;
+        size_of_val(&self.nodes[..]) + size_of_val(&self.prims[..]) + size_of_val(&self.node_bounds[..]) + size_of_val(&self.leaf_bounds[..])
+    }
+
     /// Levels below the root of the deepest leaf (0 when the root is a leaf).
     pub fn depth(&self) -> u32 {
         self.depth
