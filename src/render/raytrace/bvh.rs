@@ -22,8 +22,10 @@ use super::intersect::TriangleEdges;
 use super::traverse::{test_leaf, BestHit, ChildOrder, PreparedRay};
 use crate::math::Ray;
 use crate::render::pixel_record::Recorder;
+use crate::render::prepared::SceneEdges;
 use crate::render::{Occluder, PreparedScene, RayCounts, SceneQuery};
-use crate::scene::{PrimitiveId, PrimitiveKind, Scene, SurfaceHit};
+use crate::scene::{PrimitiveId, PrimitiveKind, Scene, SurfaceHit, Triangle};
+use std::sync::Arc;
 use glam::{Vec3, Vec3A, Vec4};
 
 const BINS: usize = 32;
@@ -66,6 +68,49 @@ pub enum NodeContent {
     /// `count` primitives starting at `first` in the BVH's primitive order
     /// (see `Bvh::primitive`).
     Leaf { first: u32, count: u32 },
+}
+
+/// Triangle edges by scene index: what the build reads.
+pub trait EdgeSource {
+    fn count(&self) -> usize;
+    fn edges(&self, i: usize) -> TriangleEdges;
+}
+
+impl EdgeSource for [TriangleEdges] {
+    fn count(&self) -> usize {
+        self.len()
+    }
+    fn edges(&self, i: usize) -> TriangleEdges {
+        self[i]
+    }
+}
+
+impl EdgeSource for Vec<TriangleEdges> {
+    fn count(&self) -> usize {
+        self.len()
+    }
+    fn edges(&self, i: usize) -> TriangleEdges {
+        self[i]
+    }
+}
+
+impl EdgeSource for SceneEdges {
+    fn count(&self) -> usize {
+        self.len()
+    }
+    fn edges(&self, i: usize) -> TriangleEdges {
+        self[i]
+    }
+}
+
+/// The scene's triangles, their edges made as `TriangleEdges::new` makes them.
+impl EdgeSource for [Triangle] {
+    fn count(&self) -> usize {
+        self.len()
+    }
+    fn edges(&self, i: usize) -> TriangleEdges {
+        TriangleEdges::new(&self[i])
+    }
 }
 
 /// Bounds and centroid of one primitive during the build.
@@ -118,6 +163,13 @@ fn padded(min: Vec3A, max: Vec3A) -> (Vec3A, Vec3A) {
     let magnitude = min.abs().max(max.abs()).max_element();
     let pad = extent * 1.0e-5 + magnitude * 2.0e-6 + f32::MIN_POSITIVE;
     (min - Vec3A::splat(pad), max + Vec3A::splat(pad))
+}
+
+/// A triangle's padded box, from the edges the ray test uses.
+#[inline]
+fn triangle_box(e: &TriangleEdges) -> (Vec3A, Vec3A) {
+    let (v0, v1, v2) = (Vec3A::from(e.v0), Vec3A::from(e.v0 + e.e1), Vec3A::from(e.v0 + e.e2));
+    padded(v0.min(v1).min(v2), v0.max(v1).max(v2))
 }
 
 /// A node of the binary tree the build makes, before it is collapsed into
@@ -262,11 +314,13 @@ pub struct Bvh {
     pub(super) root: u32,
     pub(super) root_bounds: Aabb,
     /// Per primitive slot: the triangle's edges (unused for spheres) and the
-    /// primitive's id.
-    pub(super) prims: Vec<(TriangleEdges, PrimitiveId)>,
-    /// For the debugger: each node's own bounds, and each leaf's (by first slot).
-    node_bounds: Vec<Aabb>,
-    leaf_bounds: Vec<(u32, Aabb)>,
+    /// primitive's id. The only copy of the edges: `PreparedScene::edges`
+    /// reads them from here in scene order (`Bvh::edges_in_scene_order`).
+    pub(super) prims: Arc<Vec<(TriangleEdges, PrimitiveId)>>,
+    /// For the debugger: the bounds of leaves holding a sphere, by first
+    /// slot (other bounds are recomputed from the nodes and the edges).
+    sphere_leaf_bounds: Vec<(u32, Aabb)>,
+    leaves: usize,
     depth: u32,
     /// True when a traversal may need more than `STACK` entries.
     pub(super) deep: bool,
@@ -288,24 +342,29 @@ pub(super) fn leaf_range(word: u32) -> (usize, usize) {
     (first, first + (word & 7) as usize + 1)
 }
 
-struct Collapse {
+struct Collapse<'a> {
     nodes: Vec<Node4>,
-    node_bounds: Vec<Aabb>,
-    leaf_bounds: Vec<(u32, Aabb)>,
+    /// Whether each primitive slot holds a sphere.
+    refs: &'a [PrimRef],
+    sphere_leaf_bounds: Vec<(u32, Aabb)>,
+    leaves: usize,
     depth: u32,
 }
 
-impl Collapse {
+impl Collapse<'_> {
     /// The word for binary subtree `t` at 4-wide level `level`: a leaf, or a
     /// node whose children are `t`'s grandchildren (the larger ones opened first).
     fn word(&mut self, t: &BuildNode, level: u32) -> u32 {
         self.depth = self.depth.max(level);
-        let (b, kids) = match t {
+        let kids = match t {
             BuildNode::Leaf { b, first, count } => {
-                self.leaf_bounds.push((*first, aabb(*b)));
+                self.leaves += 1;
+                if self.refs[*first as usize..(*first + *count) as usize].iter().any(|r| r.id.is_sphere()) {
+                    self.sphere_leaf_bounds.push((*first, aabb(*b)));
+                }
                 return leaf_word(*first, *count);
             }
-            BuildNode::Inner { b, kids } => (*b, kids),
+            BuildNode::Inner { kids, .. } => kids,
         };
         let mut children: Vec<&BuildNode> = vec![&kids[0], &kids[1]];
         while children.len() < 4 {
@@ -321,7 +380,6 @@ impl Collapse {
         }
         let index = self.nodes.len();
         self.nodes.push(Node4 { planes: [Vec4::ZERO; 6], child: [0; 4], valid: 0, _pad: [0; 3] });
-        self.node_bounds.push(aabb(b));
         let mut node = self.nodes[index];
         for (i, c) in children.into_iter().enumerate() {
             let cb = c.bounds();
@@ -340,11 +398,10 @@ impl Collapse {
 impl Bvh {
     /// Builds the hierarchy over every triangle (`edges`, in scene order) and
     /// every sphere of `scene`.
-    pub fn build(scene: &Scene, edges: &[TriangleEdges]) -> Bvh {
-        let mut refs: Vec<PrimRef> = Vec::with_capacity(edges.len() + scene.spheres.len());
-        for (i, e) in edges.iter().enumerate() {
-            let (v0, v1, v2) = (Vec3A::from(e.v0), Vec3A::from(e.v0 + e.e1), Vec3A::from(e.v0 + e.e2));
-            let (min, max) = padded(v0.min(v1).min(v2), v0.max(v1).max(v2));
+    pub fn build<E: EdgeSource + ?Sized>(scene: &Scene, edges: &E) -> Bvh {
+        let mut refs: Vec<PrimRef> = Vec::with_capacity(edges.count() + scene.spheres.len());
+        for i in 0..edges.count() {
+            let (min, max) = triangle_box(&edges.edges(i));
             refs.push(PrimRef { min, max, id: PrimitiveId::triangle(i as u32) });
         }
         for (i, s) in scene.spheres.iter().enumerate() {
@@ -358,9 +415,9 @@ impl Bvh {
                 nodes: Vec::new(),
                 root: leaf_word(0, 1),
                 root_bounds: Aabb::EMPTY,
-                prims: Vec::new(),
-                node_bounds: Vec::new(),
-                leaf_bounds: Vec::new(),
+                prims: Arc::new(Vec::new()),
+                sphere_leaf_bounds: Vec::new(),
+                leaves: 0,
                 depth: 0,
                 deep: false,
             };
@@ -369,37 +426,50 @@ impl Bvh {
         let tree = build_rec(&mut refs, 0, 0, &mut binary_depth);
         let mut c = Collapse {
             nodes: Vec::with_capacity(refs.len() / 4 + 1),
-            node_bounds: Vec::with_capacity(refs.len() / 4 + 1),
-            leaf_bounds: Vec::with_capacity(refs.len() / 2 + 1),
+            refs: &refs,
+            sphere_leaf_bounds: Vec::new(),
+            leaves: 0,
             depth: 0,
         };
         let root = c.word(&tree, 0);
         let root_bounds = aabb(tree.bounds());
         drop(tree);
-        c.leaf_bounds.sort_unstable_by_key(|(first, _)| *first);
-        let prims = refs.iter().map(|r| (if r.id.is_sphere() { dummy } else { edges[r.id.index() as usize] }, r.id)).collect();
+        c.sphere_leaf_bounds.sort_unstable_by_key(|(first, _)| *first);
+        let prims = refs.iter().map(|r| (if r.id.is_sphere() { dummy } else { edges.edges(r.id.index() as usize) }, r.id)).collect::<Vec<_>>();
         Bvh {
             nodes: c.nodes,
             root,
             root_bounds,
-            prims,
-            node_bounds: c.node_bounds,
-            leaf_bounds: c.leaf_bounds,
+            prims: Arc::new(prims),
+            sphere_leaf_bounds: c.sphere_leaf_bounds,
+            leaves: c.leaves,
             depth: c.depth,
             deep: (c.depth as usize + 1) * 3 >= STACK,
         }
     }
 
+    /// The triangles' edges in scene order, read from the primitive slots.
+    pub fn edges_in_scene_order(&self) -> SceneEdges {
+        let triangles = self.prims.iter().filter(|(_, id)| !id.is_sphere()).count();
+        let mut slot = vec![u32::MAX; triangles];
+        for (k, (_, id)) in self.prims.iter().enumerate() {
+            if !id.is_sphere() {
+                slot[id.index() as usize] = k as u32;
+            }
+        }
+        SceneEdges::new(Arc::clone(&self.prims), slot)
+    }
+
     /// Number of nodes: interior nodes plus leaves.
     pub fn node_count(&self) -> usize {
-        self.nodes.len() + self.leaf_bounds.len()
+        self.nodes.len() + self.leaves
     }
 
     /// Bytes the hierarchy holds: its nodes, its primitive slots and the
-    /// debugger's bounds, each as length times element size.
+    /// debugger's sphere-leaf bounds, each as length times element size.
     pub fn memory_bytes(&self) -> usize {
         use std::mem::size_of_val;
-        size_of_val(&self.nodes[..]) + size_of_val(&self.prims[..]) + size_of_val(&self.node_bounds[..]) + size_of_val(&self.leaf_bounds[..])
+        size_of_val(&self.nodes[..]) + size_of_val(&self.prims[..]) + size_of_val(&self.sphere_leaf_bounds[..])
     }
 
     /// Levels below the root of the deepest leaf (0 when the root is a leaf).
@@ -420,13 +490,29 @@ impl Bvh {
     /// Bounds of node `id`.
     pub fn node_bounds(&self, id: u32) -> Aabb {
         if id & LEAF_BIT == 0 {
-            self.node_bounds[id as usize]
-        } else {
-            let first = leaf_range(id).0 as u32;
-            match self.leaf_bounds.binary_search_by_key(&first, |(f, _)| *f) {
-                Ok(i) => self.leaf_bounds[i].1,
-                Err(_) => Aabb::EMPTY,
+            // The union of the children's boxes is exactly the node's own.
+            let n = &self.nodes[id as usize];
+            let mut b = Bounds::EMPTY;
+            for i in (0..4).filter(|i| n.valid & 1 << i != 0) {
+                let (lo, hi) = (Vec3A::new(n.planes[0][i], n.planes[2][i], n.planes[4][i]), Vec3A::new(n.planes[1][i], n.planes[3][i], n.planes[5][i]));
+                b.grow(lo, hi);
             }
+            aabb(b)
+        } else {
+            let (first, end) = leaf_range(id);
+            if end > self.prims.len() {
+                return Aabb::EMPTY;
+            }
+            if let Ok(i) = self.sphere_leaf_bounds.binary_search_by_key(&(first as u32), |(f, _)| *f) {
+                return self.sphere_leaf_bounds[i].1;
+            }
+            // A leaf of triangles: the union of their boxes, made as the build made them.
+            let mut b = Bounds::EMPTY;
+            for (e, _) in &self.prims[first..end] {
+                let (lo, hi) = triangle_box(e);
+                b.grow(lo, hi);
+            }
+            aabb(b)
         }
     }
 
