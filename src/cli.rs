@@ -508,7 +508,29 @@ fn cmd_bench(scene_arg: &str, opts: &RenderOpts, frames: u32) -> Result<(), Stri
     j["frames"] = json!(frames);
     j["primary_rays_per_s"] = json!(counts.primary as f64 / (median / 1e3));
     j["rays_per_s"] = json!((counts.primary + counts.shadow + counts.secondary) as f64 / (median / 1e3));
+    // Memory of the geometry, from lengths and element sizes:
+    //   "scene_bytes"        triangles and spheres of the scene
+    //   "bvh_bytes"          BVH nodes, primitive slots and debugger bounds
+    //   "prepared_bytes"     what the prepared scene adds per triangle besides the BVH
+    //   "bytes_per_triangle" the three summed, over "triangles" (null without triangles)
+    //   "peak_rss_bytes"     the process's peak resident memory (null where unknown)
+    let memory = l.prepared.memory();
+    let triangles = l.prepared.scene.triangles.len();
+    j["scene_bytes"] = json!(memory.scene_bytes);
+    j["bvh_bytes"] = json!(memory.bvh_bytes);
+    j["prepared_bytes"] = json!(memory.prepared_bytes);
+    j["bytes_per_triangle"] = json!((triangles > 0).then(|| memory.total() as f64 / triangles as f64));
+    j["peak_rss_bytes"] = json!(peak_rss_bytes());
     write_json("-", &j)
+}
+
+/// The process's peak resident memory (`VmHWM` of /proc/self/status), where
+/// the system reports it.
+fn peak_rss_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
 }
 
 fn cmd_pixel(scene_arg: &str, x: u32, y: u32, opts: &RenderOpts, as_json: bool) -> Result<(), String> {

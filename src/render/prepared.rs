@@ -3,13 +3,15 @@
 
 use super::raytrace::bvh::Bvh;
 use super::raytrace::intersect::TriangleEdges;
-use crate::scene::Scene;
+use crate::scene::{PrimitiveId, Scene};
+use std::sync::Arc;
 use std::time::Instant;
 
 pub struct PreparedScene {
     pub scene: Scene,
-    /// Per triangle, in scene order: the data the ray-triangle test reads.
-    pub edges: Vec<TriangleEdges>,
+    /// Per triangle, in scene order: the data the ray-triangle test reads
+    /// (stored once, in the BVH's primitive slots).
+    pub edges: SceneEdges,
     pub bvh: Bvh,
     /// Time to build the BVH, milliseconds.
     pub build_ms: f64,
@@ -23,13 +25,86 @@ pub struct PreparedScene {
     pub volume_cache: super::shadow_volume::ShadowVolumeCache,
 }
 
+/// The triangles' edges in scene order: a view of the BVH's primitive
+/// slots (which hold the edges in leaf order) through each triangle's slot.
+pub struct SceneEdges {
+    prims: Arc<Vec<(TriangleEdges, PrimitiveId)>>,
+    /// Per triangle, in scene order: its slot in `prims`.
+    slot: Vec<u32>,
+}
+
+impl SceneEdges {
+    /// `slot[i]` must be the slot of triangle `i` in `prims`.
+    pub(crate) fn new(prims: Arc<Vec<(TriangleEdges, PrimitiveId)>>, slot: Vec<u32>) -> SceneEdges {
+        debug_assert!(slot.iter().enumerate().all(|(i, &s)| prims[s as usize].1 == PrimitiveId::triangle(i as u32)));
+        SceneEdges { prims, slot }
+    }
+
+    /// Number of triangles.
+    pub fn len(&self) -> usize {
+        self.slot.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.slot.is_empty()
+    }
+
+    /// Every triangle's edges, in scene order.
+    pub fn iter(&self) -> impl ExactSizeIterator<Item = &TriangleEdges> + '_ {
+        self.slot.iter().map(|&s| &self.prims[s as usize].0)
+    }
+
+    /// Bytes of the view itself (the edges are the BVH's).
+    pub fn memory_bytes(&self) -> usize {
+        std::mem::size_of_val(&self.slot[..])
+    }
+}
+
+impl std::ops::Index<usize> for SceneEdges {
+    type Output = TriangleEdges;
+    #[inline]
+    fn index(&self, i: usize) -> &TriangleEdges {
+        &self.prims[self.slot[i] as usize].0
+    }
+}
+
+/// Bytes held per scene by its geometry (see `PreparedScene::memory`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MemoryUse {
+    /// The scene's triangles and spheres.
+    pub scene_bytes: usize,
+    /// The BVH: nodes, primitive slots, bounds kept for the debugger.
+    pub bvh_bytes: usize,
+    /// What `PreparedScene` adds besides the BVH (where each triangle's
+    /// edges sit in the BVH).
+    pub prepared_bytes: usize,
+}
+
+impl MemoryUse {
+    pub fn total(&self) -> usize {
+        self.scene_bytes + self.bvh_bytes + self.prepared_bytes
+    }
+}
+
 impl PreparedScene {
     pub fn new(scene: Scene) -> PreparedScene {
-        let edges: Vec<TriangleEdges> = scene.triangles.iter().map(TriangleEdges::new).collect();
         let start = Instant::now();
-        let bvh = Bvh::build(&scene, &edges);
+        let bvh = Bvh::build(&scene, &scene.triangles[..]);
         let build_ms = start.elapsed().as_secs_f64() * 1e3;
+        let edges = bvh.edges_in_scene_order();
         PreparedScene { scene, edges, bvh, build_ms, shadow_cache: Default::default(), photon_cache: Default::default(), volume_cache: Default::default() }
+    }
+
+    /// What the scene's geometry and its acceleration structures hold in
+    /// memory, counted as length times element size (allocator slack and
+    /// the lazily built caches left out).
+    pub fn memory(&self) -> MemoryUse {
+        use std::mem::size_of_val;
+        MemoryUse {
+            scene_bytes: size_of_val(&self.scene.triangles[..]) + size_of_val(&self.scene.spheres[..]),
+            bvh_bytes: self.bvh.memory_bytes(),
+            prepared_bytes: self.edges.memory_bytes(),
+        }
     }
 
     /// The photon map for the scene's current lights and materials and the

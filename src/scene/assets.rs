@@ -35,6 +35,17 @@ pub fn read_asset(path: &Path, kind: InputKind) -> Result<Vec<u8>, String> {
     read_file(path, kind)
 }
 
+/// One name per file a scene may refer to: the built-in asset's clean path,
+/// or the real path on disk (links and `..` resolved), or, when the file
+/// cannot be resolved, its clean path (reading it will then say why).
+pub fn canonical_path(path: &Path) -> PathBuf {
+    let clean = lexical_normalize(path);
+    if clean.starts_with(BUILTIN_ROOT) {
+        return clean;
+    }
+    std::fs::canonicalize(path).unwrap_or(clean)
+}
+
 /// Resolves `.` and `..` without touching the file system.
 fn lexical_normalize(path: &Path) -> PathBuf {
     let mut out = PathBuf::new();

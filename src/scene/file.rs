@@ -2,6 +2,7 @@
 //! descriptions, then checked and turned into a `Scene`. Every error names the
 //! file, the line and the key or table at fault.
 
+use super::mesh_cache::MeshCache;
 use super::obj::{self, NormalMode};
 use super::texture::load_texture;
 use super::{Camera, Fov, Light, Material, ObjectInfo, RenderDefaults, Scene, Sphere, Triangle};
@@ -263,9 +264,10 @@ fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str) -> R
         scene.materials.push(mat);
     }
 
+    let mut meshes = MeshCache::default();
     for (i, o) in desc.object.iter().enumerate() {
         let where_ = format!("{}: object {}", at(o.span()), i + 1);
-        add_object(&mut scene, o.get_ref(), i as u32, &where_, base)?;
+        add_object(&mut scene, o.get_ref(), i as u32, &where_, base, &mut meshes)?;
     }
     for (index, path, where_) in textures {
         let drawn = scene.triangles.iter().any(|t| t.material as usize == index) || scene.spheres.iter().any(|s| s.material as usize == index);
@@ -276,7 +278,7 @@ fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str) -> R
     Ok(scene)
 }
 
-fn add_object(scene: &mut Scene, o: &ObjectDesc, object: u32, where_: &str, base: &Path) -> Result<(), String> {
+fn add_object(scene: &mut Scene, o: &ObjectDesc, object: u32, where_: &str, base: &Path, meshes: &mut MeshCache) -> Result<(), String> {
     let two_sided = o.two_sided.unwrap_or(false);
     let placement = placement(o, where_)?;
     let explicit_material = match &o.material {
@@ -318,22 +320,24 @@ fn add_object(scene: &mut Scene, o: &ObjectDesc, object: u32, where_: &str, base
             };
             let path = base.join(file);
             let textures = if explicit_material.is_some() { obj::MtlTextures::None } else { obj::MtlTextures::Used };
-            let loaded = obj::load_obj(&path, mode, textures).map_err(|e| format!("{where_}: {e}"))?;
-            scene.warnings.extend(loaded.warnings);
+            let loaded = meshes.load(&path, mode, textures).map_err(|e| format!("{where_}: {e}"))?;
+            scene.warnings.extend(loaded.warnings.iter().cloned());
             if loaded.degenerate > 0 {
                 scene.warnings.push(format!("{}: skipped {} triangles with zero area", path.display(), loaded.degenerate));
             }
             // MTL materials are added under "<file>/<name>" so they never clash with the scene's.
             let mut mtl_index = Vec::new();
-            for m in loaded.materials {
-                scene.materials.push(m);
+            for m in &loaded.materials {
+                scene.materials.push(m.clone());
                 mtl_index.push((scene.materials.len() - 1) as u32);
             }
             let fallback = match explicit_material {
                 Some(m) => m,
                 None => scene.default_material_index(),
             };
-            for mut t in loaded.triangles {
+            scene.triangles.reserve(loaded.triangles.len());
+            for t in &loaded.triangles {
+                let mut t = t.clone();
                 t.material = match (explicit_material, t.material) {
                     (Some(m), _) => m,
                     (None, u32::MAX) => fallback,

@@ -7,6 +7,7 @@ pub mod builtin;
 pub mod camera;
 pub mod file;
 pub mod load;
+pub mod mesh_cache;
 pub mod material;
 pub mod obj;
 pub mod recentre;

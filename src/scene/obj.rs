@@ -14,7 +14,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 /// How a mesh gets its shading normals.
-#[derive(Deserialize, Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Deserialize, Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[serde(rename_all = "lowercase")]
 pub enum NormalMode {
     /// The file's normals, else smooth.
@@ -35,7 +35,7 @@ pub struct LoadedMesh {
 }
 
 /// Which of the file's MTL materials to load textures for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum MtlTextures {
     /// Those of materials a face uses.
     Used,
@@ -43,7 +43,20 @@ pub enum MtlTextures {
     None,
 }
 
+thread_local! {
+    /// OBJ files parsed by this thread so far (see `parses_on_this_thread`).
+    static PARSES: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+}
+
+/// How many OBJ files `load_obj` has read and parsed on the calling thread:
+/// lets tests see that a scene load parses a shared mesh once. Per thread,
+/// so tests running in parallel do not count each other's loads.
+pub fn parses_on_this_thread() -> u64 {
+    PARSES.with(|p| p.get())
+}
+
 pub fn load_obj(path: &Path, mode: NormalMode, textures: MtlTextures) -> Result<LoadedMesh, String> {
+    PARSES.with(|p| p.set(p.get() + 1));
     load_obj_unbounded(path, mode, textures).map_err(|e| crate::input::bounded_message(&e))
 }
 

@@ -1,11 +1,11 @@
 //! The bounding volume hierarchy over the scene's triangles and analytic
-//! spheres, built with the binned surface area heuristic (SAH), and the
-//! single-ray queries through it (`BvhQuery`), traversed near child first
-//! with the kernels of `traverse.rs`.
+//! spheres, built with the binned surface area heuristic (SAH) in
+//! `bvh/build.rs`, and the single-ray queries through it (`BvhQuery`),
+//! traversed near child first with the kernels of `traverse.rs`.
 //!
 //! It must see exactly what the brute-force reference sees, so:
 //! - leaves call the same `intersect_triangle` / `intersect_sphere` with the
-//!   same `TriangleEdges` values (copied, reordered for locality);
+//!   same `TriangleEdges` values (stored once, in leaf order for locality);
 //! - when two primitives are hit at exactly the same `t`, the one first in
 //!   scene order wins (all triangles before all spheres, then by index), as
 //!   brute force's strict `t < best_t` scan does;
@@ -23,20 +23,16 @@ use super::traverse::{test_leaf, BestHit, ChildOrder, PreparedRay};
 use crate::math::Ray;
 use crate::render::pixel_record::Recorder;
 use crate::render::{Occluder, PreparedScene, RayCounts, SceneQuery};
-use crate::scene::{PrimitiveId, PrimitiveKind, Scene, SurfaceHit};
+use crate::scene::{PrimitiveId, PrimitiveKind, SurfaceHit};
+use std::sync::Arc;
 use glam::{Vec3, Vec3A, Vec4};
 
-const BINS: usize = 32;
+mod build;
+use build::{aabb, triangle_box, Bounds};
+pub use build::EdgeSource;
+
 /// Leaves never hold more than this; the SAH decides below it.
 const MAX_LEAF: usize = 8;
-/// SAH costs of one node visit and one primitive test.
-const COST_TRAVERSE: f32 = 1.0;
-const COST_INTERSECT: f32 = 1.0;
-/// Subtrees with more primitives than this are built in parallel.
-const PARALLEL_MIN: usize = 4096;
-/// Below this depth the build splits by SAH; deeper it splits at the median,
-/// which bounds the depth at MEDIAN_DEPTH + 32.
-const MEDIAN_DEPTH: u32 = 32;
 /// Traversal stack entries kept on the machine stack; deeper trees (which
 /// need more than 3 per level) use a heap stack instead.
 pub(super) const STACK: usize = 64;
@@ -68,181 +64,6 @@ pub enum NodeContent {
     Leaf { first: u32, count: u32 },
 }
 
-/// Bounds and centroid of one primitive during the build.
-#[derive(Clone, Copy)]
-struct PrimRef {
-    min: Vec3A,
-    max: Vec3A,
-    id: PrimitiveId,
-}
-
-impl PrimRef {
-    #[inline]
-    fn centroid(&self) -> Vec3A {
-        (self.min + self.max) * 0.5
-    }
-}
-
-#[derive(Clone, Copy)]
-struct Bounds {
-    min: Vec3A,
-    max: Vec3A,
-}
-
-impl Bounds {
-    const EMPTY: Bounds = Bounds { min: Vec3A::splat(f32::INFINITY), max: Vec3A::splat(f32::NEG_INFINITY) };
-
-    #[inline]
-    fn grow(&mut self, min: Vec3A, max: Vec3A) {
-        self.min = self.min.min(min);
-        self.max = self.max.max(max);
-    }
-
-    #[inline]
-    fn union(a: Bounds, b: Bounds) -> Bounds {
-        Bounds { min: a.min.min(b.min), max: a.max.max(b.max) }
-    }
-
-    /// Half the surface area (the SAH only needs ratios).
-    #[inline]
-    fn half_area(&self) -> f32 {
-        let d = (self.max - self.min).max(Vec3A::ZERO);
-        d.x * d.y + d.y * d.z + d.z * d.x
-    }
-}
-
-/// A primitive's box, padded so rounding in the ray tests cannot leave a hit
-/// outside it.
-fn padded(min: Vec3A, max: Vec3A) -> (Vec3A, Vec3A) {
-    let extent = (max - min).max_element();
-    let magnitude = min.abs().max(max.abs()).max_element();
-    let pad = extent * 1.0e-5 + magnitude * 2.0e-6 + f32::MIN_POSITIVE;
-    (min - Vec3A::splat(pad), max + Vec3A::splat(pad))
-}
-
-/// A node of the binary tree the build makes, before it is collapsed into
-/// 4-wide nodes.
-enum BuildNode {
-    Leaf { b: Bounds, first: u32, count: u32 },
-    Inner { b: Bounds, kids: Box<[BuildNode; 2]> },
-}
-
-impl BuildNode {
-    fn bounds(&self) -> Bounds {
-        match self {
-            BuildNode::Leaf { b, .. } | BuildNode::Inner { b, .. } => *b,
-        }
-    }
-}
-
-#[derive(Clone, Copy)]
-struct Bin {
-    b: Bounds,
-    n: u32,
-}
-
-fn build_rec(refs: &mut [PrimRef], first: u32, depth: u32, max_depth: &mut u32) -> BuildNode {
-    *max_depth = (*max_depth).max(depth);
-    let mut b = Bounds::EMPTY;
-    let mut cb = Bounds::EMPTY;
-    for r in refs.iter() {
-        b.grow(r.min, r.max);
-        let c = r.centroid();
-        cb.grow(c, c);
-    }
-    let n = refs.len();
-    let leaf = BuildNode::Leaf { b, first, count: n as u32 };
-    if n <= 1 {
-        return leaf;
-    }
-    let extent = cb.max - cb.min;
-    let mut mid = 0;
-    if depth < MEDIAN_DEPTH && extent.max_element() > 0.0 {
-        // Binned SAH over all three axes in one pass.
-        // Fewer bins for small nodes: their sweeps would cost more than the binning.
-        let nb = if n <= 32 { 8 } else if n <= 512 { 16 } else { BINS };
-        let mut bins = [[Bin { b: Bounds::EMPTY, n: 0 }; BINS]; 3];
-        let scale = Vec3A::select(extent.cmpgt(Vec3A::ZERO), Vec3A::splat(nb as f32 * 0.99999) / extent, Vec3A::ZERO);
-        for r in refs.iter() {
-            let k = ((r.centroid() - cb.min) * scale).as_uvec3().min(glam::UVec3::splat(nb as u32 - 1));
-            for a in 0..3 {
-                let bin = &mut bins[a][k[a] as usize];
-                bin.b.grow(r.min, r.max);
-                bin.n += 1;
-            }
-        }
-        let mut best = (f32::INFINITY, 0usize, 0usize);
-        for (a, bins) in bins.iter().enumerate() {
-            if extent[a] <= 0.0 {
-                continue;
-            }
-            // Right-to-left sweep: cost of the right side of each split plane.
-            let mut right_cost = [0.0f32; BINS];
-            let mut acc = Bounds::EMPTY;
-            let mut cnt = 0u32;
-            for i in (1..nb).rev() {
-                acc = Bounds::union(acc, bins[i].b);
-                cnt += bins[i].n;
-                right_cost[i] = if cnt > 0 { acc.half_area() * cnt as f32 } else { 0.0 };
-            }
-            let mut acc = Bounds::EMPTY;
-            let mut cnt = 0u32;
-            for i in 0..nb - 1 {
-                acc = Bounds::union(acc, bins[i].b);
-                cnt += bins[i].n;
-                if cnt == 0 || cnt as usize == n {
-                    continue;
-                }
-                let cost = acc.half_area() * cnt as f32 + right_cost[i + 1];
-                if cost < best.0 {
-                    best = (cost, a, i + 1);
-                }
-            }
-        }
-        if best.0.is_finite() {
-            let split_cost = COST_TRAVERSE + COST_INTERSECT * best.0 / b.half_area().max(f32::MIN_POSITIVE);
-            let leaf_cost = COST_INTERSECT * n as f32;
-            if n <= MAX_LEAF && leaf_cost <= split_cost {
-                return leaf;
-            }
-            let (_, axis, plane) = best;
-            let (lo, s) = (cb.min[axis], scale[axis]);
-            let in_left = |r: &PrimRef| (((r.centroid()[axis] - lo) * s) as u32).min(nb as u32 - 1) < plane as u32;
-            // In-place partition.
-            let (mut i, mut j) = (0usize, n);
-            while i < j {
-                if in_left(&refs[i]) {
-                    i += 1;
-                } else {
-                    j -= 1;
-                    refs.swap(i, j);
-                }
-            }
-            mid = i;
-        }
-    }
-    if mid == 0 || mid == n {
-        // No useful SAH split (coincident centroids, or too deep): a leaf if
-        // small enough, else halves by the centroid median.
-        if n <= MAX_LEAF {
-            return leaf;
-        }
-        let axis = if extent.x >= extent.y && extent.x >= extent.z { 0 } else if extent.y >= extent.z { 1 } else { 2 };
-        mid = n / 2;
-        refs.select_nth_unstable_by(mid, |p, q| p.centroid()[axis].total_cmp(&q.centroid()[axis]).then(p.id.cmp(&q.id)));
-    }
-    let (left, right) = refs.split_at_mut(mid);
-    let (l, r) = if n > PARALLEL_MIN {
-        let (mut dl, mut dr) = (depth, depth);
-        let (l, r) = rayon::join(|| build_rec(left, first, depth + 1, &mut dl), || build_rec(right, first + mid as u32, depth + 1, &mut dr));
-        *max_depth = (*max_depth).max(dl).max(dr);
-        (l, r)
-    } else {
-        (build_rec(left, first, depth + 1, max_depth), build_rec(right, first + mid as u32, depth + 1, max_depth))
-    };
-    BuildNode::Inner { b: Bounds::union(l.bounds(), r.bounds()), kids: Box::new([l, r]) }
-}
-
 /// A 4-wide node: the children's boxes as planes (min x, max x, min y, max
 /// y, min z, max z), one lane per child, and the children's words.
 #[derive(Clone, Copy, Debug)]
@@ -262,18 +83,16 @@ pub struct Bvh {
     pub(super) root: u32,
     pub(super) root_bounds: Aabb,
     /// Per primitive slot: the triangle's edges (unused for spheres) and the
-    /// primitive's id.
-    pub(super) prims: Vec<(TriangleEdges, PrimitiveId)>,
-    /// For the debugger: each node's own bounds, and each leaf's (by first slot).
-    node_bounds: Vec<Aabb>,
-    leaf_bounds: Vec<(u32, Aabb)>,
+    /// primitive's id. The only copy of the edges: `PreparedScene::edges`
+    /// reads them from here in scene order (`Bvh::edges_in_scene_order`).
+    pub(super) prims: Arc<Vec<(TriangleEdges, PrimitiveId)>>,
+    /// For the debugger: the bounds of leaves holding a sphere, by first
+    /// slot (other bounds are recomputed from the nodes and the edges).
+    sphere_leaf_bounds: Vec<(u32, Aabb)>,
+    leaves: usize,
     depth: u32,
     /// True when a traversal may need more than `STACK` entries.
     pub(super) deep: bool,
-}
-
-fn aabb(b: Bounds) -> Aabb {
-    Aabb { min: Vec3::from(b.min), max: Vec3::from(b.max) }
 }
 
 #[inline(always)]
@@ -288,111 +107,17 @@ pub(super) fn leaf_range(word: u32) -> (usize, usize) {
     (first, first + (word & 7) as usize + 1)
 }
 
-struct Collapse {
-    nodes: Vec<Node4>,
-    node_bounds: Vec<Aabb>,
-    leaf_bounds: Vec<(u32, Aabb)>,
-    depth: u32,
-}
-
-impl Collapse {
-    /// The word for binary subtree `t` at 4-wide level `level`: a leaf, or a
-    /// node whose children are `t`'s grandchildren (the larger ones opened first).
-    fn word(&mut self, t: &BuildNode, level: u32) -> u32 {
-        self.depth = self.depth.max(level);
-        let (b, kids) = match t {
-            BuildNode::Leaf { b, first, count } => {
-                self.leaf_bounds.push((*first, aabb(*b)));
-                return leaf_word(*first, *count);
-            }
-            BuildNode::Inner { b, kids } => (*b, kids),
-        };
-        let mut children: Vec<&BuildNode> = vec![&kids[0], &kids[1]];
-        while children.len() < 4 {
-            let open = children
-                .iter()
-                .enumerate()
-                .filter(|(_, c)| matches!(c, BuildNode::Inner { .. }))
-                .max_by(|(_, a), (_, c)| a.bounds().half_area().total_cmp(&c.bounds().half_area()))
-                .map(|(i, _)| i);
-            let Some(i) = open else { break };
-            let BuildNode::Inner { kids, .. } = children[i] else { unreachable!() };
-            children.splice(i..=i, [&kids[0], &kids[1]]);
-        }
-        let index = self.nodes.len();
-        self.nodes.push(Node4 { planes: [Vec4::ZERO; 6], child: [0; 4], valid: 0, _pad: [0; 3] });
-        self.node_bounds.push(aabb(b));
-        let mut node = self.nodes[index];
-        for (i, c) in children.into_iter().enumerate() {
-            let cb = c.bounds();
-            for axis in 0..3 {
-                node.planes[axis * 2][i] = cb.min[axis];
-                node.planes[axis * 2 + 1][i] = cb.max[axis];
-            }
-            node.child[i] = self.word(c, level + 1);
-            node.valid |= 1 << i;
-        }
-        self.nodes[index] = node;
-        index as u32
-    }
-}
-
 impl Bvh {
-    /// Builds the hierarchy over every triangle (`edges`, in scene order) and
-    /// every sphere of `scene`.
-    pub fn build(scene: &Scene, edges: &[TriangleEdges]) -> Bvh {
-        let mut refs: Vec<PrimRef> = Vec::with_capacity(edges.len() + scene.spheres.len());
-        for (i, e) in edges.iter().enumerate() {
-            let (v0, v1, v2) = (Vec3A::from(e.v0), Vec3A::from(e.v0 + e.e1), Vec3A::from(e.v0 + e.e2));
-            let (min, max) = padded(v0.min(v1).min(v2), v0.max(v1).max(v2));
-            refs.push(PrimRef { min, max, id: PrimitiveId::triangle(i as u32) });
-        }
-        for (i, s) in scene.spheres.iter().enumerate() {
-            let (c, r) = (Vec3A::from(s.center), Vec3A::splat(s.radius.abs()));
-            let (min, max) = padded(c - r, c + r);
-            refs.push(PrimRef { min, max, id: PrimitiveId::sphere(i as u32) });
-        }
-        let dummy = TriangleEdges { v0: Vec3::ZERO, e1: Vec3::ZERO, e2: Vec3::ZERO, det_epsilon: 0.0, two_sided: false };
-        if refs.is_empty() {
-            return Bvh {
-                nodes: Vec::new(),
-                root: leaf_word(0, 1),
-                root_bounds: Aabb::EMPTY,
-                prims: Vec::new(),
-                node_bounds: Vec::new(),
-                leaf_bounds: Vec::new(),
-                depth: 0,
-                deep: false,
-            };
-        }
-        let mut binary_depth = 0;
-        let tree = build_rec(&mut refs, 0, 0, &mut binary_depth);
-        let mut c = Collapse {
-            nodes: Vec::with_capacity(refs.len() / 4 + 1),
-            node_bounds: Vec::with_capacity(refs.len() / 4 + 1),
-            leaf_bounds: Vec::with_capacity(refs.len() / 2 + 1),
-            depth: 0,
-        };
-        let root = c.word(&tree, 0);
-        let root_bounds = aabb(tree.bounds());
-        drop(tree);
-        c.leaf_bounds.sort_unstable_by_key(|(first, _)| *first);
-        let prims = refs.iter().map(|r| (if r.id.is_sphere() { dummy } else { edges[r.id.index() as usize] }, r.id)).collect();
-        Bvh {
-            nodes: c.nodes,
-            root,
-            root_bounds,
-            prims,
-            node_bounds: c.node_bounds,
-            leaf_bounds: c.leaf_bounds,
-            depth: c.depth,
-            deep: (c.depth as usize + 1) * 3 >= STACK,
-        }
-    }
-
     /// Number of nodes: interior nodes plus leaves.
     pub fn node_count(&self) -> usize {
-        self.nodes.len() + self.leaf_bounds.len()
+        self.nodes.len() + self.leaves
+    }
+
+    /// Bytes the hierarchy holds: its nodes, its primitive slots and the
+    /// debugger's sphere-leaf bounds, each as length times element size.
+    pub fn memory_bytes(&self) -> usize {
+        use std::mem::size_of_val;
+        size_of_val(&self.nodes[..]) + size_of_val(&self.prims[..]) + size_of_val(&self.sphere_leaf_bounds[..])
     }
 
     /// Levels below the root of the deepest leaf (0 when the root is a leaf).
@@ -413,13 +138,29 @@ impl Bvh {
     /// Bounds of node `id`.
     pub fn node_bounds(&self, id: u32) -> Aabb {
         if id & LEAF_BIT == 0 {
-            self.node_bounds[id as usize]
-        } else {
-            let first = leaf_range(id).0 as u32;
-            match self.leaf_bounds.binary_search_by_key(&first, |(f, _)| *f) {
-                Ok(i) => self.leaf_bounds[i].1,
-                Err(_) => Aabb::EMPTY,
+            // The union of the children's boxes is exactly the node's own.
+            let n = &self.nodes[id as usize];
+            let mut b = Bounds::EMPTY;
+            for i in (0..4).filter(|i| n.valid & 1 << i != 0) {
+                let (lo, hi) = (Vec3A::new(n.planes[0][i], n.planes[2][i], n.planes[4][i]), Vec3A::new(n.planes[1][i], n.planes[3][i], n.planes[5][i]));
+                b.grow(lo, hi);
             }
+            aabb(b)
+        } else {
+            let (first, end) = leaf_range(id);
+            if end > self.prims.len() {
+                return Aabb::EMPTY;
+            }
+            if let Ok(i) = self.sphere_leaf_bounds.binary_search_by_key(&(first as u32), |(f, _)| *f) {
+                return self.sphere_leaf_bounds[i].1;
+            }
+            // A leaf of triangles: the union of their boxes, made as the build made them.
+            let mut b = Bounds::EMPTY;
+            for (e, _) in &self.prims[first..end] {
+                let (lo, hi) = triangle_box(e);
+                b.grow(lo, hi);
+            }
+            aabb(b)
         }
     }
 
@@ -652,7 +393,7 @@ mod tests {
     use crate::render::raytrace::brute::BruteQuery;
     use crate::render::raytrace::intersect::intersect_triangle;
     use crate::render::pixel_record::NoRecord;
-    use crate::scene::{builtin, Sphere, Triangle};
+    use crate::scene::{builtin, Scene, Sphere, Triangle};
     use proptest::prelude::*;
 
     /// SplitMix64: a tiny seeded generator for reproducible rays.
