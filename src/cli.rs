@@ -125,9 +125,9 @@ struct RenderOpts {
     /// shaded | barycentric | raydir | depth | zbuffer | normal | id | uv | cost | diff | shadowmap | wireframe (see `pinhole list`)
     #[arg(long, default_value = "shaded")]
     view: String,
-    /// ray | map | volume | none
-    #[arg(long, default_value = "ray")]
-    shadows: String,
+    /// ray | map | volume | none (default: ray; none for the opengl renderer, which cannot cast rays)
+    #[arg(long)]
+    shadows: Option<String>,
     /// Rasterizers: interpolate attributes affinely in screen space (no 1/z correction).
     #[arg(long)]
     affine: bool,
@@ -251,7 +251,11 @@ const MAX_THREADS: usize = 256;
 fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
     let renderer = render::renderer_by_name(&opts.renderer)?;
     let view = View::parse(&opts.view)?;
-    let shadows = ShadowMode::parse(&opts.shadows)?;
+    let shadows = match &opts.shadows {
+        Some(name) => ShadowMode::parse(name)?,
+        None if renderer.name() == "opengl" => ShadowMode::None,
+        None => ShadowMode::Ray,
+    };
     let interpolation = render::Interpolation::parse(&opts.interpolation)?;
     let shadow_volume = render::shadow_volume::VolumeMode::parse(&opts.shadow_volume).map_err(|e| format!("--shadow-volume: {e}"))?;
     if opts.spp == 0 || opts.spp > 65536 {
