@@ -125,9 +125,9 @@ struct RenderOpts {
     /// shaded | barycentric | raydir | depth | zbuffer | normal | id | uv | cost | diff | shadowmap | wireframe (see `pinhole list`)
     #[arg(long, default_value = "shaded")]
     view: String,
-    /// ray | map | volume | none
-    #[arg(long, default_value = "ray")]
-    shadows: String,
+    /// ray | map | volume | none (default: ray; none for the opengl renderer, which cannot cast rays)
+    #[arg(long)]
+    shadows: Option<String>,
     /// Rasterizers: interpolate attributes affinely in screen space (no 1/z correction).
     #[arg(long)]
     affine: bool,
@@ -251,7 +251,11 @@ const MAX_THREADS: usize = 256;
 fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
     let renderer = render::renderer_by_name(&opts.renderer)?;
     let view = View::parse(&opts.view)?;
-    let shadows = ShadowMode::parse(&opts.shadows)?;
+    let shadows = match &opts.shadows {
+        Some(name) => ShadowMode::parse(name)?,
+        None if renderer.name() == "opengl" => ShadowMode::None,
+        None => ShadowMode::Ray,
+    };
     let interpolation = render::Interpolation::parse(&opts.interpolation)?;
     let shadow_volume = render::shadow_volume::VolumeMode::parse(&opts.shadow_volume).map_err(|e| format!("--shadow-volume: {e}"))?;
     if opts.spp == 0 || opts.spp > 65536 {
@@ -327,6 +331,7 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
     if settings.shadows == ShadowMode::Map {
         render::shadow_map::check_memory(&scene, settings.shadow_map_size)?;
     }
+    renderer.check(&scene, &settings)?;
     let prepared = pool.install(|| PreparedScene::new(scene));
     Ok(Loaded { prepared, settings, renderer, pool, load_ms })
 }

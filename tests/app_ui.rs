@@ -424,3 +424,24 @@ fn indirect_light_selector_reaches_the_pixels() {
     let status = pinhole::app::panels::status::status_text(h.state());
     assert!(status.contains("noise ≈"), "{status}");
 }
+
+#[test]
+fn opengl_in_the_viewer_draws_what_render_frame_draws() {
+    // The viewer's worker calls the renderer on its own thread; the
+    // headless GL context is made current there for each pass.
+    if let Err(e) = pinhole::render::opengl::driver() {
+        eprintln!("skipped: {e}");
+        return;
+    }
+    let mut h = harness(small_scene("teapot"));
+    h.state_mut().settings.renderer = "opengl".into();
+    settle(&mut h);
+    let error = h.state().with_output(|o| o.error.clone()).unwrap_or_default();
+    assert!(error.contains("--shadows none"), "shadow rays are refused in one sentence: {error:?}");
+    h.state_mut().settings.shadows = pinhole::render::ShadowMode::None;
+    settle(&mut h);
+    let img = shown(h.state());
+    assert_eq!(img, reference(h.state()));
+    let background = h.state().scene.render.background;
+    assert!(img.iter().filter(|p| **p != background).count() > img.len() / 10, "the teapot is drawn");
+}

@@ -11,6 +11,7 @@ pub mod frame;
 pub mod gi;
 pub mod kd_tree;
 pub mod lighting;
+pub mod opengl;
 pub mod photon_map;
 pub mod prepared;
 pub mod sampling;
@@ -296,6 +297,13 @@ pub trait Renderer: Sync + Send {
     /// number of threads.
     fn render_pass(&self, job: &PassJob, out: &mut [Radiance]) -> RayCounts;
 
+    /// Whether this renderer can draw `scene` with `settings`: one sentence
+    /// saying why not (an option it does not support, no driver). Checked
+    /// before a frame starts.
+    fn check(&self, _scene: &crate::scene::Scene, _settings: &RenderSettings) -> Result<(), String> {
+        Ok(())
+    }
+
     /// Replays pixel `(x, y)` of this pass through the same code path with a
     /// recorder, returning the very value `render_pass` stores there; `None`
     /// when this renderer cannot replay pixels.
@@ -308,6 +316,7 @@ pub trait Renderer: Sync + Send {
 pub fn renderers() -> Vec<Box<dyn Renderer>> {
     let mut all: Vec<Box<dyn Renderer>> = vec![Box::new(raytrace::brute::BruteForce), Box::new(raytrace::bvh_renderer::BvhRayTracer)];
     all.extend(raster::renderers());
+    all.push(Box::new(opengl::OpenGl));
     all
 }
 

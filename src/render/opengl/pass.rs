@@ -1,0 +1,288 @@
+//! One sample pass through GL: the programs and buffers kept in the
+//! context between passes, the pass drawn into a float framebuffer, read
+//! back and flipped into the frame's row order.
+
+use super::context::Gl;
+use super::scene_data;
+use super::shaders;
+use crate::math::{Radiance, Vec3};
+use crate::render::{Interpolation, PassJob, RayCounts};
+use glow::HasContext;
+
+/// What lives in the context between passes.
+pub struct State {
+    triangles: glow::Program,
+    spheres: glow::Program,
+    vertex_array: glow::VertexArray,
+    vertex_buffer: glow::Buffer,
+    cube_array: glow::VertexArray,
+    sphere_buffer: glow::Buffer,
+    material_buffer: glow::Buffer,
+    light_buffer: glow::Buffer,
+    /// The uploaded geometry: its fingerprint, triangle runs, sphere count.
+    uploaded: Option<(u64, Vec<(u32, u32, bool)>, usize)>,
+    target: Option<Target>,
+}
+
+/// The framebuffer a pass draws into: RGBA32F colour and a 32-bit float depth.
+struct Target {
+    width: u32,
+    height: u32,
+    framebuffer: glow::Framebuffer,
+    colour: glow::Texture,
+    depth: glow::Renderbuffer,
+}
+
+unsafe fn compile(gl: &glow::Context, vertex: &str, fragment: &str) -> Result<glow::Program, String> {
+    unsafe {
+        let program = gl.create_program()?;
+        let mut shaders = Vec::new();
+        for (kind, source) in [(glow::VERTEX_SHADER, vertex), (glow::FRAGMENT_SHADER, fragment)] {
+            let shader = gl.create_shader(kind)?;
+            gl.shader_source(shader, source);
+            gl.compile_shader(shader);
+            if !gl.get_shader_compile_status(shader) {
+                return Err(format!("a shader did not compile: {}", gl.get_shader_info_log(shader)));
+            }
+            gl.attach_shader(program, shader);
+            shaders.push(shader);
+        }
+        gl.link_program(program);
+        if !gl.get_program_link_status(program) {
+            return Err(format!("a program did not link: {}", gl.get_program_info_log(program)));
+        }
+        for s in shaders {
+            gl.detach_shader(program, s);
+            gl.delete_shader(s);
+        }
+        Ok(program)
+    }
+}
+
+impl State {
+    unsafe fn new(gl: &glow::Context) -> Result<State, String> {
+        unsafe {
+            let triangles = compile(gl, shaders::TRIANGLE_VERTEX, &shaders::triangle_fragment())?;
+            let spheres = compile(gl, shaders::SPHERE_VERTEX, &shaders::sphere_fragment())?;
+            let vertex_array = gl.create_vertex_array()?;
+            let vertex_buffer = gl.create_buffer()?;
+            gl.bind_vertex_array(Some(vertex_array));
+            gl.bind_buffer(glow::ARRAY_BUFFER, Some(vertex_buffer));
+            let stride = (scene_data::VERTEX_FLOATS * 4) as i32;
+            for (location, offset) in [(0u32, 0i32), (1, 12), (2, 24)] {
+                gl.enable_vertex_attrib_array(location);
+                gl.vertex_attrib_pointer_f32(location, 3, glow::FLOAT, false, stride, offset);
+            }
+            gl.enable_vertex_attrib_array(3);
+            gl.vertex_attrib_pointer_i32(3, 1, glow::UNSIGNED_INT, stride, 36);
+            let cube_array = gl.create_vertex_array()?;
+            let cube_buffer = gl.create_buffer()?;
+            gl.bind_vertex_array(Some(cube_array));
+            gl.bind_buffer(glow::ARRAY_BUFFER, Some(cube_buffer));
+            gl.buffer_data_u8_slice(glow::ARRAY_BUFFER, bytes(&scene_data::cube_corners()), glow::STATIC_DRAW);
+            gl.enable_vertex_attrib_array(0);
+            gl.vertex_attrib_pointer_f32(0, 3, glow::FLOAT, false, 12, 0);
+            gl.bind_vertex_array(None);
+            Ok(State {
+                triangles,
+                spheres,
+                vertex_array,
+                vertex_buffer,
+                cube_array,
+                sphere_buffer: gl.create_buffer()?,
+                material_buffer: gl.create_buffer()?,
+                light_buffer: gl.create_buffer()?,
+                uploaded: None,
+                target: None,
+            })
+        }
+    }
+
+    unsafe fn target(&mut self, gl: &glow::Context, width: u32, height: u32) -> Result<glow::Framebuffer, String> {
+        unsafe {
+            if let Some(t) = &self.target {
+                if (t.width, t.height) == (width, height) {
+                    return Ok(t.framebuffer);
+                }
+                gl.delete_framebuffer(t.framebuffer);
+                gl.delete_texture(t.colour);
+                gl.delete_renderbuffer(t.depth);
+                self.target = None;
+            }
+            let framebuffer = gl.create_framebuffer()?;
+            let colour = gl.create_texture()?;
+            let depth = gl.create_renderbuffer()?;
+            gl.bind_texture(glow::TEXTURE_2D, Some(colour));
+            gl.tex_storage_2d(glow::TEXTURE_2D, 1, glow::RGBA32F, width as i32, height as i32);
+            gl.bind_renderbuffer(glow::RENDERBUFFER, Some(depth));
+            gl.renderbuffer_storage(glow::RENDERBUFFER, glow::DEPTH_COMPONENT32F, width as i32, height as i32);
+            gl.bind_framebuffer(glow::FRAMEBUFFER, Some(framebuffer));
+            gl.framebuffer_texture_2d(glow::FRAMEBUFFER, glow::COLOR_ATTACHMENT0, glow::TEXTURE_2D, Some(colour), 0);
+            gl.framebuffer_renderbuffer(glow::FRAMEBUFFER, glow::DEPTH_ATTACHMENT, glow::RENDERBUFFER, Some(depth));
+            let status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
+            if status != glow::FRAMEBUFFER_COMPLETE {
+                gl.delete_framebuffer(framebuffer);
+                gl.delete_texture(colour);
+                gl.delete_renderbuffer(depth);
+                return Err(format!("the driver cannot draw into a {width}x{height} float framebuffer (status {status:#x})"));
+            }
+            self.target = Some(Target { width, height, framebuffer, colour, depth });
+            Ok(framebuffer)
+        }
+    }
+
+    /// Uploads the geometry unless the same is there already.
+    unsafe fn upload(&mut self, gl: &glow::Context, scene: &crate::scene::Scene) {
+        let key = scene_data::fingerprint(scene);
+        if self.uploaded.as_ref().is_some_and(|u| u.0 == key) {
+            return;
+        }
+        let g = scene_data::geometry(scene);
+        unsafe {
+            gl.bind_buffer(glow::ARRAY_BUFFER, Some(self.vertex_buffer));
+            gl.buffer_data_u8_slice(glow::ARRAY_BUFFER, bytes(&g.vertices), glow::STATIC_DRAW);
+            gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(self.sphere_buffer));
+            let spheres = if g.spheres.is_empty() { vec![0.0; 8] } else { g.spheres };
+            gl.buffer_data_u8_slice(glow::SHADER_STORAGE_BUFFER, bytes(&spheres), glow::STATIC_DRAW);
+        }
+        self.uploaded = Some((key, g.runs, scene.spheres.len()));
+    }
+}
+
+fn bytes(v: &[f32]) -> &[u8] {
+    // SAFETY: f32 has no padding and u8 has alignment 1.
+    unsafe { std::slice::from_raw_parts(v.as_ptr().cast::<u8>(), std::mem::size_of_val(v)) }
+}
+
+/// Sets the uniforms both programs share.
+unsafe fn uniforms(gl: &glow::Context, program: glow::Program, job: &PassJob) {
+    let view = job.view;
+    let scene = &job.prepared.scene;
+    let (w, h) = (view.width as f32, view.height as f32);
+    unsafe {
+        let at = |name: &str| gl.get_uniform_location(program, name);
+        gl.uniform_3_f32(at("eye").as_ref(), view.eye.x, view.eye.y, view.eye.z);
+        gl.uniform_matrix_3_f32_slice(at("camera_to_world").as_ref(), false, &view.camera_to_world.to_cols_array());
+        gl.uniform_matrix_3_f32_slice(at("world_to_camera").as_ref(), false, &view.world_to_camera.to_cols_array());
+        gl.uniform_2_f32(at("half_extent").as_ref(), view.half_x, view.half_y);
+        gl.uniform_2_f32(at("image_size").as_ref(), w, h);
+        gl.uniform_2_f32(at("sample_offset").as_ref(), job.offset.x, job.offset.y);
+        // GL samples at pixel centres: shift the image by the pass's offset from them.
+        gl.uniform_2_f32(at("ndc_shift").as_ref(), (0.5 - job.offset.x) * 2.0 / w, (job.offset.y - 0.5) * 2.0 / h);
+        gl.uniform_1_f32(at("near_plane").as_ref(), view.near);
+        gl.uniform_1_f32(at("far_plane").as_ref(), view.far);
+        let a = scene.render.ambient;
+        gl.uniform_3_f32(at("ambient").as_ref(), a.x, a.y, a.z);
+        gl.uniform_1_i32(at("light_count").as_ref(), scene.lights.len() as i32);
+        gl.uniform_1_i32(at("flat_shading").as_ref(), (job.settings.interpolation == Interpolation::Flat) as i32);
+    }
+}
+
+/// Draws `job`'s pass and stores its rows in `out`.
+pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance]) -> Result<RayCounts, String> {
+    let gl = &g.gl;
+    let scene = &job.prepared.scene;
+    let (width, height) = (job.view.width, job.view.height);
+    unsafe {
+        if g.state.is_none() {
+            g.state = Some(State::new(gl)?);
+        }
+        let state = g.state.as_mut().expect("created above");
+        let framebuffer = state.target(gl, width, height)?;
+        state.upload(gl, scene);
+        gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(state.material_buffer));
+        gl.buffer_data_u8_slice(glow::SHADER_STORAGE_BUFFER, bytes(&scene_data::materials(scene)), glow::DYNAMIC_DRAW);
+        gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(state.light_buffer));
+        gl.buffer_data_u8_slice(glow::SHADER_STORAGE_BUFFER, bytes(&scene_data::lights(scene)), glow::DYNAMIC_DRAW);
+        gl.bind_buffer_base(glow::SHADER_STORAGE_BUFFER, 0, Some(state.material_buffer));
+        gl.bind_buffer_base(glow::SHADER_STORAGE_BUFFER, 1, Some(state.light_buffer));
+        gl.bind_buffer_base(glow::SHADER_STORAGE_BUFFER, 2, Some(state.sphere_buffer));
+
+        gl.bind_framebuffer(glow::FRAMEBUFFER, Some(framebuffer));
+        gl.viewport(0, 0, width as i32, height as i32);
+        // Only the rows asked for (GL rows count from the bottom).
+        let rows = job.rows.start.min(height)..job.rows.end.min(height);
+        gl.enable(glow::SCISSOR_TEST);
+        gl.scissor(0, (height - rows.end) as i32, width as i32, rows.len() as i32);
+        // Reversed depth in [0, 1]: 1 at the near plane, 0 at the far plane.
+        (g.clip_control)(glow::LOWER_LEFT, glow::ZERO_TO_ONE);
+        let bg: Vec3 = scene.render.background;
+        gl.clear_buffer_f32_slice(glow::COLOR, 0, &[bg.x, bg.y, bg.z, 1.0]);
+        gl.clear_buffer_f32_slice(glow::DEPTH, 0, &[0.0]);
+        gl.enable(glow::DEPTH_TEST);
+        gl.depth_func(glow::GREATER);
+        gl.depth_mask(true);
+        gl.disable(glow::BLEND);
+        gl.front_face(glow::CCW);
+        gl.cull_face(glow::BACK);
+
+        let (runs, sphere_count) = {
+            let u = state.uploaded.as_ref().expect("uploaded above");
+            (u.1.clone(), u.2)
+        };
+        if !runs.is_empty() {
+            gl.use_program(Some(state.triangles));
+            uniforms(gl, state.triangles, job);
+            gl.bind_vertex_array(Some(state.vertex_array));
+            for (first, count, two_sided) in runs {
+                if two_sided {
+                    gl.disable(glow::CULL_FACE);
+                } else {
+                    gl.enable(glow::CULL_FACE);
+                }
+                gl.draw_arrays(glow::TRIANGLES, (first * 3) as i32, (count * 3) as i32);
+            }
+        }
+        if sphere_count > 0 {
+            // Both sides of each sphere's bounding cube: whatever part of
+            // the cube the near plane cuts off, the far side still covers
+            // the sphere, and the fragment shader finds the exact surface.
+            gl.disable(glow::CULL_FACE);
+            gl.enable(glow::DEPTH_CLAMP);
+            gl.use_program(Some(state.spheres));
+            uniforms(gl, state.spheres, job);
+            gl.bind_vertex_array(Some(state.cube_array));
+            gl.draw_arrays_instanced(glow::TRIANGLES, 0, 36, sphere_count as i32);
+            gl.disable(glow::DEPTH_CLAMP);
+        }
+        gl.bind_vertex_array(None);
+        gl.disable(glow::SCISSOR_TEST);
+
+        let w = width as usize;
+        let mut pixels = vec![0f32; w * rows.len() * 4];
+        gl.pixel_store_i32(glow::PACK_ALIGNMENT, 4);
+        gl.read_pixels(
+            0,
+            (height - rows.end) as i32,
+            width as i32,
+            rows.len() as i32,
+            glow::RGBA,
+            glow::FLOAT,
+            glow::PixelPackData::Slice(Some(bytes_mut(&mut pixels))),
+        );
+        gl.bind_framebuffer(glow::FRAMEBUFFER, None);
+        let error = gl.get_error();
+        if error != glow::NO_ERROR {
+            return Err(format!("OpenGL reported error {error:#x} while drawing"));
+        }
+        // GL's rows run bottom-up: the last row read is the first asked for.
+        let n = rows.len();
+        for (k, y) in rows.clone().enumerate() {
+            let src = &pixels[(n - 1 - k) * w * 4..(n - k) * w * 4];
+            for x in 0..width {
+                if !job.is_active(x, y) {
+                    continue;
+                }
+                let p = &src[x as usize * 4..x as usize * 4 + 3];
+                out[k * w + x as usize] = Vec3::new(p[0], p[1], p[2]);
+            }
+        }
+        // GL counts none of this; the counters stay zero.
+        Ok(RayCounts::default())
+    }
+}
+
+fn bytes_mut(v: &mut [f32]) -> &mut [u8] {
+    // SAFETY: every bit pattern is a valid f32 and u8 has alignment 1.
+    unsafe { std::slice::from_raw_parts_mut(v.as_mut_ptr().cast::<u8>(), std::mem::size_of_val(v)) }
+}

@@ -1,0 +1,107 @@
+//! The scene as GL buffers take it: one vertex per triangle corner (no
+//! index buffer, so the face normal and material can be per triangle),
+//! runs of single- and two-sided triangles in scene order, spheres, and
+//! the materials and lights the fragment shaders read.
+
+use crate::scene::{Light, Scene};
+
+/// Floats per vertex: position, shading normal, face normal, material bits.
+pub const VERTEX_FLOATS: usize = 10;
+
+/// The vertex data of every triangle, in scene order.
+pub struct Geometry {
+    pub vertices: Vec<f32>,
+    /// Consecutive triangles with the same sidedness: (first triangle, count, two-sided).
+    pub runs: Vec<(u32, u32, bool)>,
+    /// Per sphere: (centre, radius), (material bits, 0, 0, 0).
+    pub spheres: Vec<f32>,
+}
+
+pub fn geometry(scene: &Scene) -> Geometry {
+    let mut vertices = Vec::with_capacity(scene.triangles.len() * 3 * VERTEX_FLOATS);
+    let mut runs: Vec<(u32, u32, bool)> = Vec::new();
+    for (i, t) in scene.triangles.iter().enumerate() {
+        let face = t.geometric_normal();
+        for k in 0..3 {
+            vertices.extend_from_slice(&t.v[k].to_array());
+            vertices.extend_from_slice(&t.n[k].to_array());
+            vertices.extend_from_slice(&face.to_array());
+            vertices.push(f32::from_bits(t.material));
+        }
+        match runs.last_mut() {
+            Some(run) if run.2 == t.two_sided => run.1 += 1,
+            _ => runs.push((i as u32, 1, t.two_sided)),
+        }
+    }
+    let mut spheres = Vec::with_capacity(scene.spheres.len() * 8);
+    for s in &scene.spheres {
+        spheres.extend_from_slice(&[s.center.x, s.center.y, s.center.z, s.radius, f32::from_bits(s.material), 0.0, 0.0, 0.0]);
+    }
+    Geometry { vertices, runs, spheres }
+}
+
+/// A fingerprint of what `geometry` reads, to know when the uploaded
+/// buffers are stale (a scene loaded or edited since).
+pub fn fingerprint(scene: &Scene) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325 ^ scene.triangles.len() as u64 ^ ((scene.spheres.len() as u64) << 32);
+    let mut mix = |x: u32| h = (h ^ x as u64).wrapping_mul(0x0000_0100_0000_01b3).rotate_left(5);
+    for t in &scene.triangles {
+        for k in 0..3 {
+            for v in [t.v[k], t.n[k]] {
+                mix(v.x.to_bits());
+                mix(v.y.to_bits());
+                mix(v.z.to_bits());
+            }
+        }
+        mix(t.material | (t.two_sided as u32) << 31);
+    }
+    for s in &scene.spheres {
+        for x in [s.center.x, s.center.y, s.center.z, s.radius] {
+            mix(x.to_bits());
+        }
+        mix(s.material);
+    }
+    h
+}
+
+/// Per material: (k_L, 0), (k_G, sharpness).
+pub fn materials(scene: &Scene) -> Vec<f32> {
+    let mut out = Vec::with_capacity(scene.materials.len().max(1) * 8);
+    for m in &scene.materials {
+        out.extend_from_slice(&[m.lambertian.x, m.lambertian.y, m.lambertian.z, 0.0, m.glossy.x, m.glossy.y, m.glossy.z, m.sharpness]);
+    }
+    if out.is_empty() {
+        out.resize(8, 0.0);
+    }
+    out
+}
+
+/// Per light: (position or direction, 0 = point | 1 = directional), (power or irradiance, 0).
+pub fn lights(scene: &Scene) -> Vec<f32> {
+    let mut out = Vec::with_capacity(scene.lights.len().max(1) * 8);
+    for l in &scene.lights {
+        match *l {
+            Light::Point { position, power } => out.extend_from_slice(&[position.x, position.y, position.z, 0.0, power.x, power.y, power.z, 0.0]),
+            Light::Directional { direction, irradiance } => {
+                out.extend_from_slice(&[direction.x, direction.y, direction.z, 1.0, irradiance.x, irradiance.y, irradiance.z, 0.0])
+            }
+        }
+    }
+    if out.is_empty() {
+        out.resize(8, 0.0);
+    }
+    out
+}
+
+/// The unit cube's 12 triangles as 36 corners, for the spheres' bounding boxes.
+pub fn cube_corners() -> Vec<f32> {
+    const FACES: [[usize; 4]; 6] = [[0, 1, 3, 2], [4, 6, 7, 5], [0, 4, 5, 1], [2, 3, 7, 6], [0, 2, 6, 4], [1, 5, 7, 3]];
+    let corner = |i: usize| [if i & 1 != 0 { 1.0 } else { -1.0 }, if i & 2 != 0 { 1.0 } else { -1.0 }, if i & 4 != 0 { 1.0 } else { -1.0 }];
+    let mut out = Vec::with_capacity(36 * 3);
+    for f in FACES {
+        for k in [0, 1, 2, 0, 2, 3] {
+            out.extend_from_slice(&corner(f[k]));
+        }
+    }
+    out
+}
