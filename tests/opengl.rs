@@ -1,6 +1,7 @@
 //! The `opengl` renderer against the brute-force ray caster on every
 //! built-in scene it can draw, with `--shadows none` (GL casts no shadow
-//! rays): at least 99% of pixels within 1e-3 relative. The rest lie on
+//! rays) and with `--shadows map` (GL's maps against the CPU's): at least
+//! 99% of pixels within 1e-3 relative. The rest lie on
 //! silhouettes, where GL's coverage (vertices snapped to 1/256 pixel,
 //! its own fill rule) and the ray test decide differently, and where GPU
 //! float (interpolated positions and normals, `pow`) rounds otherwise.
@@ -119,6 +120,43 @@ fn a_wrong_light_or_camera_fails_the_comparison() {
 }
 
 #[test]
+fn shadow_maps_drawn_by_gl_agree_with_the_cpu_maps() {
+    // --shadows map: GL draws each light's map from the CPU maps' own
+    // cameras and looks it up as the CPU does; against the ray caster with
+    // the CPU's maps. GL's stored depths are interpolated rather than taken
+    // from the triangle's plane, and its map coverage follows GL's rules,
+    // so a texel near a shadow boundary may decide otherwise.
+    let Some(_) = driver() else { return };
+    let gl = renderer_by_name("opengl").unwrap();
+    let reference_renderer = renderer_by_name("raytrace:bvh").unwrap();
+    let mut worst = (1.0f64, "");
+    for name in pinhole::scene::builtin::names() {
+        let sc = scene(name);
+        let s = RenderSettings { shadows: ShadowMode::Map, ..settings(&sc) };
+        if gl.check(&sc, &s).is_err() {
+            continue;
+        }
+        let prepared = PreparedScene::new(sc.clone());
+        let a = render(gl.as_ref(), &prepared, &s);
+        let (fraction, wrong) = agreement(&a, &render(reference_renderer.as_ref(), &prepared, &s));
+        eprintln!("{name} map: {:.3}% agree ({wrong} pixels differ)", fraction * 100.0);
+        assert!(fraction >= MAP_AGREEMENT, "{name}: only {:.3}% of pixels within 1e-3", fraction * 100.0);
+        if fraction < worst.0 {
+            worst = (fraction, name);
+        }
+        // The maps shadow something: without them the image differs.
+        if name == "stress-shadow" || name == "teapot" {
+            let none = render(gl.as_ref(), &prepared, &settings(&sc));
+            assert!(agreement(&a, &none).0 < 0.99, "{name}: the maps change nothing");
+        }
+    }
+    eprintln!("worst with maps: {} at {:.3}%", worst.1, worst.0 * 100.0);
+}
+
+/// The share of pixels GL's shadow maps must agree on (see the test).
+const MAP_AGREEMENT: f64 = 0.99;
+
+#[test]
 fn sample_passes_follow_the_sample_positions() {
     // --spp 4: four passes at the stratified positions, averaged as for the CPU renderers.
     if driver().is_none() {
@@ -140,7 +178,7 @@ fn unsupported_settings_are_refused_in_one_sentence() {
     let mut s = settings(&sc);
     s.shadows = ShadowMode::Ray;
     let e = gl.check(&sc, &s).unwrap_err();
-    assert!(e.contains("--shadows none"), "{e}");
+    assert!(e.contains("--shadows none|map"), "{e}");
     assert!(!e.contains('\n'));
     let e = gl.check(&scene("test-pattern"), &settings(&scene("test-pattern"))).unwrap_err();
     assert!(e.contains("texture"), "{e}");

@@ -327,7 +327,7 @@ fn ortho_project(view: &CameraView, c: Vec3) -> Vec2 {
 
 /// The light's cameras: six cube faces for a point light, one orthographic
 /// view for a directional light.
-fn light_views(scene: &Scene, light: &Light, size: u32) -> Vec<CameraView> {
+pub fn light_views(scene: &Scene, light: &Light, size: u32) -> Vec<CameraView> {
     let Some((lo, hi)) = scene.bounds() else { return Vec::new() };
     match *light {
         Light::Point { position, .. } => {

@@ -9,6 +9,7 @@ mod context;
 mod pass;
 mod scene_data;
 mod shaders;
+mod shadow_pass;
 
 use crate::math::Radiance;
 use crate::render::{debug, gi, Interpolation, PassJob, RayCounts, RenderSettings, Renderer, ShadowMode};
@@ -49,8 +50,8 @@ impl Renderer for OpenGl {
 /// What the fragment shaders do not compute yet, as one sentence.
 fn unsupported(scene: &Scene, settings: &RenderSettings) -> Result<(), String> {
     let refuse = |what: &str| Err(format!("the opengl renderer {what}"));
-    if settings.shadows != ShadowMode::None {
-        return refuse("supports --shadows none only");
+    if !matches!(settings.shadows, ShadowMode::None | ShadowMode::Map) {
+        return refuse("supports --shadows none|map only (it casts no rays)");
     }
     if !matches!(settings.view, debug::View::Shaded) {
         return refuse("draws the shaded view only");

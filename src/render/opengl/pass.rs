@@ -6,13 +6,17 @@ use super::context::Gl;
 use super::scene_data;
 use super::shaders;
 use crate::math::{Radiance, Vec3};
-use crate::render::{Interpolation, PassJob, RayCounts};
+use crate::render::{Interpolation, PassJob, RayCounts, ShadowMode};
 use glow::HasContext;
 
 /// What lives in the context between passes.
 pub struct State {
     triangles: glow::Program,
     spheres: glow::Program,
+    /// The same with shadow-map lookups (`--shadows map`).
+    triangles_mapped: glow::Program,
+    spheres_mapped: glow::Program,
+    maps: super::shadow_pass::ShadowPass,
     vertex_array: glow::VertexArray,
     vertex_buffer: glow::Buffer,
     cube_array: glow::VertexArray,
@@ -33,7 +37,7 @@ struct Target {
     depth: glow::Renderbuffer,
 }
 
-unsafe fn compile(gl: &glow::Context, vertex: &str, fragment: &str) -> Result<glow::Program, String> {
+pub(super) unsafe fn compile(gl: &glow::Context, vertex: &str, fragment: &str) -> Result<glow::Program, String> {
     unsafe {
         let program = gl.create_program()?;
         let mut shaders = Vec::new();
@@ -62,8 +66,12 @@ unsafe fn compile(gl: &glow::Context, vertex: &str, fragment: &str) -> Result<gl
 impl State {
     unsafe fn new(gl: &glow::Context) -> Result<State, String> {
         unsafe {
-            let triangles = compile(gl, shaders::TRIANGLE_VERTEX, &shaders::triangle_fragment())?;
-            let spheres = compile(gl, shaders::SPHERE_VERTEX, &shaders::sphere_fragment())?;
+            let triangles = compile(gl, shaders::TRIANGLE_VERTEX, &shaders::triangle_fragment(""))?;
+            let spheres = compile(gl, shaders::SPHERE_VERTEX, &shaders::sphere_fragment(""))?;
+            let mapped = "#define SHADOW_MAP 1\n";
+            let triangles_mapped = compile(gl, shaders::TRIANGLE_VERTEX, &shaders::triangle_fragment(mapped))?;
+            let spheres_mapped = compile(gl, shaders::SPHERE_VERTEX, &shaders::sphere_fragment(mapped))?;
+            let maps = super::shadow_pass::ShadowPass::new(gl)?;
             let vertex_array = gl.create_vertex_array()?;
             let vertex_buffer = gl.create_buffer()?;
             gl.bind_vertex_array(Some(vertex_array));
@@ -86,6 +94,9 @@ impl State {
             Ok(State {
                 triangles,
                 spheres,
+                triangles_mapped,
+                spheres_mapped,
+                maps,
                 vertex_array,
                 vertex_buffer,
                 cube_array,
@@ -149,7 +160,7 @@ impl State {
     }
 }
 
-fn bytes(v: &[f32]) -> &[u8] {
+pub(super) fn bytes(v: &[f32]) -> &[u8] {
     // SAFETY: f32 has no padding and u8 has alignment 1.
     unsafe { std::slice::from_raw_parts(v.as_ptr().cast::<u8>(), std::mem::size_of_val(v)) }
 }
@@ -190,10 +201,19 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance]) -> Result<
         let state = g.state.as_mut().expect("created above");
         let framebuffer = state.target(gl, width, height)?;
         state.upload(gl, scene);
+        gl.bind_buffer_base(glow::SHADER_STORAGE_BUFFER, 2, Some(state.sphere_buffer));
+        let mapped = job.settings.shadows == ShadowMode::Map;
+        let first_faces = if mapped {
+            let runs = state.uploaded.as_ref().map(|u| u.1.clone()).unwrap_or_default();
+            let key = state.uploaded.as_ref().map_or(0, |u| u.0);
+            state.maps.draw(gl, g.clip_control, scene, key, &runs, job.settings.shadow_map_size, state.vertex_array, state.cube_array)?
+        } else {
+            Vec::new()
+        };
         gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(state.material_buffer));
         gl.buffer_data_u8_slice(glow::SHADER_STORAGE_BUFFER, bytes(&scene_data::materials(scene)), glow::DYNAMIC_DRAW);
         gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(state.light_buffer));
-        gl.buffer_data_u8_slice(glow::SHADER_STORAGE_BUFFER, bytes(&scene_data::lights(scene)), glow::DYNAMIC_DRAW);
+        gl.buffer_data_u8_slice(glow::SHADER_STORAGE_BUFFER, bytes(&scene_data::lights(scene, &first_faces)), glow::DYNAMIC_DRAW);
         gl.bind_buffer_base(glow::SHADER_STORAGE_BUFFER, 0, Some(state.material_buffer));
         gl.bind_buffer_base(glow::SHADER_STORAGE_BUFFER, 1, Some(state.light_buffer));
         gl.bind_buffer_base(glow::SHADER_STORAGE_BUFFER, 2, Some(state.sphere_buffer));
@@ -220,9 +240,16 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance]) -> Result<
             let u = state.uploaded.as_ref().expect("uploaded above");
             (u.1.clone(), u.2)
         };
+        let (triangles, spheres) = if mapped { (state.triangles_mapped, state.spheres_mapped) } else { (state.triangles, state.spheres) };
+        if mapped {
+            state.maps.bind_for_lookup(gl);
+        }
         if !runs.is_empty() {
-            gl.use_program(Some(state.triangles));
-            uniforms(gl, state.triangles, job);
+            gl.use_program(Some(triangles));
+            uniforms(gl, triangles, job);
+            if mapped {
+                state.maps.lookup_uniforms(gl, triangles, job.settings);
+            }
             gl.bind_vertex_array(Some(state.vertex_array));
             for (first, count, two_sided) in runs {
                 if two_sided {
@@ -239,8 +266,11 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance]) -> Result<
             // the sphere, and the fragment shader finds the exact surface.
             gl.disable(glow::CULL_FACE);
             gl.enable(glow::DEPTH_CLAMP);
-            gl.use_program(Some(state.spheres));
-            uniforms(gl, state.spheres, job);
+            gl.use_program(Some(spheres));
+            uniforms(gl, spheres, job);
+            if mapped {
+                state.maps.lookup_uniforms(gl, spheres, job.settings);
+            }
             gl.bind_vertex_array(Some(state.cube_array));
             gl.draw_arrays_instanced(glow::TRIANGLES, 0, 36, sphere_count as i32);
             gl.disable(glow::DEPTH_CLAMP);

@@ -76,14 +76,17 @@ pub fn materials(scene: &Scene) -> Vec<f32> {
     out
 }
 
-/// Per light: (position or direction, 0 = point | 1 = directional), (power or irradiance, 0).
-pub fn lights(scene: &Scene) -> Vec<f32> {
+/// Per light: (position or direction, 0 = point | 1 = directional),
+/// (power or irradiance, first shadow-map face or -1). `first_faces`: per
+/// light, with `--shadows map`.
+pub fn lights(scene: &Scene, first_faces: &[i32]) -> Vec<f32> {
     let mut out = Vec::with_capacity(scene.lights.len().max(1) * 8);
-    for l in &scene.lights {
+    for (i, l) in scene.lights.iter().enumerate() {
+        let face = first_faces.get(i).copied().unwrap_or(-1) as f32;
         match *l {
-            Light::Point { position, power } => out.extend_from_slice(&[position.x, position.y, position.z, 0.0, power.x, power.y, power.z, 0.0]),
+            Light::Point { position, power } => out.extend_from_slice(&[position.x, position.y, position.z, 0.0, power.x, power.y, power.z, face]),
             Light::Directional { direction, irradiance } => {
-                out.extend_from_slice(&[direction.x, direction.y, direction.z, 1.0, irradiance.x, irradiance.y, irradiance.z, 0.0])
+                out.extend_from_slice(&[direction.x, direction.y, direction.z, 1.0, irradiance.x, irradiance.y, irradiance.z, face])
             }
         }
     }

@@ -25,6 +25,60 @@ layout(std430, binding = 1) readonly buffer Lights { vec4 lights[]; };
 
 const float PI = 3.14159265358979323846;
 
+#ifdef SHADOW_MAP
+// `--shadows map`: the maps drawn by GL (`SHADOW_VERTEX` and friends), one
+// layer per face; per face: (eye, half_x), (half_y, ortho, 0, 0) and the
+// world-to-camera rows. A light's first face is `lights[2 i + 1].w`.
+layout(std430, binding = 3) readonly buffer Faces { vec4 faces[]; };
+uniform sampler2DArray shadow_maps;
+uniform float map_size;
+uniform float map_bias;
+uniform bool slope_bias;
+const float MAX_SLOPE = 10.0;
+
+int cube_face(vec3 v) {
+    vec3 a = abs(v);
+    if (a.x >= a.y && a.x >= a.z) return v.x >= 0.0 ? 0 : 1;
+    if (a.y >= a.z) return v.y >= 0.0 ? 2 : 3;
+    return v.z >= 0.0 ? 4 : 5;
+}
+
+// ShadowMaps::occluder: the nearest texel's stored depth against the point's,
+// with the slope-scaled bias in texels.
+bool shadowed(int light, vec3 p, vec3 g, vec3 w_i) {
+    vec4 la = lights[2 * light];
+    int first = int(lights[2 * light + 1].w);
+    if (first < 0) return false;
+    bool point = la.w == 0.0;
+    int face = point ? first + cube_face(p - la.xyz) : first;
+    vec4 a = faces[5 * face];
+    vec4 b = faces[5 * face + 1];
+    mat3 w2c = transpose(mat3(faces[5 * face + 2].xyz, faces[5 * face + 3].xyz, faces[5 * face + 4].xyz));
+    vec3 c = w2c * (p - a.xyz);
+    float dist;
+    float texel_w;
+    vec2 img;
+    if (point) {
+        if (!(c.z < 0.0)) return false;
+        float z = -c.z;
+        dist = length(p - la.xyz);
+        texel_w = 2.0 * z / map_size;
+        float inv = 1.0 / -c.z;
+        img = vec2((c.x * inv / a.w + 1.0) * 0.5 * map_size, (1.0 - c.y * inv / b.x) * 0.5 * map_size);
+    } else {
+        dist = -c.z;
+        texel_w = 2.0 * max(a.w, b.x) / map_size;
+        img = vec2((c.x / a.w + 1.0) * 0.5 * map_size, (1.0 - c.y / b.x) * 0.5 * map_size);
+        if (!(img.x >= 0.0 && img.y >= 0.0 && img.x < map_size && img.y < map_size)) return false;
+    }
+    ivec2 texel = ivec2(clamp(floor(max(img, vec2(0.0))), vec2(0.0), vec2(map_size - 1.0)));
+    float stored = texelFetch(shadow_maps, ivec3(texel.x, int(map_size) - 1 - texel.y, face), 0).r;
+    float cos_n = clamp(abs(dot(g, w_i)), 1e-6, 1.0);
+    float tan_n = slope_bias ? min(sqrt(max(1.0 - cos_n * cos_n, 0.0)) / cos_n, MAX_SLOPE) : 0.0;
+    return dist - stored > map_bias * texel_w * (1.0 + tan_n);
+}
+#endif
+
 // Camera-space direction (z = -1) through this fragment's sample, pixel rows top-down.
 vec3 camera_dir() {
     float px = floor(gl_FragCoord.x) + sample_offset.x;
@@ -37,7 +91,7 @@ vec3 normalize_or_zero(vec3 v) {
     return l > 0.0 ? v / l : vec3(0.0);
 }
 
-vec3 shade(vec3 p, vec3 n, vec3 w_o, uint m) {
+vec3 shade(vec3 p, vec3 n, vec3 g, vec3 w_o, uint m) {
     vec3 albedo = materials[2u * m].xyz;
     vec3 glossy = materials[2u * m + 1u].xyz;
     float s = materials[2u * m + 1u].w;
@@ -59,6 +113,9 @@ vec3 shade(vec3 p, vec3 n, vec3 w_o, uint m) {
         }
         float cos_theta = dot(w_i, n);
         if (cos_theta <= 0.0 || incident == vec3(0.0)) continue;
+#ifdef SHADOW_MAP
+        if (shadowed(i, p, g, w_i)) continue;
+#endif
         vec3 f = albedo * (1.0 / PI);
         if (glossy != vec3(0.0)) {
             vec3 w_h = normalize_or_zero(w_i + w_o);
@@ -102,9 +159,9 @@ void main() {
 }
 "#;
 
-pub fn triangle_fragment() -> String {
+pub fn triangle_fragment(defines: &str) -> String {
     format!(
-        "#version 450 core\n{COMMON}{}",
+        "#version 450 core\n{defines}{COMMON}{}",
         r#"
 uniform bool flat_shading;
 in vec3 v_position;
@@ -122,7 +179,7 @@ void main() {
         n = -n;
     }
     if (flat_shading) n = g;
-    colour = vec4(shade(v_position, n, -dir, v_material), 1.0);
+    colour = vec4(shade(v_position, n, g, -dir, v_material), 1.0);
 }
 "#
     )
@@ -151,9 +208,9 @@ void main() {
 }
 "#;
 
-pub fn sphere_fragment() -> String {
+pub fn sphere_fragment(defines: &str) -> String {
     format!(
-        "#version 450 core\n{COMMON}{}",
+        "#version 450 core\n{defines}{COMMON}{}",
         r#"
 struct Sphere { vec4 centre_radius; uvec4 material; };
 layout(std430, binding = 2) readonly buffer Spheres { Sphere spheres[]; };
@@ -179,8 +236,108 @@ void main() {
     if (dot(n, dir) > 0.0) n = -n;
     float w = dot(p - eye, -camera_to_world[2]);
     gl_FragDepth = clamp(near_plane * (far_plane - w) / ((far_plane - near_plane) * w), 0.0, 1.0);
-    colour = vec4(shade(p, n, -dir, m), 1.0);
+    colour = vec4(shade(p, n, n, -dir, m), 1.0);
 }
 "#
     )
 }
+
+/// The shadow pass: each face of each light's map drawn from the light
+/// (`shadow_map::light_views`), storing what `shadow_map` stores: the
+/// distance from the light (perspective faces) or the depth along the
+/// light's direction (orthographic), nearest first.
+pub const SHADOW_VERTEX: &str = r#"#version 450 core
+layout(location = 0) in vec3 position;
+uniform vec3 eye;
+uniform mat3 world_to_camera;
+uniform vec2 half_extent;
+uniform bool ortho;
+uniform float near_plane;
+// Orthographic: the range of depths of the scene's box, mapped to [1, 0].
+uniform vec2 depth_range;
+out vec3 v_position;
+out float v_depth;
+void main() {
+    vec3 c = world_to_camera * (position - eye);
+    float d = -c.z;
+    if (ortho) {
+        gl_Position = vec4(c.x / half_extent.x, c.y / half_extent.y, (depth_range.y - d) / (depth_range.y - depth_range.x), 1.0);
+    } else {
+        gl_Position = vec4(c.x / half_extent.x, c.y / half_extent.y, near_plane, d);
+    }
+    v_position = position;
+    v_depth = d;
+}
+"#;
+
+pub const SHADOW_FRAGMENT: &str = r#"#version 450 core
+uniform vec3 eye;
+uniform bool ortho;
+in vec3 v_position;
+in float v_depth;
+layout(location = 0) out float stored;
+void main() {
+    stored = ortho ? v_depth : length(v_position - eye);
+}
+"#;
+
+/// Spheres in the shadow pass: the bounding cube again, each texel's ray
+/// from the light meeting the sphere exactly (`shadow_map`'s sphere_entry).
+pub const SHADOW_SPHERE_VERTEX: &str = r#"#version 450 core
+layout(location = 0) in vec3 corner;
+struct Sphere { vec4 centre_radius; uvec4 material; };
+layout(std430, binding = 2) readonly buffer Spheres { Sphere spheres[]; };
+uniform vec3 eye;
+uniform mat3 world_to_camera;
+uniform vec2 half_extent;
+uniform bool ortho;
+uniform float near_plane;
+uniform vec2 depth_range;
+flat out int v_sphere;
+void main() {
+    vec4 s = spheres[gl_InstanceID].centre_radius;
+    vec3 c = world_to_camera * (s.xyz + corner * (s.w * 1.01) - eye);
+    float d = -c.z;
+    if (ortho) {
+        gl_Position = vec4(c.x / half_extent.x, c.y / half_extent.y, (depth_range.y - d) / (depth_range.y - depth_range.x), 1.0);
+    } else {
+        gl_Position = vec4(c.x / half_extent.x, c.y / half_extent.y, near_plane, d);
+    }
+    v_sphere = gl_InstanceID;
+}
+"#;
+
+pub const SHADOW_SPHERE_FRAGMENT: &str = r#"#version 450 core
+struct Sphere { vec4 centre_radius; uvec4 material; };
+layout(std430, binding = 2) readonly buffer Spheres { Sphere spheres[]; };
+uniform vec3 eye;
+uniform mat3 camera_to_world;
+uniform vec2 half_extent;
+uniform bool ortho;
+uniform float near_plane;
+uniform float map_size;
+uniform vec2 depth_range;
+flat in int v_sphere;
+layout(location = 0) out float stored;
+void main() {
+    vec4 s = spheres[v_sphere].centre_radius;
+    float px = floor(gl_FragCoord.x) + 0.5;
+    float py = (map_size - 1.0 - floor(gl_FragCoord.y)) + 0.5;
+    vec2 q = vec2((2.0 * px / map_size - 1.0) * half_extent.x, (1.0 - 2.0 * py / map_size) * half_extent.y);
+    vec3 o = ortho ? eye + camera_to_world * vec3(q, 0.0) : eye;
+    vec3 d = ortho ? -camera_to_world[2] : camera_to_world * vec3(q, -1.0);
+    vec3 u = normalize(d);
+    vec3 f = o - s.xyz;
+    float b = -dot(f, u);
+    vec3 l = f + u * b;
+    float dist = length(l);
+    float disc = (s.w - dist) * (s.w + dist);
+    if (!(disc >= 0.0)) discard;
+    float h = sqrt(disc);
+    float t = ortho ? b - h : (length(f) > s.w ? b - h : b + h);
+    if (!ortho && !(t > 0.0)) discard;
+    float view_depth = ortho ? t : t * dot(u, -camera_to_world[2]);
+    gl_FragDepth = ortho ? clamp((depth_range.y - t) / (depth_range.y - depth_range.x), 0.0, 1.0) : clamp(near_plane / view_depth, 0.0, 1.0);
+    stored = t;
+}
+"#;
