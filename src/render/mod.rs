@@ -60,6 +60,20 @@ named_enum! {
     }
 }
 
+named_enum! {
+    /// What a mirror (and a dielectric's Fresnel reflection) reflects.
+    #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+    pub enum Reflections ("reflection mode") {
+        /// A traced ray: whatever it hits, shaded.
+        #[default]
+        Ray = "ray",
+        /// The environment (or background) looked up in the reflected
+        /// direction, no ray: the rasterizer's environment-map trick, blind
+        /// to nearby objects.
+        Env = "env",
+    }
+}
+
 /// Per-render knobs. Scene-level values (background, ambient, exposure) stay
 /// in `Scene::render`.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -137,6 +151,12 @@ pub struct RenderSettings {
     /// does, to show the speckles. A debug knob.
     #[serde(default = "default_true")]
     pub terminator_lift: bool,
+    /// How textures and normal maps are read.
+    #[serde(default)]
+    pub texture_filter: crate::scene::texture::TextureFilter,
+    /// Traced reflections or environment lookups.
+    #[serde(default)]
+    pub reflections: Reflections,
 }
 
 fn default_true() -> bool {
@@ -171,6 +191,8 @@ impl RenderSettings {
             near_clip: true,
             shadow_map_slope_bias: true,
             terminator_lift: true,
+            texture_filter: crate::scene::texture::TextureFilter::Trilinear,
+            reflections: Reflections::Ray,
         }
     }
 }

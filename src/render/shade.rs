@@ -56,12 +56,19 @@ pub fn shade<Q: SceneQuery, R: Recorder>(
 ) -> Radiance {
     let Shading { scene, .. } = *sh;
     let material = &scene.materials[hit.material as usize];
-    let albedo = material.albedo(hit.uv);
+    let albedo = albedo_at(material, hit, sh.settings);
     let ambient = ambient_term(sh, hit, albedo);
     let surface = surface_lane(material, albedo, hit.position, hit.shading_normal, w_o);
     let mut visibility = ShadowQueries { sh: &mut *sh, hit, depth, pending: PendingShadow::default() };
     let direct: Vec3 = lighting::direct_light(&scene.lights, &surface, ambient.into(), &mut visibility).into();
     after_direct(sh, hit, material, albedo, w_o, depth, direct)
+}
+
+/// The diffuse albedo `shade()` lights at `hit`: the material's texture
+/// read at the hit's uv with its footprint and the chosen filter.
+#[inline]
+pub fn albedo_at(material: &Material, hit: &SurfaceHit, settings: &RenderSettings) -> Vec3 {
+    material.albedo(hit.uv, &hit.diff.footprint(), settings.texture_filter)
 }
 
 /// The term `shade()` starts from, before the lights: the constant ambient,
@@ -496,7 +503,7 @@ mod tests {
         let p = v[0] * b.x + v[1] * b.y + v[2] * b.z;
         let hit = SurfaceHit {
             position: p, geometric_normal: Vec3::Z, shading_normal: Vec3::Z, barycentric: b, uv: Vec2::ZERO, t: 1.0,
-            kind: PrimitiveKind::Triangle, primitive: 0, object: 0, material: 0, back_face: false,
+            kind: PrimitiveKind::Triangle, primitive: 0, object: 0, material: 0, back_face: false, diff: crate::scene::Differentials::ZERO,
         };
         let lifted = lifted_position(&scene, &hit);
         assert!(lifted.z > 0.05, "the origin must rise above the facet: {lifted}");

@@ -3,7 +3,7 @@
 //! file, the line and the key or table at fault.
 
 use super::obj::{self, NormalMode};
-use super::texture::load_texture;
+use super::texture::{load_texture_as, Encoding, Wrap};
 use super::{Camera, Fov, Light, Material, ObjectInfo, RenderDefaults, Scene, Sphere, Triangle};
 use crate::input::{MAX_COORDINATE, MAX_LIGHT, MAX_VALUE};
 use crate::math::{Vec2, Vec3};
@@ -76,6 +76,9 @@ struct MaterialDesc {
     transmission: Option<F3>,
     ior: Option<f32>,
     texture: Option<String>,
+    wrap: Option<String>,
+    uv_scale: Option<F2>,
+    normal_map: Option<String>,
 }
 
 #[derive(Deserialize)]
@@ -257,8 +260,21 @@ fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str) -> R
         if !(mat.ior.is_finite() && mat.ior > 0.0 && mat.ior <= MAX_IOR) {
             return Err(format!("{where_}: ior must be a finite number > 0 (at most {MAX_IOR})"));
         }
+        if let Some(w) = &m.wrap {
+            mat.wrap = Wrap::parse(w).map_err(|e| format!("{where_}: wrap: {e}"))?;
+        }
+        if let Some(scale) = m.uv_scale {
+            let scale = Vec2::from(scale);
+            if !(scale.is_finite() && scale.abs().max_element() <= MAX_VALUE) {
+                return Err(format!("{where_}: uv_scale must be two finite numbers between -{MAX_VALUE:e} and {MAX_VALUE:e}"));
+            }
+            mat.uv_scale = scale;
+        }
         if let Some(tex) = &m.texture {
-            textures.push((scene.materials.len(), base.join(tex), where_));
+            textures.push((scene.materials.len(), base.join(tex), where_.clone(), Encoding::Srgb));
+        }
+        if let Some(map) = &m.normal_map {
+            textures.push((scene.materials.len(), base.join(map), where_, Encoding::Linear));
         }
         scene.materials.push(mat);
     }
@@ -267,10 +283,17 @@ fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str) -> R
         let where_ = format!("{}: object {}", at(o.span()), i + 1);
         add_object(&mut scene, o.get_ref(), i as u32, &where_, base)?;
     }
-    for (index, path, where_) in textures {
+    for (index, path, where_, encoding) in textures {
         let drawn = scene.triangles.iter().any(|t| t.material as usize == index) || scene.spheres.iter().any(|s| s.material as usize == index);
         if drawn {
-            scene.materials[index].texture = Some(Arc::new(load_texture(&path).map_err(|e| format!("{where_}: texture: {e}"))?));
+            let loaded = Some(Arc::new(load_texture_as(&path, encoding).map_err(|e| match encoding {
+                Encoding::Srgb => format!("{where_}: texture: {e}"),
+                Encoding::Linear => format!("{where_}: normal_map: {e}"),
+            })?));
+            match encoding {
+                Encoding::Srgb => scene.materials[index].texture = loaded,
+                Encoding::Linear => scene.materials[index].normal_map = loaded,
+            }
         }
     }
     Ok(scene)

@@ -199,6 +199,42 @@ pub struct SurfaceHit {
     pub material: u32,
     /// True when the surface was hit from its back (two-sided surfaces only).
     pub back_face: bool,
+    /// How position, direction and uv change from this pixel to the next
+    /// (zero when not tracked): the texture level of detail and the
+    /// differentials of reflected rays come from here.
+    pub diff: Differentials,
+}
+
+/// Derivatives with respect to the image position (x right, y down, in
+/// pixels) of a sample's hit point, of the direction of the ray that found
+/// it, and of the hit's uv. Ray casters carry ray differentials (Igehy
+/// 1999) to the hit; rasterizers differentiate their perspective-correct
+/// interpolation. All zero: no footprint (the finest texture level).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Differentials {
+    pub dp_dx: Vec3,
+    pub dp_dy: Vec3,
+    pub dd_dx: Vec3,
+    pub dd_dy: Vec3,
+    pub duv_dx: Vec2,
+    pub duv_dy: Vec2,
+}
+
+impl Differentials {
+    pub const ZERO: Differentials = Differentials {
+        dp_dx: Vec3::ZERO,
+        dp_dy: Vec3::ZERO,
+        dd_dx: Vec3::ZERO,
+        dd_dy: Vec3::ZERO,
+        duv_dx: Vec2::ZERO,
+        duv_dy: Vec2::ZERO,
+    };
+
+    /// The texture footprint these derivatives give.
+    #[inline]
+    pub fn footprint(&self) -> texture::Footprint {
+        texture::Footprint { duv_dx: self.duv_dx, duv_dy: self.duv_dy }
+    }
 }
 
 /// Rays leaving a surface start a little off it, so that rounding cannot
@@ -276,6 +312,7 @@ impl Scene {
             object: tri.object,
             material: tri.material,
             back_face,
+            diff: Differentials::ZERO,
         }
     }
 
@@ -301,6 +338,7 @@ impl Scene {
             object: s.object,
             material: s.material,
             back_face,
+            diff: Differentials::ZERO,
         }
     }
 
