@@ -7,6 +7,7 @@
 
 pub mod bsdf_sampling;
 pub mod debug;
+pub mod differentials;
 pub mod frame;
 pub mod gi;
 pub mod kd_tree;
@@ -354,11 +355,13 @@ pub fn renderer_by_name(name: &str) -> Result<Box<dyn Renderer>, String> {
 }
 
 /// What `resolve_sample` returns for a sample that sees nothing, when that
-/// does not depend on the ray: the background in the shaded view. Lets a
+/// does not depend on the ray: the background in the shaded view (an
+/// environment depends on the ray's direction: `None`). Lets a
 /// rasterizer skip building eye rays for empty pixels (most of a frame).
 #[inline]
 pub fn miss_without_ray(job: &PassJob) -> Option<Radiance> {
-    (job.settings.view == debug::View::Shaded).then_some(job.prepared.scene.render.background)
+    let scene = &job.prepared.scene;
+    (job.settings.view == debug::View::Shaded && scene.environment.is_none()).then_some(scene.render.background)
 }
 
 /// The value one sample contributes, given what it sees: `shade()` for the
@@ -429,8 +432,9 @@ fn resolve_with<Q: SceneQuery, R: Recorder>(
             }
         }
         (debug::View::Shaded, None) => {
-            rec.shaded(0, scene.render.background);
-            scene.render.background
+            let l = scene.miss_radiance(ray.dir);
+            rec.shaded(0, l);
+            l
         }
         (view, hit) => {
             let c = debug::view_color(view, job.view, ray, hit);

@@ -30,6 +30,14 @@ struct SceneDesc {
     materials: BTreeMap<String, Spanned<MaterialDesc>>,
     #[serde(default)]
     object: Vec<Spanned<ObjectDesc>>,
+    environment: Option<Spanned<EnvironmentDesc>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct EnvironmentDesc {
+    file: String,
+    intensity: Option<f32>,
 }
 
 #[derive(Deserialize)]
@@ -295,6 +303,16 @@ fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str) -> R
                 Encoding::Linear => scene.materials[index].normal_map = loaded,
             }
         }
+    }
+    if let Some(env) = &desc.environment {
+        let where_ = format!("{}: [environment]", at(env.span()));
+        let env = env.get_ref();
+        let intensity = env.intensity.unwrap_or(1.0);
+        if !(intensity.is_finite() && (0.0..=MAX_VALUE).contains(&intensity)) {
+            return Err(format!("{where_}: intensity must be a finite number from 0 to {MAX_VALUE:e}"));
+        }
+        let texture = load_texture_as(&base.join(&env.file), Encoding::Srgb).map_err(|e| format!("{where_}: file: {e}"))?;
+        scene.environment = Some(super::environment::Environment { texture: Arc::new(texture), intensity });
     }
     Ok(scene)
 }

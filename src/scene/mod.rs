@@ -5,6 +5,7 @@
 pub mod assets;
 pub mod builtin;
 pub mod camera;
+pub mod environment;
 pub mod file;
 pub mod load;
 pub mod material;
@@ -177,6 +178,8 @@ pub struct Scene {
     pub objects: Vec<ObjectInfo>,
     /// Things worth telling the user that did not stop the scene loading.
     pub warnings: Vec<String>,
+    /// `[environment]`: what rays that hit nothing see instead of `background`.
+    pub environment: Option<environment::Environment>,
 }
 
 /// Everything a renderer found about the surface a sample sees. Renderers
@@ -265,6 +268,21 @@ impl SurfaceHit {
 }
 
 impl Scene {
+    /// Whether some material reads a texture or normal map: only then do
+    /// renderers work out their samples' footprints (`SurfaceHit::diff`).
+    pub fn has_textures(&self) -> bool {
+        self.materials.iter().any(|m| m.texture.is_some() || m.normal_map.is_some())
+    }
+
+    /// The radiance a ray along unit `dir` sees when it hits nothing.
+    #[inline]
+    pub fn miss_radiance(&self, dir: Vec3) -> Vec3 {
+        match &self.environment {
+            Some(env) => env.radiance(dir),
+            None => self.render.background,
+        }
+    }
+
     pub fn triangle_count(&self) -> usize {
         self.triangles.len()
     }

@@ -59,12 +59,18 @@ pub struct Footprint {
 impl MipLevel {
     #[inline]
     fn texel(&self, x: i64, y: i64, wrap: Wrap) -> Vec3 {
-        let (w, h) = (self.width as i64, self.height as i64);
-        let (x, y) = match wrap {
-            Wrap::Repeat => (x.rem_euclid(w), y.rem_euclid(h)),
-            Wrap::Clamp => (x.clamp(0, w - 1), y.clamp(0, h - 1)),
+        self.texel_uv(x, y, wrap, wrap)
+    }
+
+    /// Texel `(x, y)` with the columns addressed by `wrap_u`, the rows by `wrap_v`.
+    #[inline]
+    fn texel_uv(&self, x: i64, y: i64, wrap_u: Wrap, wrap_v: Wrap) -> Vec3 {
+        let address = |i: i64, n: i64, wrap: Wrap| match wrap {
+            Wrap::Repeat => i.rem_euclid(n),
+            Wrap::Clamp => i.clamp(0, n - 1),
         };
-        self.texels[(x + y * w) as usize]
+        let (x, y) = (address(x, self.width as i64, wrap_u), address(y, self.height as i64, wrap_v));
+        self.texels[(x + y * self.width as i64) as usize]
     }
 
     /// Texel-space position of `uv` (texel centres at +0.5; v = 0 is the
@@ -85,13 +91,20 @@ impl MipLevel {
     }
 
     pub fn bilinear(&self, uv: Vec2, wrap: Wrap) -> Vec3 {
+        self.bilinear_uv(uv, wrap, wrap)
+    }
+
+    /// `bilinear` with separate addressing of columns and rows (a
+    /// latitude-longitude map repeats around and clamps at the poles).
+    pub fn bilinear_uv(&self, uv: Vec2, wrap_u: Wrap, wrap_v: Wrap) -> Vec3 {
         let Some((x, y)) = self.position(uv) else { return Vec3::ZERO };
         let (x, y) = (x - 0.5, y - 0.5);
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
         let (xi, yi) = (x0 as i64, y0 as i64);
-        let top = self.texel(xi, yi, wrap).lerp(self.texel(xi + 1, yi, wrap), fx);
-        let bottom = self.texel(xi, yi + 1, wrap).lerp(self.texel(xi + 1, yi + 1, wrap), fx);
+        let t = |x, y| self.texel_uv(x, y, wrap_u, wrap_v);
+        let top = t(xi, yi).lerp(t(xi + 1, yi), fx);
+        let bottom = t(xi, yi + 1).lerp(t(xi + 1, yi + 1), fx);
         top.lerp(bottom, fy)
     }
 
