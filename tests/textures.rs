@@ -86,3 +86,27 @@ fn rasterize_and_raytrace_agree_on_textures() {
     // Edge pixels: coverage differs legitimately along silhouettes.
     assert!(loose as f64 <= 0.005 * n as f64, "{loose} of {n} pixels differ by more than 1e-2");
 }
+
+/// A normal map whose every texel points straight out (0.5, 0.5, 1) leaves
+/// every pixel exactly as without one, in both families.
+#[test]
+fn a_flat_normal_map_changes_nothing_bit_for_bit() {
+    use pinhole::scene::Texture;
+    use std::sync::Arc;
+    let plain: Scene = pinhole::scene::builtin::load_builtin("textures").unwrap().unwrap();
+    let mut flat = plain.clone();
+    let bumpy = flat.materials.iter().position(|m| m.normal_map.is_some()).unwrap();
+    flat.materials[bumpy].normal_map = Some(Arc::new(Texture::new(2, 2, vec![Vec3::new(0.5, 0.5, 1.0); 4])));
+    let mut none = plain.clone();
+    none.materials[bumpy].normal_map = None;
+    let (flat, none) = (PreparedScene::new(flat), PreparedScene::new(none));
+    for renderer in ["raytrace", "rasterize"] {
+        let a = render(&flat, renderer, TextureFilter::Trilinear, 1);
+        let b = render(&none, renderer, TextureFilter::Trilinear, 1);
+        let bits = |p: &[Radiance]| p.iter().map(|c| c.to_array().map(f32::to_bits)).collect::<Vec<_>>();
+        assert!(bits(&a) == bits(&b), "{renderer}: a flat normal map changed the image");
+    }
+    // The real map does change it.
+    let bumped = PreparedScene::new(plain);
+    assert!(render(&bumped, "raytrace", TextureFilter::Trilinear, 1) != render(&none, "raytrace", TextureFilter::Trilinear, 1));
+}

@@ -12,6 +12,7 @@ pub mod frame;
 pub mod gi;
 pub mod kd_tree;
 pub mod lighting;
+pub mod normal_map;
 pub mod photon_map;
 pub mod prepared;
 pub mod sampling;

@@ -500,10 +500,13 @@ pub fn radiance_along<Q: SceneQuery, R: Recorder>(
     sh.counts.secondary += 1;
     sh.rec.ray(ray, f32::INFINITY, depth);
     let hit = query.closest(ray, f32::INFINITY, inside, sh.counts, sh.rec);
-    let hit = match (hit, rd) {
-        (Some(h), Some(rd)) if scene.has_textures() => Some(differentials::with_ray_differentials(scene, rd, ray, h)),
-        (hit, _) => hit,
-    };
+    let hit = hit.map(|mut h| {
+        if let Some(rd) = rd.filter(|_| scene.has_textures()) {
+            h = differentials::with_ray_differentials(scene, rd, ray, h);
+        }
+        super::normal_map::apply(scene, sh.settings.texture_filter, &mut h);
+        h
+    });
     sh.rec.closest(hit.as_ref());
     match hit {
         Some(h) => shade(sh, &h, -ray.dir, depth),

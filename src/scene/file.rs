@@ -304,6 +304,9 @@ fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str) -> R
             }
         }
     }
+    if scene.materials.iter().any(|m| m.normal_map.is_some()) {
+        scene.tangents = super::tangents::build_tangents(&scene);
+    }
     if let Some(env) = &desc.environment {
         let where_ = format!("{}: [environment]", at(env.span()));
         let env = env.get_ref();

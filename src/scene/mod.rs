@@ -11,6 +11,7 @@ pub mod load;
 pub mod material;
 pub mod obj;
 pub mod recentre;
+pub mod tangents;
 pub mod texture;
 
 pub use camera::{Camera, CameraView, Fov};
@@ -180,6 +181,9 @@ pub struct Scene {
     pub warnings: Vec<String>,
     /// `[environment]`: what rays that hit nothing see instead of `background`.
     pub environment: Option<environment::Environment>,
+    /// Per triangle, per corner: the normal map's tangent frame
+    /// (`tangents::build_tangents`); empty when no material has a normal map.
+    pub tangents: Vec<[glam::Vec4; 3]>,
 }
 
 /// Everything a renderer found about the surface a sample sees. Renderers

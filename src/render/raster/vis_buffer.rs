@@ -345,7 +345,11 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             let hit = scene.sphere_hit(id.index(), self.payload[i][0], &ray);
             // The sphere is hit by the eye ray, as in the ray casters: the same differentials.
             Some(match scene.has_textures() {
-                true => with_ray_differentials(scene, &RayDifferential::eye(self.job.view, p.x, p.y), &ray, hit),
+                true => {
+                    let mut hit = with_ray_differentials(scene, &RayDifferential::eye(self.job.view, p.x, p.y), &ray, hit);
+                    crate::render::normal_map::apply(scene, self.job.settings.texture_filter, &mut hit);
+                    hit
+                }
                 false => hit,
             })
         } else {
@@ -362,6 +366,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             let mut hit = scene.triangle_hit(id.index(), b, t, &ray);
             if scene.has_textures() {
                 hit.diff = super::derivatives::screen_differentials(scene, self.job.view, id.index(), b, p.x, p.y);
+                crate::render::normal_map::apply(scene, self.job.settings.texture_filter, &mut hit);
             }
             Some(hit)
         };

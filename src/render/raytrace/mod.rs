@@ -64,12 +64,17 @@ pub fn cast_pixel<Q: SceneQuery, R: Recorder>(job: &PassJob, query: &Q, x: u32, 
 }
 
 /// The eye ray's hit at image position `p` with the ray's differentials
-/// carried to it (Igehy's transfer), when a texture can read them.
+/// carried to it (Igehy's transfer) and its normal map applied, when a
+/// texture can read them.
 #[inline]
 pub fn with_eye_differentials(job: &PassJob, p: Vec2, ray: &Ray, hit: Option<SurfaceHit>) -> Option<SurfaceHit> {
     let scene = &job.prepared.scene;
     match hit {
-        Some(h) if scene.has_textures() => Some(with_ray_differentials(scene, &RayDifferential::eye(job.view, p.x, p.y), ray, h)),
+        Some(h) if scene.has_textures() => {
+            let mut h = with_ray_differentials(scene, &RayDifferential::eye(job.view, p.x, p.y), ray, h);
+            crate::render::normal_map::apply(scene, job.settings.texture_filter, &mut h);
+            Some(h)
+        }
         other => other,
     }
 }
