@@ -110,3 +110,30 @@ fn a_flat_normal_map_changes_nothing_bit_for_bit() {
     let bumped = PreparedScene::new(plain);
     assert!(render(&bumped, "raytrace", TextureFilter::Trilinear, 1) != render(&none, "raytrace", TextureFilter::Trilinear, 1));
 }
+
+/// `--view mip`: below level 2 on the ground under the camera (blue to
+/// cyan: red 0.1, blue 0.9), far coarser towards the horizon, dark grey on the untextured mirror; the
+/// same in both families.
+#[test]
+fn the_mip_view_shows_the_level_read() {
+    use pinhole::render::debug::{mip_color, View, MIP_UNTEXTURED};
+    let scene: Scene = pinhole::scene::builtin::load_builtin("textures").unwrap().unwrap();
+    let prepared = PreparedScene::new(scene);
+    let frame = |renderer: &str| {
+        let mut s = RenderSettings::for_scene(&prepared.scene);
+        (s.width, s.height, s.view) = (W, H, View::Mip);
+        render_frame(renderer_by_name(renderer).unwrap().as_ref(), &prepared, &s, &AtomicBool::new(false), None).unwrap().pixels
+    };
+    let a = frame("raytrace");
+    let at = |x: u32, y: u32| a[(x + y * W) as usize];
+    let near = at(W / 2, H - 1);
+    assert!((near.x - 0.1).abs() < 1e-5 && (near.z - 0.9).abs() < 1e-5, "{near}");
+    // Just below the horizon (row 41 of 100) the ground is read far coarser.
+    let far = at(5, 41);
+    assert!((far - mip_color(2.0)).length() > 0.3 && (far - mip_color(0.0)).length() > 0.3, "{far}");
+    // The mirror sphere (right of centre) has no texture.
+    assert_eq!(at(W * 69 / 100, H / 2), MIP_UNTEXTURED);
+    let b = frame("rasterize");
+    let same = a.iter().zip(&b).filter(|(p, q)| (**p - **q).abs().max_element() < 1e-3).count();
+    assert!(same as f64 >= 0.995 * a.len() as f64, "{same} of {} pixels agree", a.len());
+}

@@ -437,6 +437,11 @@ fn resolve_with<Q: SceneQuery, R: Recorder>(
             rec.shaded(0, l);
             l
         }
+        (debug::View::Mip, hit) => {
+            let c = debug::mip_view(scene, job.settings.texture_filter, hit);
+            rec.shaded(0, c);
+            c
+        }
         (view, hit) => {
             let c = debug::view_color(view, job.view, ray, hit);
             rec.shaded(0, c);
