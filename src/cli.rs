@@ -195,6 +195,12 @@ struct RenderOpts {
     /// --view wireframe: the line algorithm, float (DDA) | integer (Bresenham).
     #[arg(long, default_value = "float")]
     lines: String,
+    /// How textures are read: nearest | bilinear | trilinear (mipmapped).
+    #[arg(long = "texture-filter", default_value = "trilinear", value_name = "FILTER")]
+    texture_filter: String,
+    /// What mirrors reflect: ray (traced) | env (the environment in the reflected direction, no ray).
+    #[arg(long, default_value = "ray", value_name = "ray|env")]
+    reflections: String,
 }
 
 /// What is left to do once the command line ran: the viewer is not part of
@@ -257,6 +263,8 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
         None => ShadowMode::Ray,
     };
     let interpolation = render::Interpolation::parse(&opts.interpolation)?;
+    let texture_filter = crate::scene::texture::TextureFilter::parse(&opts.texture_filter).map_err(|e| format!("--texture-filter: {e}"))?;
+    let reflections = render::Reflections::parse(&opts.reflections).map_err(|e| format!("--reflections: {e}"))?;
     let shadow_volume = render::shadow_volume::VolumeMode::parse(&opts.shadow_volume).map_err(|e| format!("--shadow-volume: {e}"))?;
     if opts.spp == 0 || opts.spp > 65536 {
         return Err(format!("--spp {} is not between 1 and 65536", opts.spp));
@@ -295,6 +303,8 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
     settings.shadows = shadows;
     settings.shadow_volume = shadow_volume;
     settings.interpolation = interpolation;
+    settings.texture_filter = texture_filter;
+    settings.reflections = reflections;
     settings.affine = opts.affine;
     if let Some(b) = opts.bump {
         if !(b.is_finite() && b >= 0.0) {

@@ -219,7 +219,7 @@ fn run_image(dir: &Path, name: &str, bytes: &[u8]) {
         }
         let tex = pinhole::scene::texture::load_texture(&path);
         if let Ok(t) = &tex {
-            assert!(t.texels.iter().all(|c| c.is_finite() && c.min_element() >= 0.0), "texture with bad texels");
+            assert!(t.levels.iter().flat_map(|l| l.texels.iter()).all(|c| c.is_finite() && c.min_element() >= 0.0), "texture with bad texels");
         }
         tex.map(|_| None)
     }));

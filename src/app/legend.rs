@@ -7,7 +7,7 @@
 use crate::render::debug::{cost_of_t, depth_distance, t_of_cost, zbuffer_depth};
 use super::PinholeApp;
 use crate::math::Vec3;
-use crate::render::debug::{cost_color, id_color, COST_SCALE};
+use crate::render::debug::{cost_color, id_color, mip_color, COST_SCALE, MIP_SCALE};
 use eframe::egui;
 use egui::{Color32, Pos2, Rect};
 
@@ -33,6 +33,7 @@ pub fn title(view: &str) -> Option<String> {
         "uv" => "uv: texture coordinates".into(),
         "diff" => "diff: this renderer minus raytrace:brute".into(),
         "shadowmap" => "shadowmap: a light's depth map".into(),
+        "mip" => "mip: texture level read per pixel".into(),
         other => format!("view: {other}"),
     })
 }
@@ -151,6 +152,12 @@ pub fn show(app: &PinholeApp, ctx: &egui::Context, viewport: Rect) {
                     "barycentric" => small(ui, "red = b0 (v0), green = b1 (v1), blue = b2 (v2); they sum to 1"),
                     "raydir" => small(ui, "colour = (d + 1) / 2: red grows with x (right), green with y (up), blue with z (back)"),
                     "normal" => small(ui, "colour = (n + 1) / 2 in world space"),
+                    "mip" => {
+                        small(ui, &format!("level 0 = the full-size texture, each next level half as wide; {} filter", s.texture_filter.name()));
+                        let ticks: Vec<(f32, String)> = (0..=MIP_SCALE as u32).step_by(2).map(|l| (l as f32 / MIP_SCALE, format!("{l}"))).collect();
+                        bar(ui, |t| mip_color(t * MIP_SCALE), &ticks);
+                        small(ui, "nearest and bilinear read level 0 only; dark grey: no texture; no hit: black");
+                    }
                     "uv" => small(ui, "an 8 × 8 checker in (u, v): straight in perspective-correct interpolation, bent in affine"),
                     "diff" => {
                         small(ui, "red: brighter, blue: darker than the reference (10% of its mean = full scale); equal pixels dimmed grey");

@@ -32,6 +32,10 @@ pub struct ViewerSettings {
     pub interpolation: Interpolation,
     /// Indirect light and its knobs.
     pub gi: crate::render::gi::GiSettings,
+    /// How textures are read.
+    pub texture_filter: crate::scene::texture::TextureFilter,
+    /// Traced reflections or environment lookups.
+    pub reflections: crate::render::Reflections,
     /// Image size over the scene's size.
     pub res_scale: f32,
     /// Encode the image as sRGB for display.
@@ -91,6 +95,8 @@ impl Default for ViewerSettings {
             view: View::Shaded,
             interpolation: Interpolation::Phong,
             gi: Default::default(),
+            texture_filter: Default::default(),
+            reflections: Default::default(),
             res_scale: 1.0,
             gamma: true,
             panels: Panels::default(),
@@ -126,6 +132,8 @@ impl ViewerSettings {
             view: self.view,
             interpolation: self.interpolation,
             gi: self.gi.clone(),
+            texture_filter: self.texture_filter,
+            reflections: self.reflections,
             shadow_map_size: k.shadow_map_size,
             shadow_map_bias: k.shadow_map_bias,
             msaa: k.msaa,
@@ -148,6 +156,8 @@ impl ViewerSettings {
         self.max_depth = settings.max_depth;
         self.interpolation = settings.interpolation;
         self.gi = settings.gi.clone();
+        self.texture_filter = settings.texture_filter;
+        self.reflections = settings.reflections;
         self.per_scene = SceneKnobs {
             shadow_map_size: settings.shadow_map_size,
             shadow_map_bias: settings.shadow_map_bias,

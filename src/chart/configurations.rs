@@ -8,6 +8,8 @@ use crate::render::{debug, shadow_map, Interpolation, RenderSettings, ShadowMode
 use crate::render::raster::depth_format::DepthFormat;
 use crate::render::shadow_volume::VolumeMode;
 use crate::render::raster::DEFAULT_RASTERIZE;
+use crate::render::Reflections;
+use crate::scene::texture::TextureFilter;
 use crate::scene::Scene;
 
 /// One point of the methods sweep.
@@ -58,6 +60,12 @@ pub fn describe(renderer: &str, s: &RenderSettings) -> String {
     }
     if s.interpolation != Interpolation::Phong {
         knob("interpolation", s.interpolation.name().to_string());
+    }
+    if s.texture_filter != TextureFilter::Trilinear {
+        knob("texture-filter", s.texture_filter.name().to_string());
+    }
+    if s.reflections != Reflections::Ray {
+        knob("reflections", s.reflections.name().to_string());
     }
     if s.affine {
         out.push("--affine".into());
@@ -155,6 +163,24 @@ pub fn method_configurations(scene: &Scene, base: &RenderSettings) -> Vec<Config
         }
     }
 
+    // Textures: read from level 0 only (aliasing), at one sample and four.
+    if scene.has_textures() {
+        for filter in [TextureFilter::Nearest, TextureFilter::Bilinear] {
+            for spp in [1, 4] {
+                add("textures", ray, with(&|s| {
+                    s.texture_filter = filter;
+                    s.spp = spp;
+                }));
+            }
+        }
+    }
+    // Reflections: the environment looked up instead of traced, blind to
+    // nearby objects; only where something is a mirror.
+    if scene.materials.iter().any(|m| m.mirror != crate::math::Vec3::ZERO) {
+        add("reflections", ray, with(&|s| s.reflections = Reflections::Env));
+        add("reflections", raster, with(&|s| s.reflections = Reflections::Env));
+    }
+
     // Indirect light: the cheap approximation (it darkens the ambient term,
     // so only where there is one), photons, and paths (the truth's method).
     let has_ambient = scene.render.ambient.max_element() > 0.0;
@@ -219,6 +245,18 @@ mod tests {
             .map(|c| c.settings.shadow_map_size)
             .collect();
         assert!(sizes.contains(&1024) && !sizes.contains(&2048), "{sizes:?}");
+    }
+
+    #[test]
+    fn textures_and_env_reflections_are_swept_where_they_matter() {
+        let scene = crate::scene::builtin::load_builtin("textures").unwrap().unwrap();
+        let configs = method_configurations(&scene, &RenderSettings::for_scene(&scene));
+        let labels: Vec<&str> = configs.iter().map(|c| c.label.as_str()).collect();
+        assert!(labels.contains(&"raytrace:bvh --texture-filter nearest"), "{labels:?}");
+        assert!(labels.contains(&"raytrace:bvh --spp 4 --texture-filter bilinear"), "{labels:?}");
+        assert!(labels.contains(&"rasterize:fixed --reflections env"), "{labels:?}");
+        let teapot = crate::scene::builtin::load_builtin("teapot").unwrap().unwrap();
+        assert!(method_configurations(&teapot, &RenderSettings::for_scene(&teapot)).iter().all(|c| c.group != "textures" && c.group != "reflections"));
     }
 
     #[test]

@@ -52,6 +52,47 @@ named_enum! {
         Shadowmap = "shadowmap",
         /// The shaded image with every triangle edge drawn over it (`wireframe`).
         Wireframe = "wireframe",
+        /// The mip level each sample's texture lookup reads (`mip_color`),
+        /// dark grey where the surface has no texture.
+        Mip = "mip",
+    }
+}
+
+/// Mip levels the mip view's colour scale spans (0 to this; coarser levels
+/// take its last colour).
+pub const MIP_SCALE: f32 = 10.0;
+
+/// The mip view's colour for level `level` (fractional with trilinear
+/// filtering): blue at 0 through cyan, green, yellow and red to magenta at
+/// `MIP_SCALE`.
+pub fn mip_color(level: f32) -> Vec3 {
+    const STOPS: [Vec3; 6] = [
+        Vec3::new(0.1, 0.2, 0.9),
+        Vec3::new(0.1, 0.8, 0.9),
+        Vec3::new(0.2, 0.85, 0.2),
+        Vec3::new(0.95, 0.9, 0.1),
+        Vec3::new(0.95, 0.25, 0.1),
+        Vec3::new(0.85, 0.2, 0.85),
+    ];
+    let x = (level / MIP_SCALE).clamp(0.0, 1.0) * (STOPS.len() - 1) as f32;
+    let i = (x.floor() as usize).min(STOPS.len() - 2);
+    STOPS[i].lerp(STOPS[i + 1], x - i as f32)
+}
+
+/// The colour a surface without a texture has in the mip view.
+pub const MIP_UNTEXTURED: Vec3 = Vec3::splat(0.15);
+
+/// The mip view of one sample: the level its material's texture (else its
+/// normal map) is read at with `filter`.
+pub fn mip_view(scene: &crate::scene::Scene, filter: crate::scene::texture::TextureFilter, hit: Option<&SurfaceHit>) -> Radiance {
+    let Some(h) = hit else { return Vec3::ZERO };
+    let material = &scene.materials[h.material as usize];
+    match material.texture.as_ref().or(material.normal_map.as_ref()) {
+        Some(t) => {
+            let (_, f) = material.scaled(h.uv, &h.diff.footprint());
+            mip_color(t.level_used(&f, filter))
+        }
+        None => MIP_UNTEXTURED,
     }
 }
 
@@ -71,7 +112,8 @@ pub fn view_color(view: View, camera: &CameraView, ray: &Ray, hit: Option<&Surfa
         // whole-frame comparison (`diff_image`).
         // The shadow map view is drawn by `shadow_map::view_sample`.
         // The wireframe view is the shaded image with lines drawn after the frame.
-        View::Shaded | View::Raydir | View::Cost | View::Diff | View::Shadowmap | View::Wireframe => Vec3::ZERO,
+        // The mip view needs the scene's textures (`mip_view`).
+        View::Shaded | View::Raydir | View::Cost | View::Diff | View::Shadowmap | View::Wireframe | View::Mip => Vec3::ZERO,
         View::Barycentric => h.barycentric,
         View::Depth => Vec3::splat(depth_value(camera, (h.position - camera.eye).length())),
         View::Zbuffer => Vec3::splat(zbuffer_value(camera, camera.view_depth(h.position).max(camera.near))),

@@ -205,6 +205,7 @@ mod tests {
                 object: 0,
                 material: 0,
                 back_face: false,
+                diff: crate::scene::Differentials::ZERO,
             };
             let gi = GiSettings { mode: GiMode::Ao, ao_samples: 20_000, ao_distance: distance, ..GiSettings::default() };
             let mut rng = SampleRng::for_pixel(1, 2, 3);

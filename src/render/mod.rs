@@ -7,10 +7,12 @@
 
 pub mod bsdf_sampling;
 pub mod debug;
+pub mod differentials;
 pub mod frame;
 pub mod gi;
 pub mod kd_tree;
 pub mod lighting;
+pub mod normal_map;
 pub mod opengl;
 pub mod photon_map;
 pub mod prepared;
@@ -58,6 +60,20 @@ named_enum! {
         /// Normals interpolated and lighting computed per sample.
         #[default]
         Phong = "phong",
+    }
+}
+
+named_enum! {
+    /// What a mirror (and a dielectric's Fresnel reflection) reflects.
+    #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+    pub enum Reflections ("reflection mode") {
+        /// A traced ray: whatever it hits, shaded.
+        #[default]
+        Ray = "ray",
+        /// The environment (or background) looked up in the reflected
+        /// direction, no ray: the rasterizer's environment-map trick, blind
+        /// to nearby objects.
+        Env = "env",
     }
 }
 
@@ -138,6 +154,12 @@ pub struct RenderSettings {
     /// does, to show the speckles. A debug knob.
     #[serde(default = "default_true")]
     pub terminator_lift: bool,
+    /// How textures and normal maps are read.
+    #[serde(default)]
+    pub texture_filter: crate::scene::texture::TextureFilter,
+    /// Traced reflections or environment lookups.
+    #[serde(default)]
+    pub reflections: Reflections,
 }
 
 fn default_true() -> bool {
@@ -172,6 +194,8 @@ impl RenderSettings {
             near_clip: true,
             shadow_map_slope_bias: true,
             terminator_lift: true,
+            texture_filter: crate::scene::texture::TextureFilter::Trilinear,
+            reflections: Reflections::Ray,
         }
     }
 }
@@ -341,11 +365,13 @@ pub fn renderer_by_name(name: &str) -> Result<Box<dyn Renderer>, String> {
 }
 
 /// What `resolve_sample` returns for a sample that sees nothing, when that
-/// does not depend on the ray: the background in the shaded view. Lets a
+/// does not depend on the ray: the background in the shaded view (an
+/// environment depends on the ray's direction: `None`). Lets a
 /// rasterizer skip building eye rays for empty pixels (most of a frame).
 #[inline]
 pub fn miss_without_ray(job: &PassJob) -> Option<Radiance> {
-    (job.settings.view == debug::View::Shaded).then_some(job.prepared.scene.render.background)
+    let scene = &job.prepared.scene;
+    (job.settings.view == debug::View::Shaded && scene.environment.is_none()).then_some(scene.render.background)
 }
 
 /// The value one sample contributes, given what it sees: `shade()` for the
@@ -416,8 +442,14 @@ fn resolve_with<Q: SceneQuery, R: Recorder>(
             }
         }
         (debug::View::Shaded, None) => {
-            rec.shaded(0, scene.render.background);
-            scene.render.background
+            let l = scene.miss_radiance(ray.dir);
+            rec.shaded(0, l);
+            l
+        }
+        (debug::View::Mip, hit) => {
+            let c = debug::mip_view(scene, job.settings.texture_filter, hit);
+            rec.shaded(0, c);
+            c
         }
         (view, hit) => {
             let c = debug::view_color(view, job.view, ray, hit);

@@ -194,7 +194,8 @@ fn trace_photon(scene: &Scene, query: &BvhQuery, mut ray: Ray, mut power: Vec3, 
     for bounce in 0..MAX_PHOTON_BOUNCES {
         let Some(hit) = query.closest(&ray, f32::INFINITY, inside, &mut counts, &mut NoRecord) else { break };
         let material = &scene.materials[hit.material as usize];
-        let albedo = material.albedo(hit.uv);
+        // Photons have no pixel footprint: the finest level, bilinear.
+        let albedo = material.albedo(hit.uv, &crate::scene::texture::Footprint::default(), crate::scene::texture::TextureFilter::Bilinear);
         let diffuse = albedo + if material.has_glossy() { material.glossy } else { Vec3::ZERO };
         if bounce > 0 && diffuse != Vec3::ZERO {
             stored.push(Photon { position: hit.position, w_i: -ray.dir, power, normal: hit.geometric_normal });

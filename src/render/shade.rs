@@ -5,7 +5,8 @@
 use super::gi::{self, GiMode, PathState};
 use super::lighting::{self, IncidenceLanes, LightVisibility, SurfaceLanes};
 use super::pixel_record::{LightSample, Recorder};
-use super::{RayCounts, RenderSettings, SceneQuery, ShadowMode};
+use super::differentials::{self, RayDifferential};
+use super::{RayCounts, Reflections, RenderSettings, SceneQuery, ShadowMode};
 use crate::math::lanes::V3;
 use crate::math::{Radiance, Ray, Vec3};
 use crate::scene::{Light, Material, Scene, SurfaceHit};
@@ -56,12 +57,19 @@ pub fn shade<Q: SceneQuery, R: Recorder>(
 ) -> Radiance {
     let Shading { scene, .. } = *sh;
     let material = &scene.materials[hit.material as usize];
-    let albedo = material.albedo(hit.uv);
+    let albedo = albedo_at(material, hit, sh.settings);
     let ambient = ambient_term(sh, hit, albedo);
     let surface = surface_lane(material, albedo, hit.position, hit.shading_normal, w_o);
     let mut visibility = ShadowQueries { sh: &mut *sh, hit, depth, pending: PendingShadow::default() };
     let direct: Vec3 = lighting::direct_light(&scene.lights, &surface, ambient.into(), &mut visibility).into();
     after_direct(sh, hit, material, albedo, w_o, depth, direct)
+}
+
+/// The diffuse albedo `shade()` lights at `hit`: the material's texture
+/// read at the hit's uv with its footprint and the chosen filter.
+#[inline]
+pub fn albedo_at(material: &Material, hit: &SurfaceHit, settings: &RenderSettings) -> Vec3 {
+    material.albedo(hit.uv, &hit.diff.footprint(), settings.texture_filter)
 }
 
 /// The term `shade()` starts from, before the lights: the constant ambient,
@@ -205,7 +213,7 @@ fn follow<Q: SceneQuery, R: Recorder>(
 ) -> Radiance {
     let before = sh.path.throughput;
     sh.path.throughput *= weight;
-    let l = radiance_along(sh, ray, depth + 1, inside);
+    let l = radiance_along(sh, ray, None, depth + 1, inside);
     sh.path.throughput = before;
     l
 }
@@ -448,20 +456,43 @@ fn secondary<Q: SceneQuery, R: Recorder>(
         reflect_weight += material.transmission * fresnel;
         if let Some(dir) = refracted {
             let ray = hit.spawn_ray_back(dir, settings.shadow_bump);
-            result += material.transmission * (1.0 - fresnel) * radiance_along(sh, &ray, depth + 1, true);
+            let rd = differentials::refracted(hit);
+            result += material.transmission * (1.0 - fresnel) * radiance_along(sh, &ray, Some(&rd), depth + 1, true);
         }
     }
     if reflect_weight != Vec3::ZERO {
-        let ray = hit.spawn_ray_front(reflect_dir, settings.shadow_bump);
-        result += reflect_weight * radiance_along(sh, &ray, depth + 1, false);
+        result += reflect_weight * reflection(sh, hit, reflect_dir, -w_o, depth);
     }
     result
 }
 
-/// Radiance along a secondary ray: closest hit, then `shade()`; the background on a miss.
+/// What a mirror at `hit` reflects towards the eye along unit `dir`, the
+/// ray having arrived along `d_in`: the traced ray's radiance (with its
+/// differentials reflected), or with `--reflections env` the environment
+/// looked up in `dir`, no ray cast.
+fn reflection<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &SurfaceHit, dir: Vec3, d_in: Vec3, depth: u32) -> Radiance {
+    let Shading { scene, settings, .. } = *sh;
+    match settings.reflections {
+        Reflections::Ray => {
+            let ray = hit.spawn_ray_front(dir, settings.shadow_bump);
+            let rd = differentials::reflected(scene, hit, d_in, hit.geometric_normal);
+            radiance_along(sh, &ray, Some(&rd), depth + 1, false)
+        }
+        Reflections::Env => {
+            let l = scene.miss_radiance(dir);
+            sh.rec.shaded(depth + 1, l);
+            l
+        }
+    }
+}
+
+/// Radiance along a secondary ray: closest hit, then `shade()`; the
+/// environment or background on a miss. With differentials `rd` the hit
+/// gets its footprint from them; without, the finest texture level.
 pub fn radiance_along<Q: SceneQuery, R: Recorder>(
     sh: &mut Shading<Q, R>,
     ray: &Ray,
+    rd: Option<&RayDifferential>,
     depth: u32,
     inside: bool,
 ) -> Radiance {
@@ -469,12 +500,20 @@ pub fn radiance_along<Q: SceneQuery, R: Recorder>(
     sh.counts.secondary += 1;
     sh.rec.ray(ray, f32::INFINITY, depth);
     let hit = query.closest(ray, f32::INFINITY, inside, sh.counts, sh.rec);
+    let hit = hit.map(|mut h| {
+        if let Some(rd) = rd.filter(|_| scene.has_textures()) {
+            h = differentials::with_ray_differentials(scene, rd, ray, h);
+        }
+        super::normal_map::apply(scene, sh.settings.texture_filter, &mut h);
+        h
+    });
     sh.rec.closest(hit.as_ref());
     match hit {
         Some(h) => shade(sh, &h, -ray.dir, depth),
         None => {
-            sh.rec.shaded(depth, scene.render.background);
-            scene.render.background
+            let l = scene.miss_radiance(ray.dir);
+            sh.rec.shaded(depth, l);
+            l
         }
     }
 }
@@ -496,7 +535,7 @@ mod tests {
         let p = v[0] * b.x + v[1] * b.y + v[2] * b.z;
         let hit = SurfaceHit {
             position: p, geometric_normal: Vec3::Z, shading_normal: Vec3::Z, barycentric: b, uv: Vec2::ZERO, t: 1.0,
-            kind: PrimitiveKind::Triangle, primitive: 0, object: 0, material: 0, back_face: false,
+            kind: PrimitiveKind::Triangle, primitive: 0, object: 0, material: 0, back_face: false, diff: crate::scene::Differentials::ZERO,
         };
         let lifted = lifted_position(&scene, &hit);
         assert!(lifted.z > 0.05, "the origin must rise above the facet: {lifted}");

@@ -41,6 +41,7 @@ const UNUSED_HIT: SurfaceHit = SurfaceHit {
     object: 0,
     material: 0,
     back_face: false,
+    diff: crate::scene::Differentials::ZERO,
 };
 
 /// Up to eight samples that see a surface, with where their results go.
@@ -122,7 +123,7 @@ pub fn shade_batch<Q: SceneQuery>(job: &PassJob, query: &Q, batch: &Batch, block
     for i in 0..n {
         let hit = &batch.hits[i];
         let material = &scene.materials[hit.material as usize];
-        albedo[i] = material.albedo(hit.uv);
+        albedo[i] = shade::albedo_at(material, hit, settings);
         let mut sh = Shading { scene, query, settings, path: &mut paths[i], counts: &mut *counts, rec: &mut NoRecord };
         ambient[i] = shade::ambient_term(&mut sh, hit, albedo[i]);
         glossy[i] = material.glossy;

@@ -733,7 +733,7 @@ mod tests {
         assert!(maps.maps[0].faces.is_empty());
         let hit = SurfaceHit {
             position: Vec3::NEG_Y, geometric_normal: Vec3::Y, shading_normal: Vec3::Y, barycentric: Vec3::ZERO, uv: Vec2::ZERO, t: 1.0,
-            kind: crate::scene::PrimitiveKind::Sphere, primitive: 0, object: 0, material: 0, back_face: false,
+            kind: crate::scene::PrimitiveKind::Sphere, primitive: 0, object: 0, material: 0, back_face: false, diff: crate::scene::Differentials::ZERO,
         };
         assert_eq!(maps.occluder(&scene, 0, &hit, Vec3::Y, 1.0, true, true), None);
         assert!(maps.view_color(Vec2::new(1.0, 1.0), 10, 10).is_finite());

@@ -17,7 +17,12 @@ const FILES: &[(&str, &[u8])] = &[
     ("models/stress-coarse-sphere.obj", include_bytes!("../../assets/models/stress-coarse-sphere.obj")),
     ("models/stress-tjunction.obj", include_bytes!("../../assets/models/stress-tjunction.obj")),
     ("models/stress-tjunction-shared.obj", include_bytes!("../../assets/models/stress-tjunction-shared.obj")),
+    ("models/checker-ground.obj", include_bytes!("../../assets/models/checker-ground.obj")),
     ("textures/test-pattern.exr", include_bytes!("../../assets/textures/test-pattern.exr")),
+    ("textures/checker.png", include_bytes!("../../assets/textures/checker.png")),
+    ("textures/globe.png", include_bytes!("../../assets/textures/globe.png")),
+    ("textures/bumps-normal.png", include_bytes!("../../assets/textures/bumps-normal.png")),
+    ("textures/sky.hdr", include_bytes!("../../assets/textures/sky.hdr")),
 ];
 
 /// Reads a file a scene refers to: from the compiled-in assets for paths under

@@ -15,6 +15,7 @@ const SCENES: &[(&str, &str)] = &[
     ("bunny", include_str!("../../assets/scenes/bunny.toml")),
     ("test-pattern", include_str!("../../assets/scenes/test-pattern.toml")),
     ("cornell-gi", include_str!("../../assets/scenes/cornell-gi.toml")),
+    ("textures", include_str!("../../assets/scenes/textures.toml")),
 ];
 
 /// The stress gallery's scenes (`gallery::cases`), each built to provoke

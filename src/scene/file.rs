@@ -4,7 +4,7 @@
 
 use super::mesh_cache::MeshCache;
 use super::obj::{self, NormalMode};
-use super::texture::load_texture;
+use super::texture::{load_texture_as, Encoding, Wrap};
 use super::{Camera, Fov, Light, Material, ObjectInfo, RenderDefaults, Scene, Sphere, Triangle};
 use crate::input::{MAX_COORDINATE, MAX_LIGHT, MAX_VALUE};
 use crate::math::{Vec2, Vec3};
@@ -31,6 +31,14 @@ struct SceneDesc {
     materials: BTreeMap<String, Spanned<MaterialDesc>>,
     #[serde(default)]
     object: Vec<Spanned<ObjectDesc>>,
+    environment: Option<Spanned<EnvironmentDesc>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct EnvironmentDesc {
+    file: String,
+    intensity: Option<f32>,
 }
 
 #[derive(Deserialize)]
@@ -77,6 +85,9 @@ struct MaterialDesc {
     transmission: Option<F3>,
     ior: Option<f32>,
     texture: Option<String>,
+    wrap: Option<String>,
+    uv_scale: Option<F2>,
+    normal_map: Option<String>,
 }
 
 #[derive(Deserialize)]
@@ -258,8 +269,21 @@ fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str) -> R
         if !(mat.ior.is_finite() && mat.ior > 0.0 && mat.ior <= MAX_IOR) {
             return Err(format!("{where_}: ior must be a finite number > 0 (at most {MAX_IOR})"));
         }
+        if let Some(w) = &m.wrap {
+            mat.wrap = Wrap::parse(w).map_err(|e| format!("{where_}: wrap: {e}"))?;
+        }
+        if let Some(scale) = m.uv_scale {
+            let scale = Vec2::from(scale);
+            if !(scale.is_finite() && scale.abs().max_element() <= MAX_VALUE) {
+                return Err(format!("{where_}: uv_scale must be two finite numbers between -{MAX_VALUE:e} and {MAX_VALUE:e}"));
+            }
+            mat.uv_scale = scale;
+        }
         if let Some(tex) = &m.texture {
-            textures.push((scene.materials.len(), base.join(tex), where_));
+            textures.push((scene.materials.len(), base.join(tex), where_.clone(), Encoding::Srgb));
+        }
+        if let Some(map) = &m.normal_map {
+            textures.push((scene.materials.len(), base.join(map), where_, Encoding::Linear));
         }
         scene.materials.push(mat);
     }
@@ -269,11 +293,31 @@ fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str) -> R
         let where_ = format!("{}: object {}", at(o.span()), i + 1);
         add_object(&mut scene, o.get_ref(), i as u32, &where_, base, &mut meshes)?;
     }
-    for (index, path, where_) in textures {
+    for (index, path, where_, encoding) in textures {
         let drawn = scene.triangles.iter().any(|t| t.material as usize == index) || scene.spheres.iter().any(|s| s.material as usize == index);
         if drawn {
-            scene.materials[index].texture = Some(Arc::new(load_texture(&path).map_err(|e| format!("{where_}: texture: {e}"))?));
+            let loaded = Some(Arc::new(load_texture_as(&path, encoding).map_err(|e| match encoding {
+                Encoding::Srgb => format!("{where_}: texture: {e}"),
+                Encoding::Linear => format!("{where_}: normal_map: {e}"),
+            })?));
+            match encoding {
+                Encoding::Srgb => scene.materials[index].texture = loaded,
+                Encoding::Linear => scene.materials[index].normal_map = loaded,
+            }
         }
+    }
+    if scene.materials.iter().any(|m| m.normal_map.is_some()) {
+        scene.tangents = super::tangents::build_tangents(&scene);
+    }
+    if let Some(env) = &desc.environment {
+        let where_ = format!("{}: [environment]", at(env.span()));
+        let env = env.get_ref();
+        let intensity = env.intensity.unwrap_or(1.0);
+        if !(intensity.is_finite() && (0.0..=MAX_VALUE).contains(&intensity)) {
+            return Err(format!("{where_}: intensity must be a finite number from 0 to {MAX_VALUE:e}"));
+        }
+        let texture = load_texture_as(&base.join(&env.file), Encoding::Srgb).map_err(|e| format!("{where_}: file: {e}"))?;
+        scene.environment = Some(super::environment::Environment { texture: Arc::new(texture), intensity });
     }
     Ok(scene)
 }

@@ -1,6 +1,6 @@
 //! Materials: the terms of the scene format's BSDF, plus an optional texture.
 
-use super::texture::Texture;
+use super::texture::{Footprint, Texture, TextureFilter, Wrap};
 use crate::math::{Vec2, Vec3};
 use std::sync::Arc;
 
@@ -19,6 +19,12 @@ pub struct Material {
     pub ior: f32,
     /// Multiplies `lambertian` when present (linear values, decoded from sRGB).
     pub texture: Option<Arc<Texture>>,
+    /// Addressing of the texture and normal map outside [0, 1].
+    pub wrap: Wrap,
+    /// Multiplies uvs before any lookup (a checker repeated n times).
+    pub uv_scale: Vec2,
+    /// Tangent-space normal map (linear data: 0.5, 0.5, 1 is "straight out").
+    pub normal_map: Option<Arc<Texture>>,
 }
 
 impl Material {
@@ -37,6 +43,9 @@ impl Material {
             transmission: Vec3::ZERO,
             ior: 1.5,
             texture: None,
+            wrap: Wrap::Repeat,
+            uv_scale: Vec2::ONE,
+            normal_map: None,
         }
     }
 
@@ -54,11 +63,32 @@ impl Material {
         self.mirror != Vec3::ZERO || self.transmission != Vec3::ZERO
     }
 
-    /// Diffuse albedo at a surface point (texture applied).
-    pub fn albedo(&self, uv: Vec2) -> Vec3 {
+    /// Diffuse albedo at a surface point with uv `uv` and footprint `f`
+    /// (texture applied, read with `filter`).
+    #[inline]
+    pub fn albedo(&self, uv: Vec2, f: &Footprint, filter: TextureFilter) -> Vec3 {
         match &self.texture {
-            Some(t) => self.lambertian * t.sample(uv),
+            Some(t) => {
+                let (uv, f) = self.scaled(uv, f);
+                self.lambertian * t.sample(uv, &f, filter, self.wrap)
+            }
             None => self.lambertian,
         }
+    }
+
+    /// The normal map's value at `uv` (linear, 0..1 per channel), if there is one.
+    #[inline]
+    pub fn normal_map_texel(&self, uv: Vec2, f: &Footprint, filter: TextureFilter) -> Option<Vec3> {
+        self.normal_map.as_ref().map(|t| {
+            let (uv, f) = self.scaled(uv, f);
+            t.sample(uv, &f, filter, self.wrap)
+        })
+    }
+
+    /// uv and footprint with `uv_scale` applied.
+    #[inline]
+    pub fn scaled(&self, uv: Vec2, f: &Footprint) -> (Vec2, Footprint) {
+        let s = self.uv_scale;
+        (uv * s, Footprint { duv_dx: f.duv_dx * s, duv_dy: f.duv_dy * s })
     }
 }

@@ -5,12 +5,14 @@
 pub mod assets;
 pub mod builtin;
 pub mod camera;
+pub mod environment;
 pub mod file;
 pub mod load;
 pub mod mesh_cache;
 pub mod material;
 pub mod obj;
 pub mod recentre;
+pub mod tangents;
 pub mod texture;
 
 pub use camera::{Camera, CameraView, Fov};
@@ -178,6 +180,11 @@ pub struct Scene {
     pub objects: Vec<ObjectInfo>,
     /// Things worth telling the user that did not stop the scene loading.
     pub warnings: Vec<String>,
+    /// `[environment]`: what rays that hit nothing see instead of `background`.
+    pub environment: Option<environment::Environment>,
+    /// Per triangle, per corner: the normal map's tangent frame
+    /// (`tangents::build_tangents`); empty when no material has a normal map.
+    pub tangents: Vec<[glam::Vec4; 3]>,
 }
 
 /// Everything a renderer found about the surface a sample sees. Renderers
@@ -200,6 +207,42 @@ pub struct SurfaceHit {
     pub material: u32,
     /// True when the surface was hit from its back (two-sided surfaces only).
     pub back_face: bool,
+    /// How position, direction and uv change from this pixel to the next
+    /// (zero when not tracked): the texture level of detail and the
+    /// differentials of reflected rays come from here.
+    pub diff: Differentials,
+}
+
+/// Derivatives with respect to the image position (x right, y down, in
+/// pixels) of a sample's hit point, of the direction of the ray that found
+/// it, and of the hit's uv. Ray casters carry ray differentials (Igehy
+/// 1999) to the hit; rasterizers differentiate their perspective-correct
+/// interpolation. All zero: no footprint (the finest texture level).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Differentials {
+    pub dp_dx: Vec3,
+    pub dp_dy: Vec3,
+    pub dd_dx: Vec3,
+    pub dd_dy: Vec3,
+    pub duv_dx: Vec2,
+    pub duv_dy: Vec2,
+}
+
+impl Differentials {
+    pub const ZERO: Differentials = Differentials {
+        dp_dx: Vec3::ZERO,
+        dp_dy: Vec3::ZERO,
+        dd_dx: Vec3::ZERO,
+        dd_dy: Vec3::ZERO,
+        duv_dx: Vec2::ZERO,
+        duv_dy: Vec2::ZERO,
+    };
+
+    /// The texture footprint these derivatives give.
+    #[inline]
+    pub fn footprint(&self) -> texture::Footprint {
+        texture::Footprint { duv_dx: self.duv_dx, duv_dy: self.duv_dy }
+    }
 }
 
 /// Rays leaving a surface start a little off it, so that rounding cannot
@@ -230,6 +273,21 @@ impl SurfaceHit {
 }
 
 impl Scene {
+    /// Whether some material reads a texture or normal map: only then do
+    /// renderers work out their samples' footprints (`SurfaceHit::diff`).
+    pub fn has_textures(&self) -> bool {
+        self.materials.iter().any(|m| m.texture.is_some() || m.normal_map.is_some())
+    }
+
+    /// The radiance a ray along unit `dir` sees when it hits nothing.
+    #[inline]
+    pub fn miss_radiance(&self, dir: Vec3) -> Vec3 {
+        match &self.environment {
+            Some(env) => env.radiance(dir),
+            None => self.render.background,
+        }
+    }
+
     pub fn triangle_count(&self) -> usize {
         self.triangles.len()
     }
@@ -277,6 +335,7 @@ impl Scene {
             object: tri.object,
             material: tri.material,
             back_face,
+            diff: Differentials::ZERO,
         }
     }
 
@@ -302,6 +361,7 @@ impl Scene {
             object: s.object,
             material: s.material,
             back_face,
+            diff: Differentials::ZERO,
         }
     }
 

@@ -1,41 +1,231 @@
-//! Textures: image files decoded into linear RGB, sampled bilinearly.
+//! Textures: image files decoded into linear RGB, with a mip pyramid built
+//! once at load time, sampled nearest, bilinear or trilinear (Computer
+//! Graphics from Scratch ch. 14).
 
 use super::assets::read_asset;
 use crate::input::{decode_image, InputKind, MAX_VALUE};
 use crate::math::{Vec2, Vec3};
+use crate::named::named_enum;
 use std::path::Path;
 
-/// A linear-RGB texture, sampled bilinearly with wrapping.
+named_enum! {
+    /// How a texture is read at a sample.
+    #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+    pub enum TextureFilter ("texture filter") {
+        /// The one texel of level 0 the sample falls in.
+        Nearest = "nearest",
+        /// The four nearest texels of level 0, blended by distance.
+        Bilinear = "bilinear",
+        /// Bilinear in the two mip levels whose texels are nearest the
+        /// sample's footprint in size, blended by the level of detail.
+        #[default]
+        Trilinear = "trilinear",
+    }
+}
+
+named_enum! {
+    /// Texture addressing outside [0, 1]: tile, or hold the edge texel.
+    #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+    pub enum Wrap ("wrap mode") {
+        #[default]
+        Repeat = "repeat",
+        Clamp = "clamp",
+    }
+}
+
+/// One level of the pyramid: `width x height` linear texels, row 0 at the top.
 #[derive(Debug, PartialEq)]
-pub struct Texture {
+pub struct MipLevel {
     pub width: u32,
     pub height: u32,
     pub texels: Vec<Vec3>,
 }
 
-impl Texture {
-    pub fn sample(&self, uv: Vec2) -> Vec3 {
-        let (w, h) = (self.width as i64, self.height as i64);
-        // v = 0 is the bottom row of the image (OBJ convention).
-        let x = uv.x * w as f32 - 0.5;
-        let y = (1.0 - uv.y) * h as f32 - 0.5;
-        if !(x.is_finite() && y.is_finite()) {
-            return Vec3::ZERO;
+/// A linear-RGB texture and its mip pyramid: `levels[0]` is the image,
+/// each next level half the size (rounded down, at least 1) down to 1 x 1.
+#[derive(Debug, PartialEq)]
+pub struct Texture {
+    pub levels: Vec<MipLevel>,
+}
+
+/// How much of the texture one pixel covers: the uv derivatives along the
+/// image's x and y (already scaled by the material's `uv_scale`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Footprint {
+    pub duv_dx: Vec2,
+    pub duv_dy: Vec2,
+}
+
+impl MipLevel {
+    #[inline]
+    fn texel(&self, x: i64, y: i64, wrap: Wrap) -> Vec3 {
+        self.texel_uv(x, y, wrap, wrap)
+    }
+
+    /// Texel `(x, y)` with the columns addressed by `wrap_u`, the rows by `wrap_v`.
+    #[inline]
+    fn texel_uv(&self, x: i64, y: i64, wrap_u: Wrap, wrap_v: Wrap) -> Vec3 {
+        let address = |i: i64, n: i64, wrap: Wrap| match wrap {
+            Wrap::Repeat => i.rem_euclid(n),
+            Wrap::Clamp => i.clamp(0, n - 1),
+        };
+        let (x, y) = (address(x, self.width as i64, wrap_u), address(y, self.height as i64, wrap_v));
+        self.texels[(x + y * self.width as i64) as usize]
+    }
+
+    /// Texel-space position of `uv` (texel centres at +0.5; v = 0 is the
+    /// bottom row, the OBJ convention); `None` when not finite.
+    #[inline]
+    fn position(&self, uv: Vec2) -> Option<(f32, f32)> {
+        let x = uv.x * self.width as f32;
+        let y = (1.0 - uv.y) * self.height as f32;
+        // Far outside the texture the integer conversion below would saturate.
+        (x.is_finite() && y.is_finite() && x.abs() < 1e9 && y.abs() < 1e9).then_some((x, y))
+    }
+
+    pub fn nearest(&self, uv: Vec2, wrap: Wrap) -> Vec3 {
+        match self.position(uv) {
+            Some((x, y)) => self.texel(x.floor() as i64, y.floor() as i64, wrap),
+            None => Vec3::ZERO,
         }
+    }
+
+    pub fn bilinear(&self, uv: Vec2, wrap: Wrap) -> Vec3 {
+        self.bilinear_uv(uv, wrap, wrap)
+    }
+
+    /// `bilinear` with separate addressing of columns and rows (a
+    /// latitude-longitude map repeats around and clamps at the poles).
+    pub fn bilinear_uv(&self, uv: Vec2, wrap_u: Wrap, wrap_v: Wrap) -> Vec3 {
+        let Some((x, y)) = self.position(uv) else { return Vec3::ZERO };
+        let (x, y) = (x - 0.5, y - 0.5);
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
-        let texel = |xi: i64, yi: i64| self.texels[(xi.rem_euclid(w) + yi.rem_euclid(h) * w) as usize];
         let (xi, yi) = (x0 as i64, y0 as i64);
-        let top = texel(xi, yi).lerp(texel(xi + 1, yi), fx);
-        let bottom = texel(xi, yi + 1).lerp(texel(xi + 1, yi + 1), fx);
+        let t = |x, y| self.texel_uv(x, y, wrap_u, wrap_v);
+        let top = t(xi, yi).lerp(t(xi + 1, yi), fx);
+        let bottom = t(xi, yi + 1).lerp(t(xi + 1, yi + 1), fx);
         top.lerp(bottom, fy)
+    }
+
+    /// The next level: half the size (rounded down, at least 1); each texel
+    /// the plain average of the 2 x 2 texels it covers in linear space (on
+    /// an odd side the last texel takes the leftover row or column too, so
+    /// every texel counts).
+    fn halved(&self) -> MipLevel {
+        let (w, h) = ((self.width / 2).max(1), (self.height / 2).max(1));
+        let span = |i: u32, n: u32, src: u32| -> (u32, u32) {
+            let start = (2 * i).min(src - 1);
+            let end = if i + 1 == n { src } else { (2 * i + 2).min(src) };
+            (start, end)
+        };
+        let mut texels = Vec::with_capacity(w as usize * h as usize);
+        for y in 0..h {
+            let (y0, y1) = span(y, h, self.height);
+            for x in 0..w {
+                let (x0, x1) = span(x, w, self.width);
+                let mut sum = Vec3::ZERO;
+                for sy in y0..y1 {
+                    for sx in x0..x1 {
+                        sum += self.texels[(sx + sy * self.width) as usize];
+                    }
+                }
+                texels.push(sum / ((x1 - x0) * (y1 - y0)) as f32);
+            }
+        }
+        MipLevel { width: w, height: h, texels }
     }
 }
 
-/// Loads an 8-bit sRGB image (or a float EXR) into a linear texture. A float
-/// texel that is NaN, infinite, negative or above `MAX_VALUE` is an error
-/// naming the texel: such a value would reach pixels through every sample.
+impl Texture {
+    /// A texture from level 0, its pyramid built here.
+    pub fn new(width: u32, height: u32, texels: Vec<Vec3>) -> Texture {
+        assert_eq!(texels.len(), width as usize * height as usize);
+        let mut levels = vec![MipLevel { width, height, texels }];
+        loop {
+            let last = levels.last().unwrap();
+            if last.width == 1 && last.height == 1 {
+                break;
+            }
+            let next = last.halved();
+            levels.push(next);
+        }
+        Texture { levels }
+    }
+
+    pub fn width(&self) -> u32 {
+        self.levels[0].width
+    }
+
+    pub fn height(&self) -> u32 {
+        self.levels[0].height
+    }
+
+    /// The level of detail of a footprint (OpenGL's lambda): log2 of the
+    /// longer of the two pixel steps measured in level-0 texels, clamped
+    /// to the pyramid. 0 when a pixel step is at most one texel.
+    pub fn level_of_detail(&self, f: &Footprint) -> f32 {
+        let size = Vec2::new(self.width() as f32, self.height() as f32);
+        let (along_x, along_y) = ((f.duv_dx * size).length(), (f.duv_dy * size).length());
+        let rho = along_x.max(along_y);
+        let top = (self.levels.len() - 1) as f32;
+        if along_x.is_nan() || along_y.is_nan() {
+            return top;
+        }
+        if rho <= 1.0 {
+            return 0.0;
+        }
+        rho.log2().min(top)
+    }
+
+    /// The texture at `uv` with footprint `f`, read with `filter`.
+    pub fn sample(&self, uv: Vec2, f: &Footprint, filter: TextureFilter, wrap: Wrap) -> Vec3 {
+        match filter {
+            TextureFilter::Nearest => self.levels[0].nearest(uv, wrap),
+            TextureFilter::Bilinear => self.levels[0].bilinear(uv, wrap),
+            TextureFilter::Trilinear => {
+                let lambda = self.level_of_detail(f);
+                let base = lambda.floor();
+                let fine = &self.levels[base as usize];
+                let blend = lambda - base;
+                if blend == 0.0 {
+                    fine.bilinear(uv, wrap)
+                } else {
+                    let coarse = &self.levels[(base as usize + 1).min(self.levels.len() - 1)];
+                    fine.bilinear(uv, wrap).lerp(coarse.bilinear(uv, wrap), blend)
+                }
+            }
+        }
+    }
+
+    /// The mip level `sample` reads with `filter` (0 for the single-level filters).
+    pub fn level_used(&self, f: &Footprint, filter: TextureFilter) -> f32 {
+        match filter {
+            TextureFilter::Trilinear => self.level_of_detail(f),
+            TextureFilter::Nearest | TextureFilter::Bilinear => 0.0,
+        }
+    }
+}
+
+/// How a texture's 8-bit values are turned into numbers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Encoding {
+    /// Colours: sRGB-decoded to linear radiance factors.
+    Srgb,
+    /// Data (normal maps): the stored value itself, 0..1.
+    Linear,
+}
+
+/// Loads an 8-bit sRGB image (or a float EXR/HDR) into a linear texture and
+/// builds its pyramid. A float texel that is NaN, infinite, negative or
+/// above `MAX_VALUE` is an error naming the texel: such a value would reach
+/// pixels through every sample.
 pub fn load_texture(path: &Path) -> Result<Texture, String> {
+    load_texture_as(path, Encoding::Srgb)
+}
+
+/// `load_texture` with the 8-bit values read as `encoding` says.
+pub fn load_texture_as(path: &Path, encoding: Encoding) -> Result<Texture, String> {
     let bytes = read_asset(path, InputKind::Image).map_err(|e| format!("cannot read {e}"))?;
     let img = decode_image(&bytes, &path.display().to_string())?;
     drop(bytes);
@@ -52,13 +242,81 @@ pub fn load_texture(path: &Path) -> Result<Texture, String> {
                 ));
             }
             texels.push(c);
-        } else {
+        } else if encoding == Encoding::Srgb {
             texels.push(Vec3::new(srgb_to_linear(c.x), srgb_to_linear(c.y), srgb_to_linear(c.z)));
+        } else {
+            texels.push(c);
         }
     }
-    Ok(Texture { width: rgb.width(), height: rgb.height(), texels })
+    Ok(Texture::new(rgb.width(), rgb.height(), texels))
 }
 
 fn srgb_to_linear(c: f32) -> f32 {
     if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn grey(values: &[f32]) -> Vec<Vec3> {
+        values.iter().map(|&v| Vec3::splat(v)).collect()
+    }
+
+    #[test]
+    fn a_4x4_pyramid_by_hand() {
+        #[rustfmt::skip]
+        let t = Texture::new(4, 4, grey(&[
+            0.0, 1.0,  2.0, 3.0,
+            4.0, 5.0,  6.0, 7.0,
+            8.0, 9.0,  10.0, 11.0,
+            12.0, 13.0, 14.0, 15.0,
+        ]));
+        assert_eq!(t.levels.len(), 3);
+        // Level 1: each texel the mean of a 2 x 2 block.
+        assert_eq!((t.levels[1].width, t.levels[1].height), (2, 2));
+        assert_eq!(t.levels[1].texels, grey(&[2.5, 4.5, 10.5, 12.5]));
+        // Level 2: the mean of everything.
+        assert_eq!(t.levels[2].texels, grey(&[7.5]));
+    }
+
+    #[test]
+    fn odd_sides_keep_every_texel() {
+        let t = Texture::new(3, 1, grey(&[1.0, 2.0, 6.0]));
+        assert_eq!(t.levels.len(), 2);
+        assert_eq!(t.levels[1].texels, grey(&[3.0]));
+    }
+
+    #[test]
+    fn level_of_detail_for_known_footprints() {
+        let t = Texture::new(256, 256, vec![Vec3::ONE; 256 * 256]);
+        let f = |dx: Vec2, dy: Vec2| Footprint { duv_dx: dx, duv_dy: dy };
+        // One pixel step spans 4 texels along u: level 2.
+        assert_eq!(t.level_of_detail(&f(Vec2::new(4.0 / 256.0, 0.0), Vec2::new(0.0, 1.0 / 256.0))), 2.0);
+        // The longer step decides: 16 texels along v -> level 4.
+        assert_eq!(t.level_of_detail(&f(Vec2::new(1.0 / 256.0, 0.0), Vec2::new(0.0, 16.0 / 256.0))), 4.0);
+        // A diagonal step of (3, 4) texels is 5 texels long.
+        assert!((t.level_of_detail(&f(Vec2::new(3.0 / 256.0, 4.0 / 256.0), Vec2::ZERO)) - 5f32.log2()).abs() < 1e-6);
+        // Magnified: level 0; enormous: the 1 x 1 level; NaN: the coarsest.
+        assert_eq!(t.level_of_detail(&f(Vec2::new(0.1 / 256.0, 0.0), Vec2::ZERO)), 0.0);
+        assert_eq!(t.level_of_detail(&f(Vec2::new(1e6, 0.0), Vec2::ZERO)), 8.0);
+        assert_eq!(t.level_of_detail(&f(Vec2::new(f32::NAN, 0.0), Vec2::ZERO)), 8.0);
+    }
+
+    #[test]
+    fn filters_and_wrap_by_hand() {
+        let t = Texture::new(2, 1, grey(&[0.0, 1.0]));
+        let none = Footprint::default();
+        // Texel centres are at u = 0.25 and 0.75.
+        assert_eq!(t.sample(Vec2::new(0.3, 0.5), &none, TextureFilter::Nearest, Wrap::Repeat), Vec3::ZERO);
+        assert_eq!(t.sample(Vec2::new(0.5, 0.5), &none, TextureFilter::Bilinear, Wrap::Repeat), Vec3::splat(0.5));
+        // Beyond the right edge: repeat blends towards texel 0, clamp holds texel 1.
+        assert_eq!(t.sample(Vec2::new(1.0, 0.5), &none, TextureFilter::Bilinear, Wrap::Repeat), Vec3::splat(0.5));
+        assert_eq!(t.sample(Vec2::new(1.0, 0.5), &none, TextureFilter::Bilinear, Wrap::Clamp), Vec3::ONE);
+        assert_eq!(t.sample(Vec2::new(-3.9, 0.5), &none, TextureFilter::Nearest, Wrap::Clamp), Vec3::ZERO);
+        // Trilinear halfway between level 0 and the 1 x 1 level (0.5).
+        let half = Footprint { duv_dx: Vec2::new(2f32.sqrt() / 2.0, 0.0), duv_dy: Vec2::ZERO };
+        let v = t.sample(Vec2::new(0.75, 0.5), &half, TextureFilter::Trilinear, Wrap::Repeat);
+        assert!((v.x - 0.75).abs() < 1e-6, "{v}");
+    }
 }

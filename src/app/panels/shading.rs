@@ -10,7 +10,8 @@ use crate::render::gi::{GiMode, GiSettings, MAX_BOUNCES};
 use crate::render::raster::depth_format::DepthFormat;
 use crate::render::wireframe::LineAlgorithm;
 use crate::render::shadow_volume::VolumeMode;
-use crate::render::{Interpolation, ShadowMode};
+use crate::render::{Interpolation, Reflections, ShadowMode};
+use crate::scene::texture::TextureFilter;
 use crate::scene::RenderDefaults;
 
 /// `settings`: the render knobs and gamma; `look`: the scene's ambient,
@@ -70,6 +71,17 @@ pub fn show(ui: &mut egui::Ui, settings: &mut ViewerSettings, look: &mut RenderD
             ui.label("interpolation");
             for m in Interpolation::ALL {
                 ui.radio_value(&mut s.interpolation, m, m.name());
+            }
+        });
+        // Combo boxes: "ray" and "nearest" would share their names with other controls.
+        egui::ComboBox::from_label("texture filter").selected_text(s.texture_filter.name()).show_ui(ui, |ui| {
+            for f in TextureFilter::ALL {
+                ui.selectable_value(&mut s.texture_filter, f, f.name());
+            }
+        });
+        egui::ComboBox::from_label("reflections").selected_text(s.reflections.name()).show_ui(ui, |ui| {
+            for r in Reflections::ALL {
+                ui.selectable_value(&mut s.reflections, r, r.name());
             }
         });
         // Rasterizer-only knobs; the ray casters ignore them.

@@ -22,6 +22,7 @@ pub mod bbox;
 pub mod clip;
 pub mod coverage;
 pub mod depth_format;
+pub mod derivatives;
 pub mod fixed;
 pub mod incremental;
 pub mod method;

@@ -14,6 +14,7 @@
 //! overwrites the sample, so the last primitive drawn is the one seen. The
 //! keys are still written, for the fragment record.
 
+use crate::render::differentials::{with_ray_differentials, RayDifferential};
 use super::depth_format::DepthEncoding;
 use super::rect::{PixelRect, TestCounter};
 use super::setup::ScreenTri;
@@ -341,7 +342,16 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         let hit = if id.is_none() {
             None
         } else if id.is_sphere() {
-            Some(scene.sphere_hit(id.index(), self.payload[i][0], &ray))
+            let hit = scene.sphere_hit(id.index(), self.payload[i][0], &ray);
+            // The sphere is hit by the eye ray, as in the ray casters: the same differentials.
+            Some(match scene.has_textures() {
+                true => {
+                    let mut hit = with_ray_differentials(scene, &RayDifferential::eye(self.job.view, p.x, p.y), &ray, hit);
+                    crate::render::normal_map::apply(scene, self.job.settings.texture_filter, &mut hit);
+                    hit
+                }
+                false => hit,
+            })
         } else {
             let [b1, b2] = self.payload[i];
             let b = Vec3::new(1.0 - b1 - b2, b1, b2);
@@ -353,7 +363,12 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
                     (pos - ray.origin).dot(ray.dir)
                 }
             };
-            Some(scene.triangle_hit(id.index(), b, t, &ray))
+            let mut hit = scene.triangle_hit(id.index(), b, t, &ray);
+            if scene.has_textures() {
+                hit.diff = super::derivatives::screen_differentials(scene, self.job.view, id.index(), b, p.x, p.y);
+                crate::render::normal_map::apply(scene, self.job.settings.texture_filter, &mut hit);
+            }
+            Some(hit)
         };
         (ray, hit)
     }

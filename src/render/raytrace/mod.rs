@@ -14,7 +14,9 @@ pub mod traverse;
 use super::pixel_record::{NoRecord, Recorder};
 use super::{resolve_sample, PassJob, RayCounts, SceneQuery};
 use super::debug::{cost_color, View};
-use crate::math::Radiance;
+use crate::math::{Radiance, Ray, Vec2};
+use crate::render::differentials::{with_ray_differentials, RayDifferential};
+use crate::scene::SurfaceHit;
 use rayon::prelude::*;
 
 /// Casts one eye ray per pixel of `job.rows` through `query`, rows in parallel.
@@ -51,7 +53,7 @@ pub fn cast_pixel<Q: SceneQuery, R: Recorder>(job: &PassJob, query: &Q, x: u32, 
     counts.primary += 1;
     rec.ray(&ray, t_max, 0);
     let work_before = counts.nodes + counts.tests;
-    let hit = query.closest(&ray, t_max, false, counts, rec);
+    let hit = with_eye_differentials(job, p, &ray, query.closest(&ray, t_max, false, counts, rec));
     rec.closest(hit.as_ref());
     if job.settings.view == View::Cost {
         let c = cost_color((counts.nodes + counts.tests - work_before) as f32);
@@ -59,4 +61,20 @@ pub fn cast_pixel<Q: SceneQuery, R: Recorder>(job: &PassJob, query: &Q, x: u32, 
         return c;
     }
     resolve_sample(job, query, &ray, hit.as_ref(), job.pixel_index(x, y), counts, rec)
+}
+
+/// The eye ray's hit at image position `p` with the ray's differentials
+/// carried to it (Igehy's transfer) and its normal map applied, when a
+/// texture can read them.
+#[inline]
+pub fn with_eye_differentials(job: &PassJob, p: Vec2, ray: &Ray, hit: Option<SurfaceHit>) -> Option<SurfaceHit> {
+    let scene = &job.prepared.scene;
+    match hit {
+        Some(h) if scene.has_textures() => {
+            let mut h = with_ray_differentials(scene, &RayDifferential::eye(job.view, p.x, p.y), ray, h);
+            crate::render::normal_map::apply(scene, job.settings.texture_filter, &mut h);
+            Some(h)
+        }
+        other => other,
+    }
 }

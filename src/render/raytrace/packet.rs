@@ -19,7 +19,7 @@
 //! answers (`shade_tile_batched`, `shade_batch`).
 
 use super::bvh::{leaf_range, BvhQuery, Node4, LEAF_BIT, STACK};
-use super::cast_pass;
+use super::{cast_pass, with_eye_differentials};
 use super::intersect::{intersect_triangle_lanes, TriangleEdges};
 use super::traverse::{test_leaf, BestHit, ChildOrder, PreparedRay, SLAB_WIDEN};
 use crate::math::lanes::{mask_bits, mask_from_bits, simd_level, V3};
@@ -458,7 +458,8 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
                     let i = m.trailing_zeros() as usize;
                     m &= m - 1;
                     let (tx, ty) = lane_xy(i);
-                    let hit = pk.hit(query, i);
+                    let p = job.sample_position((x0 + tx) as u32, (y0 + ty) as u32);
+                    let hit = with_eye_differentials(job, p, &pk.rays[i], pk.hit(query, i));
                     band[ty * width + x0 + tx] = resolve_sample(job, query, &pk.rays[i], hit.as_ref(), job.pixel_index((x0 + tx) as u32, (y0 + ty) as u32), &mut counts, &mut NoRecord);
                 }
             }
@@ -495,7 +496,9 @@ fn shade_tile_batched(
     while m != 0 {
         let i = m.trailing_zeros() as usize;
         m &= m - 1;
-        hits[i] = pk.hit(query, i);
+        let (tx, ty) = lane_xy(i);
+        let p = job.sample_position((x0 + tx) as u32, (y0 + ty) as u32);
+        hits[i] = with_eye_differentials(job, p, &pk.rays[i], pk.hit(query, i));
         seen |= (hits[i].is_some() as u64) << i;
     }
     let shadows = settings.shadows == ShadowMode::Ray;
