@@ -104,6 +104,11 @@ fn a_farther_near_plane_cures_sixteen_bit_z_fighting() {
 }
 
 #[test]
+fn environment_mapped_reflections_miss_the_objects_beside_the_mirror() {
+    check("environment-reflections", 100.., ..=10);
+}
+
+#[test]
 fn the_far_scene_is_the_shadow_scene_moved() {
     use pinhole::scene::builtin::load_builtin;
     let mut far = load_builtin("stress-far").unwrap().unwrap();

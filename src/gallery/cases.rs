@@ -284,6 +284,18 @@ pub fn cases() -> Vec<GalleryCase> {
             threshold: 40,
             size: Some((160, 100)),
         },
+        GalleryCase {
+            name: "environment-reflections",
+            scene: "textures",
+            method: "environment-mapped reflections",
+            knob: "reflections",
+            explanation: "the mirror ball looks the sky up in the reflected direction with no ray: the checker ground and the globe beside it, which a traced ray finds, are missing from its reflection",
+            failing: Setting::new("rasterize", "--reflections env", |s| s.reflections = crate::render::Reflections::Env),
+            cured: Setting::new("rasterize", "--reflections ray (default)", |s| s.reflections = crate::render::Reflections::Ray),
+            truth: Setting::new("raytrace:brute", "raytrace:brute", nothing),
+            threshold: 40,
+            size: Some((160, 100)),
+        },
     ]
 }
 
