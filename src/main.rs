@@ -19,6 +19,7 @@ fn main() {
         Outcome::Done => Ok(()),
         Outcome::OpenViewer { scene, screenshot } => pinhole::app::run(scene, screenshot),
     });
+    pinhole::render::opengl::shutdown();
     if let Err(e) = result {
         eprintln!("pinhole: {e}");
         std::process::exit(1);

@@ -44,6 +44,17 @@ impl<T> Shared<T> {
         Shared { inner: Mutex::new(None) }
     }
 
+    /// Destroys the context, if one was made, while the process is still
+    /// whole. Left to the C library's exit handlers, the driver would tear
+    /// its context down while its own rasterizer threads may still run.
+    pub fn shutdown(&self) {
+        let mut guard = self.inner.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(Ok(mut headless)) = guard.take() {
+            headless.gl.state = None;
+            drop(headless);
+        }
+    }
+
     /// Runs `f` with the context current on this thread; the error (one
     /// sentence) when no OpenGL driver can be used.
     pub fn with<R>(&self, f: impl FnOnce(&mut Gl<T>) -> R) -> Result<R, String> {

@@ -17,6 +17,12 @@ use crate::scene::Scene;
 
 static GL: context::Shared<pass::State> = context::Shared::new();
 
+/// Releases the OpenGL context before the process exits (a no-op when the
+/// `opengl` renderer was never used).
+pub fn shutdown() {
+    GL.shutdown();
+}
+
 pub struct OpenGl;
 
 impl Renderer for OpenGl {
