@@ -105,6 +105,7 @@ fn a_farther_near_plane_cures_sixteen_bit_z_fighting() {
 
 #[test]
 fn environment_mapped_reflections_miss_the_objects_beside_the_mirror() {
+    // Measured: 441 failing, 0 cured.
     check("environment-reflections", 100.., ..=10);
 }
 
