@@ -34,6 +34,7 @@ shot renderer-raytrace-brute one-triangle PINHOLE_RENDERER=raytrace:brute PINHOL
 shot panel-camera-materials spheres PINHOLE_PANELS=camera,materials
 shot view-barycentric one-triangle PINHOLE_VIEW=barycentric PINHOLE_PANELS=shading
 shot view-normal bunny PINHOLE_VIEW=normal PINHOLE_PANELS=lights
+shot view-mip textures PINHOLE_VIEW=mip PINHOLE_PANELS=shading
 # CGPP Figure 15.2: the gamma test pattern with gamma off and on.
 shot gi-path cornell-gi PINHOLE_GI=path PINHOLE_SPP=16 PINHOLE_PANELS=shading
 shot gamma-off test-pattern PINHOLE_GAMMA=off PINHOLE_PANELS=shading
