@@ -435,7 +435,7 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
             let mut pk = Packet::new();
             let mut shadow_pk = Packet::new();
             let mut hits = [None; P];
-            let mut blocked = vec![0u64; scene.lights.len()];
+            let mut blocked = TileShadows { tile: vec![0; scene.lights.len()], batch: vec![0; scene.lights.len()] };
             for x0 in (0..width).step_by(TILE_W) {
                 let mut valid = 0u64;
                 for i in 0..P {
@@ -471,6 +471,13 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
         })
 }
 
+/// Which shadow rays of a tile are blocked, per light: lane bits of the
+/// tile, and of the batch being shaded. Kept per band so no tile allocates.
+struct TileShadows {
+    tile: Vec<u64>,
+    batch: Vec<u8>,
+}
+
 /// Shades one traced tile in batches of eight (`shade_batch`): first the
 /// tile's shadow rays towards every light go as one packet per light, then
 /// the lanes that see a surface are shaded eight at a time, each light's
@@ -482,13 +489,14 @@ fn shade_tile_batched(
     pk: &Packet,
     valid: u64,
     shadow_pk: &mut Packet,
-    blocked: &mut [u64],
+    shadows_of: &mut TileShadows,
     hits: &mut [Option<SurfaceHit>; P],
     band: &mut [Radiance],
     (x0, y0): (usize, usize),
     width: usize,
     counts: &mut RayCounts,
 ) {
+    let TileShadows { tile: blocked, batch: lane_blocked } = shadows_of;
     let scene = &query.prepared.scene;
     let settings = job.settings;
     let mut seen = 0u64;
@@ -534,7 +542,6 @@ fn shade_tile_batched(
         band[ty * width + x0 + tx] = value;
     };
     let mut batch = Batch::new();
-    let mut lane_blocked = vec![0u8; blocked.len()];
     let mut flush = |batch: &mut Batch, band: &mut [Radiance], counts: &mut RayCounts| {
         if batch.is_empty() {
             return;
