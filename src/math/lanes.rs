@@ -206,7 +206,7 @@ fn log2<L: Lane>(c: L) -> L {
 /// and `2^f = e^(f ln 2)` by its Taylor series to the 7th power (error
 /// below 1e-8).
 #[inline(always)]
-fn exp2<L: Lane>(x: L) -> L {
+pub fn exp2<L: Lane>(x: L) -> L {
     let n = (x + x.splat(0.5)).floor();
     let g = (x - n) * x.splat(std::f32::consts::LN_2);
     let mut p = x.splat(1.0 / 5040.0);

@@ -8,7 +8,7 @@
 //! (shadow rays, maps, volumes, or a packet's answers), because how it is
 //! known differs between callers while the arithmetic must not.
 
-use crate::math::lanes::{pow, Lane, V3};
+use crate::math::lanes::{exp2, pow, Lane, V3};
 use crate::scene::Light;
 use std::f32::consts::PI;
 
@@ -75,7 +75,8 @@ pub fn incidence<L: Lane>(light: &Light, p: V3<L>, n: V3<L>) -> IncidenceLanes<L
 }
 
 /// The BSDF of CGPP listing 15.19: Lambertian plus normalized Blinn-Phong,
-/// `f = k_L / pi + k_G (s + 8) / (8 pi) max(0, n.h)^s`. The glossy lobe is
+/// `f = k_L / pi + k_G N(s) max(0, n.h)^s` with `N` from
+/// `blinn_phong_normalization`. The glossy lobe is
 /// left out where k_G = 0, and where it cannot matter: `c^s <= exp(-s (1 -
 /// c))` since `ln c <= c - 1`, so when that bound is below 1e-9 the lobe adds
 /// nothing visible and the power is not computed (in no lane, when no lane
@@ -95,8 +96,20 @@ pub fn bsdf<L: Lane>(s: &SurfaceLanes<L>, w_i: V3<L>) -> V3<L> {
     if !L::any(needed) {
         return f;
     }
-    let lobe = (sharp + like.splat(8.0)) / like.splat(8.0 * PI) * pow(c, sharp);
+    let lobe = blinn_phong_normalization(sharp) * pow(c, sharp);
     V3::select(needed, f + s.glossy.scale(lobe), f)
+}
+
+/// `N(s) = (s + 2)(s + 4) / (8 pi (2^(-s/2) + s))`: the factor that makes
+/// the Blinn-Phong lobe `N(s) (n.h)^s` reflect exactly what arrives when
+/// seen along the normal, and less at every other angle (the horizon cuts
+/// the lobe off there). The book's `(s + 8) / (8 pi)` approximates it and
+/// reflects up to 7.5% more than arrives near s = 8; both tend to `s / (8
+/// pi)` as s grows, and at s = 0 both give the Lambertian `1 / pi`.
+#[inline(always)]
+pub fn blinn_phong_normalization<L: Lane>(s: L) -> L {
+    let half = (s * s.splat(-0.5)).max(s.splat(-126.0));
+    (s + s.splat(2.0)) * (s + s.splat(4.0)) / (s.splat(8.0 * PI) * (exp2(half) + s))
 }
 
 /// Answers, per light, whether it is visible from the surface, and hears

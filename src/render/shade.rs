@@ -15,7 +15,8 @@ use std::f32::consts::PI;
 
 /// The BSDF of CGPP listing 15.19 for one sample (`lighting::bsdf`, one lane
 /// wide): Lambertian plus normalized Blinn-Phong,
-/// `f = k_L / pi + k_G (s + 8) / (8 pi) max(0, n.h)^s`.
+/// `f = k_L / pi + k_G N(s) max(0, n.h)^s` (`N` is
+/// `lighting::blinn_phong_normalization`).
 #[inline]
 pub fn bsdf(material: &Material, albedo: Vec3, n: Vec3, w_i: Vec3, w_o: Vec3) -> Vec3 {
     let surface = surface_lane(material, albedo, Vec3::ZERO, n, w_o);
@@ -560,13 +561,18 @@ mod tests {
 
     #[test]
     fn blinn_phong_peak_by_hand() {
-        // At the mirror direction n.h = 1: f = k_G (s + 8) / (8 pi).
+        // At the mirror direction n.h = 1: f = k_G (s + 2)(s + 4) / (8 pi (2^(-s/2) + s)),
+        // and 2^-50 vanishes beside 100.
         let mut m = Material::black();
         m.glossy = Vec3::splat(0.2);
         m.sharpness = 100.0;
         let w = Vec3::new(0.0, 0.6, 0.8);
         let w_o = Vec3::new(0.0, -0.6, 0.8);
         let f = bsdf(&m, Vec3::ZERO, Vec3::Z, w, w_o);
-        assert!((f.x - 0.2 * 108.0 / (8.0 * PI)).abs() < 1e-5, "{f}");
+        assert!((f.x - 0.2 * 102.0 * 104.0 / (8.0 * PI * 100.0)).abs() < 1e-5, "{f}");
+        // s = 2: 2^-1 = 0.5, so N = 4 * 6 / (8 pi * 2.5).
+        m.sharpness = 2.0;
+        let f = bsdf(&m, Vec3::ZERO, Vec3::Z, w, w_o);
+        assert!((f.x - 0.2 * 24.0 / (8.0 * PI * 2.5)).abs() < 1e-6, "{f}");
     }
 }

@@ -121,7 +121,7 @@ vec3 shade(vec3 p, vec3 n, vec3 g, vec3 w_o, uint m) {
             vec3 w_h = normalize_or_zero(w_i + w_o);
             float c = max(dot(n, w_h), 0.0);
             if (s * (1.0 - c) < 20.7) {
-                f += glossy * ((s + 8.0) / (8.0 * PI) * pow(c, s));
+                f += glossy * ((s + 2.0) * (s + 4.0) / (8.0 * PI * (exp2(max(-0.5 * s, -126.0)) + s)) * pow(c, s));
             }
         }
         l_o += (incident * f) * cos_theta;
