@@ -20,6 +20,15 @@ pub struct SampleRng {
     sample: u32,
     spp: u32,
     pairs: u32,
+    /// `sqrt(spp)` when `spp` is a square (the cells form a grid), else 0
+    /// (a Latin hypercube): fixed per stream, so worked out once.
+    grid: u32,
+}
+
+/// `SampleRng::grid` for `spp` samples.
+fn grid_side(spp: u32) -> u32 {
+    let n = (spp as f32).sqrt().round() as u32;
+    if n * n == spp { n } else { 0 }
 }
 
 /// How many 2D draws per sample are stratified across the pixel's samples;
@@ -53,13 +62,13 @@ impl SampleRng {
         // The key names the pixel only: the samples of a pixel share their
         // cell shuffles and differ in which cell they take.
         let key = (pixel as u64) ^ seed.wrapping_mul(GOLDEN).rotate_left(17);
-        SampleRng { key, counter: (sample as u64) << 32, sample, spp: spp.max(1), pairs: 0 }
+        SampleRng { key, counter: (sample as u64) << 32, sample, spp: spp.max(1), pairs: 0, grid: grid_side(spp.max(1)) }
     }
 
     /// The stream of item `index` of an enumerated task (`stream` names the
     /// task, e.g. photon shooting), apart from every pixel's stream.
     pub fn for_index(stream: u64, index: u64, seed: u64) -> SampleRng {
-        SampleRng { key: mix64(seed.wrapping_add(GOLDEN)) ^ mix64(stream.wrapping_mul(GOLDEN) ^ index) ^ (1 << 63), counter: 0, sample: 0, spp: 1, pairs: 0 }
+        SampleRng { key: mix64(seed.wrapping_add(GOLDEN)) ^ mix64(stream.wrapping_mul(GOLDEN) ^ index) ^ (1 << 63), counter: 0, sample: 0, spp: 1, pairs: 0, grid: 1 }
     }
 
     /// Uniform in [0, 1): 24 random bits, so 1.0 itself is never returned.
@@ -89,8 +98,8 @@ impl SampleRng {
         // all the pixel's samples (derived from the key, not the counter).
         let shuffle = mix64(self.key ^ (self.pairs as u64 + 1).wrapping_mul(GOLDEN));
         self.pairs += 1;
-        let n = (self.spp as f32).sqrt().round() as u32;
-        if n * n == self.spp {
+        let n = self.grid;
+        if n != 0 {
             let cell = permute(self.sample, self.spp, shuffle as u32);
             Vec2::new(((cell % n) as f32 + jitter.x) / n as f32, ((cell / n) as f32 + jitter.y) / n as f32)
         } else {
