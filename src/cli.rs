@@ -73,6 +73,7 @@ enum Command {
         #[arg(short = 'o', long = "output", value_name = "OUT.png")]
         output: PathBuf,
         /// methods: renderers, samples, shadow maps, interpolation, indirect light;
+        /// gi: each method of indirect light as a curve (path at each of --spp-list);
         /// spp: each of --renderers at each of --spp-list.
         #[arg(long, default_value = "methods")]
         sweep: String,
@@ -91,6 +92,10 @@ enum Command {
         reference: Option<PathBuf>,
         #[arg(long = "reference-spp", default_value_t = 256)]
         reference_spp: u32,
+        /// --sweep gi: a peer renderer's curve to draw beside ours, as a CSV with the
+        /// header series,label,ms,rel_rmse (scripts/gi_chart.sh measures Mitsuba's).
+        #[arg(long, value_name = "FILE.csv")]
+        peer: Option<PathBuf>,
         #[command(flatten)]
         opts: RenderOpts,
     },
@@ -231,10 +236,14 @@ pub fn run() -> Result<Outcome, String> {
         Some(Command::Bench { scene, opts, frames }) => cmd_bench(&scene, &opts, frames),
         Some(Command::Compare { a, b, json }) => cmd_compare(&a, &b, json),
         Some(Command::Pixel { scene, x, y, opts, json }) => cmd_pixel(&scene, x, y, &opts, json),
-        Some(Command::Chart { scene, output, sweep, metric, renderers, spp_list, reference, reference_spp, opts }) => match sweep.as_str() {
-            "methods" => cmd_chart_methods(&scene, &output, &metric, reference.as_deref(), reference_spp, &opts),
+        Some(Command::Chart { scene, output, sweep, metric, renderers, spp_list, reference, reference_spp, peer, opts }) => match sweep.as_str() {
+            _ if peer.is_some() && sweep != "gi" => Err("--peer: a peer's curve is drawn on --sweep gi charts only".to_string()),
+            "methods" => cmd_chart_methods(&scene, &output, &metric, reference.as_deref(), reference_spp, None, &opts),
+            "gi" => parse_spp_list(&spp_list).and_then(|spps| {
+                cmd_chart_methods(&scene, &output, &metric, reference.as_deref(), reference_spp, Some((&spps, peer.as_deref())), &opts)
+            }),
             "spp" => cmd_chart(&scene, &output, &renderers, &spp_list, reference.as_deref(), reference_spp, &opts),
-            other => Err(format!("--sweep: \"{other}\" is not one of methods, spp")),
+            other => Err(format!("--sweep: \"{other}\" is not one of methods, gi, spp")),
         }
         Some(Command::Gallery { output, case, threads }) => cmd_gallery(&output, case.as_deref(), threads),
         Some(Command::List) => cmd_list(),
@@ -559,10 +568,23 @@ fn cmd_pixel(scene_arg: &str, x: u32, y: u32, opts: &RenderOpts, as_json: bool) 
     }
 }
 
+/// `--spp-list`: comma-separated sample counts.
+fn parse_spp_list(list: &str) -> Result<Vec<u32>, String> {
+    list.split(',')
+        .map(|s| s.trim().parse::<u32>().ok().filter(|&n| (1..=65536).contains(&n)).ok_or(format!("--spp-list: \"{s}\" is not a sample count")))
+        .collect()
+}
+
 /// `chart --sweep methods`: every configuration of `chart::method_configurations`
 /// against the reference, as a scatter with its Pareto front, and the CSV.
-fn cmd_chart_methods(scene_arg: &str, output: &Path, metric: &str, reference: Option<&Path>, reference_spp: u32, opts: &RenderOpts) -> Result<(), String> {
+/// With `gi = Some((path spps, peer))`, `chart --sweep gi`: the methods of
+/// indirect light as curves, a peer's curve beside them, the same CSV.
+fn cmd_chart_methods(scene_arg: &str, output: &Path, metric: &str, reference: Option<&Path>, reference_spp: u32, gi: Option<(&[u32], Option<&Path>)>, opts: &RenderOpts) -> Result<(), String> {
     check_png_output(output)?;
+    let peers = match gi.and_then(|(_, peer)| peer) {
+        Some(path) => crate::chart::gi_sweep::load_peer_csv(path)?,
+        None => Vec::new(),
+    };
     let metric = match metric {
         "rel-rmse" | "rmse" => crate::chart::ErrorMetric::RelRmse,
         "flip" => crate::chart::ErrorMetric::Flip,
@@ -585,15 +607,29 @@ fn cmd_chart_methods(scene_arg: &str, output: &Path, metric: &str, reference: Op
         .install(|| crate::chart::load_reference(&source, &l.prepared, w, h, cache.as_deref(), &cancel, None))?
         .ok_or("cancelled")?;
     eprintln!("reference: {}", truth.name);
-    let configs = crate::chart::method_configurations(&l.prepared.scene, &l.settings);
+    let configs = match gi {
+        Some((spps, _)) => {
+            if l.prepared.scene.render.ambient.max_element() <= 0.0 {
+                eprintln!("note: the scene has no ambient term, so --gi ao (which dims it) equals --gi none and is left out");
+            }
+            crate::chart::gi_sweep::gi_configurations(&l.settings, &l.prepared.scene, spps)
+        }
+        None => crate::chart::method_configurations(&l.prepared.scene, &l.settings),
+    };
     let mut points = Vec::new();
     for (i, c) in configs.iter().enumerate() {
         eprintln!("[{}/{}] {}", i + 1, configs.len(), c.label);
-        let m = l.pool.install(|| crate::chart::measure(&l.prepared, c, &truth, 3, &cancel))?.ok_or("cancelled")?;
-        points.push(m);
+        let m = match gi {
+            Some(_) => l.pool.install(|| crate::chart::gi_sweep::measure_with_builds(&l.prepared, c, &truth, &cancel)),
+            None => l.pool.install(|| crate::chart::measure(&l.prepared, c, &truth, 3, &cancel)),
+        };
+        points.push(m?.ok_or("cancelled")?);
     }
     let title = format!("{}: error against time, {w}x{h}, {} threads; reference: {}", l.prepared.scene.name, l.pool.current_num_threads(), truth.name);
-    let png = crate::chart::plot::draw_methods_png(&points, metric, &title, 1100, 700)?;
+    let png = match gi {
+        Some(_) => crate::chart::plot::draw_curves_png(&points, &peers, metric, &title, 1100, 700)?,
+        None => crate::chart::plot::draw_methods_png(&points, metric, &title, 1100, 700)?,
+    };
     let csv_path = output.with_extension("csv");
     let csv = crate::chart::methods_csv(&points);
     crate::image_io::write_all_atomic(&[(output, &png), (&csv_path, csv.as_bytes())])?;
@@ -616,10 +652,7 @@ fn cmd_chart(scene_arg: &str, output: &Path, renderers: &str, spp_list: &str, re
     if !(1..=65536).contains(&reference_spp) {
         return Err(format!("--reference-spp {reference_spp} is not between 1 and 65536"));
     }
-    let spps: Vec<u32> = spp_list
-        .split(',')
-        .map(|s| s.trim().parse::<u32>().ok().filter(|&n| (1..=65536).contains(&n)).ok_or(format!("--spp-list: \"{s}\" is not a sample count")))
-        .collect::<Result<_, _>>()?;
+    let spps = parse_spp_list(spp_list)?;
     let names: Vec<&str> = renderers.split(',').map(str::trim).collect();
     for n in &names {
         render::renderer_by_name(n)?;

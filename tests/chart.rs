@@ -121,3 +121,32 @@ fn bad_chart_arguments_are_one_sentence() {
         assert!(!out.status.success() && err.contains(needle) && err.trim().lines().count() == 1, "{err}");
     }
 }
+
+/// `--sweep gi`: each method of indirect light as a curve, path tracing at
+/// each of `--spp-list`; with more samples the path-traced error falls,
+/// and a peer's CSV is read (and a bad one refused with its line).
+#[test]
+fn the_gi_sweep_draws_each_method_as_a_curve_beside_a_peer() {
+    let d = dir("gi");
+    let peer = d.join("peer.csv");
+    std::fs::write(&peer, "series,label,ms,rel_rmse\nmitsuba,1 spp,5,1.2\nmitsuba,16 spp,50,0.4\n").unwrap();
+    let (rows, err) = chart("cornell-gi", &d, &["--sweep", "gi", "--spp-list", "1,16", "--peer", peer.to_str().unwrap()]);
+    let path: Vec<&Row> = rows.iter().filter(|r| r.method.contains("--gi path")).collect();
+    assert_eq!(path.len(), 2, "path at 1 and 16 spp");
+    assert!(path[1].rel_rmse < path[0].rel_rmse * 0.6, "16 spp must be well below 1 spp: {} vs {}", path[1].rel_rmse, path[0].rel_rmse);
+    assert_eq!(rows.iter().filter(|r| r.method.contains("--gi photons")).count(), 4);
+    assert!(rows.iter().filter(|r| !r.method.contains("--gi")).count() >= 3, "direct light only");
+    assert!(err.contains("ambient"), "the scene has no ambient term, so ao is left out and the user is told: {err}");
+    // The best path-traced and photon images beat direct light alone, which misses the bounced light.
+    let direct = rows.iter().filter(|r| !r.method.contains("--gi")).map(|r| r.rel_rmse).fold(f64::INFINITY, f64::min);
+    assert!(path[1].rel_rmse < direct, "{} vs {direct}", path[1].rel_rmse);
+
+    std::fs::write(&peer, "series,label,ms,rel_rmse\nmitsuba,1 spp,five,1.2\n").unwrap();
+    let png = d.join("bad.png");
+    let out = pinhole(&["chart", "cornell-gi", "-o", png.to_str().unwrap(), "--sweep", "gi", "--peer", peer.to_str().unwrap()], &d);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("peer.csv:2") && err.contains("ms") && err.trim().lines().count() == 1, "{err}");
+    let out = pinhole(&["chart", "cornell-gi", "-o", png.to_str().unwrap(), "--peer", peer.to_str().unwrap()], &d);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("--peer"), "a peer only goes on the gi chart: {err}");
+}

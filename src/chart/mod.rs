@@ -6,9 +6,11 @@
 //! - `reference`: the truth (an EXR, or a cached path-traced image);
 //! - `measure`: timing and error of one configuration, the Pareto front, CSV;
 //! - `spp_sweep`: the older sweep over samples per pixel;
+//! - `gi_sweep`: each method of indirect light as a curve, and a peer's curve;
 //! - `plot`: the PNG charts.
 
 pub mod configurations;
+pub mod gi_sweep;
 pub mod measure;
 pub mod plot;
 pub mod reference;

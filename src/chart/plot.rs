@@ -152,3 +152,92 @@ pub fn draw_methods_png(points: &[Measurement], metric: ErrorMetric, title: &str
     }
     crate::image_io::encode_png(width, height, &buf)
 }
+
+/// The curves chart (`--sweep gi`): one line per group through its points in
+/// order of time, each point labelled with the knob that moves it, and each
+/// peer series as a dashed black line with crosses. Returns PNG bytes.
+pub fn draw_curves_png(points: &[Measurement], peers: &[super::gi_sweep::PeerPoint], metric: ErrorMetric, title: &str, width: u32, height: u32) -> Result<Vec<u8>, String> {
+    register_font();
+    let err = |p: &Measurement| metric.of(p).max(1e-6);
+    let mut buf = vec![255u8; (width * height * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buf, (width, height)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        let (xmin, xmax) = bounds(points.iter().map(|p| p.ms).chain(peers.iter().map(|p| p.ms)));
+        let (ymin, ymax) = bounds(points.iter().map(err).chain(peers.iter().map(|p| p.rel_rmse.max(1e-6))));
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 20))
+            .margin(16)
+            .x_label_area_size(44)
+            .y_label_area_size(70)
+            .build_cartesian_2d((xmin..xmax).log_scale(), (ymin..ymax).log_scale())
+            .map_err(|e| e.to_string())?;
+        chart
+            .configure_mesh()
+            .x_desc("frame time (ms, log)")
+            .y_desc(format!("{} (log)", metric.axis_name()))
+            .x_label_formatter(&|v| short_number(*v))
+            .y_label_formatter(&|v| short_number(*v))
+            .label_style(("sans-serif", 14))
+            .draw()
+            .map_err(|e| e.to_string())?;
+        let mut groups: Vec<&str> = Vec::new();
+        for p in points {
+            if !groups.contains(&p.group.as_str()) {
+                groups.push(&p.group);
+            }
+        }
+        for (gi, group) in groups.iter().enumerate() {
+            let color = Palette99::pick(gi).to_rgba();
+            let mut curve: Vec<&Measurement> = points.iter().filter(|p| p.group == *group).collect();
+            curve.sort_by(|a, b| a.ms.total_cmp(&b.ms));
+            let line: Vec<(f64, f64)> = curve.iter().map(|p| (p.ms, err(p))).collect();
+            chart
+                .draw_series(LineSeries::new(line, color.stroke_width(2)))
+                .map_err(|e| e.to_string())?
+                .label(*group)
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
+            chart
+                .draw_series(curve.iter().map(|p| {
+                    EmptyElement::at((p.ms, err(p)))
+                        + Circle::new((0, 0), 4, color.filled())
+                        + Text::new(super::gi_sweep::point_label(&p.label), (6, -14), ("sans-serif", 12))
+                }))
+                .map_err(|e| e.to_string())?;
+        }
+        let mut series: Vec<&str> = Vec::new();
+        for p in peers {
+            if !series.contains(&p.series.as_str()) {
+                series.push(&p.series);
+            }
+        }
+        // Peer values are rmse / mean: they belong on the chart only when it plots that.
+        for name in series.iter().filter(|_| metric == ErrorMetric::RelRmse) {
+            let mut curve: Vec<&super::gi_sweep::PeerPoint> = peers.iter().filter(|p| p.series == *name).collect();
+            curve.sort_by(|a, b| a.ms.total_cmp(&b.ms));
+            let line: Vec<(f64, f64)> = curve.iter().map(|p| (p.ms, p.rel_rmse.max(1e-6))).collect();
+            chart
+                .draw_series(DashedLineSeries::new(line, 8, 5, BLACK.stroke_width(2)))
+                .map_err(|e| e.to_string())?
+                .label(*name)
+                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(2)));
+            chart
+                .draw_series(curve.iter().map(|p| {
+                    EmptyElement::at((p.ms, p.rel_rmse.max(1e-6)))
+                        + Cross::new((0, 0), 5, BLACK.stroke_width(2))
+                        + Text::new(p.label.clone(), (6, 6), ("sans-serif", 12))
+                }))
+                .map_err(|e| e.to_string())?;
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 14))
+            .draw()
+            .map_err(|e| e.to_string())?;
+        root.present().map_err(|e| e.to_string())?;
+    }
+    crate::image_io::encode_png(width, height, &buf)
+}
