@@ -194,6 +194,14 @@ struct RenderOpts {
     /// their estimated relative error is below TARGET (e.g. 0.05).
     #[arg(long, value_name = "TARGET")]
     adaptive: Option<f32>,
+    /// Sub-sampling: trace every N-th pixel in x and y (1, 2, 4, 8, 16) and
+    /// interpolate the pixels between.
+    #[arg(long, default_value_t = 1, value_name = "N")]
+    subsample: u32,
+    /// --subsample: also trace in full each grid cell whose corners differ in
+    /// contrast ((max - min) / (max + min), per channel) by more than C.
+    #[arg(long = "subsample-contrast", value_name = "C")]
+    subsample_contrast: Option<f32>,
     /// Rasterizers: what the depth buffer stores: f32 | unorm24 | unorm16 | reversed.
     #[arg(long = "depth-buffer", default_value = "f32", value_name = "FORMAT")]
     depth_buffer: String,
@@ -346,6 +354,19 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
             return Err(format!("--adaptive {t} must be a relative error > 0 (e.g. 0.05)"));
         }
         settings.adaptive = Some(t);
+    }
+    if !render::frame::subsample::STEPS.contains(&opts.subsample) {
+        return Err(format!("--subsample {} is not one of 1, 2, 4, 8, 16", opts.subsample));
+    }
+    settings.subsample.step = opts.subsample;
+    if let Some(c) = opts.subsample_contrast {
+        if !(c >= 0.0 && c.is_finite()) {
+            return Err(format!("--subsample-contrast {c} must be a contrast >= 0 (e.g. 0.3)"));
+        }
+        if opts.subsample == 1 {
+            return Err("--subsample-contrast refines a sub-sampled frame: give --subsample 2, 4, 8 or 16 too".into());
+        }
+        settings.subsample.contrast = Some(c);
     }
     if settings.shadows == ShadowMode::Map {
         render::shadow_map::check_memory(&scene, settings.shadow_map_size)?;

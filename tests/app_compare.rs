@@ -185,3 +185,24 @@ fn the_wipe_shows_two_renderers_and_measures_their_difference() {
     h.step();
     assert!(!h.state().split.enabled);
 }
+
+/// Sub-sampling in the viewer: the live view shows the sub-sampled frame
+/// the command line renders (interpolated between the traced grid), not
+/// the full one, and the status counts only the rays traced.
+#[test]
+fn the_viewer_shows_a_sub_sampled_frame() {
+    let mut h = new_harness(small_scene("spheres"));
+    settle(&mut h);
+    let full = h.state().with_output(|o| o.linear.clone());
+    h.state_mut().settings.subsample = pinhole::render::frame::Subsample { step: 4, contrast: None };
+    settle(&mut h);
+    let app = h.state();
+    let settings = app.effective_settings();
+    assert_eq!(settings.subsample.step, 4);
+    let shown = app.with_output(|o| o.linear.clone());
+    assert_eq!(shown, rendered(app, &app.settings.renderer, &settings), "the live view is the sub-sampled frame");
+    assert_ne!(shown, full, "interpolated pixels differ from traced ones somewhere");
+    let (w, hgt) = app.image_size();
+    let grid = |n: u32| n.div_ceil(4) + u32::from((n - 1) % 4 != 0);
+    assert_eq!(app.with_output(|o| o.stats.counts.primary), (grid(w) * grid(hgt)) as u64, "{w}x{hgt}: one ray per grid pixel");
+}

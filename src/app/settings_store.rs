@@ -36,6 +36,8 @@ pub struct ViewerSettings {
     pub texture_filter: crate::scene::texture::TextureFilter,
     /// Traced reflections or environment lookups.
     pub reflections: crate::render::Reflections,
+    /// Sub-sampling: a grid traced, the rest interpolated.
+    pub subsample: crate::render::frame::Subsample,
     /// Image size over the scene's size.
     pub res_scale: f32,
     /// Encode the image as sRGB for display.
@@ -97,6 +99,7 @@ impl Default for ViewerSettings {
             gi: Default::default(),
             texture_filter: Default::default(),
             reflections: Default::default(),
+            subsample: Default::default(),
             res_scale: 1.0,
             gamma: true,
             panels: Panels::default(),
@@ -134,6 +137,7 @@ impl ViewerSettings {
             gi: self.gi.clone(),
             texture_filter: self.texture_filter,
             reflections: self.reflections,
+            subsample: self.subsample,
             shadow_map_size: k.shadow_map_size,
             shadow_map_bias: k.shadow_map_bias,
             msaa: k.msaa,
@@ -158,6 +162,7 @@ impl ViewerSettings {
         self.gi = settings.gi.clone();
         self.texture_filter = settings.texture_filter;
         self.reflections = settings.reflections;
+        self.subsample = settings.subsample;
         self.per_scene = SceneKnobs {
             shadow_map_size: settings.shadow_map_size,
             shadow_map_bias: settings.shadow_map_bias,

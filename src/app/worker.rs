@@ -569,6 +569,20 @@ impl WorkerLoop {
             return;
         }
 
+        // A sub-sampled frame is rendered whole: which cells are traced in
+        // full depends on the grid around them.
+        if f.req.settings.subsample.is_on() && f.req.settings.view == View::Shaded {
+            let renderer = f.renderer.as_ref();
+            let settings = &f.req.settings;
+            let result = self.pool.install(|| guarded(|| render::frame::subsample::render_subsampled(renderer, prepared, settings, cancel, None)));
+            match result {
+                Ok(Some(frame)) => self.publish_whole(f, frame),
+                Ok(None) => self.frame = Some(f),
+                Err(e) => self.fail(&f.req, e),
+            }
+            return;
+        }
+
         // One band of the current pass.
         let spp = f.frame.spp();
         let band_rows = if self.ms_per_row > 0.0 { (BAND_MS / self.ms_per_row).clamp(1.0, height as f64) as u32 } else { (height / 16).max(1) };
@@ -656,6 +670,38 @@ impl WorkerLoop {
         }
         out.version += 1;
         drop(out);
+        self.publish_done();
+    }
+}
+
+impl WorkerLoop {
+    /// Shows a frame rendered whole (not band by band) as complete.
+    fn publish_whole(&mut self, f: Frame, frame: render::FrameResult) {
+        let elapsed_ms = f.started.elapsed().as_secs_f64() * 1e3;
+        let rgb8 = image_io::to_rgb8(&frame.pixels, f.req.params.render.exposure, f.req.gamma);
+        let mut out = self.shared.output.lock().unwrap();
+        out.error = None;
+        out.width = frame.width;
+        out.height = frame.height;
+        out.linear = frame.pixels;
+        out.rgb8 = rgb8;
+        out.generation = f.req.generation;
+        out.scene_id = f.req.scene_id;
+        out.spp = f.req.settings.spp.max(1);
+        out.passes = out.spp;
+        out.preview = false;
+        out.complete = true;
+        out.differing_pixels = None;
+        if !f.first_image {
+            out.stats.first_image_ms = elapsed_ms;
+        }
+        out.stats.pass_ms = elapsed_ms / out.spp as f64;
+        out.stats.counts = frame.counts;
+        out.stats.noise = None;
+        out.stats.frame_ms = elapsed_ms;
+        out.version += 1;
+        drop(out);
+        self.last_req = Some(f.req);
         self.publish_done();
     }
 }

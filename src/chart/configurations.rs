@@ -70,6 +70,12 @@ pub fn describe(renderer: &str, s: &RenderSettings) -> String {
     if s.affine {
         out.push("--affine".into());
     }
+    if s.subsample.is_on() {
+        out.push(format!("--subsample {}", s.subsample.step));
+        if let Some(c) = s.subsample.contrast {
+            out.push(format!("--subsample-contrast {c}"));
+        }
+    }
     let gi = &s.gi;
     if gi.mode != GiMode::None {
         let mut knob = |k: &str, v: String| out.push(format!("--{k} {v}"));
@@ -122,6 +128,12 @@ pub fn method_configurations(scene: &Scene, base: &RenderSettings) -> Vec<Config
     // The same image by other visibility algorithms: they differ in time only.
     for variant in ["rasterize:tiled", "rasterize:scanline"] {
         add("samples", variant, plain.clone());
+    }
+
+    // Fewer rays than pixels: a grid traced and the rest interpolated, and
+    // the same with the cells whose corners differ traced in full.
+    for contrast in [None, Some(0.3)] {
+        add("sub-sampling", ray, with(&|s| s.subsample = crate::render::frame::Subsample { step: 4, contrast }));
     }
 
     // Shadows: none, traced (above), or looked up in maps of a few sizes and biases.

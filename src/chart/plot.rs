@@ -154,7 +154,7 @@ pub fn draw_methods_png(points: &[Measurement], metric: ErrorMetric, title: &str
 }
 
 /// The curves chart (`--sweep gi`): one line per group through its points in
-/// order of time, each point labelled with the knob that moves it, and each
+/// the order they were measured, each point labelled with the knob that moves it, and each
 /// peer series as a dashed black line with crosses. Returns PNG bytes.
 pub fn draw_curves_png(points: &[Measurement], peers: &[super::gi_sweep::PeerPoint], metric: ErrorMetric, title: &str, width: u32, height: u32) -> Result<Vec<u8>, String> {
     register_font();
@@ -189,8 +189,9 @@ pub fn draw_curves_png(points: &[Measurement], peers: &[super::gi_sweep::PeerPoi
         }
         for (gi, group) in groups.iter().enumerate() {
             let color = Palette99::pick(gi).to_rgba();
-            let mut curve: Vec<&Measurement> = points.iter().filter(|p| p.group == *group).collect();
-            curve.sort_by(|a, b| a.ms.total_cmp(&b.ms));
+            // In the sweep's order, which is the order of the knob (samples,
+            // photons): a costlier knob setting is not always slower.
+            let curve: Vec<&Measurement> = points.iter().filter(|p| p.group == *group).collect();
             let line: Vec<(f64, f64)> = curve.iter().map(|p| (p.ms, err(p))).collect();
             chart
                 .draw_series(LineSeries::new(line, color.stroke_width(2)))
@@ -213,8 +214,7 @@ pub fn draw_curves_png(points: &[Measurement], peers: &[super::gi_sweep::PeerPoi
         }
         // Peer values are rmse / mean: they belong on the chart only when it plots that.
         for name in series.iter().filter(|_| metric == ErrorMetric::RelRmse) {
-            let mut curve: Vec<&super::gi_sweep::PeerPoint> = peers.iter().filter(|p| p.series == *name).collect();
-            curve.sort_by(|a, b| a.ms.total_cmp(&b.ms));
+            let curve: Vec<&super::gi_sweep::PeerPoint> = peers.iter().filter(|p| p.series == *name).collect();
             let line: Vec<(f64, f64)> = curve.iter().map(|p| (p.ms, p.rel_rmse.max(1e-6))).collect();
             chart
                 .draw_series(DashedLineSeries::new(line, 8, 5, BLACK.stroke_width(2)))

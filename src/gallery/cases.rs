@@ -296,6 +296,20 @@ pub fn cases() -> Vec<GalleryCase> {
             threshold: 40,
             size: Some((160, 100)),
         },
+        GalleryCase {
+            name: "subsample-misses",
+            scene: "textures",
+            method: "sub-sampling",
+            knob: "subsample",
+            explanation: "every fourth pixel is traced and the rest interpolated, refined only where the traced corners differ: the normal-mapped bumps (too faint at the corners to trigger refinement) and the checker squares near the horizon (smaller than the grid) are smeared or lost",
+            failing: Setting::new("raytrace", "--subsample 4 --subsample-contrast 0.3", |s| {
+                s.subsample = crate::render::frame::Subsample { step: 4, contrast: Some(0.3) }
+            }),
+            cured: Setting::new("raytrace", "--subsample 1 (every pixel traced)", |s| s.subsample = crate::render::frame::Subsample::default()),
+            truth: Setting::new("raytrace:brute", "raytrace:brute", nothing),
+            threshold: 40,
+            size: Some((160, 100)),
+        },
     ]
 }
 

@@ -2,7 +2,9 @@
 //! completion, `replay_pixel` replays one of its pixels sample by sample.
 
 mod accumulator;
+pub mod subsample;
 
+pub use subsample::Subsample;
 pub use accumulator::{add_sample, admitted, final_value, mean, relative_error, wants_more, Accumulator, Band, ADAPTIVE_MIN_SAMPLES};
 
 use super::{sample_offset, PassJob, PreparedScene, RayCounts, RenderSettings, Renderer};
@@ -45,6 +47,10 @@ pub fn render_frame_in_bands(
     bands: u32,
     rows_done: Option<&AtomicU64>,
 ) -> Option<FrameResult> {
+    // Sub-sampling interpolates shaded images; debug views show every pixel.
+    if settings.subsample.is_on() && settings.view == super::debug::View::Shaded {
+        return subsample::render_subsampled(renderer, prepared, settings, cancel, passes_done);
+    }
     let mut frame = Accumulator::new(settings);
     let band_rows = settings.height.div_ceil(bands.clamp(1, settings.height.max(1)));
     while !frame.is_complete() {

@@ -127,6 +127,10 @@ pub struct RenderSettings {
     /// relative error is above this keep taking samples (up to `spp`).
     #[serde(default)]
     pub adaptive: Option<f32>,
+    /// Sub-sampling: trace a grid of pixels and interpolate the rest
+    /// (`frame::subsample`); the shaded view of whole frames only.
+    #[serde(default)]
+    pub subsample: frame::Subsample,
     /// Rasterizers with a depth buffer: what it stores (`raster::depth_format`).
     /// The ray casters, naive, bbox and the painter ignore it.
     #[serde(default)]
@@ -189,6 +193,7 @@ impl RenderSettings {
             msaa: 1,
             gi: gi::GiSettings::default(),
             adaptive: None,
+            subsample: frame::Subsample::default(),
             depth_buffer: raster::depth_format::DepthFormat::F32,
             lines: wireframe::LineAlgorithm::Float,
             near_clip: true,

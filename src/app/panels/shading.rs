@@ -84,6 +84,7 @@ pub fn show(ui: &mut egui::Ui, settings: &mut ViewerSettings, look: &mut RenderD
                 ui.selectable_value(&mut s.reflections, r, r.name());
             }
         });
+        subsample_controls(ui, &mut s.subsample);
         // Rasterizer-only knobs; the ray casters ignore them.
         let s = &mut s.per_scene;
         ui.horizontal(|ui| {
@@ -164,4 +165,27 @@ fn gi_knobs(ui: &mut egui::Ui, gi: &mut GiSettings) {
         let l = ui.label("seed");
         ui.add(egui::DragValue::new(&mut gi.seed)).labelled_by(l.id);
     });
+}
+
+/// Sub-sampling: the grid spacing, and whether (and above what contrast)
+/// grid cells whose corners differ are traced in full.
+fn subsample_controls(ui: &mut egui::Ui, sub: &mut crate::render::frame::Subsample) {
+    use crate::render::frame::subsample::STEPS;
+    let name = |step: u32| if step == 1 { "off".to_string() } else { format!("every {step}") };
+    egui::ComboBox::from_label("sub-sample").selected_text(name(sub.step)).show_ui(ui, |ui| {
+        for step in STEPS {
+            ui.selectable_value(&mut sub.step, step, name(step));
+        }
+    })
+    .response
+    .on_hover_text("trace every N-th pixel in x and y and interpolate the pixels between (whole frames, shaded view)");
+    if sub.step > 1 {
+        ui.horizontal(|ui| {
+            let mut refine = sub.contrast.is_some();
+            ui.checkbox(&mut refine, "refine where corners differ by");
+            let mut c = sub.contrast.unwrap_or(0.3);
+            ui.add_enabled(refine, egui::DragValue::new(&mut c).range(0.0..=1.0).speed(0.01));
+            sub.contrast = refine.then_some(c);
+        });
+    }
 }
