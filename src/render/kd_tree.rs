@@ -50,13 +50,21 @@ impl<T> KdTree<T> {
     /// nearest first (ties broken by index, so the answer is a function of
     /// the query alone).
     pub fn nearest(&self, at: Vec3, k: usize, max_distance2: f32, out: &mut Vec<Neighbour>) {
+        self.nearest_as_heap(at, k, max_distance2, out);
+        out.sort_by(|a, b| a.distance2.total_cmp(&b.distance2).then(a.index.cmp(&b.index)));
+    }
+
+    /// `nearest` without the sort: the same neighbours, as a max-heap on
+    /// (distance, index), so the farthest comes first. Their order is still
+    /// a function of the query alone (the tree is walked the same way every
+    /// time), which is all a sum over them needs to be reproducible.
+    pub fn nearest_as_heap(&self, at: Vec3, k: usize, max_distance2: f32, out: &mut Vec<Neighbour>) {
         out.clear();
         if k == 0 || self.items.is_empty() {
             return;
         }
         let mut search = Search { at, k, worst: max_distance2, found: out };
         self.visit(0, self.items.len(), &mut search);
-        out.sort_by(|a, b| a.distance2.total_cmp(&b.distance2).then(a.index.cmp(&b.index)));
     }
 
     fn visit(&self, lo: usize, hi: usize, s: &mut Search) {
@@ -193,6 +201,13 @@ mod tests {
                     for nb in &out {
                         assert_eq!((tree.position(nb.index) - at).length_squared(), nb.distance2);
                     }
+                    // The heap form holds the same neighbours, the farthest first.
+                    let mut heap = Vec::new();
+                    tree.nearest_as_heap(at, k, max2, &mut heap);
+                    let mut sorted = heap.clone();
+                    sorted.sort_by(|a, b| a.distance2.total_cmp(&b.distance2).then(a.index.cmp(&b.index)));
+                    assert_eq!(sorted, out, "n {n}, k {k}");
+                    assert_eq!(heap.first().map(|n| n.distance2), out.last().map(|n| n.distance2));
                 }
             }
         }

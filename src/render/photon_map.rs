@@ -166,9 +166,10 @@ impl PhotonMap {
     pub fn radiance(&self, hit: &SurfaceHit, material: &Material, albedo: Vec3, w_o: Vec3, k: usize) -> Radiance {
         NEIGHBOURS.with(|cell| {
             let mut found = cell.borrow_mut();
-            self.tree.nearest(hit.position, k.max(1), self.max_radius2, &mut found);
-            let Some(last) = found.last() else { return Radiance::ZERO };
-            let r2 = last.distance2;
+            self.tree.nearest_as_heap(hit.position, k.max(1), self.max_radius2, &mut found);
+            // The heap's top is the farthest neighbour: the disc's radius.
+            let Some(farthest) = found.first() else { return Radiance::ZERO };
+            let r2 = farthest.distance2;
             if r2 <= 0.0 {
                 return Radiance::ZERO;
             }
