@@ -10,9 +10,10 @@ mod pass;
 mod scene_data;
 mod shaders;
 mod shadow_pass;
+mod textures;
 
 use crate::math::Radiance;
-use crate::render::{debug, gi, Interpolation, PassJob, RayCounts, RenderSettings, Renderer, ShadowMode};
+use crate::render::{debug, gi, Interpolation, PassJob, RayCounts, Reflections, RenderSettings, Renderer, ShadowMode};
 use crate::scene::Scene;
 
 static GL: context::Shared<pass::State> = context::Shared::new();
@@ -68,11 +69,13 @@ fn unsupported(scene: &Scene, settings: &RenderSettings) -> Result<(), String> {
     if settings.interpolation == Interpolation::Gouraud {
         return refuse("supports --interpolation phong|flat only");
     }
-    if let Some(m) = scene.materials.iter().find(|m| m.texture.is_some()) {
-        return refuse(&format!("does not draw textures yet (material \"{}\")", m.name));
+    if let Some(m) = scene.materials.iter().find(|m| m.transmission != crate::math::Vec3::ZERO) {
+        return refuse(&format!("cannot trace glass rays (material \"{}\")", m.name));
     }
-    if let Some(m) = scene.materials.iter().find(|m| m.has_secondary()) {
-        return refuse(&format!("cannot trace mirror or glass rays (material \"{}\")", m.name));
+    if settings.reflections == Reflections::Ray {
+        if let Some(m) = scene.materials.iter().find(|m| m.has_secondary()) {
+            return refuse(&format!("cannot trace mirror rays; use --reflections env (material \"{}\")", m.name));
+        }
     }
     Ok(())
 }

@@ -6,7 +6,8 @@ use super::context::Gl;
 use super::scene_data;
 use super::shaders;
 use crate::math::{Radiance, Vec3};
-use crate::render::{Interpolation, PassJob, RayCounts, ShadowMode};
+use crate::render::{Interpolation, PassJob, RayCounts, Reflections, ShadowMode};
+use crate::scene::texture::{TextureFilter, Wrap};
 use glow::HasContext;
 
 /// What lives in the context between passes.
@@ -16,7 +17,9 @@ pub struct State {
     /// The same with shadow-map lookups (`--shadows map`).
     triangles_mapped: glow::Program,
     spheres_mapped: glow::Program,
+    background: glow::Program,
     maps: super::shadow_pass::ShadowPass,
+    textures: super::textures::Textures,
     vertex_array: glow::VertexArray,
     vertex_buffer: glow::Buffer,
     cube_array: glow::VertexArray,
@@ -24,7 +27,7 @@ pub struct State {
     material_buffer: glow::Buffer,
     light_buffer: glow::Buffer,
     /// The uploaded geometry: its fingerprint, triangle runs, sphere count.
-    uploaded: Option<(u64, Vec<(u32, u32, bool)>, usize)>,
+    uploaded: Option<(u64, Vec<scene_data::Run>, usize)>,
     target: Option<Target>,
 }
 
@@ -71,6 +74,7 @@ impl State {
             let mapped = "#define SHADOW_MAP 1\n";
             let triangles_mapped = compile(gl, shaders::TRIANGLE_VERTEX, &shaders::triangle_fragment(mapped))?;
             let spheres_mapped = compile(gl, shaders::SPHERE_VERTEX, &shaders::sphere_fragment(mapped))?;
+            let background = compile(gl, shaders::BACKGROUND_VERTEX, &shaders::background_fragment())?;
             let maps = super::shadow_pass::ShadowPass::new(gl)?;
             let vertex_array = gl.create_vertex_array()?;
             let vertex_buffer = gl.create_buffer()?;
@@ -83,6 +87,10 @@ impl State {
             }
             gl.enable_vertex_attrib_array(3);
             gl.vertex_attrib_pointer_i32(3, 1, glow::UNSIGNED_INT, stride, 36);
+            gl.enable_vertex_attrib_array(4);
+            gl.vertex_attrib_pointer_f32(4, 2, glow::FLOAT, false, stride, 40);
+            gl.enable_vertex_attrib_array(5);
+            gl.vertex_attrib_pointer_f32(5, 4, glow::FLOAT, false, stride, 48);
             let cube_array = gl.create_vertex_array()?;
             let cube_buffer = gl.create_buffer()?;
             gl.bind_vertex_array(Some(cube_array));
@@ -96,7 +104,9 @@ impl State {
                 spheres,
                 triangles_mapped,
                 spheres_mapped,
+                background,
                 maps,
+                textures: Default::default(),
                 vertex_array,
                 vertex_buffer,
                 cube_array,
@@ -186,7 +196,51 @@ unsafe fn uniforms(gl: &glow::Context, program: glow::Program, job: &PassJob) {
         gl.uniform_3_f32(at("ambient").as_ref(), a.x, a.y, a.z);
         gl.uniform_1_i32(at("light_count").as_ref(), scene.lights.len() as i32);
         gl.uniform_1_i32(at("flat_shading").as_ref(), (job.settings.interpolation == Interpolation::Flat) as i32);
+        let bg = scene.render.background;
+        gl.uniform_3_f32(at("background").as_ref(), bg.x, bg.y, bg.z);
+        gl.uniform_1_i32(at("has_environment").as_ref(), scene.environment.is_some() as i32);
+        gl.uniform_1_f32(at("environment_intensity").as_ref(), scene.environment.as_ref().map_or(0.0, |e| e.intensity));
+        gl.uniform_1_i32(at("mirror_env").as_ref(), (job.settings.reflections == Reflections::Env && job.settings.max_depth > 0) as i32);
+        gl.uniform_1_i32(at("albedo_map").as_ref(), ALBEDO_UNIT as i32);
+        gl.uniform_1_i32(at("normal_map").as_ref(), NORMAL_UNIT as i32);
+        gl.uniform_1_i32(at("environment").as_ref(), ENVIRONMENT_UNIT as i32);
     }
+}
+
+/// Texture units: 0 holds the shadow maps.
+const ALBEDO_UNIT: u32 = 1;
+const NORMAL_UNIT: u32 = 2;
+const ENVIRONMENT_UNIT: u32 = 3;
+
+/// Binds material `m`'s texture and normal map and sets what the
+/// fragment shader reads of them.
+unsafe fn material_textures(gl: &glow::Context, textures: &mut super::textures::Textures, program: glow::Program, job: &PassJob, m: u32) -> Result<(), String> {
+    let Some(material) = job.prepared.scene.materials.get(m as usize) else { return Ok(()) };
+    let filter = job.settings.texture_filter;
+    unsafe {
+        let at = |name: &str| gl.get_uniform_location(program, name);
+        for (map, unit, flag) in [(&material.texture, ALBEDO_UNIT, "has_albedo_map"), (&material.normal_map, NORMAL_UNIT, "has_normal_map")] {
+            if let Some(t) = map {
+                let id = textures.get(gl, t)?;
+                super::textures::bind(gl, unit, id, filter, material.wrap, material.wrap);
+            }
+            gl.uniform_1_i32(at(flag).as_ref(), map.is_some() as i32);
+        }
+        gl.uniform_2_f32(at("uv_scale").as_ref(), material.uv_scale.x, material.uv_scale.y);
+        Ok(())
+    }
+}
+
+/// Uploads and binds the environment (level 0, bilinear, repeating around
+/// the horizon and clamped at the poles, as `Environment::radiance` reads it).
+unsafe fn bind_environment(gl: &glow::Context, textures: &mut super::textures::Textures, scene: &crate::scene::Scene) -> Result<(), String> {
+    if let Some(env) = &scene.environment {
+        unsafe {
+            let id = textures.get(gl, &env.texture)?;
+            super::textures::bind(gl, ENVIRONMENT_UNIT, id, TextureFilter::Bilinear, Wrap::Repeat, Wrap::Clamp);
+        }
+    }
+    Ok(())
 }
 
 /// Draws `job`'s pass and stores its rows in `out`.
@@ -201,6 +255,14 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance]) -> Result<
         let state = g.state.as_mut().expect("created above");
         let framebuffer = state.target(gl, width, height)?;
         state.upload(gl, scene);
+        let keep: Vec<_> = scene
+            .materials
+            .iter()
+            .flat_map(|m| [m.texture.as_ref(), m.normal_map.as_ref()])
+            .chain([scene.environment.as_ref().map(|e| &e.texture)])
+            .flatten()
+            .collect();
+        state.textures.retain(gl, &keep);
         gl.bind_buffer_base(glow::SHADER_STORAGE_BUFFER, 2, Some(state.sphere_buffer));
         let mapped = job.settings.shadows == ShadowMode::Map;
         let first_faces = if mapped {
@@ -235,6 +297,17 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance]) -> Result<
         gl.disable(glow::BLEND);
         gl.front_face(glow::CCW);
         gl.cull_face(glow::BACK);
+        if scene.environment.is_some() {
+            bind_environment(gl, &mut state.textures, scene)?;
+            gl.disable(glow::DEPTH_TEST);
+            gl.depth_mask(false);
+            gl.use_program(Some(state.background));
+            uniforms(gl, state.background, job);
+            gl.bind_vertex_array(Some(state.cube_array));
+            gl.draw_arrays(glow::TRIANGLES, 0, 3);
+            gl.enable(glow::DEPTH_TEST);
+            gl.depth_mask(true);
+        }
 
         let (runs, sphere_count) = {
             let u = state.uploaded.as_ref().expect("uploaded above");
@@ -251,7 +324,8 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance]) -> Result<
                 state.maps.lookup_uniforms(gl, triangles, job.settings);
             }
             gl.bind_vertex_array(Some(state.vertex_array));
-            for (first, count, two_sided) in runs {
+            for scene_data::Run { first, count, two_sided, material } in runs {
+                material_textures(gl, &mut state.textures, triangles, job, material)?;
                 if two_sided {
                     gl.disable(glow::CULL_FACE);
                 } else {
@@ -272,7 +346,16 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance]) -> Result<
                 state.maps.lookup_uniforms(gl, spheres, job.settings);
             }
             gl.bind_vertex_array(Some(state.cube_array));
-            gl.draw_arrays_instanced(glow::TRIANGLES, 0, 36, sphere_count as i32);
+            // One draw per run of spheres sharing a material (and so its textures).
+            let mut first = 0;
+            while first < sphere_count {
+                let m = scene.spheres[first].material;
+                let count = scene.spheres[first..].iter().take_while(|s| s.material == m).count();
+                material_textures(gl, &mut state.textures, spheres, job, m)?;
+                gl.uniform_1_i32(gl.get_uniform_location(spheres, "first_sphere").as_ref(), first as i32);
+                gl.draw_arrays_instanced(glow::TRIANGLES, 0, 36, count as i32);
+                first += count;
+            }
             gl.disable(glow::DEPTH_CLAMP);
         }
         gl.bind_vertex_array(None);
