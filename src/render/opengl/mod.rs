@@ -37,7 +37,11 @@ impl Renderer for OpenGl {
 
     fn check(&self, scene: &Scene, settings: &RenderSettings) -> Result<(), String> {
         unsupported(scene, settings)?;
-        GL.with(|_| ()).map(|_| ())
+        let max_samples = max_samples()?;
+        if settings.msaa > 1 && settings.msaa as i32 > max_samples {
+            return Err(format!("the opengl renderer's driver offers at most {max_samples} samples per pixel, not --msaa {}", settings.msaa));
+        }
+        Ok(())
     }
 
     fn render_pass(&self, job: &PassJob, out: &mut [Radiance]) -> RayCounts {
@@ -83,4 +87,10 @@ fn unsupported(scene: &Scene, settings: &RenderSettings) -> Result<(), String> {
 /// The OpenGL driver in use (`GL_RENDERER`), or why there is none.
 pub fn driver() -> Result<String, String> {
     GL.with(|g| g.renderer.clone())
+}
+
+/// The most samples per pixel the driver's multisampling offers (`GL_MAX_SAMPLES`).
+pub fn max_samples() -> Result<i32, String> {
+    // SAFETY: a plain query on the current context.
+    GL.with(|g| unsafe { glow::HasContext::get_parameter_i32(&g.gl, glow::MAX_SAMPLES) })
 }

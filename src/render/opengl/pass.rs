@@ -12,11 +12,9 @@ use glow::HasContext;
 
 /// What lives in the context between passes.
 pub struct State {
-    triangles: glow::Program,
-    spheres: glow::Program,
-    /// The same with shadow-map lookups (`--shadows map`).
-    triangles_mapped: glow::Program,
-    spheres_mapped: glow::Program,
+    /// The triangle and sphere programs, compiled on first use for each set
+    /// of defines (shadow-map lookups, multisampling).
+    programs: Vec<(String, glow::Program, glow::Program)>,
     background: glow::Program,
     maps: super::shadow_pass::ShadowPass,
     textures: super::textures::Textures,
@@ -31,13 +29,16 @@ pub struct State {
     target: Option<Target>,
 }
 
-/// The framebuffer a pass draws into: RGBA32F colour and a 32-bit float depth.
+/// The framebuffer a pass draws into: RGBA32F colour and a 32-bit float
+/// depth; with `--msaa` a multisampled one beside it, resolved into the first.
 struct Target {
     width: u32,
     height: u32,
+    samples: u32,
     framebuffer: glow::Framebuffer,
     colour: glow::Texture,
     depth: glow::Renderbuffer,
+    multisampled: Option<(glow::Framebuffer, glow::Renderbuffer, glow::Renderbuffer)>,
 }
 
 pub(super) unsafe fn compile(gl: &glow::Context, vertex: &str, fragment: &str) -> Result<glow::Program, String> {
@@ -69,11 +70,6 @@ pub(super) unsafe fn compile(gl: &glow::Context, vertex: &str, fragment: &str) -
 impl State {
     unsafe fn new(gl: &glow::Context) -> Result<State, String> {
         unsafe {
-            let triangles = compile(gl, shaders::TRIANGLE_VERTEX, &shaders::triangle_fragment(""))?;
-            let spheres = compile(gl, shaders::SPHERE_VERTEX, &shaders::sphere_fragment(""))?;
-            let mapped = "#define SHADOW_MAP 1\n";
-            let triangles_mapped = compile(gl, shaders::TRIANGLE_VERTEX, &shaders::triangle_fragment(mapped))?;
-            let spheres_mapped = compile(gl, shaders::SPHERE_VERTEX, &shaders::sphere_fragment(mapped))?;
             let background = compile(gl, shaders::BACKGROUND_VERTEX, &shaders::background_fragment())?;
             let maps = super::shadow_pass::ShadowPass::new(gl)?;
             let vertex_array = gl.create_vertex_array()?;
@@ -100,10 +96,7 @@ impl State {
             gl.vertex_attrib_pointer_f32(0, 3, glow::FLOAT, false, 12, 0);
             gl.bind_vertex_array(None);
             Ok(State {
-                triangles,
-                spheres,
-                triangles_mapped,
-                spheres_mapped,
+                programs: Vec::new(),
                 background,
                 maps,
                 textures: Default::default(),
@@ -119,15 +112,35 @@ impl State {
         }
     }
 
-    unsafe fn target(&mut self, gl: &glow::Context, width: u32, height: u32) -> Result<glow::Framebuffer, String> {
+    /// The triangle and sphere programs compiled with `defines`.
+    unsafe fn programs(&mut self, gl: &glow::Context, defines: &str) -> Result<(glow::Program, glow::Program), String> {
+        if let Some((_, t, s)) = self.programs.iter().find(|p| p.0 == defines) {
+            return Ok((*t, *s));
+        }
+        unsafe {
+            let t = compile(gl, shaders::TRIANGLE_VERTEX, &shaders::triangle_fragment(defines))?;
+            let s = compile(gl, shaders::SPHERE_VERTEX, &shaders::sphere_fragment(defines))?;
+            self.programs.push((defines.to_string(), t, s));
+            Ok((t, s))
+        }
+    }
+
+    /// The framebuffer to draw into and the one to read from (the same
+    /// without multisampling).
+    unsafe fn target(&mut self, gl: &glow::Context, width: u32, height: u32, samples: u32) -> Result<(glow::Framebuffer, glow::Framebuffer), String> {
         unsafe {
             if let Some(t) = &self.target {
-                if (t.width, t.height) == (width, height) {
-                    return Ok(t.framebuffer);
+                if (t.width, t.height, t.samples) == (width, height, samples) {
+                    return Ok((t.multisampled.map_or(t.framebuffer, |m| m.0), t.framebuffer));
                 }
                 gl.delete_framebuffer(t.framebuffer);
                 gl.delete_texture(t.colour);
                 gl.delete_renderbuffer(t.depth);
+                if let Some((f, c, d)) = t.multisampled {
+                    gl.delete_framebuffer(f);
+                    gl.delete_renderbuffer(c);
+                    gl.delete_renderbuffer(d);
+                }
                 self.target = None;
             }
             let framebuffer = gl.create_framebuffer()?;
@@ -140,15 +153,29 @@ impl State {
             gl.bind_framebuffer(glow::FRAMEBUFFER, Some(framebuffer));
             gl.framebuffer_texture_2d(glow::FRAMEBUFFER, glow::COLOR_ATTACHMENT0, glow::TEXTURE_2D, Some(colour), 0);
             gl.framebuffer_renderbuffer(glow::FRAMEBUFFER, glow::DEPTH_ATTACHMENT, glow::RENDERBUFFER, Some(depth));
-            let status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
-            if status != glow::FRAMEBUFFER_COMPLETE {
-                gl.delete_framebuffer(framebuffer);
-                gl.delete_texture(colour);
-                gl.delete_renderbuffer(depth);
-                return Err(format!("the driver cannot draw into a {width}x{height} float framebuffer (status {status:#x})"));
+            let mut status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
+            let mut multisampled = None;
+            if samples > 1 && status == glow::FRAMEBUFFER_COMPLETE {
+                let f = gl.create_framebuffer()?;
+                let c = gl.create_renderbuffer()?;
+                let d = gl.create_renderbuffer()?;
+                gl.bind_renderbuffer(glow::RENDERBUFFER, Some(c));
+                gl.renderbuffer_storage_multisample(glow::RENDERBUFFER, samples as i32, glow::RGBA32F, width as i32, height as i32);
+                gl.bind_renderbuffer(glow::RENDERBUFFER, Some(d));
+                gl.renderbuffer_storage_multisample(glow::RENDERBUFFER, samples as i32, glow::DEPTH_COMPONENT32F, width as i32, height as i32);
+                gl.bind_framebuffer(glow::FRAMEBUFFER, Some(f));
+                gl.framebuffer_renderbuffer(glow::FRAMEBUFFER, glow::COLOR_ATTACHMENT0, glow::RENDERBUFFER, Some(c));
+                gl.framebuffer_renderbuffer(glow::FRAMEBUFFER, glow::DEPTH_ATTACHMENT, glow::RENDERBUFFER, Some(d));
+                status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
+                multisampled = Some((f, c, d));
             }
-            self.target = Some(Target { width, height, framebuffer, colour, depth });
-            Ok(framebuffer)
+            let t = Target { width, height, samples, framebuffer, colour, depth, multisampled };
+            let draw = (t.multisampled.map_or(t.framebuffer, |m| m.0), t.framebuffer);
+            self.target = Some(t);
+            if status != glow::FRAMEBUFFER_COMPLETE {
+                return Err(format!("the driver cannot draw into a {width}x{height} float framebuffer with {samples} samples (status {status:#x})"));
+            }
+            Ok(draw)
         }
     }
 
@@ -196,6 +223,7 @@ unsafe fn uniforms(gl: &glow::Context, program: glow::Program, job: &PassJob) {
         gl.uniform_3_f32(at("ambient").as_ref(), a.x, a.y, a.z);
         gl.uniform_1_i32(at("light_count").as_ref(), scene.lights.len() as i32);
         gl.uniform_1_i32(at("flat_shading").as_ref(), (job.settings.interpolation == Interpolation::Flat) as i32);
+        gl.uniform_1_i32(at("y_down").as_ref(), (job.settings.msaa > 1) as i32);
         let bg = scene.render.background;
         gl.uniform_3_f32(at("background").as_ref(), bg.x, bg.y, bg.z);
         gl.uniform_1_i32(at("has_environment").as_ref(), scene.environment.is_some() as i32);
@@ -253,7 +281,8 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance]) -> Result<
             g.state = Some(State::new(gl)?);
         }
         let state = g.state.as_mut().expect("created above");
-        let framebuffer = state.target(gl, width, height)?;
+        let samples = job.settings.msaa.max(1);
+        let (framebuffer, resolved) = state.target(gl, width, height, samples)?;
         state.upload(gl, scene);
         let keep: Vec<_> = scene
             .materials
@@ -282,10 +311,15 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance]) -> Result<
 
         gl.bind_framebuffer(glow::FRAMEBUFFER, Some(framebuffer));
         gl.viewport(0, 0, width as i32, height as i32);
-        // Only the rows asked for (GL rows count from the bottom).
+        // With --msaa the image is drawn upside down: GL's 4-sample pattern,
+        // given in its bottom-up window, then falls where pinhole's top-down
+        // D3D pattern puts its samples. Windings turn round with it.
+        let y_down = samples > 1;
         let rows = job.rows.start.min(height)..job.rows.end.min(height);
+        // Only the rows asked for (GL rows count from the bottom).
+        let first_gl_row = if y_down { rows.start } else { height - rows.end };
         gl.enable(glow::SCISSOR_TEST);
-        gl.scissor(0, (height - rows.end) as i32, width as i32, rows.len() as i32);
+        gl.scissor(0, first_gl_row as i32, width as i32, rows.len() as i32);
         // Reversed depth in [0, 1]: 1 at the near plane, 0 at the far plane.
         (g.clip_control)(glow::LOWER_LEFT, glow::ZERO_TO_ONE);
         let bg: Vec3 = scene.render.background;
@@ -295,7 +329,7 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance]) -> Result<
         gl.depth_func(glow::GREATER);
         gl.depth_mask(true);
         gl.disable(glow::BLEND);
-        gl.front_face(glow::CCW);
+        gl.front_face(if y_down { glow::CW } else { glow::CCW });
         gl.cull_face(glow::BACK);
         if scene.environment.is_some() {
             bind_environment(gl, &mut state.textures, scene)?;
@@ -313,7 +347,8 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance]) -> Result<
             let u = state.uploaded.as_ref().expect("uploaded above");
             (u.1.clone(), u.2)
         };
-        let (triangles, spheres) = if mapped { (state.triangles_mapped, state.spheres_mapped) } else { (state.triangles, state.spheres) };
+        let defines = format!("{}{}", if mapped { "#define SHADOW_MAP 1\n" } else { "" }, if samples > 1 { "#define MSAA 1\n" } else { "" });
+        let (triangles, spheres) = state.programs(gl, &defines)?;
         if mapped {
             state.maps.bind_for_lookup(gl);
         }
@@ -359,6 +394,14 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance]) -> Result<
             gl.disable(glow::DEPTH_CLAMP);
         }
         gl.bind_vertex_array(None);
+        if resolved != framebuffer {
+            // GL's resolve: each pixel the plain mean of its samples.
+            gl.bind_framebuffer(glow::READ_FRAMEBUFFER, Some(framebuffer));
+            gl.bind_framebuffer(glow::DRAW_FRAMEBUFFER, Some(resolved));
+            let (w, h) = (width as i32, height as i32);
+            gl.blit_framebuffer(0, 0, w, h, 0, 0, w, h, glow::COLOR_BUFFER_BIT, glow::NEAREST);
+            gl.bind_framebuffer(glow::FRAMEBUFFER, Some(resolved));
+        }
         gl.disable(glow::SCISSOR_TEST);
 
         let w = width as usize;
@@ -366,7 +409,7 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance]) -> Result<
         gl.pixel_store_i32(glow::PACK_ALIGNMENT, 4);
         gl.read_pixels(
             0,
-            (height - rows.end) as i32,
+            first_gl_row as i32,
             width as i32,
             rows.len() as i32,
             glow::RGBA,
@@ -374,14 +417,17 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance]) -> Result<
             glow::PixelPackData::Slice(Some(bytes_mut(&mut pixels))),
         );
         gl.bind_framebuffer(glow::FRAMEBUFFER, None);
+        gl.front_face(glow::CCW);
         let error = gl.get_error();
         if error != glow::NO_ERROR {
             return Err(format!("OpenGL reported error {error:#x} while drawing"));
         }
-        // GL's rows run bottom-up: the last row read is the first asked for.
+        // GL's rows run bottom-up: the last row read is the first asked for
+        // (unless drawn upside down).
         let n = rows.len();
         for (k, y) in rows.clone().enumerate() {
-            let src = &pixels[(n - 1 - k) * w * 4..(n - k) * w * 4];
+            let r = if y_down { k } else { n - 1 - k };
+            let src = &pixels[r * w * 4..(r + 1) * w * 4];
             for x in 0..width {
                 if !job.is_active(x, y) {
                     continue;

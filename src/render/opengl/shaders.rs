@@ -17,6 +17,7 @@ uniform float near_plane;
 uniform float far_plane;
 uniform vec3 ambient;
 uniform int light_count;
+uniform bool y_down;
 
 // Per material: (k_L, 0), (k_G, sharpness), (k_M, 0).
 layout(std430, binding = 0) readonly buffer Materials { vec4 materials[]; };
@@ -147,10 +148,22 @@ bool shadowed(int light, vec3 p, vec3 g, vec3 w_i) {
 }
 #endif
 
+// With --msaa, a program shaded per sample (the spheres, whose coverage is
+// their ray test's) looks through its own sample; others through the pixel's.
+vec2 sample_shift() {
+#if defined(MSAA) && defined(PER_SAMPLE)
+    return vec2(gl_SamplePosition.x - 0.5, y_down ? gl_SamplePosition.y - 0.5 : 0.5 - gl_SamplePosition.y);
+#else
+    return vec2(0.0);
+#endif
+}
+
 // Camera-space direction (z = -1) through this fragment's sample, pixel rows top-down.
 vec3 camera_dir() {
-    float px = floor(gl_FragCoord.x) + sample_offset.x;
-    float py = (image_size.y - 1.0 - floor(gl_FragCoord.y)) + sample_offset.y;
+    vec2 shift = sample_shift();
+    float px = floor(gl_FragCoord.x) + sample_offset.x + shift.x;
+    float row = y_down ? floor(gl_FragCoord.y) : image_size.y - 1.0 - floor(gl_FragCoord.y);
+    float py = row + sample_offset.y + shift.y;
     return vec3((2.0 * px / image_size.x - 1.0) * half_extent.x, (1.0 - 2.0 * py / image_size.y) * half_extent.y, -1.0);
 }
 
@@ -214,6 +227,8 @@ uniform mat3 world_to_camera;
 uniform vec2 half_extent;
 // Moves the image so that GL's pixel centre samples this pass's sample position (NDC units).
 uniform vec2 ndc_shift;
+// The image drawn upside down, GL's row 0 the top row (see `pass::render`).
+uniform bool y_down;
 uniform float near_plane;
 uniform float far_plane;
 out vec3 v_position;
@@ -228,7 +243,7 @@ void main() {
     float w = -c.z;
     // Reversed depth with glClipControl(ZERO_TO_ONE): near -> 1, far -> 0.
     float z = near_plane * (far_plane - w) / (far_plane - near_plane);
-    gl_Position = vec4(c.x / half_extent.x + ndc_shift.x * w, c.y / half_extent.y + ndc_shift.y * w, z, w);
+    gl_Position = vec4(c.x / half_extent.x + ndc_shift.x * w, (c.y / half_extent.y + ndc_shift.y * w) * (y_down ? -1.0 : 1.0), z, w);
     v_position = position;
     v_normal = normal;
     v_face_normal = face_normal;
@@ -244,12 +259,19 @@ pub fn triangle_fragment(defines: &str) -> String {
         "#version 450 core\n{defines}{COMMON}{}",
         r#"
 uniform bool flat_shading;
-in vec3 v_position;
-in vec3 v_normal;
+// With --msaa, a fragment is shaded once, at a sample the triangle covers
+// (the CPU's MSAA shades at the covered sample nearest the centre).
+#ifdef MSAA
+#define SAMPLED centroid
+#else
+#define SAMPLED
+#endif
+SAMPLED in vec3 v_position;
+SAMPLED in vec3 v_normal;
 flat in vec3 v_face_normal;
 flat in uint v_material;
-in vec2 v_uv;
-in vec3 v_tangent;
+SAMPLED in vec2 v_uv;
+SAMPLED in vec3 v_tangent;
 flat in float v_handedness;
 layout(location = 0) out vec4 colour;
 void main() {
@@ -312,6 +334,8 @@ uniform vec3 eye;
 uniform mat3 world_to_camera;
 uniform vec2 half_extent;
 uniform vec2 ndc_shift;
+// The image drawn upside down, GL's row 0 the top row (see `pass::render`).
+uniform bool y_down;
 uniform float near_plane;
 uniform float far_plane;
 // Spheres are drawn one material at a time: the first one of this draw.
@@ -325,14 +349,14 @@ void main() {
     vec3 c = world_to_camera * (position - eye);
     float w = -c.z;
     float z = near_plane * (far_plane - w) / (far_plane - near_plane);
-    gl_Position = vec4(c.x / half_extent.x + ndc_shift.x * w, c.y / half_extent.y + ndc_shift.y * w, z, w);
+    gl_Position = vec4(c.x / half_extent.x + ndc_shift.x * w, (c.y / half_extent.y + ndc_shift.y * w) * (y_down ? -1.0 : 1.0), z, w);
     v_sphere = index;
 }
 "#;
 
 pub fn sphere_fragment(defines: &str) -> String {
     format!(
-        "#version 450 core\n{defines}{COMMON}{}",
+        "#version 450 core\n{defines}#define PER_SAMPLE 1\n{COMMON}{}",
         r#"
 struct Sphere { vec4 centre_radius; uvec4 material; };
 layout(std430, binding = 2) readonly buffer Spheres { Sphere spheres[]; };
