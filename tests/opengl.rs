@@ -313,3 +313,39 @@ fn msaa_through_gl_multisampling_is_close_to_the_cpu_rasterizers() {
         assert!(e.contains("at most") && !e.contains('\n'), "{e}");
     }
 }
+
+#[test]
+fn debug_views_from_gl_render_targets_agree_with_the_rasterizers() {
+    // Each debug view GL draws: its fragments write the surface record
+    // into extra render targets, coloured on the CPU by the same
+    // `view_color` as every renderer, against `rasterize`'s view. What
+    // differs lies on silhouettes (coverage), and where a view quantizes
+    // (the uv checker's squares, an id's colour) a rounding apart.
+    use pinhole::render::debug::View;
+    use pinhole::render::Reflections;
+    let Some(_) = driver() else { return };
+    let gl = renderer_by_name("opengl").unwrap();
+    let cpu = renderer_by_name("rasterize").unwrap();
+    let views = [View::Depth, View::Zbuffer, View::Normal, View::Barycentric, View::Id, View::Uv, View::Raydir, View::GeometricNormal, View::TriangleId, View::MaterialId];
+    for name in ["teapot", "spheres", "test-pattern", "textures"] {
+        let sc = scene(name);
+        let prepared = PreparedScene::new(sc.clone());
+        for view in views {
+            let s = RenderSettings { width: 160, height: 100, view, reflections: Reflections::Env, ..settings(&sc) };
+            gl.check(&sc, &s).unwrap();
+            let a = render(gl.as_ref(), &prepared, &s);
+            let b = render(cpu.as_ref(), &prepared, &s);
+            assert!(a.iter().all(|p| p.is_finite()));
+            assert!(a.iter().filter(|p| **p != Vec3::ZERO).count() > a.len() / 10, "{name} {view:?}: nothing drawn");
+            let ok = a.iter().zip(&b).filter(|(x, y)| (**x - **y).abs().max_element() <= VIEW_TOLERANCE).count() as f64 / a.len() as f64;
+            eprintln!("{name} {view:?}: {:.3}% within {VIEW_TOLERANCE}", ok * 100.0);
+            assert!(ok >= 0.99, "{name} {view:?}: only {:.3}% of pixels within {VIEW_TOLERANCE}", ok * 100.0);
+        }
+    }
+    let s = RenderSettings { view: View::Cost, ..settings(&scene("teapot")) };
+    let e = gl.check(&scene("teapot"), &s).unwrap_err();
+    assert!(e.contains("--view") && !e.contains('\n'), "{e}");
+}
+
+/// Largest per-channel difference of a debug view's colour counted as agreeing.
+const VIEW_TOLERANCE: f32 = 1e-3;

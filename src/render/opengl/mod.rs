@@ -11,6 +11,7 @@ mod scene_data;
 mod shaders;
 mod shadow_pass;
 mod textures;
+mod views;
 
 use crate::math::Radiance;
 use crate::render::{debug, gi, Interpolation, PassJob, RayCounts, Reflections, RenderSettings, Renderer, ShadowMode};
@@ -64,8 +65,11 @@ fn unsupported(scene: &Scene, settings: &RenderSettings) -> Result<(), String> {
     if !matches!(settings.shadows, ShadowMode::None | ShadowMode::Map) {
         return refuse("supports --shadows none|map only (it casts no rays)");
     }
-    if !matches!(settings.view, debug::View::Shaded) {
-        return refuse("draws the shaded view only");
+    if settings.view != debug::View::Shaded && !views::drawable(settings.view) {
+        return refuse("draws the shaded view and --view barycentric|raydir|depth|zbuffer|normal|geometric-normal|id|triangle-id|material-id|uv only");
+    }
+    if settings.view != debug::View::Shaded && settings.msaa > 1 {
+        return refuse("draws debug views without --msaa only");
     }
     if settings.gi.mode != gi::GiMode::None {
         return refuse("supports --gi none only");

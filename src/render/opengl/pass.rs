@@ -39,6 +39,8 @@ struct Target {
     colour: glow::Texture,
     depth: glow::Renderbuffer,
     multisampled: Option<(glow::Framebuffer, glow::Renderbuffer, glow::Renderbuffer)>,
+    /// With a debug view: the surface targets (`views`), attachments 1 and up.
+    surfaces: Vec<glow::Texture>,
 }
 
 pub(super) unsafe fn compile(gl: &glow::Context, vertex: &str, fragment: &str) -> Result<glow::Program, String> {
@@ -127,10 +129,10 @@ impl State {
 
     /// The framebuffer to draw into and the one to read from (the same
     /// without multisampling).
-    unsafe fn target(&mut self, gl: &glow::Context, width: u32, height: u32, samples: u32) -> Result<(glow::Framebuffer, glow::Framebuffer), String> {
+    unsafe fn target(&mut self, gl: &glow::Context, width: u32, height: u32, samples: u32, views: bool) -> Result<(glow::Framebuffer, glow::Framebuffer), String> {
         unsafe {
             if let Some(t) = &self.target {
-                if (t.width, t.height, t.samples) == (width, height, samples) {
+                if (t.width, t.height, t.samples, !t.surfaces.is_empty()) == (width, height, samples, views) {
                     return Ok((t.multisampled.map_or(t.framebuffer, |m| m.0), t.framebuffer));
                 }
                 gl.delete_framebuffer(t.framebuffer);
@@ -140,6 +142,9 @@ impl State {
                     gl.delete_framebuffer(f);
                     gl.delete_renderbuffer(c);
                     gl.delete_renderbuffer(d);
+                }
+                for &s in &t.surfaces {
+                    gl.delete_texture(s);
                 }
                 self.target = None;
             }
@@ -153,6 +158,17 @@ impl State {
             gl.bind_framebuffer(glow::FRAMEBUFFER, Some(framebuffer));
             gl.framebuffer_texture_2d(glow::FRAMEBUFFER, glow::COLOR_ATTACHMENT0, glow::TEXTURE_2D, Some(colour), 0);
             gl.framebuffer_renderbuffer(glow::FRAMEBUFFER, glow::DEPTH_ATTACHMENT, glow::RENDERBUFFER, Some(depth));
+            let mut surfaces = Vec::new();
+            if views {
+                for i in 0..super::views::TARGETS {
+                    let t = gl.create_texture()?;
+                    let format = if i < super::views::FLOAT_TARGETS { glow::RGBA32F } else { glow::RGBA32UI };
+                    gl.bind_texture(glow::TEXTURE_2D, Some(t));
+                    gl.tex_storage_2d(glow::TEXTURE_2D, 1, format, width as i32, height as i32);
+                    gl.framebuffer_texture_2d(glow::FRAMEBUFFER, glow::COLOR_ATTACHMENT1 + i as u32, glow::TEXTURE_2D, Some(t), 0);
+                    surfaces.push(t);
+                }
+            }
             let mut status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
             let mut multisampled = None;
             if samples > 1 && status == glow::FRAMEBUFFER_COMPLETE {
@@ -169,7 +185,7 @@ impl State {
                 status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
                 multisampled = Some((f, c, d));
             }
-            let t = Target { width, height, samples, framebuffer, colour, depth, multisampled };
+            let t = Target { width, height, samples, framebuffer, colour, depth, multisampled, surfaces };
             let draw = (t.multisampled.map_or(t.framebuffer, |m| m.0), t.framebuffer);
             self.target = Some(t);
             if status != glow::FRAMEBUFFER_COMPLETE {
@@ -282,7 +298,8 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance]) -> Result<
         }
         let state = g.state.as_mut().expect("created above");
         let samples = job.settings.msaa.max(1);
-        let (framebuffer, resolved) = state.target(gl, width, height, samples)?;
+        let views = job.settings.view != crate::render::debug::View::Shaded;
+        let (framebuffer, resolved) = state.target(gl, width, height, samples, views)?;
         state.upload(gl, scene);
         let keep: Vec<_> = scene
             .materials
@@ -325,6 +342,16 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance]) -> Result<
         let bg: Vec3 = scene.render.background;
         gl.clear_buffer_f32_slice(glow::COLOR, 0, &[bg.x, bg.y, bg.z, 1.0]);
         gl.clear_buffer_f32_slice(glow::DEPTH, 0, &[0.0]);
+        let all_targets: Vec<u32> = (0..=super::views::TARGETS as u32).map(|i| glow::COLOR_ATTACHMENT0 + i).collect();
+        if views {
+            gl.draw_buffers(&all_targets);
+            for i in 1..=super::views::FLOAT_TARGETS as u32 {
+                gl.clear_buffer_f32_slice(glow::COLOR, i, &[0.0; 4]);
+            }
+            gl.clear_buffer_u32_slice(glow::COLOR, super::views::TARGETS as u32, &[0; 4]);
+            // The background writes the colour only.
+            gl.draw_buffers(&all_targets[..1]);
+        }
         gl.enable(glow::DEPTH_TEST);
         gl.depth_func(glow::GREATER);
         gl.depth_mask(true);
@@ -343,11 +370,19 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance]) -> Result<
             gl.depth_mask(true);
         }
 
+        if views {
+            gl.draw_buffers(&all_targets);
+        }
         let (runs, sphere_count) = {
             let u = state.uploaded.as_ref().expect("uploaded above");
             (u.1.clone(), u.2)
         };
-        let defines = format!("{}{}", if mapped { "#define SHADOW_MAP 1\n" } else { "" }, if samples > 1 { "#define MSAA 1\n" } else { "" });
+        let defines = format!(
+            "{}{}{}",
+            if mapped { "#define SHADOW_MAP 1\n" } else { "" },
+            if samples > 1 { "#define MSAA 1\n" } else { "" },
+            if views { "#define VIEWS 1\n" } else { "" }
+        );
         let (triangles, spheres) = state.programs(gl, &defines)?;
         if mapped {
             state.maps.bind_for_lookup(gl);
@@ -416,6 +451,10 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance]) -> Result<
             glow::FLOAT,
             glow::PixelPackData::Slice(Some(bytes_mut(&mut pixels))),
         );
+        let surfaces = views.then(|| super::views::Readback::read(gl, first_gl_row, width, rows.len() as u32));
+        if views {
+            gl.draw_buffers(&all_targets[..1]);
+        }
         gl.bind_framebuffer(glow::FRAMEBUFFER, None);
         gl.front_face(glow::CCW);
         let error = gl.get_error();
@@ -432,8 +471,13 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance]) -> Result<
                 if !job.is_active(x, y) {
                     continue;
                 }
-                let p = &src[x as usize * 4..x as usize * 4 + 3];
-                out[k * w + x as usize] = Vec3::new(p[0], p[1], p[2]);
+                out[k * w + x as usize] = match &surfaces {
+                    Some(s) => super::views::colour(job, s.hit(scene, r, x as usize).as_ref(), x, y),
+                    None => {
+                        let p = &src[x as usize * 4..x as usize * 4 + 3];
+                        Vec3::new(p[0], p[1], p[2])
+                    }
+                };
             }
         }
         // GL counts none of this; the counters stay zero.
@@ -441,7 +485,7 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance]) -> Result<
     }
 }
 
-fn bytes_mut(v: &mut [f32]) -> &mut [u8] {
+pub(super) fn bytes_mut(v: &mut [f32]) -> &mut [u8] {
     // SAFETY: every bit pattern is a valid f32 and u8 has alignment 1.
     unsafe { std::slice::from_raw_parts_mut(v.as_mut_ptr().cast::<u8>(), std::mem::size_of_val(v)) }
 }

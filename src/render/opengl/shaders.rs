@@ -148,6 +148,26 @@ bool shadowed(int light, vec3 p, vec3 g, vec3 w_i) {
 }
 #endif
 
+#ifdef VIEWS
+// The surface each fragment saw, for the debug views and pixel readback
+// (`views`): position and 1, shading normal and back-face flag, geometric
+// normal, barycentric weights, uv, and (kind + 1, primitive) (0: nothing).
+layout(location = 1) out vec4 out_position;
+layout(location = 2) out vec4 out_normal;
+layout(location = 3) out vec4 out_face_normal;
+layout(location = 4) out vec4 out_barycentric;
+layout(location = 5) out vec4 out_uv;
+layout(location = 6) out uvec4 out_id;
+void write_surface(vec3 p, vec3 n, bool back, vec3 g, vec3 b, vec2 uv, uint kind, uint primitive) {
+    out_position = vec4(p, 1.0);
+    out_normal = vec4(n, back ? 1.0 : 0.0);
+    out_face_normal = vec4(g, 0.0);
+    out_barycentric = vec4(b, 0.0);
+    out_uv = vec4(uv, 0.0, 0.0);
+    out_id = uvec4(kind + 1u, primitive, 0u, 0u);
+}
+#endif
+
 // With --msaa, a program shaded per sample (the spheres, whose coverage is
 // their ray test's) looks through its own sample; others through the pixel's.
 vec2 sample_shift() {
@@ -238,6 +258,8 @@ flat out uint v_material;
 out vec2 v_uv;
 out vec3 v_tangent;
 flat out float v_handedness;
+out vec3 v_corner;
+flat out uint v_primitive;
 void main() {
     vec3 c = world_to_camera * (position - eye);
     float w = -c.z;
@@ -251,6 +273,10 @@ void main() {
     v_uv = uv;
     v_tangent = tangent.xyz;
     v_handedness = tangent.w;
+    // One-hot per corner: interpolated, the barycentric weights.
+    int k = gl_VertexID % 3;
+    v_corner = vec3(k == 0, k == 1, k == 2);
+    v_primitive = uint(gl_VertexID / 3);
 }
 "#;
 
@@ -273,6 +299,8 @@ flat in uint v_material;
 SAMPLED in vec2 v_uv;
 SAMPLED in vec3 v_tangent;
 flat in float v_handedness;
+SAMPLED in vec3 v_corner;
+flat in uint v_primitive;
 layout(location = 0) out vec4 colour;
 void main() {
     vec3 big_d = camera_to_world * camera_dir();
@@ -314,10 +342,14 @@ void main() {
     vec3 n = l > 0.0 ? v_normal / l : g;
     // The map bends the front side's normal (normal_map::apply).
     if (has_normal_map) n = mapped_normal(n, v_tangent, v_handedness, normal_texel(v_uv, duv_dx, duv_dy));
-    if (dot(g, dir) > 0.0) {
+    bool back = dot(g, dir) > 0.0;
+    if (back) {
         g = -g;
         n = -n;
     }
+#ifdef VIEWS
+    write_surface(v_position, n, back, g, v_corner, v_uv, 0u, v_primitive);
+#endif
     if (flat_shading) n = g;
     vec3 albedo = albedo_at(v_material, v_uv, duv_dx, duv_dy);
     colour = vec4(shade(v_position, n, g, -dir, v_material, albedo), 1.0);
@@ -399,10 +431,14 @@ void main() {
     vec3 n = o;
     if (has_normal_map) n = mapped_normal(n, vec3(o.z, 0.0, -o.x), 1.0, normal_texel(uv, duv[0], duv[1]));
     vec3 g = o;
-    if (dot(g, dir) > 0.0) {
+    bool back = dot(g, dir) > 0.0;
+    if (back) {
         g = -g;
         n = -n;
     }
+#ifdef VIEWS
+    write_surface(p, n, back, g, vec3(0.0), uv, 1u, uint(v_sphere));
+#endif
     gl_FragDepth = clamp(near_plane * (far_plane - w) / ((far_plane - near_plane) * w), 0.0, 1.0);
     colour = vec4(shade(p, n, g, -dir, m, albedo_at(m, uv, duv[0], duv[1])), 1.0);
 }
