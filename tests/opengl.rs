@@ -336,7 +336,10 @@ fn debug_views_from_gl_render_targets_agree_with_the_rasterizers() {
             let a = render(gl.as_ref(), &prepared, &s);
             let b = render(cpu.as_ref(), &prepared, &s);
             assert!(a.iter().all(|p| p.is_finite()));
-            assert!(a.iter().filter(|p| **p != Vec3::ZERO).count() > a.len() / 10, "{name} {view:?}: nothing drawn");
+            // (The spheres scene has no triangles: its barycentric view is black.)
+            if view != View::Barycentric {
+                assert!(a.iter().filter(|p| **p != Vec3::ZERO).count() > a.len() / 10, "{name} {view:?}: nothing drawn");
+            }
             let ok = a.iter().zip(&b).filter(|(x, y)| (**x - **y).abs().max_element() <= VIEW_TOLERANCE).count() as f64 / a.len() as f64;
             eprintln!("{name} {view:?}: {:.3}% within {VIEW_TOLERANCE}", ok * 100.0);
             assert!(ok >= 0.99, "{name} {view:?}: only {:.3}% of pixels within {VIEW_TOLERANCE}", ok * 100.0);
