@@ -352,3 +352,36 @@ fn debug_views_from_gl_render_targets_agree_with_the_rasterizers() {
 
 /// Largest per-channel difference of a debug view's colour counted as agreeing.
 const VIEW_TOLERANCE: f32 = 1e-3;
+
+#[test]
+fn a_clicked_pixel_reports_what_gl_read_back() {
+    // Not a replay: the row is drawn again and the render targets read at
+    // the pixel. The surface is the one the ray caster finds there, and
+    // the output is the frame's pixel.
+    let Some(_) = driver() else { return };
+    let gl = renderer_by_name("opengl").unwrap();
+    let sc = scene("teapot");
+    let s = RenderSettings { width: 160, height: 100, ..settings(&sc) };
+    let prepared = PreparedScene::new(sc.clone());
+    let frame = render(gl.as_ref(), &prepared, &s);
+    let brute = renderer_by_name("raytrace:brute").unwrap();
+    let (x, y) = (80, 55);
+    let replay = pinhole::render::replay_pixel(gl.as_ref(), &prepared, &s, x, y).unwrap();
+    assert_eq!(replay.radiance, frame[(x + y * s.width) as usize]);
+    let r = replay.samples[0].1.gl_readback.clone().expect("a GL readback");
+    let h = r.surface.expect("the teapot is under the pixel");
+    let reference = pinhole::render::replay_pixel(brute.as_ref(), &prepared, &s, x, y).unwrap();
+    let hit = reference.samples[0].1.rays[0].closest.expect("brute force hits it too");
+    assert_eq!((h.kind, h.primitive, h.object, h.material), (hit.kind, hit.primitive, hit.object, hit.material));
+    assert!((h.position - hit.position).length() < 1e-3 * hit.t, "{} vs {}", h.position, hit.position);
+    assert!((h.shading_normal - hit.shading_normal).length() < 1e-3, "{} vs {}", h.shading_normal, hit.shading_normal);
+    assert!((h.barycentric - hit.barycentric).abs().max_element() < 1e-3);
+    // A corner sees the background: no fragment.
+    let corner = pinhole::render::replay_pixel(gl.as_ref(), &prepared, &s, 0, 0).unwrap();
+    assert!(corner.samples[0].1.gl_readback.as_ref().unwrap().surface.is_none());
+    // The CLI's pixel command says what it is.
+    let run = pinhole(&["pixel", "teapot", "80", "55", "--renderer", "opengl", "--width", "160", "--height", "100", "--shadows", "none"], &[]);
+    let text = String::from_utf8_lossy(&run.stdout);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    assert!(text.contains("GL readback, not a replay"), "{text}");
+}

@@ -15,6 +15,7 @@ mod views;
 
 use crate::math::Radiance;
 use crate::render::{debug, gi, Interpolation, PassJob, RayCounts, Reflections, RenderSettings, Renderer, ShadowMode};
+use crate::render::pixel_record::{GlReadback, PixelTrace};
 use crate::scene::Scene;
 
 static GL: context::Shared<pass::State> = context::Shared::new();
@@ -46,8 +47,8 @@ impl Renderer for OpenGl {
     }
 
     fn render_pass(&self, job: &PassJob, out: &mut [Radiance]) -> RayCounts {
-        match GL.with(|g| pass::render(g, job, out)) {
-            Ok(Ok(counts)) => counts,
+        match GL.with(|g| pass::render(g, job, out, None)) {
+            Ok(Ok((counts, _))) => counts,
             Ok(Err(e)) | Err(e) => {
                 // `check` refuses what cannot be drawn before a frame starts;
                 // a failure here leaves the rows black rather than stale.
@@ -56,6 +57,33 @@ impl Renderer for OpenGl {
                 RayCounts::default()
             }
         }
+    }
+
+    /// Not a replay: GL's shaders cannot be stepped through. The pixel's
+    /// row is drawn again and what the render targets hold there (the
+    /// fragment's interpolated inputs and its output) is recorded.
+    fn trace_pixel(&self, job: &PassJob, x: u32, y: u32, rec: &mut PixelTrace) -> Option<Radiance> {
+        match self.read_back(job, x, y) {
+            Ok(r) => {
+                let value = r.output;
+                rec.gl_readback = Some(r);
+                Some(value)
+            }
+            Err(e) => {
+                eprintln!("warning: opengl: {e}");
+                None
+            }
+        }
+    }
+}
+
+impl OpenGl {
+    /// Draws row `y` of `job`'s pass and reads back what GL left at `(x, y)`.
+    fn read_back(&self, job: &PassJob, x: u32, y: u32) -> Result<GlReadback, String> {
+        let row = PassJob { rows: y..y + 1, active: None, ..*job };
+        let mut out = vec![Radiance::ZERO; job.view.width as usize];
+        let (_, readback) = GL.with(|g| pass::render(g, &row, &mut out, Some((x, y))))??;
+        readback.ok_or_else(|| format!("no GL readback at pixel ({x}, {y})"))
     }
 }
 

@@ -287,8 +287,9 @@ unsafe fn bind_environment(gl: &glow::Context, textures: &mut super::textures::T
     Ok(())
 }
 
-/// Draws `job`'s pass and stores its rows in `out`.
-pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance]) -> Result<RayCounts, String> {
+/// Draws `job`'s pass and stores its rows in `out`; with `probe` (a pixel
+/// of the pass's rows), also returns what GL's render targets hold there.
+pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Option<(u32, u32)>) -> Result<(RayCounts, Option<crate::render::pixel_record::GlReadback>), String> {
     let gl = &g.gl;
     let scene = &job.prepared.scene;
     let (width, height) = (job.view.width, job.view.height);
@@ -298,7 +299,8 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance]) -> Result<
         }
         let state = g.state.as_mut().expect("created above");
         let samples = job.settings.msaa.max(1);
-        let views = job.settings.view != crate::render::debug::View::Shaded;
+        let views = job.settings.view != crate::render::debug::View::Shaded || probe.is_some();
+        let view_colours = job.settings.view != crate::render::debug::View::Shaded;
         let (framebuffer, resolved) = state.target(gl, width, height, samples, views)?;
         state.upload(gl, scene);
         let keep: Vec<_> = scene
@@ -471,7 +473,7 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance]) -> Result<
                 if !job.is_active(x, y) {
                     continue;
                 }
-                out[k * w + x as usize] = match &surfaces {
+                out[k * w + x as usize] = match surfaces.as_ref().filter(|_| view_colours) {
                     Some(s) => super::views::colour(job, s.hit(scene, r, x as usize).as_ref(), x, y),
                     None => {
                         let p = &src[x as usize * 4..x as usize * 4 + 3];
@@ -480,8 +482,17 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance]) -> Result<
                 };
             }
         }
+        let readback = probe.zip(surfaces.as_ref()).and_then(|((x, y), s)| {
+            let k = rows.clone().position(|r| r == y)?;
+            let r = if y_down { k } else { n - 1 - k };
+            let surface = s.hit(scene, r, x as usize).map(|h| {
+                let ray = job.view.eye_ray(x as f32 + job.offset.x, y as f32 + job.offset.y);
+                crate::scene::SurfaceHit { t: (h.position - ray.origin).length(), ..h }
+            });
+            Some(crate::render::pixel_record::GlReadback { surface, output: *out.get(k * w + x as usize)? })
+        });
         // GL counts none of this; the counters stay zero.
-        Ok(RayCounts::default())
+        Ok((RayCounts::default(), readback))
     }
 }
 
