@@ -79,4 +79,8 @@ fn opengl_in_the_viewer_matches_the_cli_and_reads_back_a_clicked_pixel() {
     h.step();
     assert!(h.query_all_by_label_contains("GL readback, not a replay").next().is_some(), "the readback is labelled");
     assert!(h.query_all_by_label_contains("triangle").next().is_some(), "the primitive is named");
+    // The context goes before the process exits, as the binary does it,
+    // not in the C library's exit handlers while the driver's threads run.
+    drop(h);
+    pinhole::render::opengl::shutdown();
 }

@@ -477,7 +477,9 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Opt
                     Some(s) => super::views::colour(job, s.hit(scene, r, x as usize).as_ref(), x, y),
                     None => {
                         let p = &src[x as usize * 4..x as usize * 4 + 3];
-                        Vec3::new(p[0], p[1], p[2])
+                        let c = Vec3::new(p[0], p[1], p[2]);
+                        // Whatever the driver computed, no NaN reaches the frame.
+                        if c.is_finite() { c } else { Vec3::ZERO }
                     }
                 };
             }
