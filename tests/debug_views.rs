@@ -19,8 +19,8 @@ fn render_view(renderer: &str, scene_name: &str, view: View) -> Vec<Radiance> {
     render(renderer, &PreparedScene::new(scene), &settings)
 }
 
-/// The renderers that draw debug views (`opengl` draws the shaded view
-/// only and refuses the others through `Renderer::check`).
+/// The renderers that draw debug views (`opengl` draws those coloured from
+/// the surface alone and refuses the others through `Renderer::check`).
 fn renderers_with_views() -> Vec<&'static str> {
     let scene = builtin("one-triangle");
     let settings = RenderSettings { view: View::Normal, ..RenderSettings::for_scene(&scene) };

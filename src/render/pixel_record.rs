@@ -123,6 +123,16 @@ pub struct FragmentRecord {
     pub sample: Option<u32>,
 }
 
+/// What the `opengl` renderer's pass left at a pixel: the surface its
+/// fragment shader saw (interpolated position, normals, barycentrics, uv,
+/// primitive; `None` where no fragment was drawn) and the colour it wrote.
+/// Read back after the pass, not a replay.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GlReadback {
+    pub surface: Option<crate::scene::SurfaceHit>,
+    pub output: Radiance,
+}
+
 /// Everything one sample of one pixel did, in order. Built by passing a
 /// `PixelTrace` through the renderer's real code path.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -136,6 +146,9 @@ pub struct PixelTrace {
     pub bounces: Vec<Bounce>,
     /// Photon mapping: the density estimates read, in order.
     pub photon_estimates: Vec<Radiance>,
+    /// The `opengl` renderer: what GL reported for the pixel, read back
+    /// from its render targets (GL's shaders cannot be replayed).
+    pub gl_readback: Option<GlReadback>,
     shadow_active: bool,
     /// Index of the ray that events go to (shadow rays interleave with the parent's).
     current: Option<usize>,

@@ -90,6 +90,13 @@ fn sample_json(scene: &Scene, t: &PixelTrace) -> Value {
         "lights": t.lights.iter().map(light_json).collect::<Vec<_>>(),
         "fragments": t.fragments.iter().map(fragment_json).collect::<Vec<_>>(),
     });
+    if let Some(r) = &t.gl_readback {
+        record["gl_readback"] = json!({
+            "note": "GL readback, not a replay",
+            "surface": r.surface.as_ref().map(|h| hit_json(scene, h)),
+            "output": v3(r.output),
+        });
+    }
     // Indirect light's records appear only where a mode made them.
     if !t.bounces.is_empty() {
         record["bounces"] = t
@@ -194,6 +201,31 @@ pub fn to_text(renderer: &str, scene: &Scene, x: u32, y: u32, replay: &PixelRepl
                     let _ = writeln!(s, "{indent}  closest: nothing (background)");
                 }
             }
+        }
+        if let Some(r) = &t.gl_readback {
+            let _ = writeln!(s, "  GL readback, not a replay (the render targets at this pixel after the pass):");
+            match &r.surface {
+                Some(h) => {
+                    let _ = writeln!(
+                        s,
+                        "    {} {} (object {}, material {}): position {}, shading normal {}, geometric normal {}, barycentric {}, uv ({:.5}, {:.5})",
+                        kind(h.kind),
+                        h.primitive,
+                        h.object,
+                        h.material,
+                        fmt3(h.position),
+                        fmt3(h.shading_normal),
+                        fmt3(h.geometric_normal),
+                        fmt3(h.barycentric),
+                        h.uv.x,
+                        h.uv.y
+                    );
+                }
+                None => {
+                    let _ = writeln!(s, "    no fragment drawn (background)");
+                }
+            }
+            let _ = writeln!(s, "    output {}", fmt3(r.output));
         }
         if !t.fragments.is_empty() {
             let _ = writeln!(s, "  fragment history ({} fragment(s) in draw order; z = view depth):", t.fragments.len());

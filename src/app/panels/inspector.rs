@@ -11,7 +11,7 @@ use crate::app::inspect::{fmt3, kind_name, object_name};
 use crate::app::PinholeApp;
 use crate::math::Radiance;
 use crate::render::pixel_report::miss_reason;
-use crate::render::pixel_record::{FragmentRecord, LightSample, PixelTrace, RayRecord};
+use crate::render::pixel_record::{FragmentRecord, GlReadback, LightSample, PixelTrace, RayRecord};
 use crate::render::PixelReplay;
 use crate::scene::{Light, Scene};
 use egui::{Color32, RichText};
@@ -110,7 +110,38 @@ fn record(app: &PinholeApp, ui: &mut egui::Ui, names: &SceneNames, r: &PixelRepl
     final_value(app, ui, r.radiance, x, y, current);
 }
 
+/// The `opengl` renderer's record: what its render targets hold at the pixel.
+fn gl_readback(ui: &mut egui::Ui, names: &SceneNames, r: &GlReadback) {
+    ui.label(RichText::new("GL readback, not a replay").strong());
+    ui.label(
+        RichText::new("GL's shaders cannot be stepped through: the pixel's row was drawn again and its render targets read back.")
+            .small()
+            .color(DIM),
+    );
+    egui::Grid::new("gl-readback").num_columns(2).spacing([8.0, 2.0]).show(ui, |ui| match &r.surface {
+        Some(h) => {
+            grid_row(ui, "primitive", format!("{} {}", kind_name(h.kind), h.primitive));
+            grid_row(ui, "object", object_name(names.scene, h.kind, h.primitive));
+            grid_row(ui, "material", names.materials.get(h.material as usize).cloned().unwrap_or_default());
+            grid_row(ui, "position", fmt3(h.position));
+            grid_row(ui, "shading normal", fmt3(h.shading_normal));
+            grid_row(ui, "geometric normal", fmt3(h.geometric_normal));
+            grid_row(ui, "barycentric", fmt3(h.barycentric));
+            grid_row(ui, "uv", format!("({:.5}, {:.5})", h.uv.x, h.uv.y));
+            grid_row(ui, "back face", h.back_face.to_string());
+            grid_row(ui, "output", fmt3(r.output));
+        }
+        None => {
+            grid_row(ui, "fragment", "none drawn (background)".into());
+            grid_row(ui, "output", fmt3(r.output));
+        }
+    });
+}
+
 fn sample(ui: &mut egui::Ui, names: &SceneNames, t: &PixelTrace, value: Radiance) {
+    if let Some(r) = &t.gl_readback {
+        gl_readback(ui, names, r);
+    }
     // Rays other than shadow rays, as a tree by depth; shadow rays go with their light.
     let mut shadow_rays: Vec<&RayRecord> = t.rays.iter().filter(|r| r.shadow).collect();
     // A rasterizer: visibility came from the fragments; its eye ray only carries w_o to shading.

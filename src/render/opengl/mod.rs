@@ -10,9 +10,12 @@ mod pass;
 mod scene_data;
 mod shaders;
 mod shadow_pass;
+mod textures;
+mod views;
 
 use crate::math::Radiance;
-use crate::render::{debug, gi, Interpolation, PassJob, RayCounts, RenderSettings, Renderer, ShadowMode};
+use crate::render::{debug, gi, Interpolation, PassJob, RayCounts, Reflections, RenderSettings, Renderer, ShadowMode};
+use crate::render::pixel_record::{GlReadback, PixelTrace};
 use crate::scene::Scene;
 
 static GL: context::Shared<pass::State> = context::Shared::new();
@@ -36,12 +39,16 @@ impl Renderer for OpenGl {
 
     fn check(&self, scene: &Scene, settings: &RenderSettings) -> Result<(), String> {
         unsupported(scene, settings)?;
-        GL.with(|_| ()).map(|_| ())
+        let max_samples = max_samples()?;
+        if settings.msaa > 1 && settings.msaa as i32 > max_samples {
+            return Err(format!("the opengl renderer's driver offers at most {max_samples} samples per pixel, not --msaa {}", settings.msaa));
+        }
+        Ok(())
     }
 
     fn render_pass(&self, job: &PassJob, out: &mut [Radiance]) -> RayCounts {
-        match GL.with(|g| pass::render(g, job, out)) {
-            Ok(Ok(counts)) => counts,
+        match GL.with(|g| pass::render(g, job, out, None)) {
+            Ok(Ok((counts, _))) => counts,
             Ok(Err(e)) | Err(e) => {
                 // `check` refuses what cannot be drawn before a frame starts;
                 // a failure here leaves the rows black rather than stale.
@@ -51,6 +58,33 @@ impl Renderer for OpenGl {
             }
         }
     }
+
+    /// Not a replay: GL's shaders cannot be stepped through. The pixel's
+    /// row is drawn again and what the render targets hold there (the
+    /// fragment's interpolated inputs and its output) is recorded.
+    fn trace_pixel(&self, job: &PassJob, x: u32, y: u32, rec: &mut PixelTrace) -> Option<Radiance> {
+        match self.read_back(job, x, y) {
+            Ok(r) => {
+                let value = r.output;
+                rec.gl_readback = Some(r);
+                Some(value)
+            }
+            Err(e) => {
+                eprintln!("warning: opengl: {e}");
+                None
+            }
+        }
+    }
+}
+
+impl OpenGl {
+    /// Draws row `y` of `job`'s pass and reads back what GL left at `(x, y)`.
+    fn read_back(&self, job: &PassJob, x: u32, y: u32) -> Result<GlReadback, String> {
+        let row = PassJob { rows: y..y + 1, active: None, ..*job };
+        let mut out = vec![Radiance::ZERO; job.view.width as usize];
+        let (_, readback) = GL.with(|g| pass::render(g, &row, &mut out, Some((x, y))))??;
+        readback.ok_or_else(|| format!("no GL readback at pixel ({x}, {y})"))
+    }
 }
 
 /// What the fragment shaders do not compute yet, as one sentence.
@@ -59,8 +93,11 @@ fn unsupported(scene: &Scene, settings: &RenderSettings) -> Result<(), String> {
     if !matches!(settings.shadows, ShadowMode::None | ShadowMode::Map) {
         return refuse("supports --shadows none|map only (it casts no rays)");
     }
-    if !matches!(settings.view, debug::View::Shaded) {
-        return refuse("draws the shaded view only");
+    if settings.view != debug::View::Shaded && !views::drawable(settings.view) {
+        return refuse("draws the shaded view and --view barycentric|raydir|depth|zbuffer|normal|geometric-normal|id|triangle-id|material-id|uv only");
+    }
+    if settings.view != debug::View::Shaded && settings.msaa > 1 {
+        return refuse("draws debug views without --msaa only");
     }
     if settings.gi.mode != gi::GiMode::None {
         return refuse("supports --gi none only");
@@ -68,11 +105,13 @@ fn unsupported(scene: &Scene, settings: &RenderSettings) -> Result<(), String> {
     if settings.interpolation == Interpolation::Gouraud {
         return refuse("supports --interpolation phong|flat only");
     }
-    if let Some(m) = scene.materials.iter().find(|m| m.texture.is_some()) {
-        return refuse(&format!("does not draw textures yet (material \"{}\")", m.name));
+    if let Some(m) = scene.materials.iter().find(|m| m.transmission != crate::math::Vec3::ZERO) {
+        return refuse(&format!("cannot trace glass rays (material \"{}\")", m.name));
     }
-    if let Some(m) = scene.materials.iter().find(|m| m.has_secondary()) {
-        return refuse(&format!("cannot trace mirror or glass rays (material \"{}\")", m.name));
+    if settings.reflections == Reflections::Ray {
+        if let Some(m) = scene.materials.iter().find(|m| m.has_secondary()) {
+            return refuse(&format!("cannot trace mirror rays; use --reflections env (material \"{}\")", m.name));
+        }
     }
     Ok(())
 }
@@ -80,4 +119,10 @@ fn unsupported(scene: &Scene, settings: &RenderSettings) -> Result<(), String> {
 /// The OpenGL driver in use (`GL_RENDERER`), or why there is none.
 pub fn driver() -> Result<String, String> {
     GL.with(|g| g.renderer.clone())
+}
+
+/// The most samples per pixel the driver's multisampling offers (`GL_MAX_SAMPLES`).
+pub fn max_samples() -> Result<i32, String> {
+    // SAFETY: a plain query on the current context.
+    GL.with(|g| unsafe { glow::HasContext::get_parameter_i32(&g.gl, glow::MAX_SAMPLES) })
 }

@@ -6,17 +6,18 @@ use super::context::Gl;
 use super::scene_data;
 use super::shaders;
 use crate::math::{Radiance, Vec3};
-use crate::render::{Interpolation, PassJob, RayCounts, ShadowMode};
+use crate::render::{Interpolation, PassJob, RayCounts, Reflections, ShadowMode};
+use crate::scene::texture::{TextureFilter, Wrap};
 use glow::HasContext;
 
 /// What lives in the context between passes.
 pub struct State {
-    triangles: glow::Program,
-    spheres: glow::Program,
-    /// The same with shadow-map lookups (`--shadows map`).
-    triangles_mapped: glow::Program,
-    spheres_mapped: glow::Program,
+    /// The triangle and sphere programs, compiled on first use for each set
+    /// of defines (shadow-map lookups, multisampling).
+    programs: Vec<(String, glow::Program, glow::Program)>,
+    background: glow::Program,
     maps: super::shadow_pass::ShadowPass,
+    textures: super::textures::Textures,
     vertex_array: glow::VertexArray,
     vertex_buffer: glow::Buffer,
     cube_array: glow::VertexArray,
@@ -24,17 +25,22 @@ pub struct State {
     material_buffer: glow::Buffer,
     light_buffer: glow::Buffer,
     /// The uploaded geometry: its fingerprint, triangle runs, sphere count.
-    uploaded: Option<(u64, Vec<(u32, u32, bool)>, usize)>,
+    uploaded: Option<(u64, Vec<scene_data::Run>, usize)>,
     target: Option<Target>,
 }
 
-/// The framebuffer a pass draws into: RGBA32F colour and a 32-bit float depth.
+/// The framebuffer a pass draws into: RGBA32F colour and a 32-bit float
+/// depth; with `--msaa` a multisampled one beside it, resolved into the first.
 struct Target {
     width: u32,
     height: u32,
+    samples: u32,
     framebuffer: glow::Framebuffer,
     colour: glow::Texture,
     depth: glow::Renderbuffer,
+    multisampled: Option<(glow::Framebuffer, glow::Renderbuffer, glow::Renderbuffer)>,
+    /// With a debug view: the surface targets (`views`), attachments 1 and up.
+    surfaces: Vec<glow::Texture>,
 }
 
 pub(super) unsafe fn compile(gl: &glow::Context, vertex: &str, fragment: &str) -> Result<glow::Program, String> {
@@ -66,11 +72,7 @@ pub(super) unsafe fn compile(gl: &glow::Context, vertex: &str, fragment: &str) -
 impl State {
     unsafe fn new(gl: &glow::Context) -> Result<State, String> {
         unsafe {
-            let triangles = compile(gl, shaders::TRIANGLE_VERTEX, &shaders::triangle_fragment(""))?;
-            let spheres = compile(gl, shaders::SPHERE_VERTEX, &shaders::sphere_fragment(""))?;
-            let mapped = "#define SHADOW_MAP 1\n";
-            let triangles_mapped = compile(gl, shaders::TRIANGLE_VERTEX, &shaders::triangle_fragment(mapped))?;
-            let spheres_mapped = compile(gl, shaders::SPHERE_VERTEX, &shaders::sphere_fragment(mapped))?;
+            let background = compile(gl, shaders::BACKGROUND_VERTEX, &shaders::background_fragment())?;
             let maps = super::shadow_pass::ShadowPass::new(gl)?;
             let vertex_array = gl.create_vertex_array()?;
             let vertex_buffer = gl.create_buffer()?;
@@ -83,6 +85,10 @@ impl State {
             }
             gl.enable_vertex_attrib_array(3);
             gl.vertex_attrib_pointer_i32(3, 1, glow::UNSIGNED_INT, stride, 36);
+            gl.enable_vertex_attrib_array(4);
+            gl.vertex_attrib_pointer_f32(4, 2, glow::FLOAT, false, stride, 40);
+            gl.enable_vertex_attrib_array(5);
+            gl.vertex_attrib_pointer_f32(5, 4, glow::FLOAT, false, stride, 48);
             let cube_array = gl.create_vertex_array()?;
             let cube_buffer = gl.create_buffer()?;
             gl.bind_vertex_array(Some(cube_array));
@@ -92,11 +98,10 @@ impl State {
             gl.vertex_attrib_pointer_f32(0, 3, glow::FLOAT, false, 12, 0);
             gl.bind_vertex_array(None);
             Ok(State {
-                triangles,
-                spheres,
-                triangles_mapped,
-                spheres_mapped,
+                programs: Vec::new(),
+                background,
                 maps,
+                textures: Default::default(),
                 vertex_array,
                 vertex_buffer,
                 cube_array,
@@ -109,15 +114,38 @@ impl State {
         }
     }
 
-    unsafe fn target(&mut self, gl: &glow::Context, width: u32, height: u32) -> Result<glow::Framebuffer, String> {
+    /// The triangle and sphere programs compiled with `defines`.
+    unsafe fn programs(&mut self, gl: &glow::Context, defines: &str) -> Result<(glow::Program, glow::Program), String> {
+        if let Some((_, t, s)) = self.programs.iter().find(|p| p.0 == defines) {
+            return Ok((*t, *s));
+        }
+        unsafe {
+            let t = compile(gl, shaders::TRIANGLE_VERTEX, &shaders::triangle_fragment(defines))?;
+            let s = compile(gl, shaders::SPHERE_VERTEX, &shaders::sphere_fragment(defines))?;
+            self.programs.push((defines.to_string(), t, s));
+            Ok((t, s))
+        }
+    }
+
+    /// The framebuffer to draw into and the one to read from (the same
+    /// without multisampling).
+    unsafe fn target(&mut self, gl: &glow::Context, width: u32, height: u32, samples: u32, views: bool) -> Result<(glow::Framebuffer, glow::Framebuffer), String> {
         unsafe {
             if let Some(t) = &self.target {
-                if (t.width, t.height) == (width, height) {
-                    return Ok(t.framebuffer);
+                if (t.width, t.height, t.samples, !t.surfaces.is_empty()) == (width, height, samples, views) {
+                    return Ok((t.multisampled.map_or(t.framebuffer, |m| m.0), t.framebuffer));
                 }
                 gl.delete_framebuffer(t.framebuffer);
                 gl.delete_texture(t.colour);
                 gl.delete_renderbuffer(t.depth);
+                if let Some((f, c, d)) = t.multisampled {
+                    gl.delete_framebuffer(f);
+                    gl.delete_renderbuffer(c);
+                    gl.delete_renderbuffer(d);
+                }
+                for &s in &t.surfaces {
+                    gl.delete_texture(s);
+                }
                 self.target = None;
             }
             let framebuffer = gl.create_framebuffer()?;
@@ -130,15 +158,40 @@ impl State {
             gl.bind_framebuffer(glow::FRAMEBUFFER, Some(framebuffer));
             gl.framebuffer_texture_2d(glow::FRAMEBUFFER, glow::COLOR_ATTACHMENT0, glow::TEXTURE_2D, Some(colour), 0);
             gl.framebuffer_renderbuffer(glow::FRAMEBUFFER, glow::DEPTH_ATTACHMENT, glow::RENDERBUFFER, Some(depth));
-            let status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
-            if status != glow::FRAMEBUFFER_COMPLETE {
-                gl.delete_framebuffer(framebuffer);
-                gl.delete_texture(colour);
-                gl.delete_renderbuffer(depth);
-                return Err(format!("the driver cannot draw into a {width}x{height} float framebuffer (status {status:#x})"));
+            let mut surfaces = Vec::new();
+            if views {
+                for i in 0..super::views::TARGETS {
+                    let t = gl.create_texture()?;
+                    let format = if i < super::views::FLOAT_TARGETS { glow::RGBA32F } else { glow::RGBA32UI };
+                    gl.bind_texture(glow::TEXTURE_2D, Some(t));
+                    gl.tex_storage_2d(glow::TEXTURE_2D, 1, format, width as i32, height as i32);
+                    gl.framebuffer_texture_2d(glow::FRAMEBUFFER, glow::COLOR_ATTACHMENT1 + i as u32, glow::TEXTURE_2D, Some(t), 0);
+                    surfaces.push(t);
+                }
             }
-            self.target = Some(Target { width, height, framebuffer, colour, depth });
-            Ok(framebuffer)
+            let mut status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
+            let mut multisampled = None;
+            if samples > 1 && status == glow::FRAMEBUFFER_COMPLETE {
+                let f = gl.create_framebuffer()?;
+                let c = gl.create_renderbuffer()?;
+                let d = gl.create_renderbuffer()?;
+                gl.bind_renderbuffer(glow::RENDERBUFFER, Some(c));
+                gl.renderbuffer_storage_multisample(glow::RENDERBUFFER, samples as i32, glow::RGBA32F, width as i32, height as i32);
+                gl.bind_renderbuffer(glow::RENDERBUFFER, Some(d));
+                gl.renderbuffer_storage_multisample(glow::RENDERBUFFER, samples as i32, glow::DEPTH_COMPONENT32F, width as i32, height as i32);
+                gl.bind_framebuffer(glow::FRAMEBUFFER, Some(f));
+                gl.framebuffer_renderbuffer(glow::FRAMEBUFFER, glow::COLOR_ATTACHMENT0, glow::RENDERBUFFER, Some(c));
+                gl.framebuffer_renderbuffer(glow::FRAMEBUFFER, glow::DEPTH_ATTACHMENT, glow::RENDERBUFFER, Some(d));
+                status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
+                multisampled = Some((f, c, d));
+            }
+            let t = Target { width, height, samples, framebuffer, colour, depth, multisampled, surfaces };
+            let draw = (t.multisampled.map_or(t.framebuffer, |m| m.0), t.framebuffer);
+            self.target = Some(t);
+            if status != glow::FRAMEBUFFER_COMPLETE {
+                return Err(format!("the driver cannot draw into a {width}x{height} float framebuffer with {samples} samples (status {status:#x})"));
+            }
+            Ok(draw)
         }
     }
 
@@ -186,11 +239,57 @@ unsafe fn uniforms(gl: &glow::Context, program: glow::Program, job: &PassJob) {
         gl.uniform_3_f32(at("ambient").as_ref(), a.x, a.y, a.z);
         gl.uniform_1_i32(at("light_count").as_ref(), scene.lights.len() as i32);
         gl.uniform_1_i32(at("flat_shading").as_ref(), (job.settings.interpolation == Interpolation::Flat) as i32);
+        gl.uniform_1_i32(at("y_down").as_ref(), (job.settings.msaa > 1) as i32);
+        let bg = scene.render.background;
+        gl.uniform_3_f32(at("background").as_ref(), bg.x, bg.y, bg.z);
+        gl.uniform_1_i32(at("has_environment").as_ref(), scene.environment.is_some() as i32);
+        gl.uniform_1_f32(at("environment_intensity").as_ref(), scene.environment.as_ref().map_or(0.0, |e| e.intensity));
+        gl.uniform_1_i32(at("mirror_env").as_ref(), (job.settings.reflections == Reflections::Env && job.settings.max_depth > 0) as i32);
+        gl.uniform_1_i32(at("albedo_map").as_ref(), ALBEDO_UNIT as i32);
+        gl.uniform_1_i32(at("normal_map").as_ref(), NORMAL_UNIT as i32);
+        gl.uniform_1_i32(at("environment").as_ref(), ENVIRONMENT_UNIT as i32);
     }
 }
 
-/// Draws `job`'s pass and stores its rows in `out`.
-pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance]) -> Result<RayCounts, String> {
+/// Texture units: 0 holds the shadow maps.
+const ALBEDO_UNIT: u32 = 1;
+const NORMAL_UNIT: u32 = 2;
+const ENVIRONMENT_UNIT: u32 = 3;
+
+/// Binds material `m`'s texture and normal map and sets what the
+/// fragment shader reads of them.
+unsafe fn material_textures(gl: &glow::Context, textures: &mut super::textures::Textures, program: glow::Program, job: &PassJob, m: u32) -> Result<(), String> {
+    let Some(material) = job.prepared.scene.materials.get(m as usize) else { return Ok(()) };
+    let filter = job.settings.texture_filter;
+    unsafe {
+        let at = |name: &str| gl.get_uniform_location(program, name);
+        for (map, unit, flag) in [(&material.texture, ALBEDO_UNIT, "has_albedo_map"), (&material.normal_map, NORMAL_UNIT, "has_normal_map")] {
+            if let Some(t) = map {
+                let id = textures.get(gl, t)?;
+                super::textures::bind(gl, unit, id, filter, material.wrap, material.wrap);
+            }
+            gl.uniform_1_i32(at(flag).as_ref(), map.is_some() as i32);
+        }
+        gl.uniform_2_f32(at("uv_scale").as_ref(), material.uv_scale.x, material.uv_scale.y);
+        Ok(())
+    }
+}
+
+/// Uploads and binds the environment (level 0, bilinear, repeating around
+/// the horizon and clamped at the poles, as `Environment::radiance` reads it).
+unsafe fn bind_environment(gl: &glow::Context, textures: &mut super::textures::Textures, scene: &crate::scene::Scene) -> Result<(), String> {
+    if let Some(env) = &scene.environment {
+        unsafe {
+            let id = textures.get(gl, &env.texture)?;
+            super::textures::bind(gl, ENVIRONMENT_UNIT, id, TextureFilter::Bilinear, Wrap::Repeat, Wrap::Clamp);
+        }
+    }
+    Ok(())
+}
+
+/// Draws `job`'s pass and stores its rows in `out`; with `probe` (a pixel
+/// of the pass's rows), also returns what GL's render targets hold there.
+pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Option<(u32, u32)>) -> Result<(RayCounts, Option<crate::render::pixel_record::GlReadback>), String> {
     let gl = &g.gl;
     let scene = &job.prepared.scene;
     let (width, height) = (job.view.width, job.view.height);
@@ -199,8 +298,19 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance]) -> Result<
             g.state = Some(State::new(gl)?);
         }
         let state = g.state.as_mut().expect("created above");
-        let framebuffer = state.target(gl, width, height)?;
+        let samples = job.settings.msaa.max(1);
+        let views = job.settings.view != crate::render::debug::View::Shaded || probe.is_some();
+        let view_colours = job.settings.view != crate::render::debug::View::Shaded;
+        let (framebuffer, resolved) = state.target(gl, width, height, samples, views)?;
         state.upload(gl, scene);
+        let keep: Vec<_> = scene
+            .materials
+            .iter()
+            .flat_map(|m| [m.texture.as_ref(), m.normal_map.as_ref()])
+            .chain([scene.environment.as_ref().map(|e| &e.texture)])
+            .flatten()
+            .collect();
+        state.textures.retain(gl, &keep);
         gl.bind_buffer_base(glow::SHADER_STORAGE_BUFFER, 2, Some(state.sphere_buffer));
         let mapped = job.settings.shadows == ShadowMode::Map;
         let first_faces = if mapped {
@@ -220,27 +330,62 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance]) -> Result<
 
         gl.bind_framebuffer(glow::FRAMEBUFFER, Some(framebuffer));
         gl.viewport(0, 0, width as i32, height as i32);
-        // Only the rows asked for (GL rows count from the bottom).
+        // With --msaa the image is drawn upside down: GL's 4-sample pattern,
+        // given in its bottom-up window, then falls where pinhole's top-down
+        // D3D pattern puts its samples. Windings turn round with it.
+        let y_down = samples > 1;
         let rows = job.rows.start.min(height)..job.rows.end.min(height);
+        // Only the rows asked for (GL rows count from the bottom).
+        let first_gl_row = if y_down { rows.start } else { height - rows.end };
         gl.enable(glow::SCISSOR_TEST);
-        gl.scissor(0, (height - rows.end) as i32, width as i32, rows.len() as i32);
+        gl.scissor(0, first_gl_row as i32, width as i32, rows.len() as i32);
         // Reversed depth in [0, 1]: 1 at the near plane, 0 at the far plane.
         (g.clip_control)(glow::LOWER_LEFT, glow::ZERO_TO_ONE);
         let bg: Vec3 = scene.render.background;
         gl.clear_buffer_f32_slice(glow::COLOR, 0, &[bg.x, bg.y, bg.z, 1.0]);
         gl.clear_buffer_f32_slice(glow::DEPTH, 0, &[0.0]);
+        let all_targets: Vec<u32> = (0..=super::views::TARGETS as u32).map(|i| glow::COLOR_ATTACHMENT0 + i).collect();
+        if views {
+            gl.draw_buffers(&all_targets);
+            for i in 1..=super::views::FLOAT_TARGETS as u32 {
+                gl.clear_buffer_f32_slice(glow::COLOR, i, &[0.0; 4]);
+            }
+            gl.clear_buffer_u32_slice(glow::COLOR, super::views::TARGETS as u32, &[0; 4]);
+            // The background writes the colour only.
+            gl.draw_buffers(&all_targets[..1]);
+        }
         gl.enable(glow::DEPTH_TEST);
         gl.depth_func(glow::GREATER);
         gl.depth_mask(true);
         gl.disable(glow::BLEND);
-        gl.front_face(glow::CCW);
+        gl.front_face(if y_down { glow::CW } else { glow::CCW });
         gl.cull_face(glow::BACK);
+        if scene.environment.is_some() {
+            bind_environment(gl, &mut state.textures, scene)?;
+            gl.disable(glow::DEPTH_TEST);
+            gl.depth_mask(false);
+            gl.use_program(Some(state.background));
+            uniforms(gl, state.background, job);
+            gl.bind_vertex_array(Some(state.cube_array));
+            gl.draw_arrays(glow::TRIANGLES, 0, 3);
+            gl.enable(glow::DEPTH_TEST);
+            gl.depth_mask(true);
+        }
 
+        if views {
+            gl.draw_buffers(&all_targets);
+        }
         let (runs, sphere_count) = {
             let u = state.uploaded.as_ref().expect("uploaded above");
             (u.1.clone(), u.2)
         };
-        let (triangles, spheres) = if mapped { (state.triangles_mapped, state.spheres_mapped) } else { (state.triangles, state.spheres) };
+        let defines = format!(
+            "{}{}{}",
+            if mapped { "#define SHADOW_MAP 1\n" } else { "" },
+            if samples > 1 { "#define MSAA 1\n" } else { "" },
+            if views { "#define VIEWS 1\n" } else { "" }
+        );
+        let (triangles, spheres) = state.programs(gl, &defines)?;
         if mapped {
             state.maps.bind_for_lookup(gl);
         }
@@ -251,7 +396,8 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance]) -> Result<
                 state.maps.lookup_uniforms(gl, triangles, job.settings);
             }
             gl.bind_vertex_array(Some(state.vertex_array));
-            for (first, count, two_sided) in runs {
+            for scene_data::Run { first, count, two_sided, material } in runs {
+                material_textures(gl, &mut state.textures, triangles, job, material)?;
                 if two_sided {
                     gl.disable(glow::CULL_FACE);
                 } else {
@@ -272,10 +418,27 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance]) -> Result<
                 state.maps.lookup_uniforms(gl, spheres, job.settings);
             }
             gl.bind_vertex_array(Some(state.cube_array));
-            gl.draw_arrays_instanced(glow::TRIANGLES, 0, 36, sphere_count as i32);
+            // One draw per run of spheres sharing a material (and so its textures).
+            let mut first = 0;
+            while first < sphere_count {
+                let m = scene.spheres[first].material;
+                let count = scene.spheres[first..].iter().take_while(|s| s.material == m).count();
+                material_textures(gl, &mut state.textures, spheres, job, m)?;
+                gl.uniform_1_i32(gl.get_uniform_location(spheres, "first_sphere").as_ref(), first as i32);
+                gl.draw_arrays_instanced(glow::TRIANGLES, 0, 36, count as i32);
+                first += count;
+            }
             gl.disable(glow::DEPTH_CLAMP);
         }
         gl.bind_vertex_array(None);
+        if resolved != framebuffer {
+            // GL's resolve: each pixel the plain mean of its samples.
+            gl.bind_framebuffer(glow::READ_FRAMEBUFFER, Some(framebuffer));
+            gl.bind_framebuffer(glow::DRAW_FRAMEBUFFER, Some(resolved));
+            let (w, h) = (width as i32, height as i32);
+            gl.blit_framebuffer(0, 0, w, h, 0, 0, w, h, glow::COLOR_BUFFER_BIT, glow::NEAREST);
+            gl.bind_framebuffer(glow::FRAMEBUFFER, Some(resolved));
+        }
         gl.disable(glow::SCISSOR_TEST);
 
         let w = width as usize;
@@ -283,36 +446,59 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance]) -> Result<
         gl.pixel_store_i32(glow::PACK_ALIGNMENT, 4);
         gl.read_pixels(
             0,
-            (height - rows.end) as i32,
+            first_gl_row as i32,
             width as i32,
             rows.len() as i32,
             glow::RGBA,
             glow::FLOAT,
             glow::PixelPackData::Slice(Some(bytes_mut(&mut pixels))),
         );
+        let surfaces = views.then(|| super::views::Readback::read(gl, first_gl_row, width, rows.len() as u32));
+        if views {
+            gl.draw_buffers(&all_targets[..1]);
+        }
         gl.bind_framebuffer(glow::FRAMEBUFFER, None);
+        gl.front_face(glow::CCW);
         let error = gl.get_error();
         if error != glow::NO_ERROR {
             return Err(format!("OpenGL reported error {error:#x} while drawing"));
         }
-        // GL's rows run bottom-up: the last row read is the first asked for.
+        // GL's rows run bottom-up: the last row read is the first asked for
+        // (unless drawn upside down).
         let n = rows.len();
         for (k, y) in rows.clone().enumerate() {
-            let src = &pixels[(n - 1 - k) * w * 4..(n - k) * w * 4];
+            let r = if y_down { k } else { n - 1 - k };
+            let src = &pixels[r * w * 4..(r + 1) * w * 4];
             for x in 0..width {
                 if !job.is_active(x, y) {
                     continue;
                 }
-                let p = &src[x as usize * 4..x as usize * 4 + 3];
-                out[k * w + x as usize] = Vec3::new(p[0], p[1], p[2]);
+                out[k * w + x as usize] = match surfaces.as_ref().filter(|_| view_colours) {
+                    Some(s) => super::views::colour(job, s.hit(scene, r, x as usize).as_ref(), x, y),
+                    None => {
+                        let p = &src[x as usize * 4..x as usize * 4 + 3];
+                        let c = Vec3::new(p[0], p[1], p[2]);
+                        // Whatever the driver computed, no NaN reaches the frame.
+                        if c.is_finite() { c } else { Vec3::ZERO }
+                    }
+                };
             }
         }
+        let readback = probe.zip(surfaces.as_ref()).and_then(|((x, y), s)| {
+            let k = rows.clone().position(|r| r == y)?;
+            let r = if y_down { k } else { n - 1 - k };
+            let surface = s.hit(scene, r, x as usize).map(|h| {
+                let ray = job.view.eye_ray(x as f32 + job.offset.x, y as f32 + job.offset.y);
+                crate::scene::SurfaceHit { t: (h.position - ray.origin).length(), ..h }
+            });
+            Some(crate::render::pixel_record::GlReadback { surface, output: *out.get(k * w + x as usize)? })
+        });
         // GL counts none of this; the counters stay zero.
-        Ok(RayCounts::default())
+        Ok((RayCounts::default(), readback))
     }
 }
 
-fn bytes_mut(v: &mut [f32]) -> &mut [u8] {
+pub(super) fn bytes_mut(v: &mut [f32]) -> &mut [u8] {
     // SAFETY: every bit pattern is a valid f32 and u8 has alignment 1.
     unsafe { std::slice::from_raw_parts_mut(v.as_mut_ptr().cast::<u8>(), std::mem::size_of_val(v)) }
 }

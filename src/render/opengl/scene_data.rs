@@ -5,21 +5,31 @@
 
 use crate::scene::{Light, Scene};
 
-/// Floats per vertex: position, shading normal, face normal, material bits.
-pub const VERTEX_FLOATS: usize = 10;
+/// Floats per vertex: position, shading normal, face normal, material
+/// bits, uv, tangent and handedness (zero without a normal map).
+pub const VERTEX_FLOATS: usize = 16;
 
 /// The vertex data of every triangle, in scene order.
 pub struct Geometry {
     pub vertices: Vec<f32>,
-    /// Consecutive triangles with the same sidedness: (first triangle, count, two-sided).
-    pub runs: Vec<(u32, u32, bool)>,
+    /// Consecutive triangles with the same sidedness and material: (first triangle, count, two-sided, material).
+    pub runs: Vec<Run>,
     /// Per sphere: (centre, radius), (material bits, 0, 0, 0).
     pub spheres: Vec<f32>,
 }
 
+/// Consecutive triangles drawn with one call: first, count, two-sided, material.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Run {
+    pub first: u32,
+    pub count: u32,
+    pub two_sided: bool,
+    pub material: u32,
+}
+
 pub fn geometry(scene: &Scene) -> Geometry {
     let mut vertices = Vec::with_capacity(scene.triangles.len() * 3 * VERTEX_FLOATS);
-    let mut runs: Vec<(u32, u32, bool)> = Vec::new();
+    let mut runs: Vec<Run> = Vec::new();
     for (i, t) in scene.triangles.iter().enumerate() {
         let face = t.geometric_normal();
         for k in 0..3 {
@@ -27,10 +37,14 @@ pub fn geometry(scene: &Scene) -> Geometry {
             vertices.extend_from_slice(&t.n[k].to_array());
             vertices.extend_from_slice(&face.to_array());
             vertices.push(f32::from_bits(t.material));
+            vertices.extend_from_slice(&t.uv[k].to_array());
+            // The handedness of the first corner on all three (`tangent_at`).
+            let tangent = scene.tangents.get(i).map_or(glam::Vec4::ZERO, |c| c[k].truncate().extend(c[0].w));
+            vertices.extend_from_slice(&tangent.to_array());
         }
         match runs.last_mut() {
-            Some(run) if run.2 == t.two_sided => run.1 += 1,
-            _ => runs.push((i as u32, 1, t.two_sided)),
+            Some(run) if run.two_sided == t.two_sided && run.material == t.material => run.count += 1,
+            _ => runs.push(Run { first: i as u32, count: 1, two_sided: t.two_sided, material: t.material }),
         }
     }
     let mut spheres = Vec::with_capacity(scene.spheres.len() * 8);
@@ -45,12 +59,19 @@ pub fn geometry(scene: &Scene) -> Geometry {
 pub fn fingerprint(scene: &Scene) -> u64 {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325 ^ scene.triangles.len() as u64 ^ ((scene.spheres.len() as u64) << 32);
     let mut mix = |x: u32| h = (h ^ x as u64).wrapping_mul(0x0000_0100_0000_01b3).rotate_left(5);
-    for t in &scene.triangles {
+    for (i, t) in scene.triangles.iter().enumerate() {
         for k in 0..3 {
             for v in [t.v[k], t.n[k]] {
                 mix(v.x.to_bits());
                 mix(v.y.to_bits());
                 mix(v.z.to_bits());
+            }
+            mix(t.uv[k].x.to_bits());
+            mix(t.uv[k].y.to_bits());
+            if let Some(c) = scene.tangents.get(i) {
+                for x in c[k].to_array() {
+                    mix(x.to_bits());
+                }
             }
         }
         mix(t.material | (t.two_sided as u32) << 31);
@@ -64,14 +85,17 @@ pub fn fingerprint(scene: &Scene) -> u64 {
     h
 }
 
-/// Per material: (k_L, 0), (k_G, sharpness).
+/// Per material: (k_L, 0), (k_G, sharpness), (k_M, 0).
+pub const MATERIAL_FLOATS: usize = 12;
+
 pub fn materials(scene: &Scene) -> Vec<f32> {
-    let mut out = Vec::with_capacity(scene.materials.len().max(1) * 8);
+    let mut out = Vec::with_capacity(scene.materials.len().max(1) * MATERIAL_FLOATS);
     for m in &scene.materials {
         out.extend_from_slice(&[m.lambertian.x, m.lambertian.y, m.lambertian.z, 0.0, m.glossy.x, m.glossy.y, m.glossy.z, m.sharpness]);
+        out.extend_from_slice(&[m.mirror.x, m.mirror.y, m.mirror.z, 0.0]);
     }
     if out.is_empty() {
-        out.resize(8, 0.0);
+        out.resize(MATERIAL_FLOATS, 0.0);
     }
     out
 }

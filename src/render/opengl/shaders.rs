@@ -17,13 +17,82 @@ uniform float near_plane;
 uniform float far_plane;
 uniform vec3 ambient;
 uniform int light_count;
+uniform bool y_down;
 
-// Per material: (k_L, 0), (k_G, sharpness).
+// Per material: (k_L, 0), (k_G, sharpness), (k_M, 0).
 layout(std430, binding = 0) readonly buffer Materials { vec4 materials[]; };
 // Per light: (position or direction, 0 = point | 1 = directional), (power or irradiance, 0).
 layout(std430, binding = 1) readonly buffer Lights { vec4 lights[]; };
 
 const float PI = 3.14159265358979323846;
+
+// The drawn material's texture and normal map (`Material::scaled`: uvs
+// times uv_scale; GL's t runs down from the top row, t = 1 - v), read by
+// GL's own filtering at the level of detail given.
+uniform bool has_albedo_map;
+uniform sampler2D albedo_map;
+uniform bool has_normal_map;
+uniform sampler2D normal_map;
+uniform vec2 uv_scale;
+// Scene::miss_radiance: the latitude-longitude environment, else the background.
+uniform bool has_environment;
+uniform sampler2D environment;
+uniform float environment_intensity;
+uniform vec3 background;
+// `--reflections env` with a depth to spare: mirrors look the environment up.
+uniform bool mirror_env;
+
+vec2 tex_coord(vec2 uv) {
+    vec2 s = uv * uv_scale;
+    return vec2(s.x, 1.0 - s.y);
+}
+
+// Texture::level_of_detail: log2 of the longer pixel step in level-0
+// texels, 0 when magnified, the coarsest level when unknown. GL is handed
+// this lambda (textureLod) and does the rest: the level pair, their blend
+// and the bilinear reads. Left to derive lambda from the same gradients
+// (textureGrad), llvmpipe approximates the steps' lengths and agrees less.
+float level_of_detail(vec2 size, vec2 duv_dx, vec2 duv_dy) {
+    vec2 g = uv_scale * size;
+    float rho = max(length(duv_dx * g), length(duv_dy * g));
+    if (isnan(rho)) return 1000.0;
+    return rho <= 1.0 ? 0.0 : min(log2(rho), 1000.0);
+}
+
+vec3 albedo_at(uint m, vec2 uv, vec2 duv_dx, vec2 duv_dy) {
+    vec3 k = materials[3u * m].xyz;
+    if (!has_albedo_map) return k;
+    float lod = level_of_detail(vec2(textureSize(albedo_map, 0)), duv_dx, duv_dy);
+    return k * textureLod(albedo_map, tex_coord(uv), lod).rgb;
+}
+
+vec3 normal_texel(vec2 uv, vec2 duv_dx, vec2 duv_dy) {
+    float lod = level_of_detail(vec2(textureSize(normal_map, 0)), duv_dx, duv_dy);
+    return textureLod(normal_map, tex_coord(uv), lod).rgb;
+}
+
+// normal_map::mapped_normal: n bent by the texel in the frame of tangent t
+// and handedness w; a straight-out texel or no frame leaves n as it is.
+vec3 mapped_normal(vec3 n, vec3 t, float w, vec3 texel) {
+    vec3 m = texel * 2.0 - 1.0;
+    if (m.x == 0.0 && m.y == 0.0 && m.z > 0.0) return n;
+    vec3 tp = t - n * dot(n, t);
+    float lt = length(tp);
+    if (!(lt > 0.0)) return n;
+    vec3 tangent = tp / lt;
+    vec3 bitangent = cross(n, tangent) * (w < 0.0 ? -1.0 : 1.0);
+    vec3 r = tangent * m.x + bitangent * m.y + n * m.z;
+    float l = length(r);
+    return l > 0.0 && !isinf(l) ? r / l : n;
+}
+
+vec3 miss_radiance(vec3 dir) {
+    if (!has_environment) return background;
+    float u = 0.5 + (dir.x == 0.0 && dir.z == 0.0 ? 0.0 : atan(dir.x, -dir.z)) * (0.5 / PI);
+    float v = 0.5 + asin(clamp(dir.y, -1.0, 1.0)) / PI;
+    vec3 c = textureLod(environment, vec2(u, 1.0 - v), 0.0).rgb * environment_intensity;
+    return any(isnan(c)) || any(isinf(c)) ? vec3(0.0) : c;
+}
 
 #ifdef SHADOW_MAP
 // `--shadows map`: the maps drawn by GL (`SHADOW_VERTEX` and friends), one
@@ -79,10 +148,42 @@ bool shadowed(int light, vec3 p, vec3 g, vec3 w_i) {
 }
 #endif
 
+#ifdef VIEWS
+// The surface each fragment saw, for the debug views and pixel readback
+// (`views`): position and 1, shading normal and back-face flag, geometric
+// normal, barycentric weights, uv, and (kind + 1, primitive) (0: nothing).
+layout(location = 1) out vec4 out_position;
+layout(location = 2) out vec4 out_normal;
+layout(location = 3) out vec4 out_face_normal;
+layout(location = 4) out vec4 out_barycentric;
+layout(location = 5) out vec4 out_uv;
+layout(location = 6) out uvec4 out_id;
+void write_surface(vec3 p, vec3 n, bool back, vec3 g, vec3 b, vec2 uv, uint kind, uint primitive) {
+    out_position = vec4(p, 1.0);
+    out_normal = vec4(n, back ? 1.0 : 0.0);
+    out_face_normal = vec4(g, 0.0);
+    out_barycentric = vec4(b, 0.0);
+    out_uv = vec4(uv, 0.0, 0.0);
+    out_id = uvec4(kind + 1u, primitive, 0u, 0u);
+}
+#endif
+
+// With --msaa, a program shaded per sample (the spheres, whose coverage is
+// their ray test's) looks through its own sample; others through the pixel's.
+vec2 sample_shift() {
+#if defined(MSAA) && defined(PER_SAMPLE)
+    return vec2(gl_SamplePosition.x - 0.5, y_down ? gl_SamplePosition.y - 0.5 : 0.5 - gl_SamplePosition.y);
+#else
+    return vec2(0.0);
+#endif
+}
+
 // Camera-space direction (z = -1) through this fragment's sample, pixel rows top-down.
 vec3 camera_dir() {
-    float px = floor(gl_FragCoord.x) + sample_offset.x;
-    float py = (image_size.y - 1.0 - floor(gl_FragCoord.y)) + sample_offset.y;
+    vec2 shift = sample_shift();
+    float px = floor(gl_FragCoord.x) + sample_offset.x + shift.x;
+    float row = y_down ? floor(gl_FragCoord.y) : image_size.y - 1.0 - floor(gl_FragCoord.y);
+    float py = row + sample_offset.y + shift.y;
     return vec3((2.0 * px / image_size.x - 1.0) * half_extent.x, (1.0 - 2.0 * py / image_size.y) * half_extent.y, -1.0);
 }
 
@@ -91,10 +192,9 @@ vec3 normalize_or_zero(vec3 v) {
     return l > 0.0 ? v / l : vec3(0.0);
 }
 
-vec3 shade(vec3 p, vec3 n, vec3 g, vec3 w_o, uint m) {
-    vec3 albedo = materials[2u * m].xyz;
-    vec3 glossy = materials[2u * m + 1u].xyz;
-    float s = materials[2u * m + 1u].w;
+vec3 shade(vec3 p, vec3 n, vec3 g, vec3 w_o, uint m, vec3 albedo) {
+    vec3 glossy = materials[3u * m + 1u].xyz;
+    float s = materials[3u * m + 1u].w;
     vec3 l_o = albedo * ambient;
     for (int i = 0; i < light_count; i++) {
         vec4 a = lights[2 * i];
@@ -126,6 +226,11 @@ vec3 shade(vec3 p, vec3 n, vec3 g, vec3 w_o, uint m) {
         }
         l_o += (incident * f) * cos_theta;
     }
+    vec3 mirror = materials[3u * m + 2u].xyz;
+    if (mirror_env && mirror != vec3(0.0)) {
+        float cos_o = clamp(dot(w_o, g), -1.0, 1.0);
+        l_o += mirror * miss_radiance(normalize(2.0 * cos_o * g - w_o));
+    }
     return l_o;
 }
 "#;
@@ -135,27 +240,43 @@ layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;
 layout(location = 2) in vec3 face_normal;
 layout(location = 3) in uint material;
+layout(location = 4) in vec2 uv;
+layout(location = 5) in vec4 tangent;
 uniform vec3 eye;
 uniform mat3 world_to_camera;
 uniform vec2 half_extent;
 // Moves the image so that GL's pixel centre samples this pass's sample position (NDC units).
 uniform vec2 ndc_shift;
+// The image drawn upside down, GL's row 0 the top row (see `pass::render`).
+uniform bool y_down;
 uniform float near_plane;
 uniform float far_plane;
 out vec3 v_position;
 out vec3 v_normal;
 flat out vec3 v_face_normal;
 flat out uint v_material;
+out vec2 v_uv;
+out vec3 v_tangent;
+flat out float v_handedness;
+out vec3 v_corner;
+flat out uint v_primitive;
 void main() {
     vec3 c = world_to_camera * (position - eye);
     float w = -c.z;
     // Reversed depth with glClipControl(ZERO_TO_ONE): near -> 1, far -> 0.
     float z = near_plane * (far_plane - w) / (far_plane - near_plane);
-    gl_Position = vec4(c.x / half_extent.x + ndc_shift.x * w, c.y / half_extent.y + ndc_shift.y * w, z, w);
+    gl_Position = vec4(c.x / half_extent.x + ndc_shift.x * w, (c.y / half_extent.y + ndc_shift.y * w) * (y_down ? -1.0 : 1.0), z, w);
     v_position = position;
     v_normal = normal;
     v_face_normal = face_normal;
     v_material = material;
+    v_uv = uv;
+    v_tangent = tangent.xyz;
+    v_handedness = tangent.w;
+    // One-hot per corner: interpolated, the barycentric weights.
+    int k = gl_VertexID % 3;
+    v_corner = vec3(k == 0, k == 1, k == 2);
+    v_primitive = uint(gl_VertexID / 3);
 }
 "#;
 
@@ -164,22 +285,74 @@ pub fn triangle_fragment(defines: &str) -> String {
         "#version 450 core\n{defines}{COMMON}{}",
         r#"
 uniform bool flat_shading;
-in vec3 v_position;
-in vec3 v_normal;
+// With --msaa, a fragment is shaded once, at a sample the triangle covers
+// (the CPU's MSAA shades at the covered sample nearest the centre).
+#ifdef MSAA
+#define SAMPLED centroid
+#else
+#define SAMPLED
+#endif
+SAMPLED in vec3 v_position;
+SAMPLED in vec3 v_normal;
 flat in vec3 v_face_normal;
 flat in uint v_material;
+SAMPLED in vec2 v_uv;
+SAMPLED in vec3 v_tangent;
+flat in float v_handedness;
+SAMPLED in vec3 v_corner;
+flat in uint v_primitive;
 layout(location = 0) out vec4 colour;
 void main() {
-    vec3 dir = normalize(camera_to_world * camera_dir());
+    vec3 big_d = camera_to_world * camera_dir();
+    vec3 dir = normalize(big_d);
     vec3 g = v_face_normal;
+    // The footprint the CPU renderers use: the camera ray's differentials
+    // carried to the triangle's plane (Igehy). The uv is affine in the
+    // position across the plane, so the quad's differences of both give
+    // the map from one to the other; GL's own differences alone would be
+    // one-sided and one per quad.
+    vec3 ex = dFdx(v_position);
+    vec3 ey = dFdy(v_position);
+    vec2 ux = dFdx(v_uv);
+    vec2 uy = dFdy(v_uv);
+    vec2 duv_dx = ux;
+    vec2 duv_dy = uy;
+    {
+        float t = dot(v_position - eye, -camera_to_world[2]);
+        float xx = dot(ex, ex), xy = dot(ex, ey), yy = dot(ey, ey);
+        float det = xx * yy - xy * xy;
+        float facing = dot(big_d, g);
+        if (det > 0.0 && facing != 0.0) {
+            vec3 steps[2] = vec3[2](camera_to_world * vec3(2.0 * half_extent.x / image_size.x, 0.0, 0.0), camera_to_world * vec3(0.0, -2.0 * half_extent.y / image_size.y, 0.0));
+            vec2 d[2];
+            for (int k = 0; k < 2; k++) {
+                vec3 dd = steps[k] * t;
+                vec3 dp = dd - big_d * (dot(dd, g) / facing);
+                float a = (yy * dot(ex, dp) - xy * dot(ey, dp)) / det;
+                float b = (xx * dot(ey, dp) - xy * dot(ex, dp)) / det;
+                d[k] = a * ux + b * uy;
+            }
+            if (!(any(isnan(d[0])) || any(isinf(d[0])) || any(isnan(d[1])) || any(isinf(d[1])))) {
+                duv_dx = d[0];
+                duv_dy = d[1];
+            }
+        }
+    }
     float l = length(v_normal);
     vec3 n = l > 0.0 ? v_normal / l : g;
-    if (dot(g, dir) > 0.0) {
+    // The map bends the front side's normal (normal_map::apply).
+    if (has_normal_map) n = mapped_normal(n, v_tangent, v_handedness, normal_texel(v_uv, duv_dx, duv_dy));
+    bool back = dot(g, dir) > 0.0;
+    if (back) {
         g = -g;
         n = -n;
     }
+#ifdef VIEWS
+    write_surface(v_position, n, back, g, v_corner, v_uv, 0u, v_primitive);
+#endif
     if (flat_shading) n = g;
-    colour = vec4(shade(v_position, n, g, -dir, v_material), 1.0);
+    vec3 albedo = albedo_at(v_material, v_uv, duv_dx, duv_dy);
+    colour = vec4(shade(v_position, n, g, -dir, v_material, albedo), 1.0);
 }
 "#
     )
@@ -193,24 +366,29 @@ uniform vec3 eye;
 uniform mat3 world_to_camera;
 uniform vec2 half_extent;
 uniform vec2 ndc_shift;
+// The image drawn upside down, GL's row 0 the top row (see `pass::render`).
+uniform bool y_down;
 uniform float near_plane;
 uniform float far_plane;
+// Spheres are drawn one material at a time: the first one of this draw.
+uniform int first_sphere;
 flat out int v_sphere;
 void main() {
-    vec4 s = spheres[gl_InstanceID].centre_radius;
+    int index = first_sphere + gl_InstanceID;
+    vec4 s = spheres[index].centre_radius;
     // Slightly larger than the sphere, so its silhouette is always inside.
     vec3 position = s.xyz + corner * (s.w * 1.01);
     vec3 c = world_to_camera * (position - eye);
     float w = -c.z;
     float z = near_plane * (far_plane - w) / (far_plane - near_plane);
-    gl_Position = vec4(c.x / half_extent.x + ndc_shift.x * w, c.y / half_extent.y + ndc_shift.y * w, z, w);
-    v_sphere = gl_InstanceID;
+    gl_Position = vec4(c.x / half_extent.x + ndc_shift.x * w, (c.y / half_extent.y + ndc_shift.y * w) * (y_down ? -1.0 : 1.0), z, w);
+    v_sphere = index;
 }
 "#;
 
 pub fn sphere_fragment(defines: &str) -> String {
     format!(
-        "#version 450 core\n{defines}{COMMON}{}",
+        "#version 450 core\n{defines}#define PER_SAMPLE 1\n{COMMON}{}",
         r#"
 struct Sphere { vec4 centre_radius; uvec4 material; };
 layout(std430, binding = 2) readonly buffer Spheres { Sphere spheres[]; };
@@ -232,11 +410,58 @@ void main() {
     float t = b - sqrt(disc);
     if (t <= 0.0 || t >= (far_plane - near_plane) * length(d)) discard;
     vec3 p = origin + dir * t;
-    vec3 n = (p - s.xyz) / s.w;
-    if (dot(n, dir) > 0.0) n = -n;
+    vec3 o = (p - s.xyz) / s.w;
     float w = dot(p - eye, -camera_to_world[2]);
+    // Scene::sphere_hit's uv: u around +y, v from the south pole up.
+    vec2 uv = vec2(0.5 + (o.x == 0.0 && o.z == 0.0 ? 0.0 : atan(o.z, o.x)) * (-0.5 / PI), 0.5 + asin(clamp(o.y, -1.0, 1.0)) / PI);
+    // Its footprint from the camera ray's differentials carried to the
+    // tangent plane (Igehy), as the ray casters do: the 2x2 quad's
+    // differences would straddle the silhouette and the u seam.
+    vec3 big_d = camera_to_world * d;
+    vec3 steps[2] = vec3[2](camera_to_world * vec3(2.0 * half_extent.x / image_size.x, 0.0, 0.0), camera_to_world * vec3(0.0, -2.0 * half_extent.y / image_size.y, 0.0));
+    vec2 duv[2];
+    for (int k = 0; k < 2; k++) {
+        vec3 dd = steps[k] * w;
+        vec3 dp = dd - big_d * (dot(dd, o) / dot(big_d, o));
+        vec3 q = dp / s.w;
+        float ring = max(o.x * o.x + o.z * o.z, 1e-12);
+        duv[k] = vec2(-(o.x * q.z - o.z * q.x) / (2.0 * PI * ring), q.y / (PI * sqrt(max(1.0 - o.y * o.y, 1e-12))));
+        if (any(isnan(duv[k])) || any(isinf(duv[k]))) duv[k] = vec2(1.0);
+    }
+    vec3 n = o;
+    if (has_normal_map) n = mapped_normal(n, vec3(o.z, 0.0, -o.x), 1.0, normal_texel(uv, duv[0], duv[1]));
+    vec3 g = o;
+    bool back = dot(g, dir) > 0.0;
+    if (back) {
+        g = -g;
+        n = -n;
+    }
+#ifdef VIEWS
+    write_surface(p, n, back, g, vec3(0.0), uv, 1u, uint(v_sphere));
+#endif
     gl_FragDepth = clamp(near_plane * (far_plane - w) / ((far_plane - near_plane) * w), 0.0, 1.0);
-    colour = vec4(shade(p, n, n, -dir, m), 1.0);
+    colour = vec4(shade(p, n, g, -dir, m, albedo_at(m, uv, duv[0], duv[1])), 1.0);
+}
+"#
+    )
+}
+
+/// The environment behind everything: one triangle over the whole image,
+/// each fragment showing what its eye ray sees when it hits nothing.
+pub const BACKGROUND_VERTEX: &str = r#"#version 450 core
+void main() {
+    vec2 corner = vec2(float((gl_VertexID & 1) * 4 - 1), float((gl_VertexID & 2) * 2 - 1));
+    gl_Position = vec4(corner, 0.0, 1.0);
+}
+"#;
+
+pub fn background_fragment() -> String {
+    format!(
+        "#version 450 core\n{COMMON}{}",
+        r#"
+layout(location = 0) out vec4 colour;
+void main() {
+    colour = vec4(miss_radiance(normalize(camera_to_world * camera_dir())), 1.0);
 }
 "#
     )

@@ -49,7 +49,7 @@ impl ShadowPass {
         clip_control: super::context::ClipControl,
         scene: &Scene,
         key: u64,
-        runs: &[(u32, u32, bool)],
+        runs: &[super::scene_data::Run],
         size: u32,
         vertex_array: glow::VertexArray,
         cube_array: glow::VertexArray,
@@ -142,7 +142,7 @@ impl ShadowPass {
                 }
                 gl.use_program(Some(self.triangles));
                 gl.bind_vertex_array(Some(vertex_array));
-                for &(start, count, two_sided) in runs {
+                for &super::scene_data::Run { first: start, count, two_sided, .. } in runs {
                     if two_sided {
                         gl.disable(glow::CULL_FACE);
                     } else {
