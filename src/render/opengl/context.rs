@@ -55,6 +55,20 @@ impl<T> Shared<T> {
         }
     }
 
+    /// `shutdown`, unless another thread is using the context right now
+    /// (at exit, waiting for it could hang the process).
+    pub fn try_shutdown(&self) {
+        let mut guard = match self.inner.try_lock() {
+            Ok(g) => g,
+            Err(std::sync::TryLockError::Poisoned(e)) => e.into_inner(),
+            Err(std::sync::TryLockError::WouldBlock) => return,
+        };
+        if let Some(Ok(mut headless)) = guard.take() {
+            headless.gl.state = None;
+            drop(headless);
+        }
+    }
+
     /// Runs `f` with the context current on this thread; the error (one
     /// sentence) when no OpenGL driver can be used.
     pub fn with<R>(&self, f: impl FnOnce(&mut Gl<T>) -> R) -> Result<R, String> {

@@ -26,6 +26,34 @@ pub fn shutdown() {
     GL.shutdown();
 }
 
+/// `f` with the context current (made on first use), and the context's
+/// release at exit arranged once the driver is loaded.
+fn with_gl<R>(f: impl FnOnce(&mut context::Gl<pass::State>) -> R) -> Result<R, String> {
+    let result = GL.with(f);
+    release_at_exit();
+    result
+}
+
+/// Makes sure the context is released at exit even when nobody calls
+/// `shutdown` (test harnesses, a `process::exit` elsewhere): the C
+/// library's exit handlers run in reverse order of registration, so a
+/// handler registered after the driver was loaded runs before the
+/// driver's own teardown, while the process is still whole.
+fn release_at_exit() {
+    static REGISTERED: std::sync::Once = std::sync::Once::new();
+    extern "C" fn release() {
+        GL.try_shutdown();
+    }
+    unsafe extern "C" {
+        fn atexit(callback: extern "C" fn()) -> std::ffi::c_int;
+    }
+    // SAFETY: `atexit` is the C library's; `release` is a plain function
+    // that takes nothing and unwinds nowhere (`shutdown` only drops the context).
+    REGISTERED.call_once(|| unsafe {
+        atexit(release);
+    });
+}
+
 pub struct OpenGl;
 
 impl Renderer for OpenGl {
@@ -47,7 +75,7 @@ impl Renderer for OpenGl {
     }
 
     fn render_pass(&self, job: &PassJob, out: &mut [Radiance]) -> RayCounts {
-        match GL.with(|g| pass::render(g, job, out, None)) {
+        match with_gl(|g| pass::render(g, job, out, None)) {
             Ok(Ok((counts, _))) => counts,
             Ok(Err(e)) | Err(e) => {
                 // `check` refuses what cannot be drawn before a frame starts;
@@ -82,7 +110,7 @@ impl OpenGl {
     fn read_back(&self, job: &PassJob, x: u32, y: u32) -> Result<GlReadback, String> {
         let row = PassJob { rows: y..y + 1, active: None, ..*job };
         let mut out = vec![Radiance::ZERO; job.view.width as usize];
-        let (_, readback) = GL.with(|g| pass::render(g, &row, &mut out, Some((x, y))))??;
+        let (_, readback) = with_gl(|g| pass::render(g, &row, &mut out, Some((x, y))))??;
         readback.ok_or_else(|| format!("no GL readback at pixel ({x}, {y})"))
     }
 }
@@ -118,11 +146,11 @@ fn unsupported(scene: &Scene, settings: &RenderSettings) -> Result<(), String> {
 
 /// The OpenGL driver in use (`GL_RENDERER`), or why there is none.
 pub fn driver() -> Result<String, String> {
-    GL.with(|g| g.renderer.clone())
+    with_gl(|g| g.renderer.clone())
 }
 
 /// The most samples per pixel the driver's multisampling offers (`GL_MAX_SAMPLES`).
 pub fn max_samples() -> Result<i32, String> {
     // SAFETY: a plain query on the current context.
-    GL.with(|g| unsafe { glow::HasContext::get_parameter_i32(&g.gl, glow::MAX_SAMPLES) })
+    with_gl(|g| unsafe { glow::HasContext::get_parameter_i32(&g.gl, glow::MAX_SAMPLES) })
 }
