@@ -201,6 +201,12 @@ struct RenderOpts {
     /// What mirrors reflect: ray (traced) | env (the environment in the reflected direction, no ray).
     #[arg(long, default_value = "ray", value_name = "ray|env")]
     reflections: String,
+    /// Rasterizers: clip triangles at the near plane only, or at every plane of the view volume.
+    #[arg(long, default_value = "near", value_name = "near|frustum")]
+    clip: String,
+    /// Rasterizers: cull copies made by `instances` by their bounding spheres (same image either way).
+    #[arg(long = "cull-instances", value_name = "BOOL", default_value_t = true, action = clap::ArgAction::Set)]
+    cull_instances: bool,
 }
 
 /// What is left to do once the command line ran: the viewer is not part of
@@ -305,6 +311,8 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
     settings.interpolation = interpolation;
     settings.texture_filter = texture_filter;
     settings.reflections = reflections;
+    settings.clip = render::raster::clip::ClipMode::parse(&opts.clip).map_err(|e| format!("--clip: {e}"))?;
+    settings.cull_instances = opts.cull_instances;
     settings.affine = opts.affine;
     if let Some(b) = opts.bump {
         if !(b.is_finite() && b >= 0.0) {
@@ -412,6 +420,10 @@ fn stats_json(l: &Loaded, render_ms: f64, counts: &RayCounts, spp: u32) -> serde
         "samples_covered": counts.samples_covered,
         "fragments_shaded": counts.fragments_shaded,
         "depth_test_failures": counts.depth_fails,
+        "instances": l.prepared.scene.instances.len(),
+        "instances_drawn": counts.instances_drawn,
+        "instances_culled": counts.instances_culled,
+        "clip": l.settings.clip.name(),
         "shadows": l.settings.shadows.name(),
         "view": l.settings.view.name(),
         "interpolation": l.settings.interpolation.name(),

@@ -164,8 +164,12 @@ pub fn object_name(scene: &Scene, kind: PrimitiveKind, index: u32) -> String {
         PrimitiveKind::Triangle => scene.triangles.get(index as usize).map(|t| t.object),
         PrimitiveKind::Sphere => scene.spheres.get(index as usize).map(|s| s.object),
     };
+    let copy = match kind {
+        PrimitiveKind::Triangle => scene.instance_of_triangle(index).map(|i| format!(", instance {}", i.index)),
+        PrimitiveKind::Sphere => None,
+    };
     object
-        .and_then(|o| scene.objects.get(o as usize).map(|info| format!("'{}' (object {o})", info.name)))
+        .and_then(|o| scene.objects.get(o as usize).map(|info| format!("'{}' (object {o}{})", info.name, copy.unwrap_or_default())))
         .unwrap_or_else(|| "?".into())
 }
 

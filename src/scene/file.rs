@@ -5,7 +5,7 @@
 use super::mesh_cache::MeshCache;
 use super::obj::{self, NormalMode};
 use super::texture::{load_texture_as, Encoding, Wrap};
-use super::{Camera, Fov, Light, Material, ObjectInfo, RenderDefaults, Scene, Sphere, Triangle};
+use super::{Camera, Fov, InstanceInfo, Light, Material, ObjectInfo, RenderDefaults, Scene, Sphere, Triangle};
 use crate::input::{MAX_COORDINATE, MAX_LIGHT, MAX_VALUE};
 use crate::math::{Vec2, Vec3};
 
@@ -113,7 +113,19 @@ struct ObjectDesc {
     uvs: Option<Vec<F2>>,
     center: Option<F3>,
     radius: Option<f32>,
+    instances: Option<Vec<Spanned<InstanceDesc>>>,
     // `normals` for triangles is a list of vectors; meshes use the mode string.
+}
+
+/// One copy of a mesh object: its placement within the object's frame and
+/// its material, each optional.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct InstanceDesc {
+    translate: Option<F3>,
+    rotate_deg: Option<F3>,
+    scale: Option<ScaleDesc>,
+    material: Option<String>,
 }
 
 /// `normals` is a mode string on meshes and a list of three vectors on triangles.
@@ -291,7 +303,7 @@ fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str) -> R
     let mut meshes = MeshCache::default();
     for (i, o) in desc.object.iter().enumerate() {
         let where_ = format!("{}: object {}", at(o.span()), i + 1);
-        add_object(&mut scene, o.get_ref(), i as u32, &where_, base, &mut meshes)?;
+        add_object(&mut scene, o.get_ref(), i as u32, &where_, base, &mut meshes, &at)?;
     }
     for (index, path, where_, encoding) in textures {
         let drawn = scene.triangles.iter().any(|t| t.material as usize == index) || scene.spheres.iter().any(|s| s.material as usize == index);
@@ -322,7 +334,7 @@ fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str) -> R
     Ok(scene)
 }
 
-fn add_object(scene: &mut Scene, o: &ObjectDesc, object: u32, where_: &str, base: &Path, meshes: &mut MeshCache) -> Result<(), String> {
+fn add_object(scene: &mut Scene, o: &ObjectDesc, object: u32, where_: &str, base: &Path, meshes: &mut MeshCache, at_line: &dyn Fn(std::ops::Range<usize>) -> String) -> Result<(), String> {
     let two_sided = o.two_sided.unwrap_or(false);
     let placement = placement(o, where_)?;
     let explicit_material = match &o.material {
@@ -345,6 +357,7 @@ fn add_object(scene: &mut Scene, o: &ObjectDesc, object: u32, where_: &str, base
             ("uvs", o.uvs.is_some()),
             ("center", o.center.is_some()),
             ("radius", o.radius.is_some()),
+            ("instances", o.instances.is_some()),
         ];
         for (key, here) in present {
             if here && !allowed.contains(&key) {
@@ -355,7 +368,7 @@ fn add_object(scene: &mut Scene, o: &ObjectDesc, object: u32, where_: &str, base
     };
     match kind {
         "mesh" => {
-            only(&["file", "normals"])?;
+            only(&["file", "normals", "instances"])?;
             let file = o.file.as_ref().ok_or(format!("{where_}: a mesh needs `file`"))?;
             let mode = match &o.normals {
                 None => NormalMode::Auto,
@@ -379,17 +392,33 @@ fn add_object(scene: &mut Scene, o: &ObjectDesc, object: u32, where_: &str, base
                 Some(m) => m,
                 None => scene.default_material_index(),
             };
-            scene.triangles.reserve(loaded.triangles.len());
-            for t in &loaded.triangles {
-                let mut t = t.clone();
-                t.material = match (explicit_material, t.material) {
-                    (Some(m), _) => m,
-                    (None, u32::MAX) => fallback,
-                    (None, k) => mtl_index[k as usize],
-                };
-                t.object = object;
-                t.two_sided = two_sided;
-                scene.triangles.push(placement.apply(t));
+            let copies = match &o.instances {
+                None => vec![MeshCopy { placement: None, material: explicit_material, index: None }],
+                Some(list) => copies(scene, list, explicit_material, where_, at_line)?,
+            };
+            scene.triangles.reserve(loaded.triangles.len() * copies.len());
+            for copy in &copies {
+                let start = scene.triangles.len();
+                for t in &loaded.triangles {
+                    let mut t = t.clone();
+                    t.material = match (copy.material, t.material) {
+                        (Some(m), _) => m,
+                        (None, u32::MAX) => fallback,
+                        (None, k) => mtl_index[k as usize],
+                    };
+                    t.object = object;
+                    t.two_sided = two_sided;
+                    // The object's own placement first, then the copy's:
+                    // each by the same arithmetic as a lone object's.
+                    let t = placement.apply(t);
+                    scene.triangles.push(match &copy.placement {
+                        Some(p) => p.apply(t),
+                        None => t,
+                    });
+                }
+                if let Some(index) = copy.index {
+                    scene.instances.push(InstanceInfo::new(object, index, start..scene.triangles.len(), &scene.triangles[start..]));
+                }
             }
         }
         "triangle" | "quad" => {
@@ -480,6 +509,51 @@ fn add_object(scene: &mut Scene, o: &ObjectDesc, object: u32, where_: &str, base
     Ok(())
 }
 
+/// One placed copy of a mesh object's triangles.
+struct MeshCopy {
+    /// The copy's own placement, applied after the object's (`None`: the object itself).
+    placement: Option<Placement>,
+    /// The copy's material, or the object's when `None` (then the MTL's).
+    material: Option<u32>,
+    /// Index in the object's `instances` list, `None` for an object without one.
+    index: Option<u32>,
+}
+
+/// The copies an `instances` list asks for, checked: every error names the
+/// line of the entry at fault and its key.
+fn copies(
+    scene: &Scene,
+    list: &[Spanned<InstanceDesc>],
+    object_material: Option<u32>,
+    where_: &str,
+    at_line: &dyn Fn(std::ops::Range<usize>) -> String,
+) -> Result<Vec<MeshCopy>, String> {
+    if list.len() > MAX_INSTANCES {
+        return Err(format!("{where_}: `instances` lists {} copies; at most {MAX_INSTANCES} are allowed", list.len()));
+    }
+    let mut out = Vec::with_capacity(list.len());
+    for (k, d) in list.iter().enumerate() {
+        let here = format!("{}: instances[{k}]", at_line(d.span()));
+        let d = d.get_ref();
+        let placement = placement_of(d.translate, d.rotate_deg, d.scale.as_ref(), &here)?;
+        let material = match &d.material {
+            Some(name) => Some(
+                scene
+                    .materials
+                    .iter()
+                    .position(|m| &m.name == name)
+                    .ok_or(format!("{here}: material \"{name}\" is not defined in [materials]"))? as u32,
+            ),
+            None => object_material,
+        };
+        out.push(MeshCopy { placement: Some(placement), material, index: Some(k as u32) });
+    }
+    Ok(out)
+}
+
+/// Most copies one `instances` list may make.
+const MAX_INSTANCES: usize = 1 << 20;
+
 /// Object placement: scale, then rotate about X, Y, Z, then translate.
 pub struct Placement {
     matrix: glam::Mat4,
@@ -527,9 +601,13 @@ impl Placement {
 }
 
 fn placement(o: &ObjectDesc, where_: &str) -> Result<Placement, String> {
-    let translate = position(o.translate, where_, "translate")?.unwrap_or(Vec3::ZERO);
-    let rotate = finite(o.rotate_deg, where_, "rotate_deg")?.unwrap_or(Vec3::ZERO);
-    let scale = match &o.scale {
+    placement_of(o.translate, o.rotate_deg, o.scale.as_ref(), where_)
+}
+
+fn placement_of(translate: Option<F3>, rotate_deg: Option<F3>, scale: Option<&ScaleDesc>, where_: &str) -> Result<Placement, String> {
+    let translate = position(translate, where_, "translate")?.unwrap_or(Vec3::ZERO);
+    let rotate = finite(rotate_deg, where_, "rotate_deg")?.unwrap_or(Vec3::ZERO);
+    let scale = match scale {
         None => Vec3::ONE,
         Some(ScaleDesc::Uniform(s)) => Vec3::splat(*s),
         Some(ScaleDesc::PerAxis(s)) => Vec3::from(*s),

@@ -141,6 +141,45 @@ pub struct ObjectInfo {
     pub triangles: std::ops::Range<usize>,
 }
 
+/// One copy made by a mesh object's `instances` list: where its triangles
+/// lie in `Scene::triangles`, and the sphere around them that rasterizers
+/// cull it by.
+#[derive(Clone, Debug, PartialEq)]
+pub struct InstanceInfo {
+    /// The `[[object]]` it is a copy of (index into `Scene::objects`).
+    pub object: u32,
+    /// Its position in that object's `instances` list.
+    pub index: u32,
+    pub triangles: std::ops::Range<usize>,
+    pub center: Vec3,
+    /// Holds every vertex of the copy (rounded up).
+    pub radius: f32,
+}
+
+impl InstanceInfo {
+    /// The record of copy `index` of `object`, whose world-space triangles are
+    /// `tris`, found at `range` of `Scene::triangles`.
+    pub fn new(object: u32, index: u32, range: std::ops::Range<usize>, tris: &[Triangle]) -> InstanceInfo {
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for t in tris {
+            for v in t.v {
+                lo = lo.min(v);
+                hi = hi.max(v);
+            }
+        }
+        let (center, radius) = if lo.x <= hi.x {
+            let center = (lo + hi) * 0.5;
+            let r2 = tris.iter().flat_map(|t| t.v).map(|v| (v - center).length_squared()).fold(0.0f32, f32::max);
+            // Grown a little, so that rounding in the distance never leaves a vertex outside.
+            (center, r2.sqrt() * (1.0 + 1e-5) + 1e-6 * center.abs().max_element())
+        } else {
+            (Vec3::ZERO, 0.0)
+        };
+        InstanceInfo { object, index, triangles: range, center, radius }
+    }
+}
+
 /// Image and display settings from `[render]`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderDefaults {
@@ -178,6 +217,8 @@ pub struct Scene {
     pub triangles: Vec<Triangle>,
     pub spheres: Vec<Sphere>,
     pub objects: Vec<ObjectInfo>,
+    /// The copies made by `instances` lists, in the order of their triangles.
+    pub instances: Vec<InstanceInfo>,
     /// Things worth telling the user that did not stop the scene loading.
     pub warnings: Vec<String>,
     /// `[environment]`: what rays that hit nothing see instead of `background`.
@@ -374,6 +415,19 @@ impl Scene {
             PrimitiveKind::Triangle => self.triangle_hit(id.index(), Vec3::new(1.0 - b1 - b2, b1, b2), t, ray),
             PrimitiveKind::Sphere => self.sphere_hit(id.index(), t, ray),
         }
+    }
+
+    /// The copy (from an `instances` list) that triangle `index` belongs to.
+    pub fn instance_of_triangle(&self, index: u32) -> Option<&InstanceInfo> {
+        let index = index as usize;
+        let k = self.instances.partition_point(|i| i.triangles.end <= index);
+        self.instances.get(k).filter(|i| i.triangles.contains(&index))
+    }
+
+    /// A copy's name: its object's name and its position in the object's list.
+    pub fn instance_name(&self, instance: &InstanceInfo) -> String {
+        let object = self.objects.get(instance.object as usize).map_or("?", |o| o.name.as_str());
+        format!("{object} instance {}", instance.index)
     }
 
     /// A default grey Lambertian material, added on demand.

@@ -259,8 +259,19 @@ fn shades_forward(job: &PassJob) -> bool {
     !job.settings.early_depth && job.settings.msaa <= 1 && !uses_stencil(job)
 }
 
-/// Renders `job.rows` of one pass of `method` into `out`.
+/// Renders `job.rows` of one pass of `method` into `out`, counting the
+/// copies made by `instances` that its setup draws and culls.
 pub fn render(method: Method, job: &PassJob, out: &mut [Radiance]) -> RayCounts {
+    let mut counts = render_regions(method, job, out);
+    if method != Method::Naive && !job.prepared.scene.instances.is_empty() {
+        let v = super::cull::visible_spans(job);
+        counts.instances_drawn += v.drawn;
+        counts.instances_culled += v.culled;
+    }
+    counts
+}
+
+fn render_regions(method: Method, job: &PassJob, out: &mut [Radiance]) -> RayCounts {
     let width = job.view.width;
     if width == 0 || job.rows.is_empty() {
         return RayCounts::default();

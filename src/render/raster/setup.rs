@@ -3,7 +3,7 @@
 //! pixel bounding box. The result is a list of screen-space triangles in scene
 //! order, each remembering which scene triangle it came from.
 
-use super::clip::{clip_near, triangle_vertices};
+use super::clip::{clip_frustum_box, clip_near, side_planes, triangle_vertices, ClipMode};
 use super::rect::{sample_span, PixelRect};
 use super::subpixel;
 use crate::math::{Vec2, Vec3};
@@ -135,6 +135,15 @@ pub fn is_back_face(view: &CameraView, t: &Triangle) -> bool {
 /// Without `near_clip` a triangle reaching nearer than the near plane is
 /// dropped instead of cut (the `near_clip` debug setting).
 pub fn setup_triangle(view: &CameraView, t: &Triangle, index: u32, off: Vec2, near_clip: bool, out: &mut Vec<ScreenTri>) {
+    setup_triangle_clipped(view, t, index, off, near_clip, None, out)
+}
+
+/// `setup_triangle`, with `frustum` (the grown side planes of
+/// `clip::side_planes`) for `--clip frustum`: the triangle is also clipped
+/// against the side planes, which drops it when nothing is left and shrinks
+/// its pieces' pixel boxes to what is left. The pieces and their attributes
+/// are those of the near clip either way.
+pub fn setup_triangle_clipped(view: &CameraView, t: &Triangle, index: u32, off: Vec2, near_clip: bool, frustum: Option<&[Vec3; 4]>, out: &mut Vec<ScreenTri>) {
     if is_back_face(view, t) {
         return;
     }
@@ -145,31 +154,54 @@ pub fn setup_triangle(view: &CameraView, t: &Triangle, index: u32, off: Vec2, ne
     if !near_clip && c.iter().any(|c| -c.z < view.near) {
         return;
     }
+    let inside = match frustum {
+        Some(planes) => match clip_frustum_box(c, view, planes) {
+            None => return,
+            Some((lo, hi)) => {
+                let pad = Vec2::ONE;
+                let (x0, x1) = sample_span(lo.x - pad.x, hi.x + pad.x, off.x, view.width);
+                let (y0, y1) = sample_span(lo.y - pad.y, hi.y + pad.y, off.y, view.height);
+                Some(PixelRect { x0, y0, x1, y1 })
+            }
+        },
+        None => None,
+    };
     for piece in clip_near(triangle_vertices(c), view.near).as_slice() {
         let p = piece.map(|v| view.project_camera(v.pos));
         let inv_z = piece.map(|v| 1.0 / -v.pos.z);
         let bz = [piece[0].bary * inv_z[0], piece[1].bary * inv_z[1], piece[2].bary * inv_z[2]];
-        if let Some(st) = ScreenTri::new(index, p, inv_z, bz, off, view.width, view.height) {
+        if let Some(mut st) = ScreenTri::new(index, p, inv_z, bz, off, view.width, view.height) {
+            if let Some(r) = inside {
+                st.bbox = st.bbox.intersect(&r);
+                if st.bbox.is_empty() {
+                    continue;
+                }
+            }
             out.push(st);
         }
     }
 }
 
-/// Every triangle of the scene set up for this pass, in scene order (setup in parallel).
+/// Every triangle of the scene set up for this pass, in scene order (setup
+/// in parallel). Copies made by `instances` whose bounding sphere lies
+/// outside the view volume are skipped whole (`cull::visible_spans`).
 pub fn setup_pass(job: &PassJob) -> Vec<ScreenTri> {
     const CHUNK: usize = 4096;
     let view = job.view;
     let rows = PixelRect::new(0, job.rows.start, view.width, job.rows.end);
-    let pieces: Vec<Vec<ScreenTri>> = job
-        .prepared
-        .scene
-        .triangles
-        .par_chunks(CHUNK)
-        .enumerate()
-        .map(|(ci, chunk)| {
-            let mut out = Vec::with_capacity(chunk.len());
-            for (j, t) in chunk.iter().enumerate() {
-                setup_triangle(view, t, (ci * CHUNK + j) as u32, job.offset, job.settings.near_clip, &mut out);
+    let scene = &job.prepared.scene;
+    let spans = super::cull::visible_spans(job).spans;
+    let chunks: Vec<std::ops::Range<usize>> = spans
+        .into_iter()
+        .flat_map(|r| (r.start..r.end).step_by(CHUNK).map(move |s| s..(s + CHUNK).min(r.end)))
+        .collect();
+    let frustum = (job.settings.clip == ClipMode::Frustum).then(|| side_planes(view));
+    let pieces: Vec<Vec<ScreenTri>> = chunks
+        .into_par_iter()
+        .map(|range| {
+            let mut out = Vec::with_capacity(range.len());
+            for i in range {
+                setup_triangle_clipped(view, &scene.triangles[i], i as u32, job.offset, job.settings.near_clip, frustum.as_ref(), &mut out);
             }
             // Drop pieces outside the rows of this job.
             out.retain(|st| !st.bbox.intersect(&rows).is_empty());
