@@ -349,6 +349,7 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
     if settings.shadows == ShadowMode::Map {
         render::shadow_map::check_memory(&scene, settings.shadow_map_size)?;
     }
+    render::layer_support::check(renderer.name(), &scene, &settings)?;
     renderer.check(&scene, &settings)?;
     let prepared = pool.install(|| PreparedScene::new(scene));
     Ok(Loaded { prepared, settings, renderer, pool, load_ms })

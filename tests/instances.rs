@@ -65,11 +65,16 @@ radius = 0.4
 material = "red"
 "#;
 
+/// A folder holding cube.obj, written once for every test of the run.
 fn dir() -> PathBuf {
-    let d = std::env::temp_dir().join(format!("pinhole-instances-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    std::fs::write(d.join("cube.obj"), CUBE).unwrap();
-    d
+    static DIR: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
+    DIR.get_or_init(|| {
+        let d = std::env::temp_dir().join(format!("pinhole-instances-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        std::fs::write(d.join("cube.obj"), CUBE).unwrap();
+        d
+    })
+    .clone()
 }
 
 /// The scene with one mesh object listing every copy.
@@ -258,4 +263,49 @@ fn pixel_report_names_the_instance_hit() {
     let j = render::pixel_report::to_json("raytrace", &prepared.scene, px.x as u32, px.y as u32, &replay);
     let text = j.to_string();
     assert!(text.contains("\"instance_name\":\"cube instance 0\""), "{text}");
+}
+
+#[test]
+fn the_two_level_layer_renders_what_flattening_renders() {
+    use pinhole::scene::file::{parse_scene_with, TwoLevel};
+    let d = dir();
+    let text = instanced_text();
+    let flat = parse_scene_with(&text, "t", &d, "t", TwoLevel::Never).unwrap();
+    let layered = parse_scene_with(&text, "t", &d, "t", TwoLevel::Always).unwrap();
+    assert!(flat.layer.is_none());
+    let layer = layered.layer.as_ref().expect("the copies in the layer");
+    assert_eq!(layer.instances.len(), COPIES.len());
+    // Index for index, the same world-space triangles.
+    assert_eq!(flat.total_triangles(), layered.total_triangles());
+    assert_eq!(layered.triangles.len(), 2);
+    for i in 0..flat.triangles.len() as u32 {
+        assert_eq!(*flat.triangle(i), *layered.triangle(i), "triangle {i}");
+    }
+    let (pf, pl) = (PreparedScene::new(flat), PreparedScene::new(layered));
+    let mut settings = RenderSettings::for_scene(&pf.scene);
+    for renderer in ["raytrace", "rasterize", "rasterize:tiled", "rasterize:barycentric", "rasterize:bbox", "rasterize:naive", "rasterize:painter"] {
+        for (interpolation, spp) in [(render::Interpolation::Phong, 1), (render::Interpolation::Gouraud, 2)] {
+            settings.interpolation = interpolation;
+            settings.spp = spp;
+            let (a, b) = (frame(renderer, &pf, &settings), frame(renderer, &pl, &settings));
+            assert!(a.pixels.iter().any(|p| p.x > 0.05), "{renderer}: the image is black");
+            assert_eq!(bits(&a.pixels), bits(&b.pixels), "{renderer} {interpolation:?}: the two-level layer differs from flattening");
+            if renderer.starts_with("rasterize") && renderer != "rasterize:naive" {
+                assert_eq!((b.counts.instances_drawn, b.counts.instances_culled), (4 * spp as u64, 2 * spp as u64), "{renderer}");
+            }
+        }
+    }
+    // Culling and frustum clipping on the layer change nothing either.
+    settings = RenderSettings::for_scene(&pf.scene);
+    let base = frame("rasterize", &pl, &settings);
+    settings.cull_instances = false;
+    settings.clip = ClipMode::Frustum;
+    assert_eq!(bits(&base.pixels), bits(&frame("rasterize", &pl, &settings).pixels));
+    // What cannot draw the layer says so.
+    let e = render::layer_support::check("raytrace:brute", &pl.scene, &RenderSettings::for_scene(&pl.scene)).unwrap_err();
+    assert!(e.contains("raytrace:brute") && e.contains("copies"), "{e}");
+    let mut map = RenderSettings::for_scene(&pl.scene);
+    map.shadows = render::ShadowMode::Map;
+    assert!(render::layer_support::check("rasterize", &pl.scene, &map).is_err());
+    assert!(render::layer_support::check("rasterize", &pf.scene, &map).is_ok());
 }

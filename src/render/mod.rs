@@ -11,6 +11,7 @@ pub mod differentials;
 pub mod frame;
 pub mod gi;
 pub mod kd_tree;
+pub mod layer_support;
 pub mod lighting;
 pub mod normal_map;
 pub mod opengl;

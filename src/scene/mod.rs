@@ -7,6 +7,7 @@ pub mod builtin;
 pub mod camera;
 pub mod environment;
 pub mod file;
+pub mod instanced;
 pub mod load;
 pub mod mesh_cache;
 pub mod material;
@@ -219,6 +220,9 @@ pub struct Scene {
     pub objects: Vec<ObjectInfo>,
     /// The copies made by `instances` lists, in the order of their triangles.
     pub instances: Vec<InstanceInfo>,
+    /// Copies not flattened into `triangles` (`instanced`): their triangles
+    /// have the indices after `triangles`, read through `Scene::triangle`.
+    pub layer: Option<std::sync::Arc<instanced::InstanceLayer>>,
     /// Things worth telling the user that did not stop the scene loading.
     pub warnings: Vec<String>,
     /// `[environment]`: what rays that hit nothing see instead of `background`.
@@ -333,6 +337,25 @@ impl Scene {
         self.triangles.len()
     }
 
+    /// Triangles drawn, the two-level layer's included.
+    pub fn total_triangles(&self) -> u64 {
+        self.triangles.len() as u64 + self.layer.as_ref().map_or(0, |l| l.triangle_count())
+    }
+
+    /// Triangle `index` in world space: a flattened one, or one of the
+    /// two-level layer made as flattening would make it.
+    #[inline]
+    pub fn triangle(&self, index: u32) -> std::borrow::Cow<'_, Triangle> {
+        match self.triangles.get(index as usize) {
+            Some(t) => std::borrow::Cow::Borrowed(t),
+            None => {
+                let layer = self.layer.as_ref().expect("a triangle index past the scene's triangles");
+                let (inst, local) = layer.locate(index).expect("a triangle index past the two-level layer");
+                std::borrow::Cow::Owned(layer.world(inst, local))
+            }
+        }
+    }
+
     /// World-space bounds of all geometry, `None` for an empty scene.
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
         let mut lo = Vec3::splat(f32::INFINITY);
@@ -347,6 +370,11 @@ impl Scene {
             lo = lo.min(s.center - Vec3::splat(s.radius));
             hi = hi.max(s.center + Vec3::splat(s.radius));
         }
+        // Copies of the two-level layer, by their bounding spheres.
+        for i in self.instances.iter().filter(|i| i.triangles.start >= self.triangles.len()) {
+            lo = lo.min(i.center - Vec3::splat(i.radius));
+            hi = hi.max(i.center + Vec3::splat(i.radius));
+        }
         (lo.x <= hi.x).then_some((lo, hi))
     }
 
@@ -355,7 +383,7 @@ impl Scene {
     /// rasterizer build their hits here, so identical visibility gives identical
     /// shading inputs.
     pub fn triangle_hit(&self, index: u32, b: Vec3, t: f32, ray: &Ray) -> SurfaceHit {
-        let tri = &self.triangles[index as usize];
+        let tri = &*self.triangle(index);
         let position = tri.v[0] * b.x + tri.v[1] * b.y + tri.v[2] * b.z;
         let mut geometric_normal = tri.geometric_normal();
         let mut shading_normal = (tri.n[0] * b.x + tri.n[1] * b.y + tri.n[2] * b.z).normalize_or(geometric_normal);

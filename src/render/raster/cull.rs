@@ -12,7 +12,8 @@ use std::ops::Range;
 
 /// The triangles a pass sets up, and what culling did.
 pub struct Visible {
-    /// Ranges of `Scene::triangles` to set up, in scene order.
+    /// Ranges of triangle indices to set up, in scene order (those past
+    /// `Scene::triangles` are the two-level layer's).
     pub spans: Vec<Range<usize>>,
     /// Copies kept and copies skipped.
     pub drawn: u64,
@@ -53,7 +54,7 @@ fn culls(job: &PassJob) -> bool {
 pub fn visible_spans(job: &PassJob) -> Visible {
     let scene = &job.prepared.scene;
     if !culls(job) {
-        return Visible { spans: vec![0..scene.triangles.len()], drawn: scene.instances.len() as u64, culled: 0 };
+        return Visible { spans: vec![0..scene.total_triangles() as usize], drawn: scene.instances.len() as u64, culled: 0 };
     }
     let frustum = Frustum::new(job.view);
     spans_of(scene, |i| frustum.may_see(job.view, i.center, i.radius))
@@ -75,8 +76,9 @@ pub fn spans_of(scene: &Scene, keep: impl Fn(&InstanceInfo) -> bool) -> Visible 
         }
         at = inst.triangles.end;
     }
-    if at < scene.triangles.len() {
-        spans.push(at..scene.triangles.len());
+    let total = scene.total_triangles() as usize;
+    if at < total {
+        spans.push(at..total);
     }
     Visible { spans, drawn, culled }
 }

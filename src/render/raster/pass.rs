@@ -136,7 +136,7 @@ impl<'a> Layer<'a> {
         match &self.geometry {
             Geometry::AllTriangles => {
                 let rays = region_rays(vb);
-                for tri in 0..self.job.prepared.edges.len() as u32 {
+                for tri in 0..self.job.prepared.scene.total_triangles() as u32 {
                     if self.job.cancelled() {
                         return;
                     }

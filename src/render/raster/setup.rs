@@ -191,17 +191,30 @@ pub fn setup_pass(job: &PassJob) -> Vec<ScreenTri> {
     let rows = PixelRect::new(0, job.rows.start, view.width, job.rows.end);
     let scene = &job.prepared.scene;
     let spans = super::cull::visible_spans(job).spans;
-    let chunks: Vec<std::ops::Range<usize>> = spans
-        .into_iter()
-        .flat_map(|r| (r.start..r.end).step_by(CHUNK).map(move |s| s..(s + CHUNK).min(r.end)))
-        .collect();
+    let chunks = chunks_of(scene, &spans, CHUNK);
     let frustum = (job.settings.clip == ClipMode::Frustum).then(|| side_planes(view));
     let pieces: Vec<Vec<ScreenTri>> = chunks
         .into_par_iter()
-        .map(|range| {
-            let mut out = Vec::with_capacity(range.len());
-            for i in range {
-                setup_triangle_clipped(view, &scene.triangles[i], i as u32, job.offset, job.settings.near_clip, frustum.as_ref(), &mut out);
+        .map(|chunk| {
+            let mut out = Vec::with_capacity(chunk.range.len());
+            let near_clip = job.settings.near_clip;
+            match chunk.copy {
+                None => {
+                    for i in chunk.range {
+                        setup_triangle_clipped(view, &scene.triangles[i], i as u32, job.offset, near_clip, frustum.as_ref(), &mut out);
+                    }
+                }
+                Some(k) => {
+                    // A copy of the two-level layer: its triangles placed as flattening places them.
+                    let layer = scene.layer.as_deref().expect("copies without a layer");
+                    let inst = &layer.instances[k];
+                    let mesh = &layer.meshes[inst.mesh as usize];
+                    for local in chunk.range {
+                        let (v, two_sided) = layer.world_vertices(inst, local);
+                        let t = Triangle { v, two_sided, ..mesh[local].clone() };
+                        setup_triangle_clipped(view, &t, inst.base + local as u32, job.offset, near_clip, frustum.as_ref(), &mut out);
+                    }
+                }
             }
             // Drop pieces outside the rows of this job.
             out.retain(|st| !st.bbox.intersect(&rows).is_empty());
@@ -209,6 +222,50 @@ pub fn setup_pass(job: &PassJob) -> Vec<ScreenTri> {
         })
         .collect();
     pieces.concat()
+}
+
+/// A run of triangles set up together: indices into `Scene::triangles`, or
+/// mesh indices of copy `copy` of the two-level layer.
+struct Chunk {
+    copy: Option<usize>,
+    range: std::ops::Range<usize>,
+}
+
+/// `spans` (triangle indices, in order) cut into runs of at most `size`
+/// that never straddle a copy of the two-level layer.
+fn chunks_of(scene: &crate::scene::Scene, spans: &[std::ops::Range<usize>], size: usize) -> Vec<Chunk> {
+    let flat = scene.triangles.len();
+    let mut out = Vec::new();
+    let cut = |out: &mut Vec<Chunk>, copy: Option<usize>, r: std::ops::Range<usize>| {
+        for s in (r.start..r.end).step_by(size) {
+            out.push(Chunk { copy, range: s..(s + size).min(r.end) });
+        }
+    };
+    for span in spans {
+        if span.start < flat {
+            cut(&mut out, None, span.start..span.end.min(flat));
+        }
+        if span.end <= flat {
+            continue;
+        }
+        let Some(layer) = scene.layer.as_deref() else { continue };
+        let start = span.start.max(flat);
+        let mut k = layer.instances.partition_point(|i| (i.base as usize) <= start).saturating_sub(1);
+        while k < layer.instances.len() {
+            let inst = &layer.instances[k];
+            let base = inst.base as usize;
+            if base >= span.end {
+                break;
+            }
+            let len = layer.meshes[inst.mesh as usize].len();
+            let (a, b) = (start.max(base) - base, (span.end.min(base + len)).saturating_sub(base));
+            if a < b {
+                cut(&mut out, Some(k), a..b);
+            }
+            k += 1;
+        }
+    }
+    out
 }
 
 /// For consecutive bands of `band` rows starting at `rows_start`, the indices
