@@ -777,6 +777,10 @@ fn cmd_list() -> Result<(), String> {
     for s in crate::scene::builtin::names() {
         let _ = writeln!(t, "  {s}");
     }
+    let _ = writeln!(t, "large scenes (instanced: raytrace and rasterize only):");
+    for s in crate::scene::builtin::large_names() {
+        let _ = writeln!(t, "  {s}");
+    }
     let _ = writeln!(t, "stress scenes (pinhole gallery: each provokes one failure):");
     for s in crate::scene::builtin::stress_names() {
         let _ = writeln!(t, "  {s}");

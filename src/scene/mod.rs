@@ -7,6 +7,7 @@ pub mod builtin;
 pub mod camera;
 pub mod environment;
 pub mod file;
+pub mod forest;
 pub mod instanced;
 pub mod load;
 pub mod mesh_cache;

@@ -208,10 +208,10 @@ pub fn setup_pass(job: &PassJob) -> Vec<ScreenTri> {
                     // A copy of the two-level layer: its triangles placed as flattening places them.
                     let layer = scene.layer.as_deref().expect("copies without a layer");
                     let inst = &layer.instances[k];
-                    let mesh = &layer.meshes[inst.mesh as usize];
                     for local in chunk.range {
+                        // Setup reads the vertices and the sidedness alone.
                         let (v, two_sided) = layer.world_vertices(inst, local);
-                        let t = Triangle { v, two_sided, ..mesh[local].clone() };
+                        let t = Triangle { v, n: [Vec3::ZERO; 3], uv: [Vec2::ZERO; 3], material: 0, object: 0, two_sided };
                         setup_triangle_clipped(view, &t, inst.base + local as u32, job.offset, near_clip, frustum.as_ref(), &mut out);
                     }
                 }
