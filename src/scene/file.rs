@@ -663,16 +663,21 @@ fn copies(
     }
     let mut out = Vec::with_capacity(list.len());
     for (k, d) in list.iter().enumerate() {
-        let here = format!("{}: instances[{k}]", at_line(d.span()));
+        // The line is found only for a message: counting lines for every
+        // entry of a long list would take time quadratic in its length.
+        let span = d.span();
+        let here = || format!("{}: instances[{k}]", at_line(span.clone()));
         let d = d.get_ref();
-        let placement = placement_of(d.translate, d.rotate_deg, d.scale.as_ref(), &here)?;
+        let placement = placement_of(d.translate, d.rotate_deg, d.scale.as_ref(), "").map_err(|_| {
+            placement_of(d.translate, d.rotate_deg, d.scale.as_ref(), &here()).err().unwrap_or_default()
+        })?;
         let material = match &d.material {
             Some(name) => Some(
                 scene
                     .materials
                     .iter()
                     .position(|m| &m.name == name)
-                    .ok_or(format!("{here}: material \"{name}\" is not defined in [materials]"))? as u32,
+                    .ok_or_else(|| format!("{}: material \"{name}\" is not defined in [materials]", here()))? as u32,
             ),
             None => object_material,
         };
