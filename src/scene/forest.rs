@@ -80,6 +80,11 @@ instances = [
         cells.swap(i, j.min(i));
     }
     let half = (SIDE as f32 - 1.0) * 0.5 * SPACING;
+    // The first copy stands in the middle of the field, in view, so that
+    // `forest-1` shows one bunny.
+    let middle = SIDE / 2 * SIDE + SIDE / 2;
+    let at = cells.iter().position(|&c| c == middle).unwrap_or(0);
+    cells.swap(0, at);
     for &cell in cells.iter().take(count.min(SIDE * SIDE)) {
         let (gx, gz) = ((cell % SIDE) as f32, (cell / SIDE) as f32);
         let x = gx * SPACING - half + (next(&mut state) - 0.5) * 0.15;

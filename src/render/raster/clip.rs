@@ -46,10 +46,45 @@ pub fn side_planes(view: &CameraView) -> [Vec3; 4] {
     [Vec3::new(-1.0, 0.0, -gx), Vec3::new(1.0, 0.0, -gx), Vec3::new(0.0, -1.0, -gy), Vec3::new(0.0, 1.0, -gy)]
 }
 
+/// What clipping against the whole view volume leaves of a triangle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FrustumClip {
+    /// Wholly outside one plane: nothing.
+    Outside,
+    /// Wholly inside every plane: the triangle itself.
+    Inside,
+    /// Cut: the image-space box of what is left.
+    Cut(Vec2, Vec2),
+}
+
 /// Clips the camera-space triangle `c` against the near plane and the side
 /// planes of the view volume (Sutherland-Hodgman, one plane after the
-/// other) and returns the image-space box of what is left, or `None` when
-/// nothing is. Only the box is kept: the pixels a triangle can cover.
+/// other). Only the box of what is left is kept: the pixels a triangle can
+/// cover. A triangle wholly inside or wholly outside one plane is decided
+/// from its corners alone.
+pub fn clip_frustum(c: [Vec3; 3], view: &CameraView, planes: &[Vec3; 4]) -> FrustumClip {
+    let mut inside = c.iter().all(|p| -p.z >= view.near);
+    if c.iter().all(|p| -p.z < view.near) {
+        return FrustumClip::Outside;
+    }
+    for n in planes {
+        let d = c.map(|p| n.dot(p));
+        if d.iter().all(|&d| d < 0.0) {
+            return FrustumClip::Outside;
+        }
+        inside &= d.iter().all(|&d| d >= 0.0);
+    }
+    if inside {
+        return FrustumClip::Inside;
+    }
+    match clip_frustum_box(c, view, planes) {
+        Some((lo, hi)) => FrustumClip::Cut(lo, hi),
+        None => FrustumClip::Outside,
+    }
+}
+
+/// The image-space box of what clipping `c` against the near plane and the
+/// side planes leaves, or `None` when nothing is.
 pub fn clip_frustum_box(c: [Vec3; 3], view: &CameraView, planes: &[Vec3; 4]) -> Option<(Vec2, Vec2)> {
     const MAX: usize = 3 + 5;
     let mut poly = [Vec3::ZERO; MAX];

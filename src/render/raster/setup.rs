@@ -3,7 +3,7 @@
 //! pixel bounding box. The result is a list of screen-space triangles in scene
 //! order, each remembering which scene triangle it came from.
 
-use super::clip::{clip_frustum_box, clip_near, side_planes, triangle_vertices, ClipMode};
+use super::clip::{clip_frustum, clip_near, side_planes, triangle_vertices, ClipMode, FrustumClip};
 use super::rect::{sample_span, PixelRect};
 use super::subpixel;
 use crate::math::{Vec2, Vec3};
@@ -155,9 +155,10 @@ pub fn setup_triangle_clipped(view: &CameraView, t: &Triangle, index: u32, off: 
         return;
     }
     let inside = match frustum {
-        Some(planes) => match clip_frustum_box(c, view, planes) {
-            None => return,
-            Some((lo, hi)) => {
+        Some(planes) => match clip_frustum(c, view, planes) {
+            FrustumClip::Outside => return,
+            FrustumClip::Inside => None,
+            FrustumClip::Cut(lo, hi) => {
                 let pad = Vec2::ONE;
                 let (x0, x1) = sample_span(lo.x - pad.x, hi.x + pad.x, off.x, view.width);
                 let (y0, y1) = sample_span(lo.y - pad.y, hi.y + pad.y, off.y, view.height);
@@ -196,7 +197,7 @@ pub fn setup_pass(job: &PassJob) -> Vec<ScreenTri> {
     let pieces: Vec<Vec<ScreenTri>> = chunks
         .into_par_iter()
         .map(|chunk| {
-            let mut out = Vec::with_capacity(chunk.range.len());
+            let mut out = Vec::new();
             let near_clip = job.settings.near_clip;
             match chunk.copy {
                 None => {
@@ -221,7 +222,12 @@ pub fn setup_pass(job: &PassJob) -> Vec<ScreenTri> {
             out
         })
         .collect();
-    pieces.concat()
+    // Each run's pieces are freed as they are moved: one copy at a time.
+    let mut all = Vec::with_capacity(pieces.iter().map(Vec::len).sum());
+    for p in pieces {
+        all.extend(p);
+    }
+    all
 }
 
 /// A run of triangles set up together: indices into `Scene::triangles`, or
