@@ -407,7 +407,8 @@ fn stats_json(l: &Loaded, render_ms: f64, counts: &RayCounts, spp: u32) -> serde
         "height": l.settings.height,
         "spp": spp,
         "threads": l.pool.current_num_threads(),
-        "triangles": l.prepared.scene.triangles.len(),
+        "triangles": l.prepared.scene.total_triangles(),
+        "flattened_triangles": l.prepared.scene.triangles.len(),
         "spheres": l.prepared.scene.spheres.len(),
         "load_ms": l.load_ms,
         "build_ms": l.prepared.build_ms,
@@ -543,7 +544,7 @@ fn cmd_bench(scene_arg: &str, opts: &RenderOpts, frames: u32) -> Result<(), Stri
     //   "bytes_per_triangle" the three summed, over "triangles" (null without triangles)
     //   "peak_rss_bytes"     the process's peak resident memory (null where unknown)
     let memory = l.prepared.memory();
-    let triangles = l.prepared.scene.triangles.len();
+    let triangles = l.prepared.scene.total_triangles() as usize;
     j["scene_bytes"] = json!(memory.scene_bytes);
     j["bvh_bytes"] = json!(memory.bvh_bytes);
     j["prepared_bytes"] = json!(memory.prepared_bytes);

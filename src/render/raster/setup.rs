@@ -187,6 +187,12 @@ pub fn setup_triangle_clipped(view: &CameraView, t: &Triangle, index: u32, off: 
 /// in parallel). Copies made by `instances` whose bounding sphere lies
 /// outside the view volume are skipped whole (`cull::visible_spans`).
 pub fn setup_pass(job: &PassJob) -> Vec<ScreenTri> {
+    setup_pass_map(job, Some)
+}
+
+/// `setup_pass`, each piece passed through `keep` as it is made, so that a
+/// variant that converts the pieces (fixed point) never holds both lists.
+pub fn setup_pass_map<T: Send>(job: &PassJob, keep: impl Fn(ScreenTri) -> Option<T> + Sync) -> Vec<T> {
     const CHUNK: usize = 4096;
     let view = job.view;
     let rows = PixelRect::new(0, job.rows.start, view.width, job.rows.end);
@@ -194,7 +200,7 @@ pub fn setup_pass(job: &PassJob) -> Vec<ScreenTri> {
     let spans = super::cull::visible_spans(job).spans;
     let chunks = chunks_of(scene, &spans, CHUNK);
     let frustum = (job.settings.clip == ClipMode::Frustum).then(|| side_planes(view));
-    let pieces: Vec<Vec<ScreenTri>> = chunks
+    let pieces: Vec<Vec<T>> = chunks
         .into_par_iter()
         .map(|chunk| {
             let mut out = Vec::new();
@@ -218,8 +224,7 @@ pub fn setup_pass(job: &PassJob) -> Vec<ScreenTri> {
                 }
             }
             // Drop pieces outside the rows of this job.
-            out.retain(|st| !st.bbox.intersect(&rows).is_empty());
-            out
+            out.into_iter().filter(|st| !st.bbox.intersect(&rows).is_empty()).filter_map(&keep).collect::<Vec<T>>()
         })
         .collect();
     // Each run's pieces are freed as they are moved: one copy at a time.
