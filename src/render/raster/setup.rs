@@ -203,7 +203,7 @@ pub fn setup_pass_map<T: Send>(job: &PassJob, keep: impl Fn(ScreenTri) -> Option
     let pieces: Vec<Vec<T>> = chunks
         .into_par_iter()
         .map(|chunk| {
-            let mut out = Vec::new();
+            let mut out = Vec::with_capacity(chunk.range.len());
             let near_clip = job.settings.near_clip;
             match chunk.copy {
                 None => {
@@ -224,7 +224,11 @@ pub fn setup_pass_map<T: Send>(job: &PassJob, keep: impl Fn(ScreenTri) -> Option
                 }
             }
             // Drop pieces outside the rows of this job.
-            out.into_iter().filter(|st| !st.bbox.intersect(&rows).is_empty()).filter_map(&keep).collect::<Vec<T>>()
+            // Held until the runs are joined: exactly as long as needed.
+            let mut kept = Vec::with_capacity(out.len());
+            kept.extend(out.into_iter().filter(|st| !st.bbox.intersect(&rows).is_empty()).filter_map(&keep));
+            kept.shrink_to_fit();
+            kept
         })
         .collect();
     // Each run's pieces are freed as they are moved: one copy at a time.
