@@ -161,7 +161,7 @@ impl PinholeApp {
 /// Name of the object a primitive belongs to.
 pub fn object_name(scene: &Scene, kind: PrimitiveKind, index: u32) -> String {
     let object = match kind {
-        PrimitiveKind::Triangle => scene.triangles.get(index as usize).map(|t| t.object),
+        PrimitiveKind::Triangle => ((index as u64) < scene.total_triangles()).then(|| scene.triangle(index).object),
         PrimitiveKind::Sphere => scene.spheres.get(index as usize).map(|s| s.object),
     };
     let copy = match kind {
