@@ -214,6 +214,12 @@ struct RenderOpts {
     /// What mirrors reflect: ray (traced) | env (the environment in the reflected direction, no ray).
     #[arg(long, default_value = "ray", value_name = "ray|env")]
     reflections: String,
+    /// Rasterizers: clip triangles at the near plane only, or at every plane of the view volume.
+    #[arg(long, default_value = "near", value_name = "near|frustum")]
+    clip: String,
+    /// Rasterizers: cull copies made by `instances` by their bounding spheres (same image either way).
+    #[arg(long = "cull-instances", value_name = "BOOL", default_value_t = true, action = clap::ArgAction::Set)]
+    cull_instances: bool,
 }
 
 /// What is left to do once the command line ran: the viewer is not part of
@@ -322,6 +328,8 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
     settings.interpolation = interpolation;
     settings.texture_filter = texture_filter;
     settings.reflections = reflections;
+    settings.clip = render::raster::clip::ClipMode::parse(&opts.clip).map_err(|e| format!("--clip: {e}"))?;
+    settings.cull_instances = opts.cull_instances;
     settings.affine = opts.affine;
     if let Some(b) = opts.bump {
         if !(b.is_finite() && b >= 0.0) {
@@ -371,6 +379,7 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
     if settings.shadows == ShadowMode::Map {
         render::shadow_map::check_memory(&scene, settings.shadow_map_size)?;
     }
+    render::layer_support::check(renderer.name(), &scene, &settings)?;
     renderer.check(&scene, &settings)?;
     let prepared = pool.install(|| PreparedScene::new(scene));
     Ok(Loaded { prepared, settings, renderer, pool, load_ms })
@@ -428,7 +437,8 @@ fn stats_json(l: &Loaded, render_ms: f64, counts: &RayCounts, spp: u32) -> serde
         "height": l.settings.height,
         "spp": spp,
         "threads": l.pool.current_num_threads(),
-        "triangles": l.prepared.scene.triangles.len(),
+        "triangles": l.prepared.scene.total_triangles(),
+        "flattened_triangles": l.prepared.scene.triangles.len(),
         "spheres": l.prepared.scene.spheres.len(),
         "load_ms": l.load_ms,
         "build_ms": l.prepared.build_ms,
@@ -442,6 +452,10 @@ fn stats_json(l: &Loaded, render_ms: f64, counts: &RayCounts, spp: u32) -> serde
         "samples_covered": counts.samples_covered,
         "fragments_shaded": counts.fragments_shaded,
         "depth_test_failures": counts.depth_fails,
+        "instances": l.prepared.scene.instances.len(),
+        "instances_drawn": counts.instances_drawn,
+        "instances_culled": counts.instances_culled,
+        "clip": l.settings.clip.name(),
         "shadows": l.settings.shadows.name(),
         "view": l.settings.view.name(),
         "interpolation": l.settings.interpolation.name(),
@@ -560,7 +574,7 @@ fn cmd_bench(scene_arg: &str, opts: &RenderOpts, frames: u32) -> Result<(), Stri
     //   "bytes_per_triangle" the three summed, over "triangles" (null without triangles)
     //   "peak_rss_bytes"     the process's peak resident memory (null where unknown)
     let memory = l.prepared.memory();
-    let triangles = l.prepared.scene.triangles.len();
+    let triangles = l.prepared.scene.total_triangles() as usize;
     j["scene_bytes"] = json!(memory.scene_bytes);
     j["bvh_bytes"] = json!(memory.bvh_bytes);
     j["prepared_bytes"] = json!(memory.prepared_bytes);
@@ -816,6 +830,10 @@ fn cmd_list() -> Result<(), String> {
     let _ = writeln!(t, "line algorithms (--view wireframe: --lines):\n  float\n  integer");
     let _ = writeln!(t, "built-in scenes:");
     for s in crate::scene::builtin::names() {
+        let _ = writeln!(t, "  {s}");
+    }
+    let _ = writeln!(t, "large scenes (instanced: raytrace and rasterize only):");
+    for s in crate::scene::builtin::large_names() {
         let _ = writeln!(t, "  {s}");
     }
     let _ = writeln!(t, "stress scenes (pinhole gallery: each provokes one failure):");

@@ -161,11 +161,15 @@ impl PinholeApp {
 /// Name of the object a primitive belongs to.
 pub fn object_name(scene: &Scene, kind: PrimitiveKind, index: u32) -> String {
     let object = match kind {
-        PrimitiveKind::Triangle => scene.triangles.get(index as usize).map(|t| t.object),
+        PrimitiveKind::Triangle => ((index as u64) < scene.total_triangles()).then(|| scene.triangle(index).object),
         PrimitiveKind::Sphere => scene.spheres.get(index as usize).map(|s| s.object),
     };
+    let copy = match kind {
+        PrimitiveKind::Triangle => scene.instance_of_triangle(index).map(|i| format!(", instance {}", i.index)),
+        PrimitiveKind::Sphere => None,
+    };
     object
-        .and_then(|o| scene.objects.get(o as usize).map(|info| format!("'{}' (object {o})", info.name)))
+        .and_then(|o| scene.objects.get(o as usize).map(|info| format!("'{}' (object {o}{})", info.name, copy.unwrap_or_default())))
         .unwrap_or_else(|| "?".into())
 }
 

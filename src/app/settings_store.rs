@@ -59,11 +59,13 @@ pub struct SceneKnobs {
     pub depth_buffer: DepthFormat,
     /// The wireframe view's line algorithm.
     pub lines: LineAlgorithm,
+    /// The planes rasterizers clip at (the same image either way).
+    pub clip: crate::render::raster::clip::ClipMode,
 }
 
 impl Default for SceneKnobs {
     fn default() -> Self {
-        SceneKnobs { shadow_map_size: shadow_map::DEFAULT_SIZE, shadow_map_bias: shadow_map::DEFAULT_BIAS, msaa: 1, early_depth: true, affine: false, depth_buffer: DepthFormat::F32, lines: LineAlgorithm::Float }
+        SceneKnobs { shadow_map_size: shadow_map::DEFAULT_SIZE, shadow_map_bias: shadow_map::DEFAULT_BIAS, msaa: 1, early_depth: true, affine: false, depth_buffer: DepthFormat::F32, lines: LineAlgorithm::Float, clip: Default::default() }
     }
 }
 
@@ -145,6 +147,7 @@ impl ViewerSettings {
             affine: k.affine,
             depth_buffer: k.depth_buffer,
             lines: k.lines,
+            clip: k.clip,
             ..RenderSettings::for_scene(scene)
         }
     }
@@ -171,6 +174,7 @@ impl ViewerSettings {
             affine: settings.affine,
             depth_buffer: settings.depth_buffer,
             lines: settings.lines,
+            clip: settings.clip,
         };
     }
 

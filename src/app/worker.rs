@@ -432,6 +432,7 @@ impl WorkerLoop {
         let maps = settings.shadows == render::ShadowMode::Map || settings.view == View::Shadowmap;
         let too_big = crate::input::check_image_size(width, height)
             .and_then(|_| if maps { render::shadow_map::check_memory(&prepared.scene, settings.shadow_map_size) } else { Ok(()) });
+        let too_big = too_big.and_then(|_| render::layer_support::check(renderer.name(), &prepared.scene, &settings));
         let too_big = too_big.and_then(|_| renderer.check(&prepared.scene, &settings));
         if let Err(e) = too_big {
             self.fail(&req, e);

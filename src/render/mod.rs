@@ -11,6 +11,7 @@ pub mod differentials;
 pub mod frame;
 pub mod gi;
 pub mod kd_tree;
+pub mod layer_support;
 pub mod lighting;
 pub mod normal_map;
 pub mod opengl;
@@ -164,6 +165,15 @@ pub struct RenderSettings {
     /// Traced reflections or environment lookups.
     #[serde(default)]
     pub reflections: Reflections,
+    /// Rasterizers: clip at the near plane only, or at every plane of the
+    /// view volume (`raster::clip`). The same image either way.
+    #[serde(default)]
+    pub clip: raster::clip::ClipMode,
+    /// Rasterizers and shadow maps: skip copies made by `instances` whose
+    /// bounding sphere is outside the view volume (`raster::cull`). The same
+    /// image either way; a knob to measure and test that.
+    #[serde(default = "default_true")]
+    pub cull_instances: bool,
 }
 
 fn default_true() -> bool {
@@ -201,6 +211,8 @@ impl RenderSettings {
             terminator_lift: true,
             texture_filter: crate::scene::texture::TextureFilter::Trilinear,
             reflections: Reflections::Ray,
+            clip: raster::clip::ClipMode::Near,
+            cull_instances: true,
         }
     }
 }
@@ -219,6 +231,9 @@ pub struct RayCounts {
     pub samples_covered: u64,
     pub fragments_shaded: u64,
     pub depth_fails: u64,
+    /// Rasterizer: copies made by `instances` set up, and culled whole.
+    pub instances_drawn: u64,
+    pub instances_culled: u64,
 }
 
 impl std::ops::AddAssign for RayCounts {
@@ -232,6 +247,8 @@ impl std::ops::AddAssign for RayCounts {
         self.samples_covered += o.samples_covered;
         self.fragments_shaded += o.fragments_shaded;
         self.depth_fails += o.depth_fails;
+        self.instances_drawn += o.instances_drawn;
+        self.instances_culled += o.instances_culled;
     }
 }
 

@@ -23,6 +23,8 @@ pub struct PreparedScene {
     /// The last shadow volumes built (`--shadows volume`), keyed by the
     /// lights; see `PreparedScene::shadow_volumes`.
     pub volume_cache: super::shadow_volume::ShadowVolumeCache,
+    /// The two-level layer's BVHs, when the scene has one.
+    pub instances: Option<super::raytrace::instances::InstanceAccel>,
 }
 
 /// The triangles' edges in scene order: a view of the BVH's primitive
@@ -91,8 +93,29 @@ impl PreparedScene {
         let start = Instant::now();
         let bvh = Bvh::build(&scene, &scene.triangles[..]);
         let build_ms = start.elapsed().as_secs_f64() * 1e3;
+        let instances = scene.layer.as_ref().map(|l| super::raytrace::instances::InstanceAccel::build(l));
+        let build_ms = if instances.is_some() { start.elapsed().as_secs_f64() * 1e3 } else { build_ms };
         let edges = bvh.edges_in_scene_order();
-        PreparedScene { scene, edges, bvh, build_ms, shadow_cache: Default::default(), photon_cache: Default::default(), volume_cache: Default::default() }
+        PreparedScene {
+            scene,
+            edges,
+            bvh,
+            build_ms,
+            shadow_cache: Default::default(),
+            photon_cache: Default::default(),
+            volume_cache: Default::default(),
+            instances,
+        }
+    }
+
+    /// The intersection data of triangle `index`, of the two-level layer too.
+    #[inline]
+    pub fn triangle_edges(&self, index: u32) -> TriangleEdges {
+        if (index as usize) < self.edges.len() {
+            self.edges[index as usize]
+        } else {
+            TriangleEdges::new(&self.scene.triangle(index))
+        }
     }
 
     /// What the scene's geometry and its acceleration structures hold in
@@ -101,8 +124,10 @@ impl PreparedScene {
     pub fn memory(&self) -> MemoryUse {
         use std::mem::size_of_val;
         MemoryUse {
-            scene_bytes: size_of_val(&self.scene.triangles[..]) + size_of_val(&self.scene.spheres[..]),
-            bvh_bytes: self.bvh.memory_bytes(),
+            scene_bytes: size_of_val(&self.scene.triangles[..])
+                + size_of_val(&self.scene.spheres[..])
+                + self.scene.layer.as_ref().map_or(0, |l| l.memory_bytes()),
+            bvh_bytes: self.bvh.memory_bytes() + self.instances.as_ref().map_or(0, |a| a.memory_bytes()),
             prepared_bytes: self.edges.memory_bytes(),
         }
     }

@@ -5,7 +5,8 @@
 use super::mesh_cache::MeshCache;
 use super::obj::{self, NormalMode};
 use super::texture::{load_texture_as, Encoding, Wrap};
-use super::{Camera, Fov, Light, Material, ObjectInfo, RenderDefaults, Scene, Sphere, Triangle};
+use super::instanced::{InstanceLayer, LayerInstance};
+use super::{Camera, Fov, InstanceInfo, Light, Material, ObjectInfo, RenderDefaults, Scene, Sphere, Triangle};
 use crate::input::{MAX_COORDINATE, MAX_LIGHT, MAX_VALUE};
 use crate::math::{Vec2, Vec3};
 
@@ -113,7 +114,19 @@ struct ObjectDesc {
     uvs: Option<Vec<F2>>,
     center: Option<F3>,
     radius: Option<f32>,
+    instances: Option<Vec<Spanned<InstanceDesc>>>,
     // `normals` for triangles is a list of vectors; meshes use the mode string.
+}
+
+/// One copy of a mesh object: its placement within the object's frame and
+/// its material, each optional.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct InstanceDesc {
+    translate: Option<F3>,
+    rotate_deg: Option<F3>,
+    scale: Option<ScaleDesc>,
+    material: Option<String>,
 }
 
 /// `normals` is a mode string on meshes and a list of three vectors on triangles.
@@ -167,12 +180,43 @@ pub fn load_scene_file(path: &Path) -> Result<Scene, String> {
 /// Parses scene TOML. `origin` names the source in messages; `base` resolves
 /// relative paths.
 pub fn parse_scene(text: &str, origin: &str, base: &Path, name: &str) -> Result<Scene, String> {
-    parse_scene_unbounded(text, origin, base, name).map_err(|e| crate::input::bounded_message(&e))
+    parse_scene_with(text, origin, base, name, TwoLevel::Auto)
+}
+
+/// How the copies made by `instances` lists are held.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum TwoLevel {
+    /// Flattened into `Scene::triangles` while the copies flattened so far
+    /// hold at most `FLATTEN_LIMIT` triangles; the rest in the two-level layer.
+    #[default]
+    Auto,
+    /// Every copy in the two-level layer (to test it against flattening).
+    Always,
+    /// Every copy flattened, however many triangles that makes.
+    Never,
+}
+
+/// Most triangles made by copies that are flattened (`TwoLevel::Auto`):
+/// beyond it a scene holds its copies as shared meshes and placements.
+pub const FLATTEN_LIMIT: usize = 2_000_000;
+
+/// `parse_scene`, choosing how copies are held.
+pub fn parse_scene_with(text: &str, origin: &str, base: &Path, name: &str, two_level: TwoLevel) -> Result<Scene, String> {
+    parse_scene_unbounded(text, origin, base, name, two_level).map_err(|e| crate::input::bounded_message(&e))
+}
+
+/// Copies bound for the two-level layer, gathered while objects are added:
+/// their virtual indices come after every flattened triangle.
+#[derive(Default)]
+struct Layered {
+    flattened: usize,
+    /// Per object: its id, its placed mesh and its copies.
+    objects: Vec<(u32, Arc<Vec<Triangle>>, Vec<MeshCopy>)>,
 }
 
 /// `parse_scene` before its message is bounded: messages quote names from
 /// the file (materials, types, paths), which can be of any length.
-fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str) -> Result<Scene, String> {
+fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str, two_level: TwoLevel) -> Result<Scene, String> {
     let desc: SceneDesc = toml::from_str(text).map_err(|e| toml_error(origin, text, &e))?;
     let at = |span: std::ops::Range<usize>| format!("{origin}:{}", line_of(text, span.start));
     let mut scene = Scene { name: name.to_string(), ..Scene::default() };
@@ -289,12 +333,17 @@ fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str) -> R
     }
 
     let mut meshes = MeshCache::default();
+    let mut layered = Layered::default();
     for (i, o) in desc.object.iter().enumerate() {
         let where_ = format!("{}: object {}", at(o.span()), i + 1);
-        add_object(&mut scene, o.get_ref(), i as u32, &where_, base, &mut meshes)?;
+        add_object(&mut scene, o.get_ref(), i as u32, &where_, base, &mut meshes, &at, two_level, &mut layered)?;
     }
+    build_layer(&mut scene, layered)?;
     for (index, path, where_, encoding) in textures {
-        let drawn = scene.triangles.iter().any(|t| t.material as usize == index) || scene.spheres.iter().any(|s| s.material as usize == index);
+        let in_layer = scene.layer.as_ref().is_some_and(|l| {
+            l.instances.iter().any(|i| i.material == Some(index as u32)) || l.meshes.iter().any(|m| m.iter().any(|t| t.material as usize == index))
+        });
+        let drawn = in_layer || scene.triangles.iter().any(|t| t.material as usize == index) || scene.spheres.iter().any(|s| s.material as usize == index);
         if drawn {
             let loaded = Some(Arc::new(load_texture_as(&path, encoding).map_err(|e| match encoding {
                 Encoding::Srgb => format!("{where_}: texture: {e}"),
@@ -322,7 +371,55 @@ fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str) -> R
     Ok(scene)
 }
 
-fn add_object(scene: &mut Scene, o: &ObjectDesc, object: u32, where_: &str, base: &Path, meshes: &mut MeshCache) -> Result<(), String> {
+/// Places the copies gathered in `layered` after every flattened triangle.
+fn build_layer(scene: &mut Scene, layered: Layered) -> Result<(), String> {
+    if layered.objects.is_empty() {
+        return Ok(());
+    }
+    let mut layer = InstanceLayer::default();
+    let mut base = scene.triangles.len() as u64;
+    for (object, mesh, copies) in layered.objects {
+        let (center, radius) = bounding_sphere(&mesh);
+        let mesh_index = layer.meshes.len() as u32;
+        let len = mesh.len() as u64;
+        layer.meshes.push(mesh);
+        for copy in copies {
+            let placement = copy.placement.unwrap_or_else(|| Placement::new(Vec3::ZERO, Vec3::ZERO, Vec3::ONE));
+            if base + len >= 1 << 31 {
+                return Err(format!("{}: the copies hold more than 2^31 triangles", scene.name));
+            }
+            let m = placement.matrix();
+            let stretch = m.x_axis.truncate().length().max(m.y_axis.truncate().length()).max(m.z_axis.truncate().length());
+            let c = m.transform_point3(center);
+            let r = radius * stretch * (1.0 + 1e-5) + 1e-6 * c.abs().max_element();
+            let range = base as usize..(base + len) as usize;
+            scene.instances.push(InstanceInfo { object, index: copy.index.unwrap_or(0), triangles: range, center: c, radius: r });
+            layer.instances.push(LayerInstance { mesh: mesh_index, placement, material: copy.material, base: base as u32 });
+            base += len;
+        }
+    }
+    scene.layer = Some(Arc::new(layer));
+    Ok(())
+}
+
+/// The centre of the bounding box of `tris` and the distance to its farthest vertex.
+fn bounding_sphere(tris: &[Triangle]) -> (Vec3, f32) {
+    let info = InstanceInfo::new(0, 0, 0..0, tris);
+    (info.center, info.radius)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn add_object(
+    scene: &mut Scene,
+    o: &ObjectDesc,
+    object: u32,
+    where_: &str,
+    base: &Path,
+    meshes: &mut MeshCache,
+    at_line: &dyn Fn(std::ops::Range<usize>) -> String,
+    two_level: TwoLevel,
+    layered: &mut Layered,
+) -> Result<(), String> {
     let two_sided = o.two_sided.unwrap_or(false);
     let placement = placement(o, where_)?;
     let explicit_material = match &o.material {
@@ -345,6 +442,7 @@ fn add_object(scene: &mut Scene, o: &ObjectDesc, object: u32, where_: &str, base
             ("uvs", o.uvs.is_some()),
             ("center", o.center.is_some()),
             ("radius", o.radius.is_some()),
+            ("instances", o.instances.is_some()),
         ];
         for (key, here) in present {
             if here && !allowed.contains(&key) {
@@ -355,7 +453,7 @@ fn add_object(scene: &mut Scene, o: &ObjectDesc, object: u32, where_: &str, base
     };
     match kind {
         "mesh" => {
-            only(&["file", "normals"])?;
+            only(&["file", "normals", "instances"])?;
             let file = o.file.as_ref().ok_or(format!("{where_}: a mesh needs `file`"))?;
             let mode = match &o.normals {
                 None => NormalMode::Auto,
@@ -379,17 +477,78 @@ fn add_object(scene: &mut Scene, o: &ObjectDesc, object: u32, where_: &str, base
                 Some(m) => m,
                 None => scene.default_material_index(),
             };
-            scene.triangles.reserve(loaded.triangles.len());
-            for t in &loaded.triangles {
-                let mut t = t.clone();
-                t.material = match (explicit_material, t.material) {
-                    (Some(m), _) => m,
-                    (None, u32::MAX) => fallback,
-                    (None, k) => mtl_index[k as usize],
-                };
-                t.object = object;
-                t.two_sided = two_sided;
-                scene.triangles.push(placement.apply(t));
+            let copies = match &o.instances {
+                None => vec![MeshCopy { placement: None, material: explicit_material, index: None }],
+                Some(list) => copies(scene, list, explicit_material, where_, at_line)?,
+            };
+            let flatten = match (two_level, &o.instances) {
+                (_, None) | (TwoLevel::Never, _) => true,
+                (TwoLevel::Always, Some(_)) => false,
+                (TwoLevel::Auto, Some(_)) => layered.flattened + loaded.triangles.len() * copies.len() <= FLATTEN_LIMIT,
+            };
+            if !flatten {
+                // The object's triangles placed once; each copy adds only its placement.
+                let mesh: Vec<Triangle> = loaded
+                    .triangles
+                    .iter()
+                    .map(|t| {
+                        let mut t = t.clone();
+                        t.material = match (explicit_material, t.material) {
+                            (Some(m), _) => m,
+                            (None, u32::MAX) => fallback,
+                            (None, k) => mtl_index[k as usize],
+                        };
+                        t.object = object;
+                        t.two_sided = two_sided;
+                        placement.apply(t)
+                    })
+                    .collect();
+                let (lo, hi) = mesh.iter().flat_map(|t| t.v).fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), v| (lo.min(v), hi.max(v)));
+                for copy in &copies {
+                    let m = copy.placement.as_ref().map_or(glam::Mat4::IDENTITY, |p| p.matrix());
+                    for k in 0..8 {
+                        let corner = Vec3::new(if k & 1 == 0 { lo.x } else { hi.x }, if k & 2 == 0 { lo.y } else { hi.y }, if k & 4 == 0 { lo.z } else { hi.z });
+                        let v = m.transform_point3(corner);
+                        if !(v.abs().max_element() <= MAX_COORDINATE) {
+                            return Err(format!(
+                                "{where_}: placed, copy {} reaches {v}; coordinates must be between -{MAX_COORDINATE:e} and {MAX_COORDINATE:e}",
+                                copy.index.unwrap_or(0)
+                            ));
+                        }
+                    }
+                }
+                let name = Path::new(file).file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+                let at = scene.triangles.len();
+                scene.objects.push(ObjectInfo { name, kind: kind.to_string(), triangles: at..at });
+                layered.objects.push((object, Arc::new(mesh), copies));
+                return Ok(());
+            }
+            if o.instances.is_some() {
+                layered.flattened += loaded.triangles.len() * copies.len();
+            }
+            scene.triangles.reserve(loaded.triangles.len() * copies.len());
+            for copy in &copies {
+                let start = scene.triangles.len();
+                for t in &loaded.triangles {
+                    let mut t = t.clone();
+                    t.material = match (copy.material, t.material) {
+                        (Some(m), _) => m,
+                        (None, u32::MAX) => fallback,
+                        (None, k) => mtl_index[k as usize],
+                    };
+                    t.object = object;
+                    t.two_sided = two_sided;
+                    // The object's own placement first, then the copy's:
+                    // each by the same arithmetic as a lone object's.
+                    let t = placement.apply(t);
+                    scene.triangles.push(match &copy.placement {
+                        Some(p) => p.apply(t),
+                        None => t,
+                    });
+                }
+                if let Some(index) = copy.index {
+                    scene.instances.push(InstanceInfo::new(object, index, start..scene.triangles.len(), &scene.triangles[start..]));
+                }
             }
         }
         "triangle" | "quad" => {
@@ -480,12 +639,65 @@ fn add_object(scene: &mut Scene, o: &ObjectDesc, object: u32, where_: &str, base
     Ok(())
 }
 
+/// One placed copy of a mesh object's triangles.
+struct MeshCopy {
+    /// The copy's own placement, applied after the object's (`None`: the object itself).
+    placement: Option<Placement>,
+    /// The copy's material, or the object's when `None` (then the MTL's).
+    material: Option<u32>,
+    /// Index in the object's `instances` list, `None` for an object without one.
+    index: Option<u32>,
+}
+
+/// The copies an `instances` list asks for, checked: every error names the
+/// line of the entry at fault and its key.
+fn copies(
+    scene: &Scene,
+    list: &[Spanned<InstanceDesc>],
+    object_material: Option<u32>,
+    where_: &str,
+    at_line: &dyn Fn(std::ops::Range<usize>) -> String,
+) -> Result<Vec<MeshCopy>, String> {
+    if list.len() > MAX_INSTANCES {
+        return Err(format!("{where_}: `instances` lists {} copies; at most {MAX_INSTANCES} are allowed", list.len()));
+    }
+    let mut out = Vec::with_capacity(list.len());
+    for (k, d) in list.iter().enumerate() {
+        // The line is found only for a message: counting lines for every
+        // entry of a long list would take time quadratic in its length.
+        let span = d.span();
+        let here = || format!("{}: instances[{k}]", at_line(span.clone()));
+        let d = d.get_ref();
+        let placement = placement_of(d.translate, d.rotate_deg, d.scale.as_ref(), "").map_err(|_| {
+            placement_of(d.translate, d.rotate_deg, d.scale.as_ref(), &here()).err().unwrap_or_default()
+        })?;
+        let material = match &d.material {
+            Some(name) => Some(
+                scene
+                    .materials
+                    .iter()
+                    .position(|m| &m.name == name)
+                    .ok_or_else(|| format!("{}: material \"{name}\" is not defined in [materials]", here()))? as u32,
+            ),
+            None => object_material,
+        };
+        out.push(MeshCopy { placement: Some(placement), material, index: Some(k as u32) });
+    }
+    Ok(out)
+}
+
+/// Most copies one `instances` list may make.
+const MAX_INSTANCES: usize = 1 << 20;
+
 /// Object placement: scale, then rotate about X, Y, Z, then translate.
+#[derive(Clone, Debug)]
 pub struct Placement {
     matrix: glam::Mat4,
     normal_matrix: glam::Mat3,
     uniform_scale: Option<f32>,
     identity: bool,
+    /// The matrix mirrors (negative determinant).
+    flips: bool,
 }
 
 impl Placement {
@@ -497,15 +709,36 @@ impl Placement {
         let normal_matrix = glam::Mat3::from_mat4(matrix).inverse().transpose();
         let uniform_scale = (scale.x == scale.y && scale.y == scale.z).then_some(scale.x);
         let identity = translate == Vec3::ZERO && rotate_deg == Vec3::ZERO && scale == Vec3::ONE;
-        Placement { matrix, normal_matrix, uniform_scale, identity }
+        let flips = matrix.determinant() < 0.0;
+        Placement { matrix, normal_matrix, uniform_scale, identity, flips }
     }
 
-    fn apply(&self, mut t: Triangle) -> Triangle {
+    /// The 4x4 matrix of the placement.
+    pub fn matrix(&self) -> glam::Mat4 {
+        self.matrix
+    }
+
+    /// The vertices `apply` gives, alone (the normals left out).
+    #[inline]
+    pub fn apply_vertices(&self, v: [Vec3; 3]) -> [Vec3; 3] {
+        if self.identity {
+            return v;
+        }
+        let mut w = v.map(|p| self.matrix.transform_point3(p));
+        if self.flips {
+            w.swap(1, 2);
+        }
+        w
+    }
+
+    /// The triangle placed: vertices by the matrix, normals by its inverse
+    /// transpose, corners reordered when the placement mirrors.
+    pub fn apply(&self, mut t: Triangle) -> Triangle {
         if self.identity {
             return t;
         }
         // A mirroring scale flips the winding; swap two corners to keep fronts in front.
-        let flips = self.matrix.determinant() < 0.0;
+        let flips = self.flips;
         for k in 0..3 {
             t.v[k] = self.matrix.transform_point3(t.v[k]);
             t.n[k] = (self.normal_matrix * t.n[k]).normalize_or_zero();
@@ -527,9 +760,13 @@ impl Placement {
 }
 
 fn placement(o: &ObjectDesc, where_: &str) -> Result<Placement, String> {
-    let translate = position(o.translate, where_, "translate")?.unwrap_or(Vec3::ZERO);
-    let rotate = finite(o.rotate_deg, where_, "rotate_deg")?.unwrap_or(Vec3::ZERO);
-    let scale = match &o.scale {
+    placement_of(o.translate, o.rotate_deg, o.scale.as_ref(), where_)
+}
+
+fn placement_of(translate: Option<F3>, rotate_deg: Option<F3>, scale: Option<&ScaleDesc>, where_: &str) -> Result<Placement, String> {
+    let translate = position(translate, where_, "translate")?.unwrap_or(Vec3::ZERO);
+    let rotate = finite(rotate_deg, where_, "rotate_deg")?.unwrap_or(Vec3::ZERO);
+    let scale = match scale {
         None => Vec3::ONE,
         Some(ScaleDesc::Uniform(s)) => Vec3::splat(*s),
         Some(ScaleDesc::PerAxis(s)) => Vec3::from(*s),

@@ -7,6 +7,8 @@ pub mod builtin;
 pub mod camera;
 pub mod environment;
 pub mod file;
+pub mod forest;
+pub mod instanced;
 pub mod load;
 pub mod mesh_cache;
 pub mod material;
@@ -141,6 +143,45 @@ pub struct ObjectInfo {
     pub triangles: std::ops::Range<usize>,
 }
 
+/// One copy made by a mesh object's `instances` list: where its triangles
+/// lie in `Scene::triangles`, and the sphere around them that rasterizers
+/// cull it by.
+#[derive(Clone, Debug, PartialEq)]
+pub struct InstanceInfo {
+    /// The `[[object]]` it is a copy of (index into `Scene::objects`).
+    pub object: u32,
+    /// Its position in that object's `instances` list.
+    pub index: u32,
+    pub triangles: std::ops::Range<usize>,
+    pub center: Vec3,
+    /// Holds every vertex of the copy (rounded up).
+    pub radius: f32,
+}
+
+impl InstanceInfo {
+    /// The record of copy `index` of `object`, whose world-space triangles are
+    /// `tris`, found at `range` of `Scene::triangles`.
+    pub fn new(object: u32, index: u32, range: std::ops::Range<usize>, tris: &[Triangle]) -> InstanceInfo {
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for t in tris {
+            for v in t.v {
+                lo = lo.min(v);
+                hi = hi.max(v);
+            }
+        }
+        let (center, radius) = if lo.x <= hi.x {
+            let center = (lo + hi) * 0.5;
+            let r2 = tris.iter().flat_map(|t| t.v).map(|v| (v - center).length_squared()).fold(0.0f32, f32::max);
+            // Grown a little, so that rounding in the distance never leaves a vertex outside.
+            (center, r2.sqrt() * (1.0 + 1e-5) + 1e-6 * center.abs().max_element())
+        } else {
+            (Vec3::ZERO, 0.0)
+        };
+        InstanceInfo { object, index, triangles: range, center, radius }
+    }
+}
+
 /// Image and display settings from `[render]`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderDefaults {
@@ -178,6 +219,11 @@ pub struct Scene {
     pub triangles: Vec<Triangle>,
     pub spheres: Vec<Sphere>,
     pub objects: Vec<ObjectInfo>,
+    /// The copies made by `instances` lists, in the order of their triangles.
+    pub instances: Vec<InstanceInfo>,
+    /// Copies not flattened into `triangles` (`instanced`): their triangles
+    /// have the indices after `triangles`, read through `Scene::triangle`.
+    pub layer: Option<std::sync::Arc<instanced::InstanceLayer>>,
     /// Things worth telling the user that did not stop the scene loading.
     pub warnings: Vec<String>,
     /// `[environment]`: what rays that hit nothing see instead of `background`.
@@ -292,6 +338,25 @@ impl Scene {
         self.triangles.len()
     }
 
+    /// Triangles drawn, the two-level layer's included.
+    pub fn total_triangles(&self) -> u64 {
+        self.triangles.len() as u64 + self.layer.as_ref().map_or(0, |l| l.triangle_count())
+    }
+
+    /// Triangle `index` in world space: a flattened one, or one of the
+    /// two-level layer made as flattening would make it.
+    #[inline]
+    pub fn triangle(&self, index: u32) -> std::borrow::Cow<'_, Triangle> {
+        match self.triangles.get(index as usize) {
+            Some(t) => std::borrow::Cow::Borrowed(t),
+            None => {
+                let layer = self.layer.as_ref().expect("a triangle index past the scene's triangles");
+                let (inst, local) = layer.locate(index).expect("a triangle index past the two-level layer");
+                std::borrow::Cow::Owned(layer.world(inst, local))
+            }
+        }
+    }
+
     /// World-space bounds of all geometry, `None` for an empty scene.
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
         let mut lo = Vec3::splat(f32::INFINITY);
@@ -306,6 +371,11 @@ impl Scene {
             lo = lo.min(s.center - Vec3::splat(s.radius));
             hi = hi.max(s.center + Vec3::splat(s.radius));
         }
+        // Copies of the two-level layer, by their bounding spheres.
+        for i in self.instances.iter().filter(|i| i.triangles.start >= self.triangles.len()) {
+            lo = lo.min(i.center - Vec3::splat(i.radius));
+            hi = hi.max(i.center + Vec3::splat(i.radius));
+        }
         (lo.x <= hi.x).then_some((lo, hi))
     }
 
@@ -314,7 +384,7 @@ impl Scene {
     /// rasterizer build their hits here, so identical visibility gives identical
     /// shading inputs.
     pub fn triangle_hit(&self, index: u32, b: Vec3, t: f32, ray: &Ray) -> SurfaceHit {
-        let tri = &self.triangles[index as usize];
+        let tri = &*self.triangle(index);
         let position = tri.v[0] * b.x + tri.v[1] * b.y + tri.v[2] * b.z;
         let mut geometric_normal = tri.geometric_normal();
         let mut shading_normal = (tri.n[0] * b.x + tri.n[1] * b.y + tri.n[2] * b.z).normalize_or(geometric_normal);
@@ -374,6 +444,19 @@ impl Scene {
             PrimitiveKind::Triangle => self.triangle_hit(id.index(), Vec3::new(1.0 - b1 - b2, b1, b2), t, ray),
             PrimitiveKind::Sphere => self.sphere_hit(id.index(), t, ray),
         }
+    }
+
+    /// The copy (from an `instances` list) that triangle `index` belongs to.
+    pub fn instance_of_triangle(&self, index: u32) -> Option<&InstanceInfo> {
+        let index = index as usize;
+        let k = self.instances.partition_point(|i| i.triangles.end <= index);
+        self.instances.get(k).filter(|i| i.triangles.contains(&index))
+    }
+
+    /// A copy's name: its object's name and its position in the object's list.
+    pub fn instance_name(&self, instance: &InstanceInfo) -> String {
+        let object = self.objects.get(instance.object as usize).map_or("?", |o| o.name.as_str());
+        format!("{object} instance {}", instance.index)
     }
 
     /// A default grey Lambertian material, added on demand.

@@ -7,6 +7,7 @@ use eframe::egui;
 use super::{color_edit, section};
 use crate::app::settings_store::ViewerSettings;
 use crate::render::gi::{GiMode, GiSettings, MAX_BOUNCES};
+use crate::render::raster::clip::ClipMode;
 use crate::render::raster::depth_format::DepthFormat;
 use crate::render::wireframe::LineAlgorithm;
 use crate::render::shadow_volume::VolumeMode;
@@ -101,6 +102,15 @@ pub fn show(ui: &mut egui::Ui, settings: &mut ViewerSettings, look: &mut RenderD
         egui::ComboBox::from_label("rasterizer: depth buffer").selected_text(s.depth_buffer.name()).show_ui(ui, |ui| {
             for f in DepthFormat::ALL {
                 ui.selectable_value(&mut s.depth_buffer, f, f.name()).on_hover_text(f.description());
+            }
+        });
+        ui.horizontal(|ui| {
+            ui.label("rasterizer: clip at");
+            for c in ClipMode::ALL {
+                ui.radio_value(&mut s.clip, c, c.name()).on_hover_text(match c {
+                    ClipMode::Near => "the near plane only",
+                    ClipMode::Frustum => "every plane of the view volume: the same image, measured in pinhole bench",
+                });
             }
         });
         ui.horizontal(|ui| {

@@ -23,7 +23,7 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
 /// The status line as plain text (tests read it).
 pub fn status_text(app: &PinholeApp) -> String {
     let renderer = app.settings.renderer.clone();
-    let triangles = app.scene.triangles.len();
+    let triangles = app.scene.total_triangles();
     let spheres = app.scene.spheres.len();
     app.with_output(|o| {
         let s = &o.stats;

@@ -1,4 +1,6 @@
-//! Near-plane clipping in camera space (CGPP 15.6.3).
+//! Near-plane clipping in camera space (CGPP 15.6.3), and clipping against
+//! every plane of the view volume (Computer Graphics from Scratch, ch. 11)
+//! for `--clip frustum`.
 //!
 //! The eye rays start on the near plane, so the ray tracer never sees anything
 //! nearer than `near`; the rasterizer gets the same result by cutting every
@@ -8,7 +10,125 @@
 //! barycentric coordinates in the ORIGINAL triangle, so fragments of the pieces
 //! still describe points of the original triangle.
 
-use crate::math::Vec3;
+use crate::math::{Vec2, Vec3};
+use crate::named::named_enum;
+use crate::scene::CameraView;
+
+named_enum! {
+    /// Which planes of the view volume triangle setup clips against.
+    #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+    pub enum ClipMode ("clip mode") {
+        /// The near plane only: the pieces are what gets rasterized, and the
+        /// pixel box of a piece is clamped to the image.
+        #[default]
+        Near = "near",
+        /// The near plane and the four side planes: a triangle wholly
+        /// outside one of them is dropped before projection, and the pixel
+        /// box of each piece shrinks to the part inside the image. The
+        /// pieces rasterized stay those of the near clip, so every fragment
+        /// and every interpolated value is the same.
+        Frustum = "frustum",
+    }
+}
+
+/// Pixels by which the side planes of `clip_frustum_box` lie outside the
+/// image: what the clipped polygon's rounding can move a point by is far
+/// below it, so no sample inside the image is ever cut off.
+pub const GUARD_PIXELS: f32 = 2.0;
+
+/// The side planes of the view volume grown by `GUARD_PIXELS`, in camera
+/// space, as inward normals through the eye: a point `p` is inside when
+/// `n . p >= 0` for all four.
+pub fn side_planes(view: &CameraView) -> [Vec3; 4] {
+    let gx = view.half_x * (1.0 + 2.0 * GUARD_PIXELS / view.width.max(1) as f32);
+    let gy = view.half_y * (1.0 + 2.0 * GUARD_PIXELS / view.height.max(1) as f32);
+    // x / -z <= gx  <=>  gx * -z - x >= 0, and so on.
+    [Vec3::new(-1.0, 0.0, -gx), Vec3::new(1.0, 0.0, -gx), Vec3::new(0.0, -1.0, -gy), Vec3::new(0.0, 1.0, -gy)]
+}
+
+/// What clipping against the whole view volume leaves of a triangle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FrustumClip {
+    /// Wholly outside one plane: nothing.
+    Outside,
+    /// Wholly inside every plane: the triangle itself.
+    Inside,
+    /// Cut: the image-space box of what is left.
+    Cut(Vec2, Vec2),
+}
+
+/// Clips the camera-space triangle `c` against the near plane and the side
+/// planes of the view volume (Sutherland-Hodgman, one plane after the
+/// other). Only the box of what is left is kept: the pixels a triangle can
+/// cover. A triangle wholly inside or wholly outside one plane is decided
+/// from its corners alone.
+pub fn clip_frustum(c: [Vec3; 3], view: &CameraView, planes: &[Vec3; 4]) -> FrustumClip {
+    let mut inside = c.iter().all(|p| -p.z >= view.near);
+    if c.iter().all(|p| -p.z < view.near) {
+        return FrustumClip::Outside;
+    }
+    for n in planes {
+        let d = c.map(|p| n.dot(p));
+        if d.iter().all(|&d| d < 0.0) {
+            return FrustumClip::Outside;
+        }
+        inside &= d.iter().all(|&d| d >= 0.0);
+    }
+    if inside {
+        return FrustumClip::Inside;
+    }
+    match clip_frustum_box(c, view, planes) {
+        Some((lo, hi)) => FrustumClip::Cut(lo, hi),
+        None => FrustumClip::Outside,
+    }
+}
+
+/// The image-space box of what clipping `c` against the near plane and the
+/// side planes leaves, or `None` when nothing is.
+pub fn clip_frustum_box(c: [Vec3; 3], view: &CameraView, planes: &[Vec3; 4]) -> Option<(Vec2, Vec2)> {
+    const MAX: usize = 3 + 5;
+    let mut poly = [Vec3::ZERO; MAX];
+    let mut next = [Vec3::ZERO; MAX];
+    poly[..3].copy_from_slice(&c);
+    let mut n = 3;
+    let near = view.near;
+    let mut cut = |poly: &mut [Vec3; MAX], n: usize, dist: &dyn Fn(Vec3) -> f32| -> usize {
+        let mut m = 0;
+        for i in 0..n {
+            let (a, b) = (poly[i], poly[(i + 1) % n]);
+            let (da, db) = (dist(a), dist(b));
+            if da >= 0.0 {
+                next[m] = a;
+                m += 1;
+            }
+            if (da >= 0.0) != (db >= 0.0) {
+                next[m] = a + (b - a) * (da / (da - db));
+                m += 1;
+            }
+        }
+        poly[..m].copy_from_slice(&next[..m]);
+        m
+    };
+    n = cut(&mut poly, n, &|p: Vec3| -p.z - near);
+    for plane in planes {
+        if n == 0 {
+            return None;
+        }
+        n = cut(&mut poly, n, &|p: Vec3| plane.dot(p));
+    }
+    if n == 0 {
+        return None;
+    }
+    let mut lo = Vec2::splat(f32::INFINITY);
+    let mut hi = Vec2::splat(f32::NEG_INFINITY);
+    for p in &poly[..n] {
+        // Points cut at the near plane may sit a rounding error nearer.
+        let q = view.project_camera(Vec3::new(p.x, p.y, p.z.min(-near * 0.5)));
+        lo = lo.min(q);
+        hi = hi.max(q);
+    }
+    Some((lo, hi))
+}
 
 /// A camera-space vertex with its barycentric coordinates in the original triangle.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -118,6 +118,13 @@ impl FixedTri {
 }
 
 /// Every triangle of the pass snapped (in order; dropped when degenerate after snapping).
+/// The pass's triangles set up and snapped, run by run (`setup::setup_pass_map`):
+/// the same list as `snap_triangles(&setup_pass(job), ..)`.
+pub fn setup_snapped(job: &crate::render::PassJob, sample_off: Vec2, width: u32, height: u32) -> Vec<FixedTri> {
+    let off = snap_offset(sample_off);
+    super::setup::setup_pass_map(job, |st| FixedTri::new(&st, off, sample_off, width, height))
+}
+
 pub fn snap_triangles(tris: &[ScreenTri], sample_off: Vec2, width: u32, height: u32) -> Vec<FixedTri> {
     use rayon::prelude::*;
     let off = snap_offset(sample_off);

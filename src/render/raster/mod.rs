@@ -4,6 +4,7 @@
 //! the `SurfaceHit` to the shared `resolve_sample`, like the ray casters:
 //!
 //! - `method`: the variants' names;
+//! - `cull`: copies made by `instances` culled whole by their bounding spheres;
 //! - `setup`: camera space, back-face culling, near clipping (`clip`), projection;
 //! - `rect`: pixel rectangles and sample spans; `subpixel`: the fixed-point grid;
 //! - coverage loops, one per file: `naive` and `bbox` (the 3D ray test),
@@ -21,6 +22,7 @@ pub mod barycentric;
 pub mod bbox;
 pub mod clip;
 pub mod coverage;
+pub mod cull;
 pub mod depth_format;
 pub mod derivatives;
 pub mod fixed;

@@ -27,7 +27,7 @@ pub fn region_rays<Q: SceneQuery, R: FragmentRecorder>(vb: &VisBuffer<Q, R>) -> 
 /// Tests triangle `tri` against the pixels of `rect` (inside `vb`'s region).
 #[inline]
 pub fn ray_test_rect<Q: SceneQuery, R: FragmentRecorder>(vb: &mut VisBuffer<Q, R>, rays: &[Ray], tri: u32, rect: PixelRect) {
-    let edges = &vb.job.prepared.edges[tri as usize];
+    let edges = &vb.job.prepared.triangle_edges(tri);
     vb.add_tested(rect);
     for y in rect.y0..rect.y1 {
         for x in rect.x0..rect.x1 {

@@ -17,7 +17,7 @@
 //! coverage loops over the region holding the pixel (its row, or its tile),
 //! with a recording `VisBuffer` that keeps that pixel's fragment history.
 
-use super::fixed::{self, snap_triangles, FixedTri};
+use super::fixed::{self, FixedTri};
 use super::msaa;
 use super::naive::{ray_test_rect, region_rays};
 use super::rect::PixelRect;
@@ -101,13 +101,13 @@ impl<'a> Layer<'a> {
                 Geometry::FloatTriangles { tris, bins }
             }
             Method::Fixed => {
-                let fts = snap_triangles(&setup_pass(&job), offset, w, h);
+                let fts = fixed::setup_snapped(&job, offset, w, h);
                 let bins = bin_rows(fts.iter().map(|f| f.bbox), r0, r1, BAND_ROWS);
                 Geometry::FixedTriangles { fts, off: snap_offset(offset), bins }
             }
             Method::Tiled => {
                 let off = snap_offset(offset);
-                let fts = snap_triangles(&setup_pass(&job), offset, w, h);
+                let fts = fixed::setup_snapped(&job, offset, w, h);
                 let bins = tiled::bin_tiles(&fts, grid, off);
                 Geometry::FixedTriangleTiles { fts, off, bins }
             }
@@ -115,7 +115,7 @@ impl<'a> Layer<'a> {
                 // The order is made over the whole image, whatever rows this
                 // job renders, so a band shows what the frame shows.
                 let frame = job_at_offset(&job, offset, 0..h);
-                let fts = snap_triangles(&setup_pass(&frame), offset, w, h);
+                let fts = fixed::setup_snapped(&frame, offset, w, h);
                 let (order, _) = painter::draw_order(&frame, &fts, &spheres);
                 let rects = order.iter().map(|p| match *p {
                     Paint::Triangle(t) => fts[t as usize].bbox,
@@ -136,7 +136,7 @@ impl<'a> Layer<'a> {
         match &self.geometry {
             Geometry::AllTriangles => {
                 let rays = region_rays(vb);
-                for tri in 0..self.job.prepared.edges.len() as u32 {
+                for tri in 0..self.job.prepared.scene.total_triangles() as u32 {
                     if self.job.cancelled() {
                         return;
                     }
@@ -259,8 +259,19 @@ fn shades_forward(job: &PassJob) -> bool {
     !job.settings.early_depth && job.settings.msaa <= 1 && !uses_stencil(job)
 }
 
-/// Renders `job.rows` of one pass of `method` into `out`.
+/// Renders `job.rows` of one pass of `method` into `out`, counting the
+/// copies made by `instances` that its setup draws and culls.
 pub fn render(method: Method, job: &PassJob, out: &mut [Radiance]) -> RayCounts {
+    let mut counts = render_regions(method, job, out);
+    if method != Method::Naive && !job.prepared.scene.instances.is_empty() {
+        let v = super::cull::visible_spans(job);
+        counts.instances_drawn += v.drawn;
+        counts.instances_culled += v.culled;
+    }
+    counts
+}
+
+fn render_regions(method: Method, job: &PassJob, out: &mut [Radiance]) -> RayCounts {
     let width = job.view.width;
     if width == 0 || job.rows.is_empty() {
         return RayCounts::default();

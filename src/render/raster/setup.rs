@@ -3,7 +3,7 @@
 //! pixel bounding box. The result is a list of screen-space triangles in scene
 //! order, each remembering which scene triangle it came from.
 
-use super::clip::{clip_near, triangle_vertices};
+use super::clip::{clip_frustum, clip_near, side_planes, triangle_vertices, ClipMode, FrustumClip};
 use super::rect::{sample_span, PixelRect};
 use super::subpixel;
 use crate::math::{Vec2, Vec3};
@@ -135,6 +135,15 @@ pub fn is_back_face(view: &CameraView, t: &Triangle) -> bool {
 /// Without `near_clip` a triangle reaching nearer than the near plane is
 /// dropped instead of cut (the `near_clip` debug setting).
 pub fn setup_triangle(view: &CameraView, t: &Triangle, index: u32, off: Vec2, near_clip: bool, out: &mut Vec<ScreenTri>) {
+    setup_triangle_clipped(view, t, index, off, near_clip, None, out)
+}
+
+/// `setup_triangle`, with `frustum` (the grown side planes of
+/// `clip::side_planes`) for `--clip frustum`: the triangle is also clipped
+/// against the side planes, which drops it when nothing is left and shrinks
+/// its pieces' pixel boxes to what is left. The pieces and their attributes
+/// are those of the near clip either way.
+pub fn setup_triangle_clipped(view: &CameraView, t: &Triangle, index: u32, off: Vec2, near_clip: bool, frustum: Option<&[Vec3; 4]>, out: &mut Vec<ScreenTri>) {
     if is_back_face(view, t) {
         return;
     }
@@ -145,38 +154,133 @@ pub fn setup_triangle(view: &CameraView, t: &Triangle, index: u32, off: Vec2, ne
     if !near_clip && c.iter().any(|c| -c.z < view.near) {
         return;
     }
+    let inside = match frustum {
+        Some(planes) => match clip_frustum(c, view, planes) {
+            FrustumClip::Outside => return,
+            FrustumClip::Inside => None,
+            FrustumClip::Cut(lo, hi) => {
+                let pad = Vec2::ONE;
+                let (x0, x1) = sample_span(lo.x - pad.x, hi.x + pad.x, off.x, view.width);
+                let (y0, y1) = sample_span(lo.y - pad.y, hi.y + pad.y, off.y, view.height);
+                Some(PixelRect { x0, y0, x1, y1 })
+            }
+        },
+        None => None,
+    };
     for piece in clip_near(triangle_vertices(c), view.near).as_slice() {
         let p = piece.map(|v| view.project_camera(v.pos));
         let inv_z = piece.map(|v| 1.0 / -v.pos.z);
         let bz = [piece[0].bary * inv_z[0], piece[1].bary * inv_z[1], piece[2].bary * inv_z[2]];
-        if let Some(st) = ScreenTri::new(index, p, inv_z, bz, off, view.width, view.height) {
+        if let Some(mut st) = ScreenTri::new(index, p, inv_z, bz, off, view.width, view.height) {
+            if let Some(r) = inside {
+                st.bbox = st.bbox.intersect(&r);
+                if st.bbox.is_empty() {
+                    continue;
+                }
+            }
             out.push(st);
         }
     }
 }
 
-/// Every triangle of the scene set up for this pass, in scene order (setup in parallel).
+/// Every triangle of the scene set up for this pass, in scene order (setup
+/// in parallel). Copies made by `instances` whose bounding sphere lies
+/// outside the view volume are skipped whole (`cull::visible_spans`).
 pub fn setup_pass(job: &PassJob) -> Vec<ScreenTri> {
+    setup_pass_map(job, Some)
+}
+
+/// `setup_pass`, each piece passed through `keep` as it is made, so that a
+/// variant that converts the pieces (fixed point) never holds both lists.
+pub fn setup_pass_map<T: Send>(job: &PassJob, keep: impl Fn(ScreenTri) -> Option<T> + Sync) -> Vec<T> {
     const CHUNK: usize = 4096;
     let view = job.view;
     let rows = PixelRect::new(0, job.rows.start, view.width, job.rows.end);
-    let pieces: Vec<Vec<ScreenTri>> = job
-        .prepared
-        .scene
-        .triangles
-        .par_chunks(CHUNK)
-        .enumerate()
-        .map(|(ci, chunk)| {
-            let mut out = Vec::with_capacity(chunk.len());
-            for (j, t) in chunk.iter().enumerate() {
-                setup_triangle(view, t, (ci * CHUNK + j) as u32, job.offset, job.settings.near_clip, &mut out);
+    let scene = &job.prepared.scene;
+    let spans = super::cull::visible_spans(job).spans;
+    let chunks = chunks_of(scene, &spans, CHUNK);
+    let frustum = (job.settings.clip == ClipMode::Frustum).then(|| side_planes(view));
+    let pieces: Vec<Vec<T>> = chunks
+        .into_par_iter()
+        .map(|chunk| {
+            let mut out = Vec::with_capacity(chunk.range.len());
+            let near_clip = job.settings.near_clip;
+            match chunk.copy {
+                None => {
+                    for i in chunk.range {
+                        setup_triangle_clipped(view, &scene.triangles[i], i as u32, job.offset, near_clip, frustum.as_ref(), &mut out);
+                    }
+                }
+                Some(k) => {
+                    // A copy of the two-level layer: its triangles placed as flattening places them.
+                    let layer = scene.layer.as_deref().expect("copies without a layer");
+                    let inst = &layer.instances[k];
+                    for local in chunk.range {
+                        // Setup reads the vertices and the sidedness alone.
+                        let (v, two_sided) = layer.world_vertices(inst, local);
+                        let t = Triangle { v, n: [Vec3::ZERO; 3], uv: [Vec2::ZERO; 3], material: 0, object: 0, two_sided };
+                        setup_triangle_clipped(view, &t, inst.base + local as u32, job.offset, near_clip, frustum.as_ref(), &mut out);
+                    }
+                }
             }
             // Drop pieces outside the rows of this job.
-            out.retain(|st| !st.bbox.intersect(&rows).is_empty());
-            out
+            // Held until the runs are joined: exactly as long as needed.
+            let mut kept = Vec::with_capacity(out.len());
+            kept.extend(out.into_iter().filter(|st| !st.bbox.intersect(&rows).is_empty()).filter_map(&keep));
+            kept.shrink_to_fit();
+            kept
         })
         .collect();
-    pieces.concat()
+    // Each run's pieces are freed as they are moved: one copy at a time.
+    let mut all = Vec::with_capacity(pieces.iter().map(Vec::len).sum());
+    for p in pieces {
+        all.extend(p);
+    }
+    all
+}
+
+/// A run of triangles set up together: indices into `Scene::triangles`, or
+/// mesh indices of copy `copy` of the two-level layer.
+struct Chunk {
+    copy: Option<usize>,
+    range: std::ops::Range<usize>,
+}
+
+/// `spans` (triangle indices, in order) cut into runs of at most `size`
+/// that never straddle a copy of the two-level layer.
+fn chunks_of(scene: &crate::scene::Scene, spans: &[std::ops::Range<usize>], size: usize) -> Vec<Chunk> {
+    let flat = scene.triangles.len();
+    let mut out = Vec::new();
+    let cut = |out: &mut Vec<Chunk>, copy: Option<usize>, r: std::ops::Range<usize>| {
+        for s in (r.start..r.end).step_by(size) {
+            out.push(Chunk { copy, range: s..(s + size).min(r.end) });
+        }
+    };
+    for span in spans {
+        if span.start < flat {
+            cut(&mut out, None, span.start..span.end.min(flat));
+        }
+        if span.end <= flat {
+            continue;
+        }
+        let Some(layer) = scene.layer.as_deref() else { continue };
+        let start = span.start.max(flat);
+        let mut k = layer.instances.partition_point(|i| (i.base as usize) <= start).saturating_sub(1);
+        while k < layer.instances.len() {
+            let inst = &layer.instances[k];
+            let base = inst.base as usize;
+            if base >= span.end {
+                break;
+            }
+            let len = layer.meshes[inst.mesh as usize].len();
+            let (a, b) = (start.max(base) - base, (span.end.min(base + len)).saturating_sub(base));
+            if a < b {
+                cut(&mut out, Some(k), a..b);
+            }
+            k += 1;
+        }
+    }
+    out
 }
 
 /// For consecutive bands of `band` rows starting at `rows_start`, the indices

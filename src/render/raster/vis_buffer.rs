@@ -286,7 +286,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         let i = self.index(x, y);
         self.count_work(i);
         if self.is_focus(x, y) {
-            let edges = &self.job.prepared.edges[tri as usize];
+            let edges = &self.job.prepared.triangle_edges(tri);
             if let Ok((t, b1, b2)) = crate::render::raytrace::intersect::intersect_triangle(ray, edges, f32::INFINITY) {
                 let stored = self.depth[i];
                 self.record(PrimitiveKind::Triangle, tri, None, Vec3::new(1.0 - b1 - b2, b1, b2), t, stored, false, i, x, y);
@@ -358,7 +358,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             let t = match self.key {
                 DepthKey::RayT => self.depth[i],
                 DepthKey::NegInvZ => {
-                    let v = &scene.triangles[id.index() as usize].v;
+                    let v = &scene.triangle(id.index()).v;
                     let pos = v[0] * b.x + v[1] * b.y + v[2] * b.z;
                     (pos - ray.origin).dot(ray.dir)
                 }

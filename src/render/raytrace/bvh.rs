@@ -278,9 +278,35 @@ impl<'a> BvhQuery<'a> {
         rec: &mut R,
     ) -> Option<BestHit> {
         let bvh = &self.prepared.bvh;
+        if let (Some(accel), Some(layer)) = (&self.prepared.instances, &self.prepared.scene.layer) {
+            let found = if bvh.prims.is_empty() { None } else { self.traverse_flat::<ANY, R>(ray, t_max, inside, counts, rec) };
+            if ANY && found.is_some() {
+                return found;
+            }
+            let mut best = found.unwrap_or(BestHit::nothing_before(t_max));
+            let (mut visits, mut tests) = (0, 0);
+            accel.traverse::<ANY, R>(layer, ray, &mut best, &mut visits, &mut tests, rec);
+            counts.nodes += visits;
+            counts.tests += tests;
+            return (!best.id.is_none()).then_some(best);
+        }
         if bvh.prims.is_empty() {
             return None;
         }
+        self.traverse_flat::<ANY, R>(ray, t_max, inside, counts, rec)
+    }
+
+    /// The walk through the BVH over the flattened triangles and the spheres.
+    #[inline(always)]
+    fn traverse_flat<const ANY: bool, R: Recorder>(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        inside: bool,
+        counts: &mut RayCounts,
+        rec: &mut R,
+    ) -> Option<BestHit> {
+        let bvh = &self.prepared.bvh;
         if bvh.deep {
             self.traverse_with::<ANY, R, _>(ray, t_max, inside, counts, rec, &mut Vec::new())
         } else {

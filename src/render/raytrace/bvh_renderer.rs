@@ -21,6 +21,10 @@ impl Renderer for BvhRayTracer {
     }
 
     fn render_pass(&self, job: &PassJob, out: &mut [Radiance]) -> RayCounts {
+        if job.prepared.instances.is_some() {
+            // Packets walk the one BVH; the two-level layer takes rays one at a time.
+            return super::cast_pass(job, &BvhQuery::new(job.prepared), out);
+        }
         cast_pass_packets(job, &BvhQuery::new(job.prepared), out)
     }
 

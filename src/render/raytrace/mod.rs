@@ -7,6 +7,7 @@
 pub mod brute;
 pub mod bvh;
 pub mod bvh_renderer;
+pub mod instances;
 pub mod intersect;
 pub mod packet;
 pub mod traverse;

@@ -1,0 +1,35 @@
+//! What can draw a scene whose copies live in the two-level instance layer
+//! (`scene::instanced`): the BVH ray tracer and the rasterizers, with ray
+//! or no shadows. The rest read `Scene::triangles` alone, so they refuse
+//! such a scene with one sentence instead of drawing it without its copies.
+
+use super::{debug::View, RenderSettings, ShadowMode};
+use crate::scene::Scene;
+
+/// `Ok` when `renderer` (by name) with `settings` draws every copy of `scene`.
+pub fn check(renderer: &str, scene: &Scene, settings: &RenderSettings) -> Result<(), String> {
+    if scene.layer.is_none() {
+        return Ok(());
+    }
+    let why = |what: &str| {
+        Err(format!(
+            "{what} cannot draw this scene's {} copies held as shared meshes (over {} triangles are not flattened); use raytrace or rasterize with --shadows ray or none",
+            scene.layer.as_ref().map_or(0, |l| l.instances.len()),
+            crate::scene::file::FLATTEN_LIMIT
+        ))
+    };
+    match renderer {
+        "raytrace:brute" | "opengl" => return why(renderer),
+        _ => {}
+    }
+    match settings.shadows {
+        ShadowMode::Map => return why("--shadows map"),
+        ShadowMode::Volume => return why("--shadows volume"),
+        ShadowMode::None | ShadowMode::Ray => {}
+    }
+    match settings.view {
+        View::Wireframe => why("--view wireframe"),
+        View::Shadowmap => why("--view shadowmap"),
+        _ => Ok(()),
+    }
+}

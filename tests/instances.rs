@@ -1,0 +1,373 @@
+//! Copies made by a mesh object's `instances` list: they are the very
+//! triangles separate objects would give (bit for bit, in every renderer
+//! family), rasterizers cull them whole without changing a pixel, and
+//! clipping at every plane of the view volume changes no pixel either.
+
+mod common;
+
+use pinhole::render::raster::clip::ClipMode;
+use pinhole::render::{self, PreparedScene, RenderSettings};
+use pinhole::scene::file::parse_scene;
+use pinhole::scene::Scene;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+
+/// A unit cube with its bottom at y = 0, CCW faces seen from outside.
+const CUBE: &str = "v -0.5 0 -0.5\nv 0.5 0 -0.5\nv 0.5 1 -0.5\nv -0.5 1 -0.5\nv -0.5 0 0.5\nv 0.5 0 0.5\nv 0.5 1 0.5\nv -0.5 1 0.5\n\
+f 1 4 3\nf 1 3 2\nf 5 6 7\nf 5 7 8\nf 1 5 8\nf 1 8 4\nf 2 3 7\nf 2 7 6\nf 4 8 7\nf 4 7 3\nf 1 2 6\nf 1 6 5\n";
+
+const HEAD: &str = r#"
+[camera]
+eye = [0.3, 2.5, 6.0]
+target = [0.0, 0.5, 0.0]
+fov_y_deg = 50.0
+near = 0.1
+far = 100.0
+
+[render]
+width = 96
+height = 64
+
+[[light]]
+type = "point"
+position = [2.0, 5.0, 3.0]
+power = [300.0, 300.0, 300.0]
+
+[materials.red]
+lambertian = [0.8, 0.2, 0.2]
+glossy = [0.2, 0.2, 0.2]
+sharpness = 30.0
+
+[materials.blue]
+lambertian = [0.2, 0.3, 0.8]
+
+[[object]]
+type = "quad"
+vertices = [[-40.0, 0.0, 40.0], [40.0, 0.0, 40.0], [40.0, 0.0, -40.0], [-40.0, 0.0, -40.0]]
+material = "blue"
+"#;
+
+/// The placements of the copies: two off screen (beside the view, behind the eye).
+const COPIES: &[&str] = &[
+    "translate = [-1.5, 0.0, 0.0]",
+    "translate = [1.5, 0.0, 0.3], rotate_deg = [0.0, 30.0, 10.0], scale = 0.7, material = \"blue\"",
+    "translate = [0.0, 0.0, -2.0], scale = [1.0, 2.0, 0.5]",
+    "translate = [0.2, 0.3, 1.2], rotate_deg = [15.0, -40.0, 0.0], scale = [-0.6, 0.6, 0.6]",
+    "translate = [30.0, 0.0, 0.0]",
+    "translate = [0.0, 0.0, 50.0]",
+];
+
+const TAIL: &str = r#"
+[[object]]
+type = "sphere"
+center = [0.0, 0.4, 1.8]
+radius = 0.4
+material = "red"
+"#;
+
+/// A folder holding cube.obj, written once for every test of the run.
+fn dir() -> PathBuf {
+    static DIR: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
+    DIR.get_or_init(|| {
+        let d = std::env::temp_dir().join(format!("pinhole-instances-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        std::fs::write(d.join("cube.obj"), CUBE).unwrap();
+        d
+    })
+    .clone()
+}
+
+/// The scene with one mesh object listing every copy.
+fn instanced_text() -> String {
+    let list: Vec<String> = COPIES.iter().map(|c| format!("  {{ {c} }},")).collect();
+    format!("{HEAD}\n[[object]]\ntype = \"mesh\"\nfile = \"cube.obj\"\nmaterial = \"red\"\ninstances = [\n{}\n]\n{TAIL}", list.join("\n"))
+}
+
+/// The same scene with each copy written as its own object.
+fn separate_text() -> String {
+    let mut s = HEAD.to_string();
+    for c in COPIES {
+        // A copy's own material replaces the object's.
+        let fields = if c.contains("material") { c.to_string() } else { format!("{c}, material = \"red\"") };
+        s += "\n[[object]]\ntype = \"mesh\"\nfile = \"cube.obj\"\n";
+        for f in split_fields(&fields) {
+            s += &f;
+            s += "\n";
+        }
+    }
+    s + TAIL
+}
+
+/// `a = [..], b = 1` as lines, splitting at commas outside brackets.
+fn split_fields(s: &str) -> Vec<String> {
+    let (mut out, mut cur, mut depth) = (Vec::new(), String::new(), 0);
+    for ch in s.chars() {
+        match ch {
+            '[' => depth += 1,
+            ']' => depth -= 1,
+            ',' if depth == 0 => {
+                out.push(cur.trim().to_string());
+                cur.clear();
+                continue;
+            }
+            _ => {}
+        }
+        cur.push(ch);
+    }
+    out.push(cur.trim().to_string());
+    out
+}
+
+fn parse(text: &str, base: &Path) -> Scene {
+    parse_scene(text, "test scene", base, "test").unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn frame(renderer: &str, prepared: &PreparedScene, settings: &RenderSettings) -> render::FrameResult {
+    let r = render::renderer_by_name(renderer).unwrap();
+    render::render_frame(r.as_ref(), prepared, settings, &AtomicBool::new(false), None).unwrap()
+}
+
+fn bits(pixels: &[glam::Vec3]) -> Vec<[u32; 3]> {
+    pixels.iter().map(|p| p.to_array().map(f32::to_bits)).collect()
+}
+
+#[test]
+fn instances_are_the_triangles_of_separate_objects() {
+    let d = dir();
+    let a = parse(&instanced_text(), &d);
+    let b = parse(&separate_text(), &d);
+    assert_eq!(a.instances.len(), COPIES.len());
+    assert_eq!(a.triangles.len(), b.triangles.len());
+    for (i, (ta, tb)) in a.triangles.iter().zip(&b.triangles).enumerate() {
+        assert_eq!((ta.v, ta.n, ta.uv, ta.material), (tb.v, tb.n, tb.uv, tb.material), "triangle {i}");
+    }
+    let (pa, pb) = (PreparedScene::new(a), PreparedScene::new(b));
+    let settings = RenderSettings::for_scene(&pa.scene);
+    for renderer in ["raytrace:brute", "raytrace", "rasterize", "rasterize:tiled"] {
+        let (fa, fb) = (frame(renderer, &pa, &settings), frame(renderer, &pb, &settings));
+        assert!(fa.pixels.iter().any(|p| p.x > 0.05), "{renderer}: the image is black");
+        assert_eq!(bits(&fa.pixels), bits(&fb.pixels), "{renderer}: instances differ from separate objects");
+    }
+}
+
+#[test]
+fn instance_placement_follows_the_objects_own() {
+    // The object's translate is applied first, then each copy's.
+    let d = dir();
+    let text = format!(
+        "{HEAD}\n[[object]]\ntype = \"mesh\"\nfile = \"cube.obj\"\ntranslate = [0.0, 1.0, 0.0]\ninstances = [{{ scale = 2.0 }}, {{}}]\n"
+    );
+    let s = parse(&text, &d);
+    let cube: Vec<_> = s.triangles[2..].iter().collect();
+    let top = |tris: &[&pinhole::scene::Triangle]| tris.iter().flat_map(|t| t.v).map(|v| v.y).fold(f32::MIN, f32::max);
+    // Copy 0: scale 2 of the lifted cube (y 1..2) gives y 2..4; copy 1: y 1..2.
+    assert_eq!(top(&cube[..12]), 4.0);
+    assert_eq!(top(&cube[12..]), 2.0);
+    assert_eq!(s.instances.len(), 2);
+    assert_eq!(s.instance_name(s.instance_of_triangle(3).unwrap()), "cube instance 0");
+    assert_eq!(s.instance_of_triangle(20).unwrap().index, 1);
+    assert!(s.instance_of_triangle(0).is_none());
+    // An empty list draws nothing.
+    let empty = parse(&format!("{HEAD}\n[[object]]\ntype = \"mesh\"\nfile = \"cube.obj\"\ninstances = []\n"), &d);
+    assert_eq!(empty.triangles.len(), 2);
+}
+
+#[test]
+fn culling_changes_no_pixel_and_is_counted() {
+    let d = dir();
+    let prepared = PreparedScene::new(parse(&instanced_text(), &d));
+    let mut on = RenderSettings::for_scene(&prepared.scene);
+    on.shadows = render::ShadowMode::Map;
+    let mut off = on.clone();
+    off.cull_instances = false;
+    for renderer in ["rasterize", "rasterize:tiled", "rasterize:barycentric", "rasterize:bbox"] {
+        let (a, b) = (frame(renderer, &prepared, &on), frame(renderer, &prepared, &off));
+        assert_eq!(bits(&a.pixels), bits(&b.pixels), "{renderer}: culling changed the image");
+        // The copies beside the view and behind the eye are culled.
+        assert_eq!((a.counts.instances_drawn, a.counts.instances_culled), (4, 2), "{renderer}");
+        assert_eq!((b.counts.instances_drawn, b.counts.instances_culled), (6, 0), "{renderer}");
+    }
+}
+
+#[test]
+fn frustum_clipping_changes_no_pixel() {
+    let d = dir();
+    let mut scenes = vec![PreparedScene::new(parse(&instanced_text(), &d))];
+    for name in ["triangle-ground", "teapot", "stress-near", "textures"] {
+        scenes.push(PreparedScene::new(common::builtin(name)));
+    }
+    for prepared in &scenes {
+        let mut near = RenderSettings::for_scene(&prepared.scene);
+        (near.width, near.height) = (96, 64);
+        let mut frustum = near.clone();
+        frustum.clip = ClipMode::Frustum;
+        for renderer in ["rasterize", "rasterize:tiled", "rasterize:scanline", "rasterize:incremental", "rasterize:bbox"] {
+            let (a, b) = (frame(renderer, prepared, &near), frame(renderer, prepared, &frustum));
+            assert_eq!(bits(&a.pixels), bits(&b.pixels), "{renderer} on {}: --clip frustum changed the image", prepared.scene.name);
+        }
+        // MSAA and the near-clip debug knob too.
+        near.msaa = 4;
+        frustum.msaa = 4;
+        let (a, b) = (frame("rasterize", prepared, &near), frame("rasterize", prepared, &frustum));
+        assert_eq!(bits(&a.pixels), bits(&b.pixels), "msaa on {}", prepared.scene.name);
+    }
+}
+
+#[test]
+fn frustum_clipping_sets_up_fewer_samples_on_a_ground_crossing_the_view() {
+    // The ground's two triangles reach far beside the view: clipped at the
+    // side planes, their pixel boxes shrink, so fewer samples are tested.
+    let prepared = PreparedScene::new(common::builtin("triangle-ground"));
+    let mut near = RenderSettings::for_scene(&prepared.scene);
+    (near.width, near.height) = (96, 64);
+    let mut frustum = near.clone();
+    frustum.clip = ClipMode::Frustum;
+    let (a, b) = (frame("rasterize:barycentric", &prepared, &near), frame("rasterize:barycentric", &prepared, &frustum));
+    assert!(b.counts.samples_tested < a.counts.samples_tested, "{} > {}", b.counts.samples_tested, a.counts.samples_tested);
+}
+
+#[test]
+fn bad_instances_name_the_line_and_the_key() {
+    let d = dir();
+    let head = format!("{HEAD}\n[[object]]\ntype = \"mesh\"\nfile = \"cube.obj\"\n");
+    let line = head.lines().count() + 2;
+    let cases = [
+        ("instances = [\n  { translate = [1.0, 0.0, 0.0] },\n  { scale = 0.0 },\n]", "scale", line + 1),
+        ("instances = [\n  { translate = [1.0, 0.0, 0.0] },\n  { material = \"nope\" },\n]", "material \"nope\"", line + 1),
+        ("instances = [\n  { translate = [1.0, 0.0, 0.0] },\n  { rotate_deg = [1.0, 2.0] },\n]", "3 numbers", line + 1),
+        ("instances = [\n  { translate = [1.0, 0.0, 0.0] },\n  { colour = 1 },\n]", "colour", line + 1),
+        ("instances = [\n  { translate = [1.0, 0.0, 0.0] },\n  { translate = [1e30, 0.0, 0.0] },\n]", "translate", line + 1),
+        ("instances = 3", "instances", line - 1),
+    ];
+    for (body, key, want_line) in cases {
+        let text = format!("{head}{body}\n");
+        let e = parse_scene(&text, "s.toml", &d, "s").err().unwrap_or_else(|| panic!("accepted {body}"));
+        assert!(e.contains(key), "{body}: {e}");
+        assert!(e.starts_with(&format!("s.toml:{want_line}:")), "{body}: line {want_line} wanted: {e}");
+    }
+    let sphere = format!("{HEAD}\n[[object]]\ntype = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\ninstances = [{{}}]\n");
+    let e = parse_scene(&sphere, "s.toml", &d, "s").err().unwrap();
+    assert!(e.contains("`instances` is not a key of a sphere object"), "{e}");
+}
+
+#[test]
+fn pixel_report_names_the_instance_hit() {
+    let d = dir();
+    let prepared = PreparedScene::new(parse(&instanced_text(), &d));
+    let settings = RenderSettings::for_scene(&prepared.scene);
+    let r = render::renderer_by_name("raytrace").unwrap();
+    // The middle of copy 0 (the left cube): find a pixel that hits it.
+    let view = prepared.scene.camera.view(settings.width, settings.height);
+    let (px, _) = view.project(glam::Vec3::new(-1.5, 0.5, 0.5)).unwrap();
+    let replay = render::replay_pixel(r.as_ref(), &prepared, &settings, px.x as u32, px.y as u32).unwrap();
+    let j = render::pixel_report::to_json("raytrace", &prepared.scene, px.x as u32, px.y as u32, &replay);
+    let text = j.to_string();
+    assert!(text.contains("\"instance_name\":\"cube instance 0\""), "{text}");
+}
+
+#[test]
+fn the_two_level_layer_renders_what_flattening_renders() {
+    use pinhole::scene::file::{parse_scene_with, TwoLevel};
+    let d = dir();
+    let text = instanced_text();
+    let flat = parse_scene_with(&text, "t", &d, "t", TwoLevel::Never).unwrap();
+    let layered = parse_scene_with(&text, "t", &d, "t", TwoLevel::Always).unwrap();
+    assert!(flat.layer.is_none());
+    let layer = layered.layer.as_ref().expect("the copies in the layer");
+    assert_eq!(layer.instances.len(), COPIES.len());
+    // Index for index, the same world-space triangles.
+    assert_eq!(flat.total_triangles(), layered.total_triangles());
+    assert_eq!(layered.triangles.len(), 2);
+    for i in 0..flat.triangles.len() as u32 {
+        assert_eq!(*flat.triangle(i), *layered.triangle(i), "triangle {i}");
+    }
+    let (pf, pl) = (PreparedScene::new(flat), PreparedScene::new(layered));
+    let mut settings = RenderSettings::for_scene(&pf.scene);
+    for renderer in ["raytrace", "rasterize", "rasterize:tiled", "rasterize:barycentric", "rasterize:bbox", "rasterize:naive", "rasterize:painter"] {
+        for (interpolation, spp) in [(render::Interpolation::Phong, 1), (render::Interpolation::Gouraud, 2)] {
+            settings.interpolation = interpolation;
+            settings.spp = spp;
+            let (a, b) = (frame(renderer, &pf, &settings), frame(renderer, &pl, &settings));
+            assert!(a.pixels.iter().any(|p| p.x > 0.05), "{renderer}: the image is black");
+            assert_eq!(bits(&a.pixels), bits(&b.pixels), "{renderer} {interpolation:?}: the two-level layer differs from flattening");
+            if renderer.starts_with("rasterize") && renderer != "rasterize:naive" {
+                assert_eq!((b.counts.instances_drawn, b.counts.instances_culled), (4 * spp as u64, 2 * spp as u64), "{renderer}");
+            }
+        }
+    }
+    // Culling and frustum clipping on the layer change nothing either.
+    settings = RenderSettings::for_scene(&pf.scene);
+    let base = frame("rasterize", &pl, &settings);
+    settings.cull_instances = false;
+    settings.clip = ClipMode::Frustum;
+    assert_eq!(bits(&base.pixels), bits(&frame("rasterize", &pl, &settings).pixels));
+    // What cannot draw the layer says so.
+    let e = render::layer_support::check("raytrace:brute", &pl.scene, &RenderSettings::for_scene(&pl.scene)).unwrap_err();
+    assert!(e.contains("raytrace:brute") && e.contains("copies"), "{e}");
+    let mut map = RenderSettings::for_scene(&pl.scene);
+    map.shadows = render::ShadowMode::Map;
+    assert!(render::layer_support::check("rasterize", &pl.scene, &map).is_err());
+    assert!(render::layer_support::check("rasterize", &pf.scene, &map).is_ok());
+}
+
+#[test]
+fn forest_renders_in_both_families_and_they_agree() {
+    let scene = common::builtin("forest");
+    assert_eq!(scene.instances.len(), 10_000);
+    assert_eq!(scene.total_triangles(), 2 + 10_000 * 69_451);
+    let prepared = PreparedScene::new(scene);
+    let mut settings = RenderSettings::for_scene(&prepared.scene);
+    (settings.width, settings.height) = (160, 90);
+    let (w, h) = (settings.width as usize, settings.height as usize);
+    let ray = frame("raytrace", &prepared, &settings);
+    // Bunnies in front and the ground behind them: not one colour.
+    let lum: Vec<f32> = ray.pixels.iter().map(|p| p.x + p.y + p.z).collect();
+    let (lo, hi) = lum.iter().fold((f32::MAX, f32::MIN), |(a, b), &l| (a.min(l), b.max(l)));
+    assert!(hi > 2.0 * lo && lo > 0.0, "{lo} {hi}");
+    // Equal as tests/raster_agreement.rs counts it: within 1e-4 relative.
+    let same = |a: glam::Vec3, b: glam::Vec3| {
+        let (d, m) = ((a - b).abs(), a.abs().max(b.abs()));
+        d.x <= 1e-4 * m.x + 1e-7 && d.y <= 1e-4 * m.y + 1e-7 && d.z <= 1e-4 * m.z + 1e-7
+    };
+    let differing = |img: &[glam::Vec3]| -> Vec<usize> { (0..w * h).filter(|&i| !same(ray.pixels[i], img[i])).collect() };
+    // Where some copy projects (its bounding sphere, one pixel grown).
+    let view = prepared.scene.camera.view(settings.width, settings.height);
+    let mut on_copy = vec![false; w * h];
+    for inst in &prepared.scene.instances {
+        let c = view.to_camera(inst.center);
+        if -c.z <= inst.radius {
+            on_copy.iter_mut().for_each(|m| *m = true);
+            continue;
+        }
+        let p = view.project_camera(c);
+        let r = inst.radius / (-c.z - inst.radius) * 0.5 * h as f32 / view.half_y + 1.5;
+        for y in ((p.y - r).max(0.0) as usize)..((p.y + r).min(h as f32).max(0.0) as usize) {
+            for x in ((p.x - r).max(0.0) as usize)..((p.x + r).min(w as f32).max(0.0) as usize) {
+                on_copy[x + y * w] = true;
+            }
+        }
+    }
+    // rasterize:bbox sets the copies up as every rasterizer does (culled,
+    // placed, clipped) and decides coverage with the ray casters' triangle
+    // test: the agreement rule's 99.5% holds.
+    let bbox = frame("rasterize:bbox", &prepared, &settings);
+    let d_bbox = differing(&bbox.pixels);
+    assert!(d_bbox.len() as f64 <= 0.005 * (w * h) as f64, "rasterize:bbox: {} pixels differ", d_bbox.len());
+    // The default rasterizer (fixed point, top-left rule) decides coverage
+    // of the distant bunnies' sub-pixel triangles by its own rule, so more
+    // pixels differ; every one of them lies on a copy (none on the open
+    // ground or the sky), where such triangles' edges are.
+    let raster = frame("rasterize", &prepared, &settings);
+    let drawn = raster.counts.instances_drawn;
+    assert!((2000..5000).contains(&drawn) && drawn + raster.counts.instances_culled == 10_000, "{drawn} drawn");
+    let d_fixed = differing(&raster.pixels);
+    println!(
+        "forest 160x90: raytrace against rasterize:bbox {} and rasterize {} of {} pixels differ; {drawn} copies drawn",
+        d_bbox.len(),
+        d_fixed.len(),
+        w * h
+    );
+    assert!(d_fixed.len() as f64 <= 0.1 * (w * h) as f64, "{} pixels differ", d_fixed.len());
+    let off: Vec<_> = d_fixed.iter().filter(|&&i| !on_copy[i]).map(|&i| (i % w, i / w)).take(8).collect();
+    assert!(off.is_empty(), "pixels off every copy differ: {off:?}");
+}
