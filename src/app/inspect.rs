@@ -163,6 +163,7 @@ pub fn object_name(scene: &Scene, kind: PrimitiveKind, index: u32) -> String {
     let object = match kind {
         PrimitiveKind::Triangle => scene.triangles.get(index as usize).map(|t| t.object),
         PrimitiveKind::Sphere => scene.spheres.get(index as usize).map(|s| s.object),
+        PrimitiveKind::Csg => scene.csgs.get(index as usize).map(|c| c.object),
     };
     object
         .and_then(|o| scene.objects.get(o as usize).map(|info| format!("'{}' (object {o})", info.name)))
@@ -173,6 +174,7 @@ pub fn kind_name(kind: PrimitiveKind) -> &'static str {
     match kind {
         PrimitiveKind::Triangle => "triangle",
         PrimitiveKind::Sphere => "sphere",
+        PrimitiveKind::Csg => "csg",
     }
 }
 

@@ -18,6 +18,7 @@ fn kind(k: PrimitiveKind) -> &'static str {
     match k {
         PrimitiveKind::Triangle => "triangle",
         PrimitiveKind::Sphere => "sphere",
+        PrimitiveKind::Csg => "csg",
     }
 }
 

@@ -35,6 +35,9 @@ impl Renderer for OpenGl {
     }
 
     fn check(&self, scene: &Scene, settings: &RenderSettings) -> Result<(), String> {
+        if !scene.csgs.is_empty() {
+            return Err("the opengl renderer cannot draw csg objects (its shaders draw triangles and spheres only); use a raytrace or rasterize renderer".into());
+        }
         unsupported(scene, settings)?;
         GL.with(|_| ()).map(|_| ())
     }
