@@ -348,7 +348,7 @@ impl Explanation {
         out.push(format!("combined ({op} at the top): {}", fmt(&self.combined)));
         out.push(match &self.winner {
             Some((b, entering)) => format!(
-                "won: t = {:.4}, the {} of operand {} ({}){}",
+                "won: t = {:.4}, the result's {}, on the surface of operand {} ({}){}",
                 b.t,
                 if *entering { "entry" } else { "exit" },
                 self.leaves.get(b.leaf as usize).map(|l| l.path.as_str()).unwrap_or("?"),
@@ -356,7 +356,7 @@ impl Explanation {
                     SurfaceRef::Sphere(_) => "sphere".to_string(),
                     SurfaceRef::Triangle { index, .. } => format!("mesh triangle {index}"),
                 },
-                if b.flipped { ", normal flipped: a subtracted surface" } else { "" }
+                if b.flipped { ", its normal flipped (a subtracted surface)" } else { "" }
             ),
             None => "won: nothing (no boundary in front of the ray)".into(),
         });
@@ -428,4 +428,15 @@ pub fn check(scene: &Scene, settings: &super::RenderSettings) -> Result<(), Stri
         return Err(format!("the {} view cannot show csg objects (it draws triangles and spheres only)", settings.view.name()));
     }
     Ok(())
+}
+
+/// For a CSG hit found along `ray` (bounded by `t_max`): the intervals and
+/// the winning boundary as text lines (`Explanation::lines`); `None` for
+/// other hits. A hit on an exit boundary (seen from inside) was found by a
+/// ray travelling inside the solid.
+pub fn explain_hit(scene: &Scene, hit: &SurfaceHit, ray: &Ray, t_max: f32) -> Option<Explanation> {
+    if hit.kind != PrimitiveKind::Csg {
+        return None;
+    }
+    explain(scene, hit.primitive, ray, t_max, hit.back_face)
 }
