@@ -589,7 +589,8 @@ mod tests {
     fn packets_find_the_single_ray_hits() {
         for name in builtin::names() {
             let prepared = PreparedScene::new(builtin::load_builtin(name).unwrap().unwrap());
-            if prepared.bvh.deep {
+            // Frames of scenes with CSG objects cast single rays (`cast_pass_packets`).
+            if prepared.bvh.deep || !prepared.scene.csgs.is_empty() {
                 continue;
             }
             let (w, h) = (61u32, 37u32);
