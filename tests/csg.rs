@@ -253,6 +253,13 @@ fn a_csg_pixel_replays_as_the_frame_drew_it() {
         assert_eq!(eye.material, prepared.scene.materials.iter().position(|m| m.name == "cavity").unwrap() as u32, "{name}: the cavity's wall");
         let report = pinhole::render::pixel_report::to_text(name, &prepared.scene, x, y, &replay);
         assert!(report.contains("combined (difference at the top)") && report.contains("won: t ="), "{report}");
+        let json = pinhole::render::pixel_report::to_json(name, &prepared.scene, x, y, &replay);
+        let csg = &json["samples"][0]["rays"][0]["csg"];
+        assert_eq!(csg["op"], "difference", "{json}");
+        assert_eq!(csg["operands"].as_array().map(Vec::len), Some(2), "{json}");
+        assert_eq!(csg["won"]["operand"], "b", "{json}");
+        assert_eq!(csg["won"]["boundary"], "entry", "{json}");
+        assert_eq!(csg["won"]["normal_flipped"], true, "{json}");
     }
 }
 

@@ -52,12 +52,16 @@ fn ray_json(scene: &Scene, r: &RayRecord) -> Value {
             Err(m) => json!({"kind": kind(t.kind), "index": t.index, "result": miss_reason(m)}),
         })
         .collect();
-    json!({
+    let mut out = json!({
         "origin": v3(r.ray.origin), "direction": v3(r.ray.dir), "t_max": finite_or_null(r.t_max),
         "depth": r.depth, "shadow": r.shadow, "nodes_visited": r.nodes_visited, "tests": tests,
         "tests_omitted": r.tests_omitted, "closest": r.closest.as_ref().map(|h| hit_json(scene, h)),
-        "csg": r.closest.as_ref().and_then(|h| crate::render::csg::explain_hit(scene, h, &r.ray, r.t_max)).map(|e| csg_json(&e)),
-    })
+    });
+    // Only a ray that hit a CSG object has the key.
+    if let Some(e) = r.closest.as_ref().and_then(|h| crate::render::csg::explain_hit(scene, h, &r.ray, r.t_max)) {
+        out["csg"] = csg_json(&e);
+    }
+    out
 }
 
 /// A CSG hit's intervals: each operand's, the combined ones, the winner.
