@@ -376,7 +376,16 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         } else if id.is_csg() {
             // The same interval rule on the same eye ray as the pass: the same boundary.
             let t_max = self.job.view.far_t(p.x, p.y);
-            crate::render::csg::closest(scene, id.index(), &ray, t_max, false)
+            let hit = crate::render::csg::closest(scene, id.index(), &ray, t_max, false);
+            // Found by the eye ray, as in the ray casters: the same differentials.
+            match hit {
+                Some(h) if scene.has_textures() => {
+                    let mut h = with_ray_differentials(scene, &RayDifferential::eye(self.job.view, p.x, p.y), &ray, h);
+                    crate::render::normal_map::apply(scene, self.job.settings.texture_filter, &mut h);
+                    Some(h)
+                }
+                other => other,
+            }
         } else if id.is_sphere() {
             let hit = scene.sphere_hit(id.index(), self.payload[i][0], &ray);
             // The sphere is hit by the eye ray, as in the ray casters: the same differentials.
