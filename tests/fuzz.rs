@@ -279,6 +279,12 @@ fn mutated_scene_files() {
         .collect();
     corpus.push("[[object]]\ntype = \"mesh\"\nfile = \"a.obj\"\n[[light]]\ntype = \"point\"\nposition = [0, 1, 2]\npower = [10, 10, 10]\n".into());
     corpus.push("[materials.m]\nlambertian = [1, 1, 1]\ntexture = \"a.exr\"\n[[object]]\ntype = \"quad\"\nmaterial = \"m\"\nvertices = [[-1, -1, -2], [1, -1, -2], [1, 1, -2], [-1, 1, -2]]\nscale = [1, 2, 1]\n".into());
+    corpus.push(
+        "[[object]]\ntype = \"csg\"\nop = \"difference\"\na = { type = \"sphere\", center = [0, 0, -3], radius = 1.0 }\n\
+         b = { type = \"csg\", op = \"union\", a = { type = \"sphere\", center = [0.5, 0.5, -2.5], radius = 0.6 }, b = { type = \"mesh\", file = \"a.obj\" } }\n\
+         [[light]]\ntype = \"point\"\nposition = [0, 1, 2]\npower = [10, 10, 10]\n"
+            .into(),
+    );
     counted("scene files", || {
         for _ in 0..cases() {
             let seed_text = rng.pick(&corpus).clone();

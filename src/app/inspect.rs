@@ -163,6 +163,7 @@ pub fn object_name(scene: &Scene, kind: PrimitiveKind, index: u32) -> String {
     let object = match kind {
         PrimitiveKind::Triangle => ((index as u64) < scene.total_triangles()).then(|| scene.triangle(index).object),
         PrimitiveKind::Sphere => scene.spheres.get(index as usize).map(|s| s.object),
+        PrimitiveKind::Csg => scene.csgs.get(index as usize).map(|c| c.object),
     };
     let copy = match kind {
         PrimitiveKind::Triangle => scene.instance_of_triangle(index).map(|i| format!(", instance {}", i.index)),
@@ -177,6 +178,7 @@ pub fn kind_name(kind: PrimitiveKind) -> &'static str {
     match kind {
         PrimitiveKind::Triangle => "triangle",
         PrimitiveKind::Sphere => "sphere",
+        PrimitiveKind::Csg => "csg",
     }
 }
 

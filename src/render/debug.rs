@@ -124,6 +124,7 @@ pub fn view_color(view: View, camera: &CameraView, ray: &Ray, hit: Option<&Surfa
         View::TriangleId => id_color(match h.kind {
             crate::scene::PrimitiveKind::Triangle => h.primitive,
             crate::scene::PrimitiveKind::Sphere => h.primitive.wrapping_add(1 << 20),
+            crate::scene::PrimitiveKind::Csg => h.primitive.wrapping_add(1 << 21),
         }),
         View::MaterialId => id_color(h.material),
         View::Uv => {

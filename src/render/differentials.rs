@@ -86,6 +86,9 @@ pub fn uv_change(scene: &Scene, hit: &SurfaceHit, dp: Vec3) -> Vec2 {
             let dv = d.y / ((1.0 - o.y * o.y).max(0.0).sqrt() * std::f32::consts::PI);
             Vec2::new(du, dv)
         }
+        // The winning operand surface is not kept in the hit: CSG surfaces
+        // read textures at the finest level.
+        PrimitiveKind::Csg => Vec2::ZERO,
     }
 }
 
@@ -117,7 +120,7 @@ pub fn reflected(scene: &Scene, hit: &SurfaceHit, d_in: Vec3, n: Vec3) -> RayDif
             let side = if hit.back_face { -1.0 } else { 1.0 };
             (diff.dp_dx * (side / r), diff.dp_dy * (side / r))
         }
-        PrimitiveKind::Triangle => (Vec3::ZERO, Vec3::ZERO),
+        PrimitiveKind::Triangle | PrimitiveKind::Csg => (Vec3::ZERO, Vec3::ZERO),
     };
     let d_dot_n = d_in.dot(n);
     let reflect = |dd: Vec3, dn: Vec3| dd - 2.0 * (dn * d_dot_n + n * (dd.dot(n) + d_in.dot(dn)));

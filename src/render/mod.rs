@@ -6,6 +6,7 @@
 //! `resolve_sample`, which shades it (or draws a debug view).
 
 pub mod bsdf_sampling;
+pub mod csg;
 pub mod debug;
 pub mod differentials;
 pub mod frame;
@@ -346,8 +347,8 @@ pub trait Renderer: Sync + Send {
     /// Whether this renderer can draw `scene` with `settings`: one sentence
     /// saying why not (an option it does not support, no driver). Checked
     /// before a frame starts.
-    fn check(&self, _scene: &crate::scene::Scene, _settings: &RenderSettings) -> Result<(), String> {
-        Ok(())
+    fn check(&self, scene: &crate::scene::Scene, settings: &RenderSettings) -> Result<(), String> {
+        csg::check(scene, settings)
     }
 
     /// Replays pixel `(x, y)` of this pass through the same code path with a

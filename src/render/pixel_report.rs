@@ -18,6 +18,7 @@ fn kind(k: PrimitiveKind) -> &'static str {
     match k {
         PrimitiveKind::Triangle => "triangle",
         PrimitiveKind::Sphere => "sphere",
+        PrimitiveKind::Csg => "csg",
     }
 }
 
@@ -61,10 +62,30 @@ fn ray_json(scene: &Scene, r: &RayRecord) -> Value {
             Err(m) => json!({"kind": kind(t.kind), "index": t.index, "result": miss_reason(m)}),
         })
         .collect();
-    json!({
+    let mut out = json!({
         "origin": v3(r.ray.origin), "direction": v3(r.ray.dir), "t_max": finite_or_null(r.t_max),
         "depth": r.depth, "shadow": r.shadow, "nodes_visited": r.nodes_visited, "tests": tests,
         "tests_omitted": r.tests_omitted, "closest": r.closest.as_ref().map(|h| hit_json(scene, h)),
+    });
+    // Only a ray that hit a CSG object has the key.
+    if let Some(e) = r.closest.as_ref().and_then(|h| crate::render::csg::explain_hit(scene, h, &r.ray, r.t_max)) {
+        out["csg"] = csg_json(&e);
+    }
+    out
+}
+
+/// A CSG hit's intervals: each operand's, the combined ones, the winner.
+fn csg_json(e: &crate::render::csg::Explanation) -> Value {
+    let list = |l: &[crate::render::csg::Interval]| -> Vec<Value> { l.iter().map(|iv| json!([iv.enter.t, iv.exit.t])).collect() };
+    json!({
+        "op": e.op.name(),
+        "operands": e.leaves.iter().map(|l| json!({"operand": l.path, "kind": l.kind, "intervals": list(&l.intervals)})).collect::<Vec<_>>(),
+        "combined": list(&e.combined),
+        "won": e.winner.map(|(b, entering)| json!({
+            "t": b.t, "boundary": if entering { "entry" } else { "exit" },
+            "operand": e.leaves.get(b.leaf as usize).map(|l| l.path.clone()), "normal_flipped": b.flipped,
+        })),
+        "text": e.lines(),
     })
 }
 
@@ -206,6 +227,12 @@ pub fn to_text(renderer: &str, scene: &Scene, x: u32, y: u32, replay: &PixelRepl
                         fmt3(h.shading_normal),
                         fmt3(h.barycentric)
                     );
+                    if let Some(e) = crate::render::csg::explain_hit(scene, h, &r.ray, r.t_max) {
+                        let _ = writeln!(s, "{indent}  csg intervals along the ray (t from its origin):");
+                        for line in e.lines() {
+                            let _ = writeln!(s, "{indent}    {line}");
+                        }
+                    }
                 }
                 None if r.shadow => {}
                 None => {

@@ -73,7 +73,7 @@ impl std::ops::Index<usize> for SceneEdges {
 /// Bytes held per scene by its geometry (see `PreparedScene::memory`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct MemoryUse {
-    /// The scene's triangles and spheres.
+    /// The scene's triangles and spheres, CSG operands' included.
     pub scene_bytes: usize,
     /// The BVH: nodes, primitive slots, bounds kept for the debugger.
     pub bvh_bytes: usize,
@@ -126,7 +126,8 @@ impl PreparedScene {
         MemoryUse {
             scene_bytes: size_of_val(&self.scene.triangles[..])
                 + size_of_val(&self.scene.spheres[..])
-                + self.scene.layer.as_ref().map_or(0, |l| l.memory_bytes()),
+                + self.scene.layer.as_ref().map_or(0, |l| l.memory_bytes())
+                + self.scene.csgs.iter().map(|c| size_of_val(&c.triangles[..]) + size_of_val(&c.spheres[..])).sum::<usize>(),
             bvh_bytes: self.bvh.memory_bytes() + self.instances.as_ref().map_or(0, |a| a.memory_bytes()),
             prepared_bytes: self.edges.memory_bytes(),
         }

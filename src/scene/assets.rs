@@ -18,6 +18,7 @@ const FILES: &[(&str, &[u8])] = &[
     ("models/stress-tjunction.obj", include_bytes!("../../assets/models/stress-tjunction.obj")),
     ("models/stress-tjunction-shared.obj", include_bytes!("../../assets/models/stress-tjunction-shared.obj")),
     ("models/checker-ground.obj", include_bytes!("../../assets/models/checker-ground.obj")),
+    ("models/cube.obj", include_bytes!("../../assets/models/cube.obj")),
     ("textures/test-pattern.exr", include_bytes!("../../assets/textures/test-pattern.exr")),
     ("textures/checker.png", include_bytes!("../../assets/textures/checker.png")),
     ("textures/globe.png", include_bytes!("../../assets/textures/globe.png")),

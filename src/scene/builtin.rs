@@ -16,6 +16,7 @@ const SCENES: &[(&str, &str)] = &[
     ("test-pattern", include_str!("../../assets/scenes/test-pattern.toml")),
     ("cornell-gi", include_str!("../../assets/scenes/cornell-gi.toml")),
     ("textures", include_str!("../../assets/scenes/textures.toml")),
+    ("csg", include_str!("../../assets/scenes/csg.toml")),
 ];
 
 /// The stress gallery's scenes (`gallery::cases`), each built to provoke
@@ -78,7 +79,7 @@ mod tests {
     fn every_builtin_scene_loads() {
         for name in names() {
             let scene = load_builtin(name).unwrap().unwrap_or_else(|e| panic!("{name}: {e}"));
-            assert!(scene.triangles.len() + scene.spheres.len() > 0, "{name} is empty");
+            assert!(scene.triangles.len() + scene.spheres.len() + scene.csgs.len() > 0, "{name} is empty");
             assert!(!scene.lights.is_empty(), "{name} has no light");
         }
     }

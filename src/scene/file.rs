@@ -115,6 +115,10 @@ struct ObjectDesc {
     center: Option<F3>,
     radius: Option<f32>,
     instances: Option<Vec<Spanned<InstanceDesc>>>,
+    /// csg only: the operation and its two operands (inline tables).
+    op: Option<String>,
+    a: Option<Spanned<Box<ObjectDesc>>>,
+    b: Option<Spanned<Box<ObjectDesc>>>,
     // `normals` for triangles is a list of vectors; meshes use the mode string.
 }
 
@@ -343,7 +347,10 @@ fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str, two_
         let in_layer = scene.layer.as_ref().is_some_and(|l| {
             l.instances.iter().any(|i| i.material == Some(index as u32)) || l.meshes.iter().any(|m| m.iter().any(|t| t.material as usize == index))
         });
-        let drawn = in_layer || scene.triangles.iter().any(|t| t.material as usize == index) || scene.spheres.iter().any(|s| s.material as usize == index);
+        let drawn = in_layer
+            || scene.triangles.iter().any(|t| t.material as usize == index)
+            || scene.spheres.iter().any(|s| s.material as usize == index)
+            || scene.csgs.iter().any(|c| c.triangles.iter().any(|t| t.material as usize == index) || c.spheres.iter().any(|s| s.material as usize == index));
         if drawn {
             let loaded = Some(Arc::new(load_texture_as(&path, encoding).map_err(|e| match encoding {
                 Encoding::Srgb => format!("{where_}: texture: {e}"),
@@ -370,6 +377,9 @@ fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str, two_
     }
     Ok(scene)
 }
+
+/// Turns `span` of the file into "file:line".
+type At<'a> = dyn Fn(std::ops::Range<usize>) -> String + 'a;
 
 /// Places the copies gathered in `layered` after every flattened triangle.
 fn build_layer(scene: &mut Scene, layered: Layered) -> Result<(), String> {
@@ -420,6 +430,14 @@ fn add_object(
     two_level: TwoLevel,
     layered: &mut Layered,
 ) -> Result<(), String> {
+    let at = at_line;
+    if o.kind != "csg" {
+        for (key, here) in [("op", o.op.is_some()), ("a", o.a.is_some()), ("b", o.b.is_some())] {
+            if here {
+                return Err(format!("{where_}: `{key}` is not a key of a {} object (only of a csg)", o.kind));
+            }
+        }
+    }
     let two_sided = o.two_sided.unwrap_or(false);
     let placement = placement(o, where_)?;
     let explicit_material = match &o.material {
@@ -624,7 +642,19 @@ fn add_object(
             }
             scene.spheres.push(Sphere { center, radius, material, object });
         }
-        other => return Err(format!("{where_}: unknown object type \"{other}\" (expected mesh, triangle, quad or sphere)")),
+        "csg" => {
+            only(&[])?;
+            reject(where_, "csg object (place its operands instead)", &[
+                ("translate", o.translate.is_some()),
+                ("rotate_deg", o.rotate_deg.is_some()),
+                ("scale", o.scale.is_some()),
+                ("two_sided", o.two_sided.is_some()),
+            ])?;
+            let mut parts = CsgParts::default();
+            let root = csg_node(scene, o, object, where_, "", base, meshes, at, explicit_material, 0, &mut parts)?;
+            scene.csgs.push(super::csg::Csg::new(root, parts.spheres, parts.triangles, object));
+        }
+        other => return Err(format!("{where_}: unknown object type \"{other}\" (expected mesh, triangle, quad, sphere or csg)")),
     }
     // Placement (scale, translate) can carry in-range vertices out of range.
     if let Some(t) = scene.triangles[first..].iter().find(|t| t.v.iter().any(|v| !(v.abs().max_element() <= MAX_COORDINATE))) {
@@ -688,6 +718,94 @@ fn copies(
 
 /// Most copies one `instances` list may make.
 const MAX_INSTANCES: usize = 1 << 20;
+
+/// The leaves' geometry of a CSG object being read.
+#[derive(Default)]
+struct CsgParts {
+    spheres: Vec<Sphere>,
+    triangles: Vec<Triangle>,
+}
+
+/// Reads csg node `o` (at `path` in its object's tree, "" for the object
+/// itself). Operands are read as objects of their own, then moved out of the
+/// scene's lists into `parts`; an operand without `material` takes the
+/// nearest enclosing csg's `material` when there is one.
+#[allow(clippy::too_many_arguments)]
+fn csg_node(
+    scene: &mut Scene,
+    o: &ObjectDesc,
+    object: u32,
+    where_: &str,
+    path: &str,
+    base: &Path,
+    meshes: &mut MeshCache,
+    at: &At,
+    inherited: Option<u32>,
+    depth: usize,
+    parts: &mut CsgParts,
+) -> Result<super::csg::CsgNode, String> {
+    use super::csg::{CsgNode, CsgOp, MAX_DEPTH};
+    let material = match &o.material {
+        Some(name) => Some(
+            scene
+                .materials
+                .iter()
+                .position(|m| &m.name == name)
+                .ok_or(format!("{where_}: material \"{name}\" is not defined in [materials]"))? as u32,
+        ),
+        None => inherited,
+    };
+    if depth >= MAX_DEPTH {
+        return Err(format!("{where_}: csg operations are nested more than {MAX_DEPTH} deep"));
+    }
+    let op_name = o.op.as_deref().ok_or(format!("{where_}: a csg needs `op` (\"union\", \"intersection\" or \"difference\")"))?;
+    let op = CsgOp::parse(op_name)
+        .ok_or(format!("{where_}: unknown csg op \"{op_name}\" (expected \"union\", \"intersection\" or \"difference\")"))?;
+    let operand = |side: &str, desc: &Option<Spanned<Box<ObjectDesc>>>, scene: &mut Scene, meshes: &mut MeshCache, parts: &mut CsgParts| -> Result<CsgNode, String> {
+        let key = if path.is_empty() { side.to_string() } else { format!("{path}.{side}") };
+        let desc = desc.as_ref().ok_or(format!("{where_}: a csg needs operand `{key}` (a sphere, a closed mesh or a csg, as an inline table)"))?;
+        let here = format!("{}: object {}, operand `{key}`", at(desc.span()), object + 1);
+        let d: &ObjectDesc = desc.get_ref();
+        match d.kind.as_str() {
+            "csg" => csg_node(scene, d, object, &here, &key, base, meshes, at, material, depth + 1, parts),
+            "sphere" | "mesh" => {
+                let (t0, s0, o0) = (scene.triangles.len(), scene.spheres.len(), scene.objects.len());
+                add_object(scene, d, object, &here, base, meshes, at, TwoLevel::Never, &mut Layered::default())?;
+                let mut tris: Vec<Triangle> = scene.triangles.drain(t0..).collect();
+                let mut spheres: Vec<Sphere> = scene.spheres.drain(s0..).collect();
+                scene.objects.truncate(o0);
+                if let (None, Some(m)) = (&d.material, material) {
+                    tris.iter_mut().for_each(|t| t.material = m);
+                    spheres.iter_mut().for_each(|s| s.material = m);
+                }
+                if let Some(s) = spheres.pop() {
+                    parts.spheres.push(s);
+                    return Ok(CsgNode::Sphere(parts.spheres.len() as u32 - 1));
+                }
+                if let Err(e) = super::csg::check_closed(&tris) {
+                    let file = d.file.as_deref().unwrap_or("?");
+                    return Err(format!("{here}: the mesh \"{file}\" is not closed ({e}); a csg operand must be a closed solid"));
+                }
+                let first = parts.triangles.len() as u32;
+                let mut lo = Vec3::splat(f32::INFINITY);
+                let mut hi = Vec3::splat(f32::NEG_INFINITY);
+                for t in &mut tris {
+                    t.two_sided = true;
+                    for v in t.v {
+                        lo = lo.min(v);
+                        hi = hi.max(v);
+                    }
+                }
+                parts.triangles.extend(tris);
+                Ok(CsgNode::Mesh { first, end: parts.triangles.len() as u32, lo, hi })
+            }
+            other => Err(format!("{here}: a csg operand must be a sphere, a closed mesh or a csg, not \"{other}\"")),
+        }
+    };
+    let a = operand("a", &o.a, scene, meshes, parts)?;
+    let b = operand("b", &o.b, scene, meshes, parts)?;
+    Ok(CsgNode::Op { op, a: Box::new(a), b: Box::new(b) })
+}
 
 /// Object placement: scale, then rotate about X, Y, Z, then translate.
 #[derive(Clone, Debug)]

@@ -5,6 +5,7 @@
 pub mod assets;
 pub mod builtin;
 pub mod camera;
+pub mod csg;
 pub mod environment;
 pub mod file;
 pub mod forest;
@@ -68,11 +69,15 @@ pub struct Sphere {
 pub enum PrimitiveKind {
     Triangle,
     Sphere,
+    /// A constructive solid geometry object (`Scene::csgs`): the surface
+    /// is one of its operands', which the hit's material and normal describe.
+    Csg,
 }
 
-/// One primitive named by a single integer: a triangle index, or a sphere
-/// index with the top bit set. Compared as integers, ids order primitives as
-/// the brute-force caster scans them (every triangle, then every sphere, each
+/// One primitive named by a single integer: a triangle index, a sphere
+/// index with the top bit set, or a CSG object's index with the top two bits
+/// set. Compared as integers, ids order primitives as the brute-force caster
+/// scans them (every triangle, then every sphere, then every CSG object, each
 /// by index), which is the order every renderer's tie rule follows. `NONE`
 /// names no primitive (an empty buffer entry, no hit yet) and compares above
 /// every real id.
@@ -82,19 +87,26 @@ pub struct PrimitiveId(u32);
 
 impl PrimitiveId {
     const SPHERE_BIT: u32 = 1 << 31;
+    const CSG_BITS: u32 = 3 << 30;
     /// No primitive.
     pub const NONE: PrimitiveId = PrimitiveId(u32::MAX);
 
-    /// Triangle `index` of `Scene::triangles` (below 2^31).
+    /// Triangle `index` of `Scene::triangles` (below 2^30).
     #[inline(always)]
     pub const fn triangle(index: u32) -> PrimitiveId {
         PrimitiveId(index)
     }
 
-    /// Sphere `index` of `Scene::spheres` (below 2^31 - 1).
+    /// Sphere `index` of `Scene::spheres` (below 2^30).
     #[inline(always)]
     pub const fn sphere(index: u32) -> PrimitiveId {
         PrimitiveId(index | Self::SPHERE_BIT)
+    }
+
+    /// CSG object `index` of `Scene::csgs` (below 2^30 - 1).
+    #[inline(always)]
+    pub const fn csg(index: u32) -> PrimitiveId {
+        PrimitiveId(index | Self::CSG_BITS)
     }
 
     #[inline(always)]
@@ -102,6 +114,7 @@ impl PrimitiveId {
         match kind {
             PrimitiveKind::Triangle => PrimitiveId::triangle(index),
             PrimitiveKind::Sphere => PrimitiveId::sphere(index),
+            PrimitiveKind::Csg => PrimitiveId::csg(index),
         }
     }
 
@@ -110,21 +123,33 @@ impl PrimitiveId {
         self == PrimitiveId::NONE
     }
 
+    /// A sphere (false for `NONE`, CSG objects and triangles).
     #[inline(always)]
     pub fn is_sphere(self) -> bool {
-        self.0 & Self::SPHERE_BIT != 0
+        self.0 & Self::CSG_BITS == Self::SPHERE_BIT
+    }
+
+    /// A CSG object (false for `NONE`).
+    #[inline(always)]
+    pub fn is_csg(self) -> bool {
+        self.0 & Self::CSG_BITS == Self::CSG_BITS && !self.is_none()
     }
 
     /// The kind of primitive (meaningless for `NONE`).
     #[inline(always)]
     pub fn kind(self) -> PrimitiveKind {
-        if self.is_sphere() { PrimitiveKind::Sphere } else { PrimitiveKind::Triangle }
+        match self.0 & Self::CSG_BITS {
+            Self::CSG_BITS => PrimitiveKind::Csg,
+            Self::SPHERE_BIT => PrimitiveKind::Sphere,
+            _ => PrimitiveKind::Triangle,
+        }
     }
 
-    /// Index into `Scene::triangles` or `Scene::spheres` (meaningless for `NONE`).
+    /// Index into `Scene::triangles`, `Scene::spheres` or `Scene::csgs`
+    /// (meaningless for `NONE`).
     #[inline(always)]
     pub fn index(self) -> u32 {
-        self.0 & !Self::SPHERE_BIT
+        self.0 & !Self::CSG_BITS
     }
 
     /// Kind and index, `None` for `NONE`.
@@ -218,6 +243,9 @@ pub struct Scene {
     pub materials: Vec<Material>,
     pub triangles: Vec<Triangle>,
     pub spheres: Vec<Sphere>,
+    /// Constructive solid geometry objects, kept apart from the triangles
+    /// and spheres (`render::csg` answers rays for them).
+    pub csgs: Vec<csg::Csg>,
     pub objects: Vec<ObjectInfo>,
     /// The copies made by `instances` lists, in the order of their triangles.
     pub instances: Vec<InstanceInfo>,
@@ -376,6 +404,10 @@ impl Scene {
             lo = lo.min(i.center - Vec3::splat(i.radius));
             hi = hi.max(i.center + Vec3::splat(i.radius));
         }
+        for c in &self.csgs {
+            lo = lo.min(c.lo);
+            hi = hi.max(c.hi);
+        }
         (lo.x <= hi.x).then_some((lo, hi))
     }
 
@@ -443,6 +475,21 @@ impl Scene {
         match id.kind() {
             PrimitiveKind::Triangle => self.triangle_hit(id.index(), Vec3::new(1.0 - b1 - b2, b1, b2), t, ray),
             PrimitiveKind::Sphere => self.sphere_hit(id.index(), t, ray),
+            // CSG hits are built by `render::csg`, never from an id.
+            PrimitiveKind::Csg => crate::render::csg::closest(self, id.index(), ray, f32::INFINITY, true).unwrap_or(SurfaceHit {
+                position: ray.at(t),
+                geometric_normal: -ray.dir,
+                shading_normal: -ray.dir,
+                barycentric: Vec3::ZERO,
+                uv: Vec2::ZERO,
+                t,
+                kind: PrimitiveKind::Csg,
+                primitive: id.index(),
+                object: 0,
+                material: 0,
+                back_face: false,
+                diff: Differentials::ZERO,
+            }),
         }
     }
 
@@ -484,6 +531,10 @@ mod tests {
         // Every triangle before every sphere, each by index; NONE above all.
         assert!(PrimitiveId::triangle(6) < t && t < PrimitiveId::triangle(u32::MAX >> 1));
         assert!(PrimitiveId::triangle(u32::MAX >> 1) < PrimitiveId::sphere(0) && PrimitiveId::sphere(0) < s);
+        let c = PrimitiveId::csg(2);
+        assert_eq!(c.decode(), Some((PrimitiveKind::Csg, 2)));
+        assert!(c.is_csg() && !c.is_sphere() && !s.is_csg() && !t.is_csg() && !PrimitiveId::NONE.is_csg());
+        assert!(s < c && c < PrimitiveId::NONE);
         assert!(s < PrimitiveId::NONE);
     }
 }

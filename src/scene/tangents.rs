@@ -81,6 +81,8 @@ pub fn tangent_at(scene: &Scene, hit: &SurfaceHit) -> Vec4 {
             let o = (hit.position - s.center) / s.radius;
             Vec3::new(o.z, 0.0, -o.x).extend(1.0)
         }
+        // No tangent frame is kept for CSG surfaces: normal maps do not apply.
+        PrimitiveKind::Csg => Vec4::ZERO,
     }
 }
 

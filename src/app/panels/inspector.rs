@@ -250,6 +250,12 @@ fn ray(ui: &mut egui::Ui, names: &SceneNames, r: &RayRecord, index: usize) {
                     grid_row(ui, "side", "back face (two-sided)".into());
                 }
             });
+            if let Some(e) = crate::render::csg::explain_hit(scene, h, &r.ray, r.t_max) {
+                ui.label(RichText::new("csg intervals (t along the ray)").strong());
+                for line in e.lines() {
+                    ui.monospace(line);
+                }
+            }
         }
         None => {
             ui.label("closest hit: nothing (background)");

@@ -66,6 +66,9 @@ impl Renderer for OpenGl {
     }
 
     fn check(&self, scene: &Scene, settings: &RenderSettings) -> Result<(), String> {
+        if !scene.csgs.is_empty() {
+            return Err("the opengl renderer cannot draw csg objects (its shaders draw triangles and spheres only); use a raytrace or rasterize renderer".into());
+        }
         unsupported(scene, settings)?;
         let max_samples = max_samples()?;
         if settings.msaa > 1 && settings.msaa as i32 > max_samples {

@@ -15,6 +15,7 @@
 //!   the pixel-history recorder and the cost view's counts;
 //! - `msaa`: coverage sample patterns and the one-shade-per-primitive resolve;
 //! - `sphere`: analytic spheres through the ray tracer's sphere test;
+//! - `csg`: constructive solid geometry, per pixel through the ray casters' interval rule;
 //! - `stencil`: the shadow volumes' stencil counts (`--shadows volume`);
 //! - `pass`: the parallel regions of a pass; `coverage`: coverage counts for tests.
 
@@ -22,6 +23,7 @@ pub mod barycentric;
 pub mod bbox;
 pub mod clip;
 pub mod coverage;
+pub mod csg;
 pub mod cull;
 pub mod depth_format;
 pub mod derivatives;
@@ -76,6 +78,13 @@ impl Renderer for Rasterizer {
 
     fn render_pass(&self, job: &PassJob, out: &mut [Radiance]) -> RayCounts {
         pass::render(self.method, job, out)
+    }
+
+    fn check(&self, scene: &crate::scene::Scene, settings: &super::RenderSettings) -> Result<(), String> {
+        if self.method == Method::Painter && !scene.csgs.is_empty() {
+            return Err("rasterize:painter cannot draw csg objects (a draw order cannot resolve their intervals); use another rasterizer".into());
+        }
+        crate::render::csg::check(scene, settings)
     }
 
     fn trace_pixel(&self, job: &PassJob, x: u32, y: u32, rec: &mut PixelTrace) -> Option<Radiance> {

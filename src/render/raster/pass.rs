@@ -70,6 +70,7 @@ pub struct Layer<'a> {
     method: Method,
     geometry: Geometry,
     spheres: Vec<Option<PixelRect>>,
+    csgs: Vec<Option<PixelRect>>,
     /// MSAA coverage sample index; `None` for the pass's own sample.
     pub sample: Option<u32>,
     /// `--shadows volume`: the volume faces the stencil pass draws.
@@ -88,6 +89,7 @@ impl<'a> Layer<'a> {
         let (r0, r1) = (job.rows.start, job.rows.end);
         let (w, h) = (job.view.width, job.view.height);
         let spheres = all_sphere_bounds(job.view, &job.prepared.scene.spheres, offset);
+        let csgs = super::csg::all_csg_bounds(job.view, &job.prepared.scene.csgs, offset);
         let geometry = match method {
             Method::Naive => Geometry::AllTriangles,
             Method::BBox => {
@@ -126,7 +128,7 @@ impl<'a> Layer<'a> {
             }
         };
         let stencil = uses_stencil(&job).then(|| StencilSetup::new(&job));
-        Layer { job, method, geometry, spheres, sample, stencil }
+        Layer { job, method, geometry, spheres, csgs, sample, stencil }
     }
 
     /// Rasterizes this layer's triangles of region `region` (band or tile
@@ -202,6 +204,7 @@ impl<'a> Layer<'a> {
         if !matches!(self.geometry, Geometry::Painted { .. }) {
             raster_spheres(vb, &self.spheres);
         }
+        super::csg::raster_csgs(vb, &self.csgs);
         if let Some(stencil) = &self.stencil {
             vb.count_volumes(stencil);
         }

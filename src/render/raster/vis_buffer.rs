@@ -306,7 +306,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         let stored = self.depth[i];
         let nearer = if cur.is_none() || self.paint {
             true
-        } else if cur.is_sphere() {
+        } else if cur.is_sphere() || cur.is_csg() {
             t < self.payload[i][0]
         } else {
             key < self.depth[i]
@@ -326,6 +326,38 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         }
     }
 
+    /// The eye ray meets CSG object `c`'s resolved surface at `t`: depth
+    /// tested as a sphere's fragment is (ray parameters against spheres and
+    /// other CSG objects, depth keys against triangles).
+    #[inline]
+    pub fn csg_fragment(&mut self, x: u32, y: u32, c: u32, t: f32, key: f32) {
+        self.counts.samples_covered += 1;
+        let i = self.index(x, y);
+        self.count_work(i);
+        let cur = self.id[i];
+        let stored = self.depth[i];
+        let nearer = if cur.is_none() || self.paint {
+            true
+        } else if cur.is_sphere() || cur.is_csg() {
+            t < self.payload[i][0]
+        } else {
+            key < self.depth[i]
+        };
+        if nearer {
+            self.depth[i] = key;
+            self.id[i] = PrimitiveId::csg(c);
+            self.payload[i] = [t, 0.0];
+            if self.forward {
+                self.shade_now(i, x, y);
+            }
+        } else {
+            self.counts.depth_fails += 1;
+        }
+        if self.is_focus(x, y) {
+            self.record(PrimitiveKind::Csg, c, None, Vec3::ZERO, key, stored, nearer, i, x, y);
+        }
+    }
+
     fn shade_now(&mut self, i: usize, x: u32, y: u32) {
         self.counts.fragments_shaded += 1;
         self.count_work(i);
@@ -341,6 +373,19 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         let scene = &self.job.prepared.scene;
         let hit = if id.is_none() {
             None
+        } else if id.is_csg() {
+            // The same interval rule on the same eye ray as the pass: the same boundary.
+            let t_max = self.job.view.far_t(p.x, p.y);
+            let hit = crate::render::csg::closest(scene, id.index(), &ray, t_max, false);
+            // Found by the eye ray, as in the ray casters: the same differentials.
+            match hit {
+                Some(h) if scene.has_textures() => {
+                    let mut h = with_ray_differentials(scene, &RayDifferential::eye(self.job.view, p.x, p.y), &ray, h);
+                    crate::render::normal_map::apply(scene, self.job.settings.texture_filter, &mut h);
+                    Some(h)
+                }
+                other => other,
+            }
         } else if id.is_sphere() {
             let hit = scene.sphere_hit(id.index(), self.payload[i][0], &ray);
             // The sphere is hit by the eye ray, as in the ray casters: the same differentials.

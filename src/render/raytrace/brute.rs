@@ -59,6 +59,10 @@ impl SceneQuery for BruteQuery<'_> {
                 best = Some((PrimitiveId::sphere(i as u32), 0.0, 0.0));
             }
         }
+        // CSG objects after every primitive, as they come in id order.
+        if let Some(h) = crate::render::csg::closest_in_scene(&prepared.scene, ray, best_t, inside, counts) {
+            return Some(h);
+        }
         best.map(|(id, b1, b2)| prepared.scene.primitive_hit(id, best_t, b1, b2, ray))
     }
 
@@ -84,6 +88,6 @@ impl SceneQuery for BruteQuery<'_> {
                 return Some(Occluder { kind: PrimitiveKind::Sphere, index: i as u32, t });
             }
         }
-        None
+        crate::render::csg::occluder_in_scene(&prepared.scene, ray, t_max, counts)
     }
 }

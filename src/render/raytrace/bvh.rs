@@ -403,13 +403,25 @@ impl<'a> BvhQuery<'a> {
 
 impl SceneQuery for BvhQuery<'_> {
     fn closest<R: Recorder>(&self, ray: &Ray, t_max: f32, inside: bool, counts: &mut RayCounts, rec: &mut R) -> Option<SurfaceHit> {
-        let best = self.traverse::<false, R>(ray, t_max, inside, counts, rec)?;
-        Some(self.prepared.scene.primitive_hit(best.id, best.t, best.bary.0, best.bary.1, ray))
+        let best = self.traverse::<false, R>(ray, t_max, inside, counts, rec);
+        let scene = &self.prepared.scene;
+        // CSG objects are kept out of the hierarchy and tested after it.
+        if !scene.csgs.is_empty() {
+            let limit = best.as_ref().map_or(t_max, |b| b.t);
+            if let Some(h) = crate::render::csg::closest_in_scene(scene, ray, limit, inside, counts) {
+                return Some(h);
+            }
+        }
+        let best = best?;
+        Some(scene.primitive_hit(best.id, best.t, best.bary.0, best.bary.1, ray))
     }
 
     fn occluder<R: Recorder>(&self, ray: &Ray, t_max: f32, counts: &mut RayCounts, rec: &mut R) -> Option<Occluder> {
-        let best = self.traverse::<true, R>(ray, t_max, false, counts, rec)?;
-        Some(Occluder::new(best.id, best.t))
+        match self.traverse::<true, R>(ray, t_max, false, counts, rec) {
+            Some(best) => Some(Occluder::new(best.id, best.t)),
+            None if self.prepared.scene.csgs.is_empty() => None,
+            None => crate::render::csg::occluder_in_scene(&self.prepared.scene, ray, t_max, counts),
+        }
     }
 }
 
@@ -597,6 +609,7 @@ mod tests {
                                 let s = &scene.spheres[p as usize];
                                 (s.center - s.radius, s.center + s.radius)
                             }
+                            PrimitiveKind::Csg => panic!("csg objects are kept out of the BVH"),
                         };
                         assert!(b.contains(&Aabb { min: lo, max: hi }), "leaf {i} does not contain {kind:?} {p}");
                     }
@@ -614,7 +627,9 @@ mod tests {
             let prepared = load(name);
             check_structure(&prepared.bvh, &prepared.scene);
             let root = prepared.bvh.bounds();
-            if let Some((lo, hi)) = prepared.scene.bounds() {
+            // CSG objects are kept out of the hierarchy.
+            let in_bvh = Scene { csgs: Vec::new(), ..prepared.scene.clone() };
+            if let Some((lo, hi)) = in_bvh.bounds() {
                 assert!(root.contains(&Aabb { min: lo, max: hi }), "{name}");
             }
         }

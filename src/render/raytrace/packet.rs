@@ -415,9 +415,10 @@ fn test_leaf_packet<S: Simd, const ANY: bool>(
 /// time; where frames are shaded in batches, the tile's shadow rays go as
 /// one packet per light and its surfaces are shaded eight at a time
 /// (`shade_tile_batched`). Bands of TILE_H rows run in parallel. The cost
-/// view (per-ray work) and very deep trees take the single-ray path.
+/// view (per-ray work), very deep trees and scenes with CSG objects (which
+/// the packets do not test) take the single-ray path.
 pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) -> RayCounts {
-    if query.prepared.bvh.deep || job.settings.view == View::Cost {
+    if query.prepared.bvh.deep || job.settings.view == View::Cost || !query.prepared.scene.csgs.is_empty() {
         return cast_pass(job, query, out);
     }
     let scene = &query.prepared.scene;
@@ -588,7 +589,8 @@ mod tests {
     fn packets_find_the_single_ray_hits() {
         for name in builtin::names() {
             let prepared = PreparedScene::new(builtin::load_builtin(name).unwrap().unwrap());
-            if prepared.bvh.deep {
+            // Frames of scenes with CSG objects cast single rays (`cast_pass_packets`).
+            if prepared.bvh.deep || !prepared.scene.csgs.is_empty() {
                 continue;
             }
             let (w, h) = (61u32, 37u32);
