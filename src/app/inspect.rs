@@ -167,7 +167,7 @@ pub fn object_name(scene: &Scene, kind: PrimitiveKind, index: u32) -> String {
     };
     let copy = match kind {
         PrimitiveKind::Triangle => scene.instance_of_triangle(index).map(|i| format!(", instance {}", i.index)),
-        PrimitiveKind::Sphere => None,
+        PrimitiveKind::Sphere | PrimitiveKind::Csg => None,
     };
     object
         .and_then(|o| scene.objects.get(o as usize).map(|info| format!("'{}' (object {o}{})", info.name, copy.unwrap_or_default())))

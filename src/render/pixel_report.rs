@@ -36,7 +36,7 @@ pub fn miss_reason(m: Miss) -> &'static str {
 fn instance_of<'s>(scene: &'s Scene, h: &SurfaceHit) -> Option<&'s crate::scene::InstanceInfo> {
     match h.kind {
         PrimitiveKind::Triangle => scene.instance_of_triangle(h.primitive),
-        PrimitiveKind::Sphere => None,
+        PrimitiveKind::Sphere | PrimitiveKind::Csg => None,
     }
 }
 

@@ -395,8 +395,8 @@ fn build_layer(scene: &mut Scene, layered: Layered) -> Result<(), String> {
         layer.meshes.push(mesh);
         for copy in copies {
             let placement = copy.placement.unwrap_or_else(|| Placement::new(Vec3::ZERO, Vec3::ZERO, Vec3::ONE));
-            if base + len >= 1 << 31 {
-                return Err(format!("{}: the copies hold more than 2^31 triangles", scene.name));
+            if base + len >= 1 << 30 {
+                return Err(format!("{}: the copies hold more than 2^30 triangles, the most a primitive id can name", scene.name));
             }
             let m = placement.matrix();
             let stretch = m.x_axis.truncate().length().max(m.y_axis.truncate().length()).max(m.z_axis.truncate().length());
