@@ -416,7 +416,17 @@ impl Scene {
     /// rasterizer build their hits here, so identical visibility gives identical
     /// shading inputs.
     pub fn triangle_hit(&self, index: u32, b: Vec3, t: f32, ray: &Ray) -> SurfaceHit {
-        let tri = &*self.triangle(index);
+        // A flattened triangle is read in place; only a copy of the
+        // two-level layer is placed in world space first.
+        match self.triangles.get(index as usize) {
+            Some(tri) => Self::hit_on(tri, index, b, t, ray),
+            None => Self::hit_on(&self.triangle(index), index, b, t, ray),
+        }
+    }
+
+    /// `triangle_hit` on the world-space triangle `tri`.
+    #[inline(always)]
+    fn hit_on(tri: &Triangle, index: u32, b: Vec3, t: f32, ray: &Ray) -> SurfaceHit {
         let position = tri.v[0] * b.x + tri.v[1] * b.y + tri.v[2] * b.z;
         let mut geometric_normal = tri.geometric_normal();
         let mut shading_normal = (tri.n[0] * b.x + tri.n[1] * b.y + tri.n[2] * b.z).normalize_or(geometric_normal);
