@@ -99,6 +99,12 @@ pub fn describe(renderer: &str, s: &RenderSettings) -> String {
     out.join(" ")
 }
 
+/// Whether `config`'s renderer draws `scene` with its settings (its
+/// `Renderer::check` passes).
+pub fn accepted(scene: &Scene, config: &Configuration) -> bool {
+    crate::render::renderer_by_name(&config.renderer).is_ok_and(|r| r.check(scene, &config.settings).is_ok())
+}
+
 /// The configurations worth measuring on `scene`, all at `base`'s image size
 /// (and seed). Shadow-map settings only when something casts a shadow,
 /// interpolation only when the scene has triangles.
@@ -220,6 +226,10 @@ pub fn method_configurations(scene: &Scene, base: &RenderSettings) -> Vec<Config
         s.gi.mode = GiMode::Path;
         s.spp = 16;
     }));
+    // What the scene cannot be drawn with (CSG objects under the painter or
+    // shadow maps, the copies' two-level layer under shadow maps...) is not
+    // measured: its image would be refused, not wrong.
+    out.retain(|c| accepted(scene, c));
     out
 }
 
@@ -269,6 +279,21 @@ mod tests {
         assert!(labels.contains(&"rasterize:fixed --reflections env"), "{labels:?}");
         let teapot = crate::scene::builtin::load_builtin("teapot").unwrap().unwrap();
         assert!(method_configurations(&teapot, &RenderSettings::for_scene(&teapot)).iter().all(|c| c.group != "textures" && c.group != "reflections"));
+    }
+
+    #[test]
+    fn configurations_the_scene_refuses_are_left_out() {
+        let scene = crate::scene::builtin::load_builtin("csg").unwrap().unwrap();
+        let base = RenderSettings::for_scene(&scene);
+        let configs = method_configurations(&scene, &base);
+        assert!(!configs.is_empty());
+        assert!(configs.iter().all(|c| accepted(&scene, c)));
+        assert!(!configs.iter().any(|c| c.renderer == "rasterize:painter"), "the painter cannot draw CSG");
+        assert!(!configs.iter().any(|c| c.settings.shadows == ShadowMode::Map), "shadow maps are built from triangles and spheres only");
+        // On a scene without CSG they are measured.
+        let teapot = crate::scene::builtin::load_builtin("teapot").unwrap().unwrap();
+        let configs = method_configurations(&teapot, &RenderSettings::for_scene(&teapot));
+        assert!(configs.iter().any(|c| c.renderer == "rasterize:painter"));
     }
 
     #[test]

@@ -55,6 +55,7 @@ pub fn gi_configurations(base: &RenderSettings, scene: &crate::scene::Scene, pat
             s.spp = spp;
         })));
     }
+    out.retain(|c| super::configurations::accepted(scene, c));
     out
 }
 
