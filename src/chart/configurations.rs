@@ -105,17 +105,23 @@ pub fn accepted(scene: &Scene, config: &Configuration) -> bool {
     crate::render::renderer_by_name(&config.renderer).is_ok_and(|r| r.check(scene, &config.settings).is_ok())
 }
 
-/// The configurations worth measuring on `scene`, all at `base`'s image size
-/// (and seed). Shadow-map settings only when something casts a shadow,
-/// interpolation only when the scene has triangles.
-pub fn method_configurations(scene: &Scene, base: &RenderSettings) -> Vec<Configuration> {
-    let plain = RenderSettings {
+/// What every swept configuration starts from: the scene's defaults, the
+/// shaded view, at `base`'s image size and seed.
+pub fn plain_settings(scene: &Scene, base: &RenderSettings) -> RenderSettings {
+    RenderSettings {
         width: base.width,
         height: base.height,
         view: debug::View::Shaded,
         gi: crate::render::gi::GiSettings { seed: base.gi.seed, ..Default::default() },
         ..RenderSettings::for_scene(scene)
-    };
+    }
+}
+
+/// The configurations worth measuring on `scene`, all at `base`'s image size
+/// (and seed). Shadow-map settings only when something casts a shadow,
+/// interpolation only when the scene has triangles.
+pub fn method_configurations(scene: &Scene, base: &RenderSettings) -> Vec<Configuration> {
+    let plain = plain_settings(scene, base);
     let with = |f: &dyn Fn(&mut RenderSettings)| {
         let mut s = plain.clone();
         f(&mut s);

@@ -7,7 +7,7 @@ use super::configurations::Configuration;
 use super::measure::{measure, Measurement};
 use super::reference::Reference;
 use crate::render::gi::GiMode;
-use crate::render::{debug, frame, PreparedScene, RenderSettings, DEFAULT_RAYTRACE};
+use crate::render::{frame, PreparedScene, RenderSettings, DEFAULT_RAYTRACE};
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
@@ -17,13 +17,7 @@ use std::time::Instant;
 /// Every configuration is the ray tracer at `base`'s size and seed; the
 /// rasterizers give the same images (their first hits are the same).
 pub fn gi_configurations(base: &RenderSettings, scene: &crate::scene::Scene, path_spps: &[u32]) -> Vec<Configuration> {
-    let plain = RenderSettings {
-        width: base.width,
-        height: base.height,
-        view: debug::View::Shaded,
-        gi: crate::render::gi::GiSettings { seed: base.gi.seed, ..Default::default() },
-        ..RenderSettings::for_scene(scene)
-    };
+    let plain = super::configurations::plain_settings(scene, base);
     let with = |f: &dyn Fn(&mut RenderSettings)| {
         let mut s = plain.clone();
         f(&mut s);
