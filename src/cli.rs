@@ -442,6 +442,7 @@ fn stats_json(l: &Loaded, render_ms: f64, counts: &RayCounts, spp: u32) -> serde
         "spheres": l.prepared.scene.spheres.len(),
         "load_ms": l.load_ms,
         "build_ms": l.prepared.build_ms,
+        "bvh_depth": l.prepared.bvh.depth(),
         "render_ms": render_ms,
         "primary_rays": per_frame(counts.primary),
         "shadow_rays": counts.shadow,
