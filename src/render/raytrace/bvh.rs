@@ -296,6 +296,47 @@ impl<'a> BvhQuery<'a> {
         self.traverse_flat::<ANY, R>(ray, t_max, inside, counts, rec)
     }
 
+    /// Starts loading a child's node (both its cache lines) or its leaf's
+    /// first primitives into the cache; a hint only, it changes no result.
+    #[inline(always)]
+    fn prefetch_child(&self, word: u32) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+            let bvh = &self.prepared.bvh;
+            let p: *const i8 = if word & LEAF_BIT == 0 {
+                bvh.nodes.as_ptr().wrapping_add(word as usize).cast()
+            } else {
+                bvh.prims.as_ptr().wrapping_add(leaf_range(word).0).cast()
+            };
+            // SAFETY: prefetching is a hint that never faults, whatever the address.
+            unsafe {
+                _mm_prefetch::<_MM_HINT_T0>(p);
+                _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(64));
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = word;
+    }
+
+    /// Starts loading the scene's record of triangle `id` (a hint only).
+    #[inline(always)]
+    fn prefetch_triangle(&self, id: PrimitiveId) {
+        #[cfg(target_arch = "x86_64")]
+        if id.kind() == PrimitiveKind::Triangle {
+            use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+            let p: *const i8 = self.prepared.scene.triangles.as_ptr().wrapping_add(id.index() as usize).cast();
+            // SAFETY: prefetching is a hint that never faults, whatever the address.
+            unsafe {
+                _mm_prefetch::<_MM_HINT_T0>(p);
+                _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(64));
+                _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(std::mem::size_of::<crate::scene::Triangle>() - 1));
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = id;
+    }
+
     /// The walk through the BVH over the flattened triangles and the spheres.
     #[inline(always)]
     fn traverse_flat<const ANY: bool, R: Recorder>(
@@ -345,6 +386,14 @@ impl<'a> BvhQuery<'a> {
                 let node = &bvh.nodes[word as usize];
                 let (mask, tn) = r.slab4(&node.planes, node.valid, best.t);
                 if mask != 0 {
+                    // Ask for every child the ray enters now: the walk is a
+                    // chain of dependent loads that miss the cache, and the
+                    // bookkeeping below can hide part of the next one.
+                    let mut m = mask;
+                    while m != 0 {
+                        self.prefetch_child(node.child[m.trailing_zeros() as usize]);
+                        m &= m - 1;
+                    }
                     if mask & (mask - 1) == 0 {
                         word = node.child[mask.trailing_zeros() as usize];
                         continue 'walk;
@@ -380,10 +429,16 @@ impl<'a> BvhQuery<'a> {
             } else {
                 let (start, end) = leaf_range(word);
                 // Shadow rays (`ANY`) never start inside a sphere they may hit.
+                let before = best.id;
                 if test_leaf::<ANY, R>(&bvh.prims[start..end], spheres, ray, inside && !ANY, &mut best, &mut tests, rec) {
                     counts.nodes += visits;
                     counts.tests += tests;
                     return Some(best);
+                }
+                if !ANY && best.id != before {
+                    // The hit record will read this triangle: start its load
+                    // while the walk goes on.
+                    self.prefetch_triangle(best.id);
                 }
             }
             // Pop the next node that may still hold something nearer.
