@@ -500,17 +500,18 @@ pub fn radiance_along<Q: SceneQuery, R: Recorder>(
     let Shading { scene, query, .. } = *sh;
     sh.counts.secondary += 1;
     sh.rec.ray(ray, f32::INFINITY, depth);
-    let hit = query.closest(ray, f32::INFINITY, inside, sh.counts, sh.rec);
-    let hit = hit.map(|mut h| {
+    let mut hit = query.closest(ray, f32::INFINITY, inside, sh.counts, sh.rec);
+    // Completed in place: the record is large, and copies of it showed up
+    // in profiles of path-traced frames.
+    if let Some(h) = hit.as_mut() {
         if let Some(rd) = rd.filter(|_| scene.has_textures()) {
-            h = differentials::with_ray_differentials(scene, rd, ray, h);
+            *h = differentials::with_ray_differentials(scene, rd, ray, *h);
         }
-        super::normal_map::apply(scene, sh.settings.texture_filter, &mut h);
-        h
-    });
+        super::normal_map::apply(scene, sh.settings.texture_filter, h);
+    }
     sh.rec.closest(hit.as_ref());
-    match hit {
-        Some(h) => shade(sh, &h, -ray.dir, depth),
+    match &hit {
+        Some(h) => shade(sh, h, -ray.dir, depth),
         None => {
             let l = scene.miss_radiance(ray.dir);
             sh.rec.shaded(depth, l);
