@@ -108,6 +108,28 @@ pub(super) fn leaf_range(word: u32) -> (usize, usize) {
 }
 
 impl Bvh {
+    /// Starts loading a child's node (both its cache lines) or its leaf's
+    /// first primitives into the cache; a hint only, it changes no result.
+    #[inline(always)]
+    pub(super) fn prefetch_child(&self, word: u32) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+            let p: *const i8 = if word & LEAF_BIT == 0 {
+                self.nodes.as_ptr().wrapping_add(word as usize).cast()
+            } else {
+                self.prims.as_ptr().wrapping_add(leaf_range(word).0).cast()
+            };
+            // SAFETY: prefetching is a hint that never faults, whatever the address.
+            unsafe {
+                _mm_prefetch::<_MM_HINT_T0>(p);
+                _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(64));
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = word;
+    }
+
     /// Number of nodes: interior nodes plus leaves.
     pub fn node_count(&self) -> usize {
         self.nodes.len() + self.leaves
@@ -296,29 +318,6 @@ impl<'a> BvhQuery<'a> {
         self.traverse_flat::<ANY, R>(ray, t_max, inside, counts, rec)
     }
 
-    /// Starts loading a child's node (both its cache lines) or its leaf's
-    /// first primitives into the cache; a hint only, it changes no result.
-    #[inline(always)]
-    fn prefetch_child(&self, word: u32) {
-        #[cfg(target_arch = "x86_64")]
-        {
-            use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-            let bvh = &self.prepared.bvh;
-            let p: *const i8 = if word & LEAF_BIT == 0 {
-                bvh.nodes.as_ptr().wrapping_add(word as usize).cast()
-            } else {
-                bvh.prims.as_ptr().wrapping_add(leaf_range(word).0).cast()
-            };
-            // SAFETY: prefetching is a hint that never faults, whatever the address.
-            unsafe {
-                _mm_prefetch::<_MM_HINT_T0>(p);
-                _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(64));
-            }
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        let _ = word;
-    }
-
     /// Starts loading the scene's record of triangle `id` (a hint only).
     #[inline(always)]
     fn prefetch_triangle(&self, id: PrimitiveId) {
@@ -391,7 +390,7 @@ impl<'a> BvhQuery<'a> {
                     // bookkeeping below can hide part of the next one.
                     let mut m = mask;
                     while m != 0 {
-                        self.prefetch_child(node.child[m.trailing_zeros() as usize]);
+                        bvh.prefetch_child(node.child[m.trailing_zeros() as usize]);
                         m &= m - 1;
                     }
                     if mask & (mask - 1) == 0 {
