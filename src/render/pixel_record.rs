@@ -123,6 +123,35 @@ pub struct FragmentRecord {
     pub sample: Option<u32>,
 }
 
+/// One fragment of a CSG object's A-buffer at a sample: where the eye ray
+/// enters or leaves one operand solid.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CsgFragmentRecord {
+    /// Along the eye ray (from its origin on the near plane).
+    pub t: f32,
+    /// The operand (leaf) it bounds, numbered as `csg::Boundary::leaf`.
+    pub leaf: u32,
+    pub surface: crate::render::csg::SurfaceRef,
+    /// A front face (or a sphere's near root): the ray enters the operand.
+    pub entering: bool,
+    /// The scan-converted triangle's screen-space weights at the sample
+    /// (`None` for a sphere's analytic roots).
+    pub screen_barycentric: Option<Vec3>,
+}
+
+/// A rasterizer's A-buffer at one sample for one CSG object: its fragments
+/// sorted by depth and what the interval rule made of them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CsgABufferRecord {
+    /// Index into `Scene::csgs`.
+    pub csg: u32,
+    /// The MSAA coverage sample, as in `FragmentRecord::sample`.
+    pub sample: Option<u32>,
+    pub fragments: Vec<CsgFragmentRecord>,
+    /// Each operand's intervals, the combined ones and the winner.
+    pub explanation: crate::render::csg::Explanation,
+}
+
 /// What the `opengl` renderer's pass left at a pixel: the surface its
 /// fragment shader saw (interpolated position, normals, barycentrics, uv,
 /// primitive; `None` where no fragment was drawn) and the colour it wrote.
@@ -140,6 +169,8 @@ pub struct PixelTrace {
     pub rays: Vec<RayRecord>,
     pub lights: Vec<LightSample>,
     pub fragments: Vec<FragmentRecord>,
+    /// Rasterizers: the A-buffer of each CSG object at this sample, in draw order.
+    pub csg_abuffers: Vec<CsgABufferRecord>,
     /// Radiance returned at each shading depth, innermost first.
     pub shaded: Vec<(u32, Radiance)>,
     /// Path tracing: the sampled bounces, in order.
@@ -163,10 +194,11 @@ impl PixelTrace {
     /// Adds `other`'s records after this one's (a rasterizer's layers, one
     /// record each, become the pixel's record).
     pub fn append(&mut self, other: PixelTrace) {
-        let PixelTrace { rays, lights, fragments, shaded, bounces, photon_estimates, .. } = other;
+        let PixelTrace { rays, lights, fragments, csg_abuffers, shaded, bounces, photon_estimates, .. } = other;
         self.rays.extend(rays);
         self.lights.extend(lights);
         self.fragments.extend(fragments);
+        self.csg_abuffers.extend(csg_abuffers);
         self.shaded.extend(shaded);
         self.bounces.extend(bounces);
         self.photon_estimates.extend(photon_estimates);
