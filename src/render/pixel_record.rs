@@ -152,6 +152,40 @@ pub struct CsgABufferRecord {
     pub explanation: crate::render::csg::Explanation,
 }
 
+impl CsgABufferRecord {
+    /// Whether fragment `f` is the boundary that won.
+    pub fn won(&self, f: &CsgFragmentRecord) -> bool {
+        self.explanation.winner.is_some_and(|(b, _)| b.leaf == f.leaf && b.surface == f.surface && b.t == f.t)
+    }
+
+    /// The operand's path in the tree ("a", "b.a", ...).
+    pub fn operand(&self, f: &CsgFragmentRecord) -> &str {
+        self.explanation.leaves.get(f.leaf as usize).map(|l| l.path.as_str()).unwrap_or("?")
+    }
+
+    /// Text lines: the sorted fragments, then the intervals and the winner
+    /// (`Explanation::lines`).
+    pub fn lines(&self) -> Vec<String> {
+        let mut out = vec![format!("A-buffer: {} fragment(s) sorted by depth (t along the eye ray)", self.fragments.len())];
+        for f in &self.fragments {
+            let surface = match f.surface {
+                crate::render::csg::SurfaceRef::Sphere(_) => "sphere".to_string(),
+                crate::render::csg::SurfaceRef::Triangle { index, .. } => format!("mesh triangle {index}"),
+            };
+            let screen = f.screen_barycentric.map(|w| format!(", 2D weights ({:.4}, {:.4}, {:.4})", w.x, w.y, w.z)).unwrap_or_default();
+            out.push(format!(
+                "  t {:.4}: operand {} ({surface}{screen}) {}{}",
+                f.t,
+                self.operand(f),
+                if f.entering { "entry" } else { "exit" },
+                if self.won(f) { "  <- won" } else { "" }
+            ));
+        }
+        out.extend(self.explanation.lines());
+        out
+    }
+}
+
 /// What the `opengl` renderer's pass left at a pixel: the surface its
 /// fragment shader saw (interpolated position, normals, barycentrics, uv,
 /// primitive; `None` where no fragment was drawn) and the colour it wrote.
@@ -202,6 +236,17 @@ impl PixelTrace {
         self.shaded.extend(shaded);
         self.bounces.extend(bounces);
         self.photon_estimates.extend(photon_estimates);
+    }
+
+    /// A rasterizer's A-buffer record behind CSG hit `hit` (its eye ray's
+    /// hit): the record of the hit's object whose winner is the hit's boundary.
+    pub fn csg_abuffer_for(&self, hit: &SurfaceHit) -> Option<&CsgABufferRecord> {
+        if hit.kind != PrimitiveKind::Csg {
+            return None;
+        }
+        let mine = self.csg_abuffers.iter().filter(|a| a.csg == hit.primitive);
+        let mut same = mine.clone().filter(|a| a.explanation.winner.is_some_and(|(b, _)| b.t == hit.t));
+        same.next().or_else(|| mine.clone().find(|a| a.explanation.winner.is_some()))
     }
 
     fn current_ray(&mut self) -> Option<&mut RayRecord> {

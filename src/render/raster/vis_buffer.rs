@@ -377,7 +377,12 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             self.counts.depth_fails += 1;
         }
         if self.is_focus(x, y) {
-            self.record(PrimitiveKind::Csg, c, None, Vec3::ZERO, key, stored, nearer, i, x, y);
+            // The winning surface's barycentrics when it is an operand triangle.
+            let bary = match b.surface {
+                SurfaceRef::Triangle { b1, b2, .. } => Vec3::new(1.0 - b1 - b2, b1, b2),
+                SurfaceRef::Sphere(_) => Vec3::ZERO,
+            };
+            self.record(PrimitiveKind::Csg, c, None, bary, key, stored, nearer, i, x, y);
         }
     }
 
