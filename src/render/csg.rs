@@ -7,9 +7,11 @@
 //! boolean operation by one sweep over their boundaries. The hit is the first
 //! boundary of the root's list with `0 < t < t_max`.
 //!
-//! Every renderer asks here: the ray casters after their BVH or scan, the
-//! rasterizers per pixel with the very eye ray the ray casters cast, so the
-//! families agree wherever the rest of the frame does. A CSG hit is an
+//! The ray casters ask here after their BVH or scan. The rasterizers bring
+//! their own per-operand lists, from the fragments of an A-buffer
+//! (`raster/csg.rs`), and combine them with the same sweep (`resolve_lists`,
+//! `count_intervals`), so the families agree wherever they see the same
+//! boundaries. A CSG hit is an
 //! ordinary `SurfaceHit` (kind `Csg`) with the winning operand surface's
 //! material, uv and normal; the normal of a subtracted operand is flipped,
 //! so it points out of the resulting solid (into a cavity).
