@@ -264,6 +264,115 @@ fn a_csg_pixel_replays_as_the_frame_drew_it() {
 }
 
 #[test]
+fn the_rasterizers_scan_convert_operand_triangles_into_an_a_buffer() {
+    use pinhole::render::csg::SurfaceRef;
+    let scene = builtin("csg");
+    let mut settings = RenderSettings::for_scene(&scene);
+    settings.width = 160;
+    settings.height = 120;
+    let prepared = PreparedScene::new(scene);
+    // A pixel on the rounded cube (object 2: (cube mesh ∩ sphere) minus a
+    // sphere): the eye ray enters the cube through one face and leaves it
+    // through another, well inside both triangles, inside the rounding sphere.
+    let (x, y) = (110, 62);
+    let csg = &prepared.scene.csgs[2];
+    let reference = {
+        let r = renderer_by_name("raytrace:brute").unwrap();
+        replay_pixel(r.as_ref(), &prepared, &settings, x, y).unwrap().samples[0].1.rays[0].closest.unwrap()
+    };
+    for name in ["rasterize:fixed", "rasterize:tiled", "rasterize:scanline", "rasterize:bbox"] {
+        let r = renderer_by_name(name).unwrap();
+        let replay = replay_pixel(r.as_ref(), &prepared, &settings, x, y).unwrap();
+        let trace = &replay.samples[0].1;
+        let abuffers: Vec<_> = trace.csg_abuffers.iter().filter(|a| a.csg == 2).collect();
+        assert_eq!(abuffers.len(), 1, "{name}: one A-buffer list for the object at the pixel");
+        let a = abuffers[0];
+        // Sorted by depth.
+        assert!(a.fragments.windows(2).all(|w| w[0].t <= w[1].t), "{name}: {:?}", a.fragments);
+        // The mesh operand (leaf 0, "a.a"): one entry on a front face and one
+        // exit on a back face, each from the coverage loop (2D weights).
+        let mesh: Vec<_> = a.fragments.iter().filter(|f| f.leaf == 0).collect();
+        assert_eq!(mesh.iter().filter(|f| f.entering).count(), 1, "{name}: {mesh:?}");
+        assert_eq!(mesh.iter().filter(|f| !f.entering).count(), 1, "{name}: {mesh:?}");
+        for f in &mesh {
+            let SurfaceRef::Triangle { index, .. } = f.surface else { panic!("{name}: a mesh fragment off a triangle: {f:?}") };
+            let w = f.screen_barycentric.unwrap_or_else(|| panic!("{name}: a mesh fragment without 2D weights: {f:?}"));
+            assert!(w.min_element() > 0.0 && (w.x + w.y + w.z - 1.0).abs() < 1e-5, "{name}: {w:?}");
+            let tri = &csg.triangles[index as usize];
+            let facing_eye = tri.geometric_normal().dot(trace.rays[0].ray.dir) < 0.0;
+            assert_eq!(facing_eye, f.entering, "{name}: a front face enters, a back face exits");
+        }
+        // The rounding sphere (leaf 1): its two roots; the dimple (leaf 2) is missed.
+        let sphere: Vec<_> = a.fragments.iter().filter(|f| f.leaf == 1).collect();
+        assert_eq!(sphere.len(), 2, "{name}: {sphere:?}");
+        assert!(sphere[0].entering && !sphere[1].entering && sphere.iter().all(|f| f.screen_barycentric.is_none()));
+        assert!(a.fragments.iter().all(|f| f.leaf != 2), "{name}");
+        // The winner: the mesh's entry, where the ray caster hits.
+        let (won, entering) = a.explanation.winner.unwrap();
+        assert!(entering && won.leaf == 0, "{name}: {won:?}");
+        assert!(a.won(mesh[0]) && mesh[0].entering, "{name}");
+        let eye = trace.rays[0].closest.unwrap();
+        assert_eq!((eye.kind, eye.primitive, eye.t), (PrimitiveKind::Csg, 2, won.t), "{name}");
+        assert!(close(eye.t, reference.t) && close3(eye.position, reference.position), "{name}: {eye:?} vs {reference:?}");
+        assert_eq!(eye.geometric_normal, reference.geometric_normal, "{name}");
+        // The report lists the A-buffer.
+        let text = pinhole::render::pixel_report::to_text(name, &prepared.scene, x, y, &replay);
+        assert!(text.contains("A-buffer: 4 fragment(s) sorted by depth") && text.contains("operand a.a (mesh triangle") && text.contains("entry  <- won"), "{text}");
+        let json = pinhole::render::pixel_report::to_json(name, &prepared.scene, x, y, &replay);
+        let list = json["samples"][0]["rays"][0]["csg"]["a_buffer"].as_array().cloned().unwrap_or_default();
+        assert_eq!(list.len(), 4, "{json}");
+        assert_eq!(list.iter().filter(|f| f["won"] == true).count(), 1, "{json}");
+        assert_eq!(list.iter().filter(|f| f["kind"] == "triangle").count(), 2, "{json}");
+    }
+    // The ray casters keep their own account (no A-buffer).
+    let r = renderer_by_name("raytrace:bvh").unwrap();
+    let replay = replay_pixel(r.as_ref(), &prepared, &settings, x, y).unwrap();
+    assert!(replay.samples[0].1.csg_abuffers.is_empty());
+    let json = pinhole::render::pixel_report::to_json("raytrace:bvh", &prepared.scene, x, y, &replay);
+    assert!(json["samples"][0]["rays"][0]["csg"]["a_buffer"].is_null() && json["samples"][0]["rays"][0]["csg"]["won"].is_object(), "{json}");
+}
+
+#[test]
+fn an_operand_entered_before_the_near_plane_still_counts() {
+    // The camera sits inside a large cube mesh operand: its entries lie
+    // behind the near plane, clipped away, so the A-buffer holds only its
+    // exits. Cube ∩ sphere is the sphere; cube minus sphere is the sphere's
+    // inner wall. Both families must draw them.
+    let dir = temp_dir("near");
+    std::fs::write(dir.join("cube.obj"), CUBE).unwrap();
+    let sphere = "{ type = \"sphere\", center = [0.3, 0.0, -2.0], radius = 0.8, material = \"second\" }";
+    let head = "[camera]\neye = [0.0, 0.0, 0.0]\ntarget = [0.0, 0.0, -1.0]\nfov_y_deg = 60.0\n[render]\nwidth = 64\nheight = 48\n\
+                [[light]]\ntype = \"point\"\nposition = [0.5, 0.5, 0.0]\npower = [50.0, 50.0, 50.0]\n";
+    for op in ["intersection", "difference"] {
+        let s = scene(
+            &format!("{head}[[object]]\ntype = \"csg\"\nop = \"{op}\"\na = {{ type = \"mesh\", file = \"cube.obj\", scale = 4.0, material = \"first\" }}\nb = {sphere}\n"),
+            &dir,
+        );
+        let settings = RenderSettings::for_scene(&s);
+        let (w, h) = (settings.width, settings.height);
+        let prepared = PreparedScene::new(s);
+        let reference = render("raytrace:brute", &prepared, &settings);
+        let ids = render("raytrace:brute", &prepared, &RenderSettings { view: View::Id, ..settings.clone() });
+        for name in ["rasterize:fixed", "rasterize:bbox"] {
+            let image = render(name, &prepared, &settings);
+            let (differ, inland) = compare(&reference, &image, &ids, w, h);
+            assert!(differ * 200 <= (w * h) as usize && inland == 0, "{op}, {name}: {differ} pixels differ, {inland} away from edges");
+        }
+        // The centre pixel sees the sphere: its near wall (∩) or its far wall (minus).
+        let r = renderer_by_name("rasterize:fixed").unwrap();
+        let replay = replay_pixel(r.as_ref(), &prepared, &settings, w / 2, h / 2).unwrap();
+        let trace = &replay.samples[0].1;
+        let hit = trace.rays[0].closest.expect("the centre sees the sphere");
+        assert_eq!(hit.material, material(&prepared.scene, "second"), "{op}");
+        let a = &trace.csg_abuffers[0];
+        assert!(a.fragments.iter().filter(|f| f.leaf == 0).all(|f| !f.entering), "{op}: only the cube's exits are drawn");
+        // Near x = 0.3 the sphere's walls lie at z = -2 -+ sqrt(0.8^2 - 0.3^2) = -2 -+ 0.742.
+        let expected = if op == "intersection" { -1.258 } else { -2.742 };
+        assert!((hit.position.z - expected).abs() < 0.02, "{op}: {:?}", hit.position);
+    }
+}
+
+#[test]
 fn renderers_that_cannot_draw_csg_say_so() {
     let scene = builtin("csg");
     let settings = RenderSettings::for_scene(&scene);

@@ -7,9 +7,11 @@
 //! boolean operation by one sweep over their boundaries. The hit is the first
 //! boundary of the root's list with `0 < t < t_max`.
 //!
-//! Every renderer asks here: the ray casters after their BVH or scan, the
-//! rasterizers per pixel with the very eye ray the ray casters cast, so the
-//! families agree wherever the rest of the frame does. A CSG hit is an
+//! The ray casters ask here after their BVH or scan. The rasterizers bring
+//! their own per-operand lists, from the fragments of an A-buffer
+//! (`raster/csg.rs`), and combine them with the same sweep (`resolve_lists`,
+//! `count_intervals`), so the families agree wherever they see the same
+//! boundaries. A CSG hit is an
 //! ordinary `SurfaceHit` (kind `Csg`) with the winning operand surface's
 //! material, uv and normal; the normal of a subtracted operand is flipped,
 //! so it points out of the resulting solid (into a cavity).
@@ -110,7 +112,7 @@ fn crossing(ray: &Ray, v0: Vec3, e1: Vec3, e2: Vec3) -> Option<(f32, f32, f32, b
 /// A sphere's interval over the whole line (Ray Tracing Gems ch. 7's
 /// discriminant, as `intersect_sphere` forms it).
 #[inline]
-fn sphere_interval(ray: &Ray, center: Vec3, radius: f32) -> Option<(f32, f32)> {
+pub fn sphere_interval(ray: &Ray, center: Vec3, radius: f32) -> Option<(f32, f32)> {
     let f = ray.origin - center;
     let b = -f.dot(ray.dir);
     let l = f + ray.dir * b;
@@ -136,7 +138,15 @@ fn mesh_intervals(csg: &Csg, first: u32, end: u32, ray: &Ray, leaf: u32, flipped
             crossings.push((Boundary { t, surface: SurfaceRef::Triangle { index, b1, b2 }, leaf, flipped }, entering));
         }
     }
-    // Equal t: entries first, so touching pieces stay one interval.
+    count_intervals(crossings)
+}
+
+/// One solid's boundaries along a line, `(boundary, entering)` in any order,
+/// turned into its sorted inside intervals by counting: inside wherever more
+/// entries than exits lie behind. Equal t: entries first, so touching pieces
+/// stay one interval. The ray casters' mesh operands and the rasterizers'
+/// A-buffer both come through here.
+pub fn count_intervals(mut crossings: Vec<(Boundary, bool)>) -> Vec<Interval> {
     crossings.sort_by(|a, b| a.0.t.total_cmp(&b.0.t).then(b.1.cmp(&a.1)));
     let mut out = Vec::new();
     let mut depth = 0i32;
@@ -197,58 +207,113 @@ fn combine(op: CsgOp, a: &[Interval], b: &[Interval]) -> Vec<Interval> {
     out
 }
 
-/// The intervals of `node` along `ray`; `next_leaf` numbers the leaves,
+/// The intervals of `node` along `ray`, each leaf's own list from the ray
+/// tests (spheres through their roots, meshes through their crossings).
+fn node_intervals(csg: &Csg, ray: &Ray, tests: &mut u64, trace: &mut Option<&mut Vec<LeafIntervals>>) -> Vec<Interval> {
+    let mut leaf_list = |node: &CsgNode, leaf: u32, flipped: bool| -> Vec<Interval> {
+        match node {
+            CsgNode::Sphere(i) => {
+                *tests += 1;
+                let s = &csg.spheres[*i as usize];
+                match sphere_interval(ray, s.center, s.radius) {
+                    Some((t0, t1)) => {
+                        let b = |t| Boundary { t, surface: SurfaceRef::Sphere(*i), leaf, flipped };
+                        vec![Interval { enter: b(t0), exit: b(t1) }]
+                    }
+                    None => Vec::new(),
+                }
+            }
+            CsgNode::Mesh { first, end, lo, hi } => {
+                if segment_meets_box(ray, *lo, *hi, f32::NEG_INFINITY, f32::INFINITY) {
+                    mesh_intervals(csg, *first, *end, ray, leaf, flipped, tests)
+                } else {
+                    Vec::new()
+                }
+            }
+            CsgNode::Op { .. } => Vec::new(),
+        }
+    };
+    tree_intervals(&csg.root, "", false, &mut 0, trace, &mut leaf_list)
+}
+
+/// The intervals of `node`: each leaf's list from `leaf_list(leaf node, leaf
+/// number, flipped)`, the lists combined up the tree by each node's
+/// operation. `next_leaf` numbers the leaves depth first, `a` before `b`;
 /// `trace` (the inspector's) collects each leaf's own list.
-fn node_intervals(
-    csg: &Csg,
+fn tree_intervals<F: FnMut(&CsgNode, u32, bool) -> Vec<Interval>>(
     node: &CsgNode,
-    ray: &Ray,
     path: &str,
     flipped: bool,
     next_leaf: &mut u32,
-    tests: &mut u64,
     trace: &mut Option<&mut Vec<LeafIntervals>>,
+    leaf_list: &mut F,
 ) -> Vec<Interval> {
-    let (kind, list) = match node {
+    let kind = match node {
         CsgNode::Op { op, a, b } => {
             let join = |side: &str| if path.is_empty() { side.to_string() } else { format!("{path}.{side}") };
             let (pa, pb) = match trace {
                 Some(_) => (join("a"), join("b")),
                 None => (String::new(), String::new()),
             };
-            let la = node_intervals(csg, a, ray, &pa, flipped, next_leaf, tests, trace);
-            let lb = node_intervals(csg, b, ray, &pb, flipped ^ (*op == CsgOp::Difference), next_leaf, tests, trace);
+            let la = tree_intervals(a, &pa, flipped, next_leaf, trace, leaf_list);
+            let lb = tree_intervals(b, &pb, flipped ^ (*op == CsgOp::Difference), next_leaf, trace, leaf_list);
             return combine(*op, &la, &lb);
         }
-        CsgNode::Sphere(i) => {
-            let leaf = *next_leaf;
-            *next_leaf += 1;
-            *tests += 1;
-            let s = &csg.spheres[*i as usize];
-            let list = match sphere_interval(ray, s.center, s.radius) {
-                Some((t0, t1)) => {
-                    let b = |t| Boundary { t, surface: SurfaceRef::Sphere(*i), leaf, flipped };
-                    vec![Interval { enter: b(t0), exit: b(t1) }]
-                }
-                None => Vec::new(),
-            };
-            ("sphere", list)
-        }
-        CsgNode::Mesh { first, end, lo, hi } => {
-            let leaf = *next_leaf;
-            *next_leaf += 1;
-            let list = if segment_meets_box(ray, *lo, *hi, f32::NEG_INFINITY, f32::INFINITY) {
-                mesh_intervals(csg, *first, *end, ray, leaf, flipped, tests)
-            } else {
-                Vec::new()
-            };
-            ("mesh", list)
-        }
+        CsgNode::Sphere(_) => "sphere",
+        CsgNode::Mesh { .. } => "mesh",
     };
+    let leaf = *next_leaf;
+    *next_leaf += 1;
+    let list = leaf_list(node, leaf, flipped);
     if let Some(t) = trace {
         t.push(LeafIntervals { path: path.to_string(), kind, intervals: list.clone() });
     }
     list
+}
+
+/// One leaf (operand solid) of an object, in the order the interval rule numbers them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Leaf<'c> {
+    pub node: &'c CsgNode,
+    /// Under an odd number of subtractions (see `Boundary::flipped`).
+    pub flipped: bool,
+}
+
+/// The leaves of `csg`, numbered as `Boundary::leaf` numbers them.
+pub fn leaves(csg: &Csg) -> Vec<Leaf<'_>> {
+    fn walk<'c>(node: &'c CsgNode, flipped: bool, out: &mut Vec<Leaf<'c>>) {
+        match node {
+            CsgNode::Op { op, a, b } => {
+                walk(a, flipped, out);
+                walk(b, flipped ^ (*op == CsgOp::Difference), out);
+            }
+            _ => out.push(Leaf { node, flipped }),
+        }
+    }
+    let mut out = Vec::new();
+    walk(&csg.root, false, &mut out);
+    out
+}
+
+/// The interval rule over lists given per leaf (the rasterizers' A-buffer):
+/// `leaf_list(leaf number, flipped)` is that leaf's sorted intervals; they
+/// are combined up the tree exactly as the ray casters combine theirs. The
+/// winning boundary below `t_max` for a ray from outside, and, with
+/// `explain`, the whole account (`object` as in `explain`).
+pub fn resolve_lists<F: FnMut(u32, bool) -> Vec<Interval>>(csg: &Csg, t_max: f32, explain: bool, mut leaf_list: F) -> (Option<(Boundary, bool)>, Option<Explanation>) {
+    let mut leaves = Vec::new();
+    let mut trace = explain.then_some(&mut leaves);
+    let combined = tree_intervals(&csg.root, "", false, &mut 0, &mut trace, &mut |_, leaf, flipped| leaf_list(leaf, flipped));
+    let winner = first_boundary(&combined, t_max, false);
+    let e = explain.then(|| Explanation { object: csg.object, op: root_op(csg), leaves, combined, winner });
+    (winner, e)
+}
+
+fn root_op(csg: &Csg) -> CsgOp {
+    match &csg.root {
+        CsgNode::Op { op, .. } => *op,
+        _ => CsgOp::Union,
+    }
 }
 
 /// The first boundary of `list` with `0 < t < t_max`, and whether it enters
@@ -278,7 +343,7 @@ fn object_closest(scene: &Scene, index: u32, ray: &Ray, t_max: f32, inside: bool
     if !segment_meets_box(ray, csg.lo, csg.hi, 0.0, t_max) {
         return None;
     }
-    let list = node_intervals(csg, &csg.root, ray, "", false, &mut 0, tests, &mut None);
+    let list = node_intervals(csg, ray, tests, &mut None);
     let (b, _) = first_boundary(&list, t_max, inside)?;
     Some(surface_hit(scene, index, b, ray))
 }
@@ -308,7 +373,7 @@ pub fn occluder_in_scene(scene: &Scene, ray: &Ray, t_max: f32, counts: &mut RayC
         if !segment_meets_box(ray, csg.lo, csg.hi, 0.0, t_max) {
             continue;
         }
-        let list = node_intervals(csg, &csg.root, ray, "", false, &mut 0, &mut counts.tests, &mut None);
+        let list = node_intervals(csg, ray, &mut counts.tests, &mut None);
         if let Some((b, _)) = first_boundary(&list, t_max, false) {
             return Some(Occluder { kind: PrimitiveKind::Csg, index: i as u32, t: b.t });
         }
@@ -322,13 +387,9 @@ pub fn occluder_in_scene(scene: &Scene, ray: &Ray, t_max: f32, counts: &mut RayC
 pub fn explain(scene: &Scene, index: u32, ray: &Ray, t_max: f32, inside: bool) -> Option<Explanation> {
     let csg = scene.csgs.get(index as usize)?;
     let mut leaves = Vec::new();
-    let combined = node_intervals(csg, &csg.root, ray, "", false, &mut 0, &mut 0, &mut Some(&mut leaves));
+    let combined = node_intervals(csg, ray, &mut 0, &mut Some(&mut leaves));
     let winner = first_boundary(&combined, t_max, inside);
-    let op = match &csg.root {
-        CsgNode::Op { op, .. } => *op,
-        _ => CsgOp::Union,
-    };
-    Some(Explanation { object: csg.object, op, leaves, combined, winner })
+    Some(Explanation { object: csg.object, op: root_op(csg), leaves, combined, winner })
 }
 
 impl Explanation {

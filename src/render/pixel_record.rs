@@ -123,6 +123,69 @@ pub struct FragmentRecord {
     pub sample: Option<u32>,
 }
 
+/// One fragment of a CSG object's A-buffer at a sample: where the eye ray
+/// enters or leaves one operand solid.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CsgFragmentRecord {
+    /// Along the eye ray (from its origin on the near plane).
+    pub t: f32,
+    /// The operand (leaf) it bounds, numbered as `csg::Boundary::leaf`.
+    pub leaf: u32,
+    pub surface: crate::render::csg::SurfaceRef,
+    /// A front face (or a sphere's near root): the ray enters the operand.
+    pub entering: bool,
+    /// The scan-converted triangle's screen-space weights at the sample
+    /// (`None` for a sphere's analytic roots).
+    pub screen_barycentric: Option<Vec3>,
+}
+
+/// A rasterizer's A-buffer at one sample for one CSG object: its fragments
+/// sorted by depth and what the interval rule made of them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CsgABufferRecord {
+    /// Index into `Scene::csgs`.
+    pub csg: u32,
+    /// The MSAA coverage sample, as in `FragmentRecord::sample`.
+    pub sample: Option<u32>,
+    pub fragments: Vec<CsgFragmentRecord>,
+    /// Each operand's intervals, the combined ones and the winner.
+    pub explanation: crate::render::csg::Explanation,
+}
+
+impl CsgABufferRecord {
+    /// Whether fragment `f` is the boundary that won.
+    pub fn won(&self, f: &CsgFragmentRecord) -> bool {
+        self.explanation.winner.is_some_and(|(b, _)| b.leaf == f.leaf && b.surface == f.surface && b.t == f.t)
+    }
+
+    /// The operand's path in the tree ("a", "b.a", ...).
+    pub fn operand(&self, f: &CsgFragmentRecord) -> &str {
+        self.explanation.leaves.get(f.leaf as usize).map(|l| l.path.as_str()).unwrap_or("?")
+    }
+
+    /// Text lines: the sorted fragments, then the intervals and the winner
+    /// (`Explanation::lines`).
+    pub fn lines(&self) -> Vec<String> {
+        let mut out = vec![format!("A-buffer: {} fragment(s) sorted by depth (t along the eye ray)", self.fragments.len())];
+        for f in &self.fragments {
+            let surface = match f.surface {
+                crate::render::csg::SurfaceRef::Sphere(_) => "sphere".to_string(),
+                crate::render::csg::SurfaceRef::Triangle { index, .. } => format!("mesh triangle {index}"),
+            };
+            let screen = f.screen_barycentric.map(|w| format!(", 2D weights ({:.4}, {:.4}, {:.4})", w.x, w.y, w.z)).unwrap_or_default();
+            out.push(format!(
+                "  t {:.4}: operand {} ({surface}{screen}) {}{}",
+                f.t,
+                self.operand(f),
+                if f.entering { "entry" } else { "exit" },
+                if self.won(f) { "  <- won" } else { "" }
+            ));
+        }
+        out.extend(self.explanation.lines());
+        out
+    }
+}
+
 /// What the `opengl` renderer's pass left at a pixel: the surface its
 /// fragment shader saw (interpolated position, normals, barycentrics, uv,
 /// primitive; `None` where no fragment was drawn) and the colour it wrote.
@@ -140,6 +203,8 @@ pub struct PixelTrace {
     pub rays: Vec<RayRecord>,
     pub lights: Vec<LightSample>,
     pub fragments: Vec<FragmentRecord>,
+    /// Rasterizers: the A-buffer of each CSG object at this sample, in draw order.
+    pub csg_abuffers: Vec<CsgABufferRecord>,
     /// Radiance returned at each shading depth, innermost first.
     pub shaded: Vec<(u32, Radiance)>,
     /// Path tracing: the sampled bounces, in order.
@@ -163,13 +228,25 @@ impl PixelTrace {
     /// Adds `other`'s records after this one's (a rasterizer's layers, one
     /// record each, become the pixel's record).
     pub fn append(&mut self, other: PixelTrace) {
-        let PixelTrace { rays, lights, fragments, shaded, bounces, photon_estimates, .. } = other;
+        let PixelTrace { rays, lights, fragments, csg_abuffers, shaded, bounces, photon_estimates, .. } = other;
         self.rays.extend(rays);
         self.lights.extend(lights);
         self.fragments.extend(fragments);
+        self.csg_abuffers.extend(csg_abuffers);
         self.shaded.extend(shaded);
         self.bounces.extend(bounces);
         self.photon_estimates.extend(photon_estimates);
+    }
+
+    /// A rasterizer's A-buffer record behind CSG hit `hit` (its eye ray's
+    /// hit): the record of the hit's object whose winner is the hit's boundary.
+    pub fn csg_abuffer_for(&self, hit: &SurfaceHit) -> Option<&CsgABufferRecord> {
+        if hit.kind != PrimitiveKind::Csg {
+            return None;
+        }
+        let mine = self.csg_abuffers.iter().filter(|a| a.csg == hit.primitive);
+        let mut same = mine.clone().filter(|a| a.explanation.winner.is_some_and(|(b, _)| b.t == hit.t));
+        same.next().or_else(|| mine.clone().find(|a| a.explanation.winner.is_some()))
     }
 
     fn current_ray(&mut self) -> Option<&mut RayRecord> {

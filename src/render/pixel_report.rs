@@ -4,7 +4,8 @@
 
 use crate::math::Vec3;
 use crate::render::raytrace::intersect::Miss;
-use crate::render::pixel_record::{FragmentRecord, LightSample, PixelTrace, RayRecord};
+use crate::render::csg::SurfaceRef;
+use crate::render::pixel_record::{CsgABufferRecord, FragmentRecord, LightSample, PixelTrace, RayRecord};
 use crate::render::PixelReplay;
 use crate::scene::{PrimitiveKind, Scene, SurfaceHit};
 use serde_json::{json, Value};
@@ -53,7 +54,13 @@ fn hit_json(scene: &Scene, h: &SurfaceHit) -> Value {
     })
 }
 
-fn ray_json(scene: &Scene, r: &RayRecord) -> Value {
+/// A rasterizer's eye ray that saw a CSG object: the A-buffer behind it.
+fn abuffer_of<'t>(t: &'t PixelTrace, r: &RayRecord) -> Option<&'t CsgABufferRecord> {
+    (r.depth == 0 && !r.shadow).then_some(())?;
+    t.csg_abuffer_for(r.closest.as_ref()?)
+}
+
+fn ray_json(scene: &Scene, t: &PixelTrace, r: &RayRecord) -> Value {
     let tests: Vec<Value> = r
         .tests
         .iter()
@@ -67,8 +74,27 @@ fn ray_json(scene: &Scene, r: &RayRecord) -> Value {
         "depth": r.depth, "shadow": r.shadow, "nodes_visited": r.nodes_visited, "tests": tests,
         "tests_omitted": r.tests_omitted, "closest": r.closest.as_ref().map(|h| hit_json(scene, h)),
     });
-    // Only a ray that hit a CSG object has the key.
-    if let Some(e) = r.closest.as_ref().and_then(|h| crate::render::csg::explain_hit(scene, h, &r.ray, r.t_max)) {
+    // Only a ray that hit a CSG object has the key; a rasterizer's eye ray
+    // gives its A-buffer's account, with the sorted fragments.
+    if let Some(a) = abuffer_of(t, r) {
+        out["csg"] = csg_json(&a.explanation);
+        out["csg"]["a_buffer"] = a
+            .fragments
+            .iter()
+            .map(|f| {
+                let (kind, primitive, b) = match f.surface {
+                    SurfaceRef::Sphere(i) => ("sphere", i, None),
+                    SurfaceRef::Triangle { index, b1, b2 } => ("triangle", index, Some(json!([1.0 - b1 - b2, b1, b2]))),
+                };
+                json!({
+                    "t": f.t, "operand": a.operand(f), "boundary": if f.entering { "entry" } else { "exit" },
+                    "kind": kind, "primitive": primitive, "barycentric": b, "screen_barycentric": f.screen_barycentric.map(v3),
+                    "won": a.won(f),
+                })
+            })
+            .collect();
+        out["csg"]["text"] = json!(a.lines());
+    } else if let Some(e) = r.closest.as_ref().and_then(|h| crate::render::csg::explain_hit(scene, h, &r.ray, r.t_max)) {
         out["csg"] = csg_json(&e);
     }
     out
@@ -117,7 +143,7 @@ fn fragment_json(f: &FragmentRecord) -> Value {
 
 fn sample_json(scene: &Scene, t: &PixelTrace) -> Value {
     let mut record = json!({
-        "rays": t.rays.iter().map(|r| ray_json(scene, r)).collect::<Vec<_>>(),
+        "rays": t.rays.iter().map(|r| ray_json(scene, t, r)).collect::<Vec<_>>(),
         "lights": t.lights.iter().map(light_json).collect::<Vec<_>>(),
         "fragments": t.fragments.iter().map(fragment_json).collect::<Vec<_>>(),
     });
@@ -227,7 +253,12 @@ pub fn to_text(renderer: &str, scene: &Scene, x: u32, y: u32, replay: &PixelRepl
                         fmt3(h.shading_normal),
                         fmt3(h.barycentric)
                     );
-                    if let Some(e) = crate::render::csg::explain_hit(scene, h, &r.ray, r.t_max) {
+                    if let Some(a) = abuffer_of(t, r) {
+                        let _ = writeln!(s, "{indent}  csg A-buffer at this sample (scan-converted operand fragments):");
+                        for line in a.lines() {
+                            let _ = writeln!(s, "{indent}    {line}");
+                        }
+                    } else if let Some(e) = crate::render::csg::explain_hit(scene, h, &r.ray, r.t_max) {
                         let _ = writeln!(s, "{indent}  csg intervals along the ray (t from its origin):");
                         for line in e.lines() {
                             let _ = writeln!(s, "{indent}    {line}");

@@ -2,7 +2,8 @@
 //! leaves are closed solids (analytic spheres and closed triangle meshes).
 //! The leaves' geometry lives in the object itself, never in
 //! `Scene::triangles` or `Scene::spheres`, so the BVH and the rasterizers'
-//! triangle loops never see it; `render::csg` casts rays at it.
+//! triangle loops never see it; `render::csg` casts rays at it and
+//! `render::raster::csg` scan-converts it into its own A-buffer.
 
 use super::{Sphere, Triangle};
 use crate::math::Vec3;

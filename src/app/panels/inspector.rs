@@ -3,15 +3,16 @@
 //! the eye ray, its traversal (nodes visited, every primitive tested in
 //! order with t, barycentrics or why it was rejected), the closest hit, each
 //! light's sample with its shadow ray, secondary rays as a tree. Rasterizers:
-//! the fragment history in draw order. Then the final radiance, checked
-//! against the frame's pixel, and the displayed 8-bit value.
+//! the fragment history in draw order, and for a CSG object its A-buffer.
+//! Then the final radiance, checked against the frame's pixel, and the
+//! displayed 8-bit value.
 
 use eframe::egui;
 use crate::app::inspect::{fmt3, kind_name, object_name};
 use crate::app::PinholeApp;
 use crate::math::Radiance;
 use crate::render::pixel_report::miss_reason;
-use crate::render::pixel_record::{FragmentRecord, GlReadback, LightSample, PixelTrace, RayRecord};
+use crate::render::pixel_record::{CsgABufferRecord, FragmentRecord, GlReadback, LightSample, PixelTrace, RayRecord};
 use crate::render::PixelReplay;
 use crate::scene::{Light, Scene};
 use egui::{Color32, RichText};
@@ -159,7 +160,9 @@ fn sample(ui: &mut egui::Ui, names: &SceneNames, t: &PixelTrace, value: Radiance
             ui.add_space(12.0 * r.depth as f32);
             ui.vertical(|ui| {
                 egui::CollapsingHeader::new(RichText::new(title).strong()).id_salt(("ray", i)).default_open(true).show(ui, |ui| {
-                    ray(ui, names, r, i);
+                    // A rasterizer's eye ray on a CSG object: the A-buffer that resolved it.
+                    let abuffer = if r.depth == 0 && !r.shadow { r.closest.as_ref().and_then(|h| t.csg_abuffer_for(h)) } else { None };
+                    ray(ui, names, r, i, abuffer);
                 });
             });
         });
@@ -212,7 +215,7 @@ fn grid_row(ui: &mut egui::Ui, name: &str, value: String) {
     ui.end_row();
 }
 
-fn ray(ui: &mut egui::Ui, names: &SceneNames, r: &RayRecord, index: usize) {
+fn ray(ui: &mut egui::Ui, names: &SceneNames, r: &RayRecord, index: usize, abuffer: Option<&CsgABufferRecord>) {
     let scene = names.scene;
     egui::Grid::new(("ray-grid", index)).num_columns(2).spacing([8.0, 2.0]).show(ui, |ui| {
         grid_row(ui, "origin", fmt3(r.ray.origin));
@@ -250,7 +253,9 @@ fn ray(ui: &mut egui::Ui, names: &SceneNames, r: &RayRecord, index: usize) {
                     grid_row(ui, "side", "back face (two-sided)".into());
                 }
             });
-            if let Some(e) = crate::render::csg::explain_hit(scene, h, &r.ray, r.t_max) {
+            if let Some(a) = abuffer {
+                csg_abuffer(ui, a, index);
+            } else if let Some(e) = crate::render::csg::explain_hit(scene, h, &r.ray, r.t_max) {
                 ui.label(RichText::new("csg intervals (t along the ray)").strong());
                 for line in e.lines() {
                     ui.monospace(line);
@@ -341,6 +346,33 @@ fn light(ui: &mut egui::Ui, names: &SceneNames, l: &LightSample, traced: Option<
             grid_row(ui, "contribution", fmt3(l.contribution));
         });
     });
+}
+
+/// A CSG object's A-buffer at the sample: its fragments sorted by depth (the
+/// winner marked), then each operand's intervals, the combined ones and the winner.
+fn csg_abuffer(ui: &mut egui::Ui, a: &CsgABufferRecord, index: usize) {
+    ui.label(RichText::new(format!("csg A-buffer: {} scan-converted fragments sorted by depth", a.fragments.len())).strong());
+    egui::Grid::new(("csg-abuffer", index)).striped(true).num_columns(4).spacing([10.0, 2.0]).show(ui, |ui| {
+        for h in ["t", "operand", "surface", "boundary"] {
+            ui.label(RichText::new(h).color(DIM));
+        }
+        ui.end_row();
+        for f in &a.fragments {
+            ui.monospace(format!("{:.5}", f.t));
+            ui.monospace(a.operand(f));
+            ui.monospace(match f.surface {
+                crate::render::csg::SurfaceRef::Sphere(_) => "sphere".to_string(),
+                crate::render::csg::SurfaceRef::Triangle { index, .. } => format!("triangle {index}"),
+            });
+            let b = RichText::new(if f.entering { "entry" } else { "exit" }).monospace();
+            ui.label(if a.won(f) { b.color(Color32::LIGHT_GREEN).strong() } else { b });
+            ui.end_row();
+        }
+    });
+    ui.label(RichText::new("csg intervals (t along the ray)").strong());
+    for line in a.explanation.lines() {
+        ui.monospace(line);
+    }
 }
 
 /// The rasterizer's pixel history (RenderDoc style): every fragment in draw

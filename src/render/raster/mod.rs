@@ -15,10 +15,12 @@
 //!   the pixel-history recorder and the cost view's counts;
 //! - `msaa`: coverage sample patterns and the one-shade-per-primitive resolve;
 //! - `sphere`: analytic spheres through the ray tracer's sphere test;
-//! - `csg`: constructive solid geometry, per pixel through the ray casters' interval rule;
+//! - `csg`: constructive solid geometry: operands scan-converted into an A-buffer
+//!   (`abuffer`), each sample's list resolved by the ray casters' interval rule;
 //! - `stencil`: the shadow volumes' stencil counts (`--shadows volume`);
 //! - `pass`: the parallel regions of a pass; `coverage`: coverage counts for tests.
 
+pub mod abuffer;
 pub mod barycentric;
 pub mod bbox;
 pub mod clip;

@@ -70,7 +70,7 @@ pub struct Layer<'a> {
     method: Method,
     geometry: Geometry,
     spheres: Vec<Option<PixelRect>>,
-    csgs: Vec<Option<PixelRect>>,
+    csgs: Vec<super::csg::CsgSetup>,
     /// MSAA coverage sample index; `None` for the pass's own sample.
     pub sample: Option<u32>,
     /// `--shadows volume`: the volume faces the stencil pass draws.
@@ -89,7 +89,7 @@ impl<'a> Layer<'a> {
         let (r0, r1) = (job.rows.start, job.rows.end);
         let (w, h) = (job.view.width, job.view.height);
         let spheres = all_sphere_bounds(job.view, &job.prepared.scene.spheres, offset);
-        let csgs = super::csg::all_csg_bounds(job.view, &job.prepared.scene.csgs, offset);
+        let csgs = super::csg::setup_csgs(job.view, &job.prepared.scene.csgs, offset);
         let geometry = match method {
             Method::Naive => Geometry::AllTriangles,
             Method::BBox => {

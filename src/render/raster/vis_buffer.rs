@@ -20,12 +20,16 @@ use super::rect::{PixelRect, TestCounter};
 use super::setup::ScreenTri;
 use crate::math::{Radiance, Ray, Vec3};
 use crate::render::debug::{cost_color, View};
-use crate::render::pixel_record::{FragmentRecord, NoRecord, PixelTrace, Recorder};
+use crate::render::pixel_record::{CsgABufferRecord, FragmentRecord, NoRecord, PixelTrace, Recorder};
 use crate::render::{miss_without_ray, resolve_counted, resolve_sample, PassJob, RayCounts, SceneQuery};
 use crate::render::shade_batch::{self, Batch};
 use crate::render::shadow_volume::split_depth;
 use super::stencil::{PixelRay, StencilSetup};
+use crate::render::csg::{Boundary, SurfaceRef};
 use crate::scene::{PrimitiveId, PrimitiveKind, SurfaceHit};
+
+/// What `VisBuffer::csg` holds where no CSG object won.
+const NO_BOUNDARY: Boundary = Boundary { t: 0.0, surface: SurfaceRef::Sphere(0), leaf: 0, flipped: false };
 
 
 /// What a depth key measures.
@@ -41,6 +45,7 @@ pub enum DepthKey {
 /// `NoRecord` ignores them, so frames pay nothing.
 pub trait FragmentRecorder: Recorder {
     fn fragment(&mut self, _f: FragmentRecord) {}
+    fn csg_abuffer(&mut self, _a: CsgABufferRecord) {}
 }
 
 impl FragmentRecorder for NoRecord {}
@@ -48,6 +53,10 @@ impl FragmentRecorder for NoRecord {}
 impl FragmentRecorder for PixelTrace {
     fn fragment(&mut self, f: FragmentRecord) {
         self.fragments.push(f);
+    }
+
+    fn csg_abuffer(&mut self, a: CsgABufferRecord) {
+        self.csg_abuffers.push(a);
     }
 }
 
@@ -90,8 +99,12 @@ pub struct VisBuffer<'j, 'a, Q: SceneQuery, R: FragmentRecorder = NoRecord> {
     pub depth: Vec<f32>,
     /// What each sample sees; `PrimitiveId::NONE` where nothing covers it.
     pub id: Vec<PrimitiveId>,
-    /// Triangles: perspective-correct (b1, b2) in the scene triangle. Spheres: (t, 0).
+    /// Triangles: perspective-correct (b1, b2) in the scene triangle. Spheres
+    /// and CSG objects: (t, 0).
     pub payload: Vec<[f32; 2]>,
+    /// CSG objects: the boundary the A-buffer resolved each sample to (where
+    /// `id` is a CSG object); empty for scenes without them.
+    csg: Vec<Boundary>,
     color: Vec<Radiance>,
     /// Cost view only (else empty): per pixel, fragments depth-tested plus fragments shaded...
     work: Vec<u32>,
@@ -146,6 +159,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             depth,
             id: vec![PrimitiveId::NONE; n],
             payload: vec![[0.0; 2]; n],
+            csg: if job.prepared.scene.csgs.is_empty() { Vec::new() } else { vec![NO_BOUNDARY; n] },
             color: if forward { vec![Radiance::ZERO; n] } else { Vec::new() },
             work: if cost { vec![0; n] } else { Vec::new() },
             tests: if cost { vec![0; n] } else { Vec::new() },
@@ -167,6 +181,12 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
     #[inline(always)]
     fn is_focus(&self, x: u32, y: u32) -> bool {
         R::ENABLED && (x, y) == self.focus
+    }
+
+    /// The pixel whose history the recorder takes (`None` when nothing is recorded).
+    #[inline(always)]
+    pub fn focus(&self) -> Option<(u32, u32)> {
+        R::ENABLED.then_some(self.focus)
     }
 
     /// Counts the samples of `r` as tested (loops that test through the buffer).
@@ -326,11 +346,13 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         }
     }
 
-    /// The eye ray meets CSG object `c`'s resolved surface at `t`: depth
-    /// tested as a sphere's fragment is (ray parameters against spheres and
-    /// other CSG objects, depth keys against triangles).
+    /// The A-buffer of CSG object `c` resolved this sample to boundary `b`
+    /// (at `b.t` along the eye ray): depth tested as a sphere's fragment is
+    /// (ray parameters against spheres and other CSG objects, depth keys
+    /// against triangles).
     #[inline]
-    pub fn csg_fragment(&mut self, x: u32, y: u32, c: u32, t: f32, key: f32) {
+    pub fn csg_fragment(&mut self, x: u32, y: u32, c: u32, b: Boundary, key: f32) {
+        let t = b.t;
         self.counts.samples_covered += 1;
         let i = self.index(x, y);
         self.count_work(i);
@@ -347,6 +369,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             self.depth[i] = key;
             self.id[i] = PrimitiveId::csg(c);
             self.payload[i] = [t, 0.0];
+            self.csg[i] = b;
             if self.forward {
                 self.shade_now(i, x, y);
             }
@@ -354,7 +377,12 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             self.counts.depth_fails += 1;
         }
         if self.is_focus(x, y) {
-            self.record(PrimitiveKind::Csg, c, None, Vec3::ZERO, key, stored, nearer, i, x, y);
+            // The winning surface's barycentrics when it is an operand triangle.
+            let bary = match b.surface {
+                SurfaceRef::Triangle { b1, b2, .. } => Vec3::new(1.0 - b1 - b2, b1, b2),
+                SurfaceRef::Sphere(_) => Vec3::ZERO,
+            };
+            self.record(PrimitiveKind::Csg, c, None, bary, key, stored, nearer, i, x, y);
         }
     }
 
@@ -374,17 +402,15 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         let hit = if id.is_none() {
             None
         } else if id.is_csg() {
-            // The same interval rule on the same eye ray as the pass: the same boundary.
-            let t_max = self.job.view.far_t(p.x, p.y);
-            let hit = crate::render::csg::closest(scene, id.index(), &ray, t_max, false);
-            // Found by the eye ray, as in the ray casters: the same differentials.
-            match hit {
-                Some(h) if scene.has_textures() => {
-                    let mut h = with_ray_differentials(scene, &RayDifferential::eye(self.job.view, p.x, p.y), &ray, h);
-                    crate::render::normal_map::apply(scene, self.job.settings.texture_filter, &mut h);
-                    Some(h)
-                }
-                other => other,
+            // The boundary the A-buffer resolved, built into a hit as the ray casters build theirs.
+            let h = crate::render::csg::surface_hit(scene, id.index(), self.csg[i], &ray);
+            // Seen along the eye ray, as in the ray casters: the same differentials.
+            if scene.has_textures() {
+                let mut h = with_ray_differentials(scene, &RayDifferential::eye(self.job.view, p.x, p.y), &ray, h);
+                crate::render::normal_map::apply(scene, self.job.settings.texture_filter, &mut h);
+                Some(h)
+            } else {
+                Some(h)
             }
         } else if id.is_sphere() {
             let hit = scene.sphere_hit(id.index(), self.payload[i][0], &ray);
@@ -595,6 +621,10 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         self.id.resize(n, PrimitiveId::NONE);
         self.payload.clear();
         self.payload.resize(n, [0.0; 2]);
+        if !self.job.prepared.scene.csgs.is_empty() {
+            self.csg.clear();
+            self.csg.resize(n, NO_BOUNDARY);
+        }
         if self.forward {
             self.color.clear();
             self.color.resize(n, Radiance::ZERO);
