@@ -101,7 +101,7 @@ impl State {
                 programs: Vec::new(),
                 background,
                 maps,
-                textures: Default::default(),
+                textures: super::textures::Textures::new(gl)?,
                 vertex_array,
                 vertex_buffer,
                 cube_array,
@@ -219,7 +219,8 @@ pub(super) fn bytes(v: &[f32]) -> &[u8] {
 }
 
 /// Sets the uniforms both programs share.
-unsafe fn uniforms(gl: &glow::Context, program: glow::Program, job: &PassJob) {
+/// `environment`: the environment's texture handle (`Textures::handle`).
+unsafe fn uniforms(gl: &glow::Context, program: glow::Program, job: &PassJob, environment: (i32, i32)) {
     let view = job.view;
     let scene = &job.prepared.scene;
     let (w, h) = (view.width as f32, view.height as f32);
@@ -245,46 +246,31 @@ unsafe fn uniforms(gl: &glow::Context, program: glow::Program, job: &PassJob) {
         gl.uniform_1_i32(at("has_environment").as_ref(), scene.environment.is_some() as i32);
         gl.uniform_1_f32(at("environment_intensity").as_ref(), scene.environment.as_ref().map_or(0.0, |e| e.intensity));
         gl.uniform_1_i32(at("mirror_env").as_ref(), (job.settings.reflections == Reflections::Env && job.settings.max_depth > 0) as i32);
-        gl.uniform_1_i32(at("albedo_map").as_ref(), ALBEDO_UNIT as i32);
-        gl.uniform_1_i32(at("normal_map").as_ref(), NORMAL_UNIT as i32);
-        gl.uniform_1_i32(at("environment").as_ref(), ENVIRONMENT_UNIT as i32);
+        let (first, count) = environment;
+        gl.uniform_2_i32(at("environment").as_ref(), first, count);
     }
 }
 
-/// Texture units: 0 holds the shadow maps.
-const ALBEDO_UNIT: u32 = 1;
-const NORMAL_UNIT: u32 = 2;
-const ENVIRONMENT_UNIT: u32 = 3;
-
-/// Binds material `m`'s texture and normal map and sets what the
-/// fragment shader reads of them.
-unsafe fn material_textures(gl: &glow::Context, textures: &mut super::textures::Textures, program: glow::Program, job: &PassJob, m: u32) -> Result<(), String> {
-    let Some(material) = job.prepared.scene.materials.get(m as usize) else { return Ok(()) };
-    let filter = job.settings.texture_filter;
+/// Sets what the fragment shader reads of material `m`'s texture and
+/// normal map.
+unsafe fn material_textures(gl: &glow::Context, textures: &super::textures::Textures, program: glow::Program, job: &PassJob, m: u32) {
+    let Some(material) = job.prepared.scene.materials.get(m as usize) else { return };
     unsafe {
         let at = |name: &str| gl.get_uniform_location(program, name);
-        for (map, unit, flag) in [(&material.texture, ALBEDO_UNIT, "has_albedo_map"), (&material.normal_map, NORMAL_UNIT, "has_normal_map")] {
-            if let Some(t) = map {
-                let id = textures.get(gl, t)?;
-                super::textures::bind(gl, unit, id, filter, material.wrap, material.wrap);
-            }
-            gl.uniform_1_i32(at(flag).as_ref(), map.is_some() as i32);
+        for (map, name, flag) in [(&material.texture, "albedo_map", "has_albedo_map"), (&material.normal_map, "normal_map", "has_normal_map")] {
+            let (first, count) = map.as_ref().map_or((0, 0), |t| textures.handle(t));
+            gl.uniform_2_i32(at(name).as_ref(), first, count);
+            gl.uniform_1_i32(at(flag).as_ref(), (count > 0) as i32);
         }
+        let filter = match job.settings.texture_filter {
+            TextureFilter::Nearest => 0,
+            TextureFilter::Bilinear => 1,
+            TextureFilter::Trilinear => 2,
+        };
+        gl.uniform_1_i32(at("texture_filter").as_ref(), filter);
+        gl.uniform_1_i32(at("wrap_clamp").as_ref(), (material.wrap == Wrap::Clamp) as i32);
         gl.uniform_2_f32(at("uv_scale").as_ref(), material.uv_scale.x, material.uv_scale.y);
-        Ok(())
     }
-}
-
-/// Uploads and binds the environment (level 0, bilinear, repeating around
-/// the horizon and clamped at the poles, as `Environment::radiance` reads it).
-unsafe fn bind_environment(gl: &glow::Context, textures: &mut super::textures::Textures, scene: &crate::scene::Scene) -> Result<(), String> {
-    if let Some(env) = &scene.environment {
-        unsafe {
-            let id = textures.get(gl, &env.texture)?;
-            super::textures::bind(gl, ENVIRONMENT_UNIT, id, TextureFilter::Bilinear, Wrap::Repeat, Wrap::Clamp);
-        }
-    }
-    Ok(())
 }
 
 /// Draws `job`'s pass and stores its rows in `out`; with `probe` (a pixel
@@ -310,7 +296,8 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Opt
             .chain([scene.environment.as_ref().map(|e| &e.texture)])
             .flatten()
             .collect();
-        state.textures.retain(gl, &keep);
+        state.textures.prepare(gl, &keep)?;
+        let environment = scene.environment.as_ref().map_or((0, 0), |e| state.textures.handle(&e.texture));
         gl.bind_buffer_base(glow::SHADER_STORAGE_BUFFER, 2, Some(state.sphere_buffer));
         let mapped = job.settings.shadows == ShadowMode::Map;
         let first_faces = if mapped {
@@ -361,11 +348,10 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Opt
         gl.front_face(if y_down { glow::CW } else { glow::CCW });
         gl.cull_face(glow::BACK);
         if scene.environment.is_some() {
-            bind_environment(gl, &mut state.textures, scene)?;
             gl.disable(glow::DEPTH_TEST);
             gl.depth_mask(false);
             gl.use_program(Some(state.background));
-            uniforms(gl, state.background, job);
+            uniforms(gl, state.background, job, environment);
             gl.bind_vertex_array(Some(state.cube_array));
             gl.draw_arrays(glow::TRIANGLES, 0, 3);
             gl.enable(glow::DEPTH_TEST);
@@ -391,13 +377,13 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Opt
         }
         if !runs.is_empty() {
             gl.use_program(Some(triangles));
-            uniforms(gl, triangles, job);
+            uniforms(gl, triangles, job, environment);
             if mapped {
                 state.maps.lookup_uniforms(gl, triangles, job.settings);
             }
             gl.bind_vertex_array(Some(state.vertex_array));
             for scene_data::Run { first, count, two_sided, material } in runs {
-                material_textures(gl, &mut state.textures, triangles, job, material)?;
+                material_textures(gl, &state.textures, triangles, job, material);
                 if two_sided {
                     gl.disable(glow::CULL_FACE);
                 } else {
@@ -413,7 +399,7 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Opt
             gl.disable(glow::CULL_FACE);
             gl.enable(glow::DEPTH_CLAMP);
             gl.use_program(Some(spheres));
-            uniforms(gl, spheres, job);
+            uniforms(gl, spheres, job, environment);
             if mapped {
                 state.maps.lookup_uniforms(gl, spheres, job.settings);
             }
@@ -423,7 +409,7 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Opt
             while first < sphere_count {
                 let m = scene.spheres[first].material;
                 let count = scene.spheres[first..].iter().take_while(|s| s.material == m).count();
-                material_textures(gl, &mut state.textures, spheres, job, m)?;
+                material_textures(gl, &state.textures, spheres, job, m);
                 gl.uniform_1_i32(gl.get_uniform_location(spheres, "first_sphere").as_ref(), first as i32);
                 gl.draw_arrays_instanced(glow::TRIANGLES, 0, 36, count as i32);
                 first += count;

@@ -26,49 +26,158 @@ layout(std430, binding = 1) readonly buffer Lights { vec4 lights[]; };
 
 const float PI = 3.14159265358979323846;
 
+// Every texture's pyramid (`textures`): texels as linear RGB triples, and
+// per level (first texel, width, height, 0), row 0 at the top. A texture
+// is (its first level, its level count). They are read texel by texel and
+// filtered here in float as `Texture::sample` filters: GL's own filtering
+// would blend with its fixed-point weights and pick levels its own way.
+layout(std430, binding = 4) readonly buffer Texels { float texel_data[]; };
+layout(std430, binding = 5) readonly buffer Levels { ivec4 level_info[]; };
+
 // The drawn material's texture and normal map (`Material::scaled`: uvs
-// times uv_scale; GL's t runs down from the top row, t = 1 - v), read by
-// GL's own filtering at the level of detail given.
+// times uv_scale).
 uniform bool has_albedo_map;
-uniform sampler2D albedo_map;
+uniform ivec2 albedo_map;
 uniform bool has_normal_map;
-uniform sampler2D normal_map;
+uniform ivec2 normal_map;
 uniform vec2 uv_scale;
+// TextureFilter: 0 nearest, 1 bilinear, 2 trilinear.
+uniform int texture_filter;
+// The material's Wrap: clamp to the edge texel, else repeat.
+uniform bool wrap_clamp;
 // Scene::miss_radiance: the latitude-longitude environment, else the background.
 uniform bool has_environment;
-uniform sampler2D environment;
+uniform ivec2 environment;
 uniform float environment_intensity;
 uniform vec3 background;
 // `--reflections env` with a depth to spare: mirrors look the environment up.
 uniform bool mirror_env;
 
-vec2 tex_coord(vec2 uv) {
-    vec2 s = uv * uv_scale;
-    return vec2(s.x, 1.0 - s.y);
+// asin and atan to float precision (Cephes' asinf and atanf): the
+// driver's own are approximations (llvmpipe's asin is off by up to about
+// 1e-4), enough to move a latitude across a texel's weight visibly.
+float precise_asin(float x) {
+    float a = abs(x);
+    if (a > 1.0) return x > 0.0 ? PI / 2.0 : -PI / 2.0;
+    float z;
+    float s;
+    bool wide = a > 0.5;
+    if (wide) {
+        z = 0.5 * (1.0 - a);
+        s = sqrt(z);
+    } else {
+        z = a * a;
+        s = a;
+    }
+    float r = ((((4.2163199048e-2 * z + 2.4181311049e-2) * z + 4.5470025998e-2) * z + 7.4953002686e-2) * z + 1.6666752422e-1) * z * s + s;
+    if (wide) r = PI / 2.0 - 2.0 * r;
+    return x < 0.0 ? -r : r;
+}
+
+float precise_atan(float x) {
+    float a = abs(x);
+    float y = 0.0;
+    if (a > 2.414213562373095) {
+        y = PI / 2.0;
+        a = -1.0 / a;
+    } else if (a > 0.4142135623730950) {
+        y = PI / 4.0;
+        a = (a - 1.0) / (a + 1.0);
+    }
+    float z = a * a;
+    y += (((8.05374449538e-2 * z - 1.38776856032e-1) * z + 1.99777106478e-1) * z - 3.33329491539e-1) * z * a + a;
+    return x < 0.0 ? -y : y;
+}
+
+// atan2(y, x) in (-pi, pi], as Rust's f32::atan2.
+float precise_atan2(float y, float x) {
+    if (x == 0.0) return y > 0.0 ? PI / 2.0 : (y < 0.0 ? -PI / 2.0 : 0.0);
+    float t = precise_atan(y / x);
+    if (x > 0.0) return t;
+    return y < 0.0 ? t - PI : t + PI;
+}
+
+// MipLevel::texel_uv's addressing: i.rem_euclid(n) or i.clamp(0, n - 1).
+int address(int i, int n, bool clamp_edge) {
+    if (clamp_edge) return clamp(i, 0, n - 1);
+    return i >= 0 ? i % n : (n - 1) - ((-(i + 1)) % n);
+}
+
+vec3 texel(ivec4 level, int x, int y, bool clamp_u, bool clamp_v) {
+    int i = 3 * (level.x + address(y, level.z, clamp_v) * level.y + address(x, level.y, clamp_u));
+    return vec3(texel_data[i], texel_data[i + 1], texel_data[i + 2]);
+}
+
+// glam's lerp: a (1 - s) + b s.
+vec3 lerp3(vec3 a, vec3 b, float s) {
+    return a * (1.0 - s) + b * s;
+}
+
+// MipLevel::position: texel-space x and y (row 0 at the top), or false
+// when not finite or far outside.
+bool level_position(vec2 uv, ivec4 level, out vec2 p) {
+    p = vec2(uv.x * float(level.y), (1.0 - uv.y) * float(level.z));
+    return !(any(isnan(p)) || any(isinf(p))) && abs(p.x) < 1e9 && abs(p.y) < 1e9;
+}
+
+// MipLevel::nearest on level 0.
+vec3 nearest_at(ivec2 t, vec2 uv, bool clamp_edge) {
+    ivec4 level = level_info[t.x];
+    vec2 p;
+    if (!level_position(uv, level, p)) return vec3(0.0);
+    return texel(level, int(floor(p.x)), int(floor(p.y)), clamp_edge, clamp_edge);
+}
+
+// MipLevel::bilinear_uv on level `l`.
+vec3 bilinear_at(ivec2 t, int l, vec2 uv, bool clamp_u, bool clamp_v) {
+    ivec4 level = level_info[t.x + l];
+    vec2 p;
+    if (!level_position(uv, level, p)) return vec3(0.0);
+    p -= 0.5;
+    vec2 p0 = floor(p);
+    vec2 f = p - p0;
+    int x = int(p0.x), y = int(p0.y);
+    vec3 top = lerp3(texel(level, x, y, clamp_u, clamp_v), texel(level, x + 1, y, clamp_u, clamp_v), f.x);
+    vec3 bottom = lerp3(texel(level, x, y + 1, clamp_u, clamp_v), texel(level, x + 1, y + 1, clamp_u, clamp_v), f.x);
+    return lerp3(top, bottom, f.y);
 }
 
 // Texture::level_of_detail: log2 of the longer pixel step in level-0
-// texels, 0 when magnified, the coarsest level when unknown. GL is handed
-// this lambda (textureLod) and does the rest: the level pair, their blend
-// and the bilinear reads. Left to derive lambda from the same gradients
-// (textureGrad), llvmpipe approximates the steps' lengths and agrees less.
-float level_of_detail(vec2 size, vec2 duv_dx, vec2 duv_dy) {
-    vec2 g = uv_scale * size;
-    float rho = max(length(duv_dx * g), length(duv_dy * g));
-    if (isnan(rho)) return 1000.0;
-    return rho <= 1.0 ? 0.0 : min(log2(rho), 1000.0);
+// texels, 0 when magnified, the coarsest level when unknown.
+float level_of_detail(ivec2 t, vec2 duv_dx, vec2 duv_dy) {
+    vec2 size = vec2(level_info[t.x].yz);
+    float top = float(t.y - 1);
+    float along_x = length(duv_dx * size);
+    float along_y = length(duv_dy * size);
+    if (isnan(along_x) || isnan(along_y)) return top;
+    float rho = max(along_x, along_y);
+    return rho <= 1.0 ? 0.0 : min(log2(rho), top);
+}
+
+// Texture::sample with the material's filter and wrap; `uv` and the
+// footprint unscaled (uv_scale applied here, as Material::scaled does).
+vec3 sample_texture(ivec2 t, vec2 uv, vec2 duv_dx, vec2 duv_dy) {
+    vec2 s = uv * uv_scale;
+    if (texture_filter == 0) return nearest_at(t, s, wrap_clamp);
+    if (texture_filter == 1) return bilinear_at(t, 0, s, wrap_clamp, wrap_clamp);
+    float lambda = level_of_detail(t, duv_dx * uv_scale, duv_dy * uv_scale);
+    float base = floor(lambda);
+    int fine = int(base);
+    float blend = lambda - base;
+    vec3 a = bilinear_at(t, fine, s, wrap_clamp, wrap_clamp);
+    if (blend == 0.0) return a;
+    int coarse = min(fine + 1, t.y - 1);
+    return lerp3(a, bilinear_at(t, coarse, s, wrap_clamp, wrap_clamp), blend);
 }
 
 vec3 albedo_at(uint m, vec2 uv, vec2 duv_dx, vec2 duv_dy) {
     vec3 k = materials[3u * m].xyz;
     if (!has_albedo_map) return k;
-    float lod = level_of_detail(vec2(textureSize(albedo_map, 0)), duv_dx, duv_dy);
-    return k * textureLod(albedo_map, tex_coord(uv), lod).rgb;
+    return k * sample_texture(albedo_map, uv, duv_dx, duv_dy);
 }
 
 vec3 normal_texel(vec2 uv, vec2 duv_dx, vec2 duv_dy) {
-    float lod = level_of_detail(vec2(textureSize(normal_map, 0)), duv_dx, duv_dy);
-    return textureLod(normal_map, tex_coord(uv), lod).rgb;
+    return sample_texture(normal_map, uv, duv_dx, duv_dy);
 }
 
 // normal_map::mapped_normal: n bent by the texel in the frame of tangent t
@@ -88,9 +197,10 @@ vec3 mapped_normal(vec3 n, vec3 t, float w, vec3 texel) {
 
 vec3 miss_radiance(vec3 dir) {
     if (!has_environment) return background;
-    float u = 0.5 + (dir.x == 0.0 && dir.z == 0.0 ? 0.0 : atan(dir.x, -dir.z)) * (0.5 / PI);
-    float v = 0.5 + asin(clamp(dir.y, -1.0, 1.0)) / PI;
-    vec3 c = textureLod(environment, vec2(u, 1.0 - v), 0.0).rgb * environment_intensity;
+    float u = 0.5 + (dir.x == 0.0 && dir.z == 0.0 ? 0.0 : precise_atan2(dir.x, -dir.z)) * (0.5 / PI);
+    float v = 0.5 + precise_asin(clamp(dir.y, -1.0, 1.0)) / PI;
+    // Environment::radiance: level 0, bilinear, repeating around, clamped at the poles.
+    vec3 c = bilinear_at(environment, 0, vec2(u, v), false, true) * environment_intensity;
     return any(isnan(c)) || any(isinf(c)) ? vec3(0.0) : c;
 }
 
@@ -413,7 +523,7 @@ void main() {
     vec3 o = (p - s.xyz) / s.w;
     float w = dot(p - eye, -camera_to_world[2]);
     // Scene::sphere_hit's uv: u around +y, v from the south pole up.
-    vec2 uv = vec2(0.5 + (o.x == 0.0 && o.z == 0.0 ? 0.0 : atan(o.z, o.x)) * (-0.5 / PI), 0.5 + asin(clamp(o.y, -1.0, 1.0)) / PI);
+    vec2 uv = vec2(0.5 + (o.x == 0.0 && o.z == 0.0 ? 0.0 : precise_atan2(o.z, o.x)) * (-0.5 / PI), 0.5 + precise_asin(clamp(o.y, -1.0, 1.0)) / PI);
     // Its footprint from the camera ray's differentials carried to the
     // tangent plane (Igehy), as the ray casters do: the 2x2 quad's
     // differences would straddle the silhouette and the u seam.
