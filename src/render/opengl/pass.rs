@@ -14,7 +14,7 @@ use glow::HasContext;
 pub struct State {
     /// The triangle and sphere programs, compiled on first use for each set
     /// of defines (shadow-map lookups, multisampling).
-    programs: Vec<(String, glow::Program, glow::Program)>,
+    programs: Vec<(String, Programs)>,
     background: glow::Program,
     maps: super::shadow_pass::ShadowPass,
     textures: super::textures::Textures,
@@ -26,7 +26,42 @@ pub struct State {
     light_buffer: glow::Buffer,
     /// The uploaded geometry: its fingerprint, triangle runs, sphere count.
     uploaded: Option<(u64, Vec<scene_data::Run>, usize)>,
+    /// The two-level layer's shared meshes (`scene_data::layer_geometry`)
+    /// and the copies' placements, one instance each.
+    layer_array: glow::VertexArray,
+    layer_buffer: glow::Buffer,
+    instance_buffer: glow::Buffer,
+    /// The layer uploaded (held, so its address names it) and each mesh's
+    /// first triangle and runs.
+    layer: Option<(std::sync::Arc<crate::scene::instanced::InstanceLayer>, Vec<(u32, Vec<scene_data::Run>)>)>,
     target: Option<Target>,
+}
+
+/// The programs compiled for one set of defines: triangles, spheres, and
+/// the layer's copies (triangles placed per instance).
+#[derive(Clone, Copy)]
+struct Programs {
+    triangles: glow::Program,
+    spheres: glow::Program,
+    copies: glow::Program,
+}
+
+/// Sets the triangle vertex layout (`scene_data::VERTEX_FLOATS`) on the
+/// bound vertex array, reading the bound array buffer.
+unsafe fn vertex_layout(gl: &glow::Context) {
+    let stride = (scene_data::VERTEX_FLOATS * 4) as i32;
+    unsafe {
+        for (location, offset) in [(0u32, 0i32), (1, 12), (2, 24)] {
+            gl.enable_vertex_attrib_array(location);
+            gl.vertex_attrib_pointer_f32(location, 3, glow::FLOAT, false, stride, offset);
+        }
+        gl.enable_vertex_attrib_array(3);
+        gl.vertex_attrib_pointer_i32(3, 1, glow::UNSIGNED_INT, stride, 36);
+        gl.enable_vertex_attrib_array(4);
+        gl.vertex_attrib_pointer_f32(4, 2, glow::FLOAT, false, stride, 40);
+        gl.enable_vertex_attrib_array(5);
+        gl.vertex_attrib_pointer_f32(5, 4, glow::FLOAT, false, stride, 48);
+    }
 }
 
 /// The framebuffer a pass draws into: RGBA32F colour and a 32-bit float
@@ -78,17 +113,23 @@ impl State {
             let vertex_buffer = gl.create_buffer()?;
             gl.bind_vertex_array(Some(vertex_array));
             gl.bind_buffer(glow::ARRAY_BUFFER, Some(vertex_buffer));
-            let stride = (scene_data::VERTEX_FLOATS * 4) as i32;
-            for (location, offset) in [(0u32, 0i32), (1, 12), (2, 24)] {
+            vertex_layout(gl);
+            let layer_array = gl.create_vertex_array()?;
+            let layer_buffer = gl.create_buffer()?;
+            let instance_buffer = gl.create_buffer()?;
+            gl.bind_vertex_array(Some(layer_array));
+            gl.bind_buffer(glow::ARRAY_BUFFER, Some(layer_buffer));
+            vertex_layout(gl);
+            gl.bind_buffer(glow::ARRAY_BUFFER, Some(instance_buffer));
+            let stride = (scene_data::INSTANCE_FLOATS * 4) as i32;
+            for location in 6..13u32 {
                 gl.enable_vertex_attrib_array(location);
-                gl.vertex_attrib_pointer_f32(location, 3, glow::FLOAT, false, stride, offset);
+                gl.vertex_attrib_pointer_f32(location, 3, glow::FLOAT, false, stride, (location as i32 - 6) * 12);
+                gl.vertex_attrib_divisor(location, 1);
             }
-            gl.enable_vertex_attrib_array(3);
-            gl.vertex_attrib_pointer_i32(3, 1, glow::UNSIGNED_INT, stride, 36);
-            gl.enable_vertex_attrib_array(4);
-            gl.vertex_attrib_pointer_f32(4, 2, glow::FLOAT, false, stride, 40);
-            gl.enable_vertex_attrib_array(5);
-            gl.vertex_attrib_pointer_f32(5, 4, glow::FLOAT, false, stride, 48);
+            gl.enable_vertex_attrib_array(13);
+            gl.vertex_attrib_pointer_i32(13, 3, glow::UNSIGNED_INT, stride, 84);
+            gl.vertex_attrib_divisor(13, 1);
             let cube_array = gl.create_vertex_array()?;
             let cube_buffer = gl.create_buffer()?;
             gl.bind_vertex_array(Some(cube_array));
@@ -109,22 +150,47 @@ impl State {
                 material_buffer: gl.create_buffer()?,
                 light_buffer: gl.create_buffer()?,
                 uploaded: None,
+                layer_array,
+                layer_buffer,
+                instance_buffer,
+                layer: None,
                 target: None,
             })
         }
     }
 
-    /// The triangle and sphere programs compiled with `defines`.
-    unsafe fn programs(&mut self, gl: &glow::Context, defines: &str) -> Result<(glow::Program, glow::Program), String> {
-        if let Some((_, t, s)) = self.programs.iter().find(|p| p.0 == defines) {
-            return Ok((*t, *s));
+    /// The programs compiled with `defines`.
+    unsafe fn programs(&mut self, gl: &glow::Context, defines: &str) -> Result<Programs, String> {
+        if let Some((_, p)) = self.programs.iter().find(|p| p.0 == defines) {
+            return Ok(*p);
         }
         unsafe {
-            let t = compile(gl, shaders::TRIANGLE_VERTEX, &shaders::triangle_fragment(defines))?;
-            let s = compile(gl, shaders::SPHERE_VERTEX, &shaders::sphere_fragment(defines))?;
-            self.programs.push((defines.to_string(), t, s));
-            Ok((t, s))
+            let fragment = shaders::triangle_fragment(defines);
+            let p = Programs {
+                triangles: compile(gl, &shaders::triangle_vertex(defines), &fragment)?,
+                spheres: compile(gl, shaders::SPHERE_VERTEX, &shaders::sphere_fragment(defines))?,
+                copies: compile(gl, &shaders::triangle_vertex(&format!("{defines}#define INSTANCED 1\n")), &fragment)?,
+            };
+            self.programs.push((defines.to_string(), p));
+            Ok(p)
         }
+    }
+
+    /// Uploads the layer's shared meshes unless they are there already;
+    /// returns each mesh's first triangle and runs.
+    unsafe fn upload_layer(&mut self, gl: &glow::Context, layer: &std::sync::Arc<crate::scene::instanced::InstanceLayer>) -> Vec<(u32, Vec<scene_data::Run>)> {
+        if let Some((l, meshes)) = &self.layer {
+            if std::sync::Arc::ptr_eq(l, layer) {
+                return meshes.clone();
+            }
+        }
+        let g = scene_data::layer_geometry(layer);
+        unsafe {
+            gl.bind_buffer(glow::ARRAY_BUFFER, Some(self.layer_buffer));
+            gl.buffer_data_u8_slice(glow::ARRAY_BUFFER, bytes(&g.vertices), glow::STATIC_DRAW);
+        }
+        self.layer = Some((layer.clone(), g.meshes.clone()));
+        g.meshes
     }
 
     /// The framebuffer to draw into and the one to read from (the same
@@ -371,7 +437,7 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Opt
             if samples > 1 { "#define MSAA 1\n" } else { "" },
             if views { "#define VIEWS 1\n" } else { "" }
         );
-        let (triangles, spheres) = state.programs(gl, &defines)?;
+        let Programs { triangles, spheres, copies } = state.programs(gl, &defines)?;
         if mapped {
             state.maps.bind_for_lookup(gl);
         }
@@ -391,6 +457,9 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Opt
                 }
                 gl.draw_arrays(glow::TRIANGLES, (first * 3) as i32, (count * 3) as i32);
             }
+        }
+        if let Some(layer) = &scene.layer {
+            draw_copies(gl, state, copies, job, layer, environment, mapped, y_down);
         }
         if sphere_count > 0 {
             // Both sides of each sphere's bounding cube: whatever part of
@@ -481,6 +550,63 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Opt
         });
         // GL counts none of this; the counters stay zero.
         Ok((RayCounts::default(), readback))
+    }
+}
+
+/// Draws the two-level layer's copies: each shared mesh once in GL's
+/// buffers, the copies left after culling each by its bounding sphere
+/// (`raster::cull::Frustum`, as the rasterizers cull them; with
+/// `cull_instances`) placed per instance, one instanced draw per run of a
+/// group of copies sharing mesh, material and mirroring.
+#[allow(clippy::too_many_arguments)]
+unsafe fn draw_copies(
+    gl: &glow::Context,
+    state: &mut State,
+    program: glow::Program,
+    job: &PassJob,
+    layer: &std::sync::Arc<crate::scene::instanced::InstanceLayer>,
+    environment: (i32, i32),
+    mapped: bool,
+    y_down: bool,
+) {
+    let scene = &job.prepared.scene;
+    let frustum = crate::render::raster::cull::Frustum::new(job.view);
+    let cull = job.settings.cull_instances;
+    // Copy k's record (its bounding sphere): the one whose triangles start at its base.
+    let info = |k: usize| {
+        let base = layer.instances[k].base as usize;
+        let i = scene.instances.partition_point(|r| r.triangles.start < base);
+        scene.instances.get(i).filter(|r| r.triangles.start == base)
+    };
+    unsafe {
+        let meshes = state.upload_layer(gl, layer);
+        let (floats, groups) = scene_data::layer_instances(layer, &meshes, |k| !cull || info(k).is_none_or(|r| frustum.may_see(job.view, r.center, r.radius)));
+        if groups.is_empty() {
+            return;
+        }
+        gl.bind_buffer(glow::ARRAY_BUFFER, Some(state.instance_buffer));
+        gl.buffer_data_u8_slice(glow::ARRAY_BUFFER, bytes(&floats), glow::STREAM_DRAW);
+        gl.use_program(Some(program));
+        uniforms(gl, program, job, environment);
+        if mapped {
+            state.maps.lookup_uniforms(gl, program, job.settings);
+        }
+        gl.bind_vertex_array(Some(state.layer_array));
+        for (group, first_instance, count) in groups {
+            let Some((mesh_first, runs)) = meshes.get(group.mesh as usize) else { continue };
+            // A mirroring placement turns the winding round.
+            gl.front_face(if y_down != group.flips { glow::CW } else { glow::CCW });
+            for run in runs {
+                material_textures(gl, &state.textures, program, job, group.material.unwrap_or(run.material));
+                if run.two_sided {
+                    gl.disable(glow::CULL_FACE);
+                } else {
+                    gl.enable(glow::CULL_FACE);
+                }
+                gl.draw_arrays_instanced_base_instance(glow::TRIANGLES, ((mesh_first + run.first) * 3) as i32, (run.count * 3) as i32, count as i32, first_instance);
+            }
+        }
+        gl.front_face(if y_down { glow::CW } else { glow::CCW });
     }
 }
 

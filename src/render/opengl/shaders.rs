@@ -345,13 +345,33 @@ vec3 shade(vec3 p, vec3 n, vec3 g, vec3 w_o, uint m, vec3 albedo) {
 }
 "#;
 
-pub const TRIANGLE_VERTEX: &str = r#"#version 450 core
+/// The triangles' vertex shader; with `INSTANCED` defined, the two-level
+/// layer's copies: each vertex of the shared mesh placed by the copy's
+/// matrix in the very order of operations `Placement::apply` uses
+/// (`precise`: no fused multiply-adds), so a copy's triangles land where
+/// flattening would put them.
+pub fn triangle_vertex(defines: &str) -> String {
+    format!(
+        "#version 450 core\n{defines}{}",
+        r#"
 layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;
 layout(location = 2) in vec3 face_normal;
 layout(location = 3) in uint material;
 layout(location = 4) in vec2 uv;
 layout(location = 5) in vec4 tangent;
+#ifdef INSTANCED
+// Per copy: the placement's matrix columns, its normal matrix columns,
+// (first virtual triangle less the mesh's first, material or ~0, mirrors).
+layout(location = 6) in vec3 m0;
+layout(location = 7) in vec3 m1;
+layout(location = 8) in vec3 m2;
+layout(location = 9) in vec3 m3;
+layout(location = 10) in vec3 n0;
+layout(location = 11) in vec3 n1;
+layout(location = 12) in vec3 n2;
+layout(location = 13) in uvec3 copy;
+#endif
 uniform vec3 eye;
 uniform mat3 world_to_camera;
 uniform vec2 half_extent;
@@ -370,25 +390,58 @@ out vec3 v_tangent;
 flat out float v_handedness;
 out vec3 v_corner;
 flat out uint v_primitive;
+
+// glam's normalize_or_zero.
+vec3 normalize_or_zero_v(vec3 v) {
+    float r = 1.0 / length(v);
+    return !isinf(r) && !isnan(r) && r > 0.0 ? v * r : vec3(0.0);
+}
+
 void main() {
-    vec3 c = world_to_camera * (position - eye);
+    int k = gl_VertexID % 3;
+#ifdef INSTANCED
+    // Mat4::transform_point3: ((x_axis x + y_axis y) + z_axis z) + w_axis.
+    precise vec3 p = m0 * position.x;
+    p = m1 * position.y + p;
+    p = m2 * position.z + p;
+    p = m3 + p;
+    precise vec3 nn = n0 * normal.x;
+    nn = n1 * normal.y + nn;
+    nn = n2 * normal.z + nn;
+    vec3 world_normal = normalize_or_zero_v(nn);
+    // The face normal of the placed corners is the normal matrix's image
+    // of the mesh's (mirrored corners are swapped back, so it keeps its side).
+    vec3 world_face = normalize(mat3(n0, n1, n2) * face_normal);
+    uint world_material = copy.y == 0xffffffffu ? material : copy.y;
+    // A mirroring placement swaps corners 1 and 2.
+    if (copy.z != 0u && k != 0) k = 3 - k;
+    uint primitive = copy.x + uint(gl_VertexID / 3);
+#else
+    vec3 p = position;
+    vec3 world_normal = normal;
+    vec3 world_face = face_normal;
+    uint world_material = material;
+    uint primitive = uint(gl_VertexID / 3);
+#endif
+    vec3 c = world_to_camera * (p - eye);
     float w = -c.z;
     // Reversed depth with glClipControl(ZERO_TO_ONE): near -> 1, far -> 0.
     float z = near_plane * (far_plane - w) / (far_plane - near_plane);
     gl_Position = vec4(c.x / half_extent.x + ndc_shift.x * w, (c.y / half_extent.y + ndc_shift.y * w) * (y_down ? -1.0 : 1.0), z, w);
-    v_position = position;
-    v_normal = normal;
-    v_face_normal = face_normal;
-    v_material = material;
+    v_position = p;
+    v_normal = world_normal;
+    v_face_normal = world_face;
+    v_material = world_material;
     v_uv = uv;
     v_tangent = tangent.xyz;
     v_handedness = tangent.w;
     // One-hot per corner: interpolated, the barycentric weights.
-    int k = gl_VertexID % 3;
     v_corner = vec3(k == 0, k == 1, k == 2);
-    v_primitive = uint(gl_VertexID / 3);
+    v_primitive = primitive;
 }
-"#;
+"#
+    )
+}
 
 pub fn triangle_fragment(defines: &str) -> String {
     format!(

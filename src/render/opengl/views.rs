@@ -72,7 +72,10 @@ impl Readback {
         let (kind, primitive) = (self.ids[i], self.ids[i + 1]);
         let (kind, object, material) = match kind {
             1 => {
-                let t = scene.triangles.get(primitive as usize)?;
+                if primitive as u64 >= scene.total_triangles() {
+                    return None;
+                }
+                let t = scene.triangle(primitive);
                 (PrimitiveKind::Triangle, t.object, t.material)
             }
             2 => {
