@@ -34,6 +34,10 @@ pub struct State {
     /// The layer uploaded (held, so its address names it) and each mesh's
     /// first triangle and runs.
     layer: Option<(std::sync::Arc<crate::scene::instanced::InstanceLayer>, Vec<(u32, Vec<scene_data::Run>)>)>,
+    /// The CSG objects' buffers (`csg_data`: objects, nodes, spheres,
+    /// triangles at bindings 6 to 9) and what they hold.
+    csg_buffers: [glow::Buffer; 4],
+    csg_uploaded: Option<super::csg_data::CsgData>,
     target: Option<Target>,
 }
 
@@ -44,6 +48,7 @@ struct Programs {
     triangles: glow::Program,
     spheres: glow::Program,
     copies: glow::Program,
+    csg: glow::Program,
 }
 
 /// Sets the triangle vertex layout (`scene_data::VERTEX_FLOATS`) on the
@@ -154,6 +159,8 @@ impl State {
                 layer_buffer,
                 instance_buffer,
                 layer: None,
+                csg_buffers: [gl.create_buffer()?, gl.create_buffer()?, gl.create_buffer()?, gl.create_buffer()?],
+                csg_uploaded: None,
                 target: None,
             })
         }
@@ -170,6 +177,7 @@ impl State {
                 triangles: compile(gl, &shaders::triangle_vertex(defines), &fragment)?,
                 spheres: compile(gl, shaders::SPHERE_VERTEX, &shaders::sphere_fragment(defines))?,
                 copies: compile(gl, &shaders::triangle_vertex(&format!("{defines}#define INSTANCED 1\n")), &fragment)?,
+                csg: compile(gl, shaders::CSG_VERTEX, &shaders::csg_fragment(defines))?,
             };
             self.programs.push((defines.to_string(), p));
             Ok(p)
@@ -437,7 +445,7 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Opt
             if samples > 1 { "#define MSAA 1\n" } else { "" },
             if views { "#define VIEWS 1\n" } else { "" }
         );
-        let Programs { triangles, spheres, copies } = state.programs(gl, &defines)?;
+        let Programs { triangles, spheres, copies, csg } = state.programs(gl, &defines)?;
         if mapped {
             state.maps.bind_for_lookup(gl);
         }
@@ -484,6 +492,9 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Opt
                 first += count;
             }
             gl.disable(glow::DEPTH_CLAMP);
+        }
+        if !scene.csgs.is_empty() {
+            draw_csgs(gl, state, csg, job, environment)?;
         }
         gl.bind_vertex_array(None);
         if resolved != framebuffer {
@@ -551,6 +562,40 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Opt
         // GL counts none of this; the counters stay zero.
         Ok((RayCounts::default(), readback))
     }
+}
+
+/// Draws the CSG objects: each one's bounding box (both sides, depth
+/// clamped, as the spheres' cubes), whose fragments evaluate the object
+/// along their eye ray (`shaders::csg_fragment`).
+unsafe fn draw_csgs(gl: &glow::Context, state: &mut State, program: glow::Program, job: &PassJob, environment: (i32, i32)) -> Result<(), String> {
+    let scene = &job.prepared.scene;
+    let data = super::csg_data::build(&scene.csgs)?;
+    unsafe {
+        if state.csg_uploaded.as_ref() != Some(&data) {
+            for (buffer, floats) in state.csg_buffers.iter().zip([&data.objects, &data.nodes, &data.spheres, &data.triangles]) {
+                gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(*buffer));
+                gl.buffer_data_u8_slice(glow::SHADER_STORAGE_BUFFER, bytes(floats), glow::STATIC_DRAW);
+            }
+            state.csg_uploaded = Some(data);
+        }
+        for (i, buffer) in state.csg_buffers.iter().enumerate() {
+            gl.bind_buffer_base(glow::SHADER_STORAGE_BUFFER, 6 + i as u32, Some(*buffer));
+        }
+        gl.disable(glow::CULL_FACE);
+        gl.enable(glow::DEPTH_CLAMP);
+        gl.use_program(Some(program));
+        uniforms(gl, program, job, environment);
+        gl.bind_vertex_array(Some(state.cube_array));
+        for i in 0..scene.csgs.len() {
+            // Each surface's material is read per fragment; `check` lets
+            // through untextured ones only, so no texture is bound here.
+            material_textures(gl, &state.textures, program, job, u32::MAX);
+            gl.uniform_1_i32(gl.get_uniform_location(program, "csg_object").as_ref(), i as i32);
+            gl.draw_arrays(glow::TRIANGLES, 0, 36);
+        }
+        gl.disable(glow::DEPTH_CLAMP);
+    }
+    Ok(())
 }
 
 /// Draws the two-level layer's copies: each shared mesh once in GL's

@@ -729,3 +729,322 @@ void main() {
     stored = t;
 }
 "#;
+
+/// A CSG object's bounding box, drawn as the spheres' cube is (both sides,
+/// depth clamped), so that every pixel whose eye ray can meet it gets a
+/// fragment.
+pub const CSG_VERTEX: &str = r#"#version 450 core
+layout(location = 0) in vec3 corner;
+layout(std430, binding = 6) readonly buffer CsgObjects { vec4 csg_objects[]; };
+uniform vec3 eye;
+uniform mat3 world_to_camera;
+uniform vec2 half_extent;
+uniform vec2 ndc_shift;
+uniform bool y_down;
+uniform float near_plane;
+uniform float far_plane;
+uniform int csg_object;
+void main() {
+    vec3 lo = csg_objects[3 * csg_object + 1].xyz;
+    vec3 hi = csg_objects[3 * csg_object + 2].xyz;
+    // A little larger than the bounds, so that the object is always inside.
+    vec3 half_size = (hi - lo) * 0.5;
+    vec3 grow = half_size * 0.01 + vec3(1e-4 * length(half_size) + 1e-6);
+    vec3 position = (lo + hi) * 0.5 + corner * (half_size + grow);
+    vec3 c = world_to_camera * (position - eye);
+    float w = -c.z;
+    float z = near_plane * (far_plane - w) / (far_plane - near_plane);
+    gl_Position = vec4(c.x / half_extent.x + ndc_shift.x * w, (c.y / half_extent.y + ndc_shift.y * w) * (y_down ? -1.0 : 1.0), z, w);
+}
+"#;
+
+/// The CSG objects (`render::csg` in GLSL): along the fragment's eye ray
+/// each operand's inside intervals over the whole line (a sphere's two
+/// roots; a closed mesh's crossings by the two-sided Möller-Trumbore test,
+/// counted into intervals), combined by a stack machine running the tree's
+/// postfix program (`csg_data`), each operation one sweep over the sorted
+/// boundaries of its two operands; the first boundary of the result with
+/// `0 < t < t_max` is the hit, shaded as `render::csg::surface_hit` makes it
+/// and written to `gl_FragDepth`. Lists are held in fixed arrays: an
+/// operand with more than `MAX_IV` intervals or a mesh crossed more than
+/// `MAX_CROSS` times along one ray loses the farthest.
+pub fn csg_fragment(defines: &str) -> String {
+    format!(
+        "#version 450 core\n{defines}#define PER_SAMPLE 1\n{COMMON}{}",
+        r#"
+layout(std430, binding = 6) readonly buffer CsgObjects { vec4 csg_objects[]; };
+layout(std430, binding = 7) readonly buffer CsgNodes { uvec4 csg_nodes[]; };
+layout(std430, binding = 8) readonly buffer CsgSpheres { vec4 csg_spheres[]; };
+layout(std430, binding = 9) readonly buffer CsgTriangles { vec4 csg_triangles[]; };
+uniform int csg_object;
+layout(location = 0) out vec4 colour;
+
+#define MAX_IV 8
+#define MAX_CROSS 16
+#define MAX_STACK 4
+#define MAX_EVENTS (4 * MAX_IV)
+
+// A boundary: t, then the surface (sphere index, or triangle index and the
+// weights of v1 and v2), its leaf and whether it is flipped.
+struct Bd { float t; float b1; float b2; int surface; bool triangle; int leaf; bool flipped; };
+
+Bd stack_enter[MAX_STACK][MAX_IV];
+Bd stack_exit[MAX_STACK][MAX_IV];
+int stack_count[MAX_STACK];
+
+vec3 ray_origin;
+vec3 ray_dir;
+
+// A sphere's interval over the whole line, as `sphere_interval`.
+bool sphere_interval(vec3 centre, float radius, out float t0, out float t1) {
+    vec3 f = ray_origin - centre;
+    float b = -dot(f, ray_dir);
+    vec3 l = f + ray_dir * b;
+    float dist = length(l);
+    float disc = (radius - dist) * (radius + dist);
+    if (!(disc >= 0.0)) return false;
+    float h = sqrt(disc);
+    t0 = b - h;
+    t1 = b + h;
+    return true;
+}
+
+// The two-sided Möller-Trumbore test over the whole line, as `crossing`.
+bool crossing(vec3 v0, vec3 e1, vec3 e2, out float t, out float b1, out float b2, out bool entering) {
+    vec3 p = cross(ray_dir, e2);
+    float det = dot(e1, p);
+    float epsilon = 8.0 * 1.1920929e-7 * length(e1) * length(e2);
+    if (!(abs(det) > epsilon)) return false;
+    float inv = 1.0 / det;
+    vec3 s = ray_origin - v0;
+    b1 = dot(s, p) * inv;
+    if (!(b1 >= 0.0 && b1 <= 1.0)) return false;
+    vec3 q = cross(s, e1);
+    b2 = dot(ray_dir, q) * inv;
+    if (b2 < 0.0 || b1 + b2 > 1.0) return false;
+    t = dot(e2, q) * inv;
+    entering = det > 0.0;
+    return !isnan(t) && !isinf(t);
+}
+
+// Sort order of crossings: by t, entries first at equal t (stable).
+bool crossing_before(Bd a, bool ea, Bd b, bool eb) {
+    return a.t < b.t || (a.t == b.t && ea && !eb);
+}
+
+// Pushes a mesh leaf's intervals (`mesh_intervals`) on stack slot `s`.
+void mesh_intervals(int s, int first, int end, int leaf, bool flipped) {
+    Bd cross_at[MAX_CROSS];
+    bool enters[MAX_CROSS];
+    int n = 0;
+    for (int i = first; i < end; i++) {
+        vec3 v0 = csg_triangles[8 * i].xyz;
+        vec3 v1 = csg_triangles[8 * i + 1].xyz;
+        vec3 v2 = csg_triangles[8 * i + 2].xyz;
+        float t, b1, b2;
+        bool entering;
+        if (!crossing(v0, v1 - v0, v2 - v0, t, b1, b2, entering)) continue;
+        Bd b = Bd(t, b1, b2, i, true, leaf, flipped);
+        // Insertion in sorted place (stable); past MAX_CROSS the farthest is lost.
+        int k = min(n, MAX_CROSS - 1);
+        if (n == MAX_CROSS && !crossing_before(b, entering, cross_at[k], enters[k])) continue;
+        while (k > 0 && crossing_before(b, entering, cross_at[k - 1], enters[k - 1])) {
+            cross_at[k] = cross_at[k - 1];
+            enters[k] = enters[k - 1];
+            k--;
+        }
+        cross_at[k] = b;
+        enters[k] = entering;
+        n = min(n + 1, MAX_CROSS);
+    }
+    int depth = 0;
+    bool started = false;
+    Bd start;
+    int count = 0;
+    for (int i = 0; i < n; i++) {
+        if (enters[i]) {
+            depth++;
+            if (depth == 1) {
+                start = cross_at[i];
+                started = true;
+            }
+        } else {
+            depth--;
+            if (depth == 0 && started && count < MAX_IV) {
+                stack_enter[s][count] = start;
+                stack_exit[s][count] = cross_at[i];
+                count++;
+                started = false;
+            } else if (depth == 0) {
+                started = false;
+            }
+            depth = max(depth, 0);
+        }
+    }
+    stack_count[s] = count;
+}
+
+bool op_inside(uint op, bool a, bool b) {
+    if (op == 2u) return a || b;
+    if (op == 3u) return a && b;
+    return a && !b;
+}
+
+// Combines stack slots `s` (a) and `s + 1` (b) into `s` by one sweep
+// (`combine`): events sorted by t, entries first, then a's first (stable).
+void combine(uint op, int s) {
+    Bd ev[MAX_EVENTS];
+    bool ev_b[MAX_EVENTS];
+    bool ev_enter[MAX_EVENTS];
+    int n = 0;
+    for (int side = 0; side < 2; side++) {
+        int slot = s + side;
+        for (int i = 0; i < stack_count[slot]; i++) {
+            for (int e = 0; e < 2; e++) {
+                Bd b = e == 0 ? stack_enter[slot][i] : stack_exit[slot][i];
+                bool entering = e == 0;
+                bool from_b = side == 1;
+                int k = n;
+                while (k > 0) {
+                    Bd p = ev[k - 1];
+                    bool before = b.t < p.t || (b.t == p.t && ((entering && !ev_enter[k - 1]) || (entering == ev_enter[k - 1] && !from_b && ev_b[k - 1])));
+                    if (!before) break;
+                    ev[k] = ev[k - 1];
+                    ev_b[k] = ev_b[k - 1];
+                    ev_enter[k] = ev_enter[k - 1];
+                    k--;
+                }
+                ev[k] = b;
+                ev_b[k] = from_b;
+                ev_enter[k] = entering;
+                n++;
+            }
+        }
+    }
+    int in_a = 0, in_b = 0;
+    bool started = false;
+    Bd start;
+    int count = 0;
+    for (int i = 0; i < n; i++) {
+        bool was = op_inside(op, in_a > 0, in_b > 0);
+        int d = ev_enter[i] ? 1 : -1;
+        if (ev_b[i]) in_b += d; else in_a += d;
+        bool now = op_inside(op, in_a > 0, in_b > 0);
+        if (!was && now) {
+            start = ev[i];
+            started = true;
+        } else if (was && !now) {
+            if (started && count < MAX_IV) {
+                stack_enter[s][count] = start;
+                stack_exit[s][count] = ev[i];
+                count++;
+            }
+            started = false;
+        }
+    }
+    stack_count[s] = count;
+}
+
+void main() {
+    vec3 d = camera_dir();
+    ray_dir = normalize(camera_to_world * d);
+    ray_origin = eye + camera_to_world * (d * near_plane);
+    float t_max = (far_plane - near_plane) * length(d);
+    uvec4 header = floatBitsToUint(csg_objects[3 * csg_object]);
+    int first = int(header.x), count = int(header.y);
+    int top = 0;
+    int leaf = 0;
+    for (int i = first; i < first + count; i++) {
+        uvec4 node = csg_nodes[i];
+        bool flipped = node.w != 0u;
+        if (node.x == 0u) {
+            if (top >= MAX_STACK) discard;
+            vec4 s = csg_spheres[2 * node.y];
+            float t0, t1;
+            if (sphere_interval(s.xyz, s.w, t0, t1)) {
+                stack_enter[top][0] = Bd(t0, 0.0, 0.0, int(node.y), false, leaf, flipped);
+                stack_exit[top][0] = Bd(t1, 0.0, 0.0, int(node.y), false, leaf, flipped);
+                stack_count[top] = 1;
+            } else {
+                stack_count[top] = 0;
+            }
+            top++;
+            leaf++;
+        } else if (node.x == 1u) {
+            if (top >= MAX_STACK) discard;
+            mesh_intervals(top, int(node.y), int(node.z), leaf, flipped);
+            top++;
+            leaf++;
+        } else {
+            if (top < 2) discard;
+            combine(node.x, top - 2);
+            top--;
+        }
+    }
+    if (top != 1) discard;
+    // first_boundary, for rays that start outside.
+    bool found = false;
+    Bd hit;
+    for (int i = 0; i < stack_count[0]; i++) {
+        Bd e = stack_enter[0][i];
+        if (e.t > 0.0) {
+            if (e.t < t_max) {
+                hit = e;
+                found = true;
+            }
+            break;
+        }
+    }
+    if (!found) discard;
+    // surface_hit.
+    vec3 p;
+    vec3 outward;
+    vec3 shading;
+    vec2 uv;
+    vec3 bary = vec3(0.0);
+    uint m;
+    if (!hit.triangle) {
+        vec4 s = csg_spheres[2 * hit.surface];
+        m = floatBitsToUint(csg_spheres[2 * hit.surface + 1].x);
+        p = ray_origin + ray_dir * hit.t;
+        vec3 o = (p - s.xyz) / s.w;
+        float lo = length(o);
+        outward = lo > 0.0 && !isinf(lo) ? o / lo : vec3(0.0, 1.0, 0.0);
+        uv = vec2(0.5 + precise_atan2(outward.z, outward.x) * -0.5 * (1.0 / PI), 0.5 + precise_asin(clamp(outward.y, -1.0, 1.0)) * (1.0 / PI));
+    } else {
+        int i = hit.surface;
+        vec3 v0 = csg_triangles[8 * i].xyz;
+        vec3 v1 = csg_triangles[8 * i + 1].xyz;
+        vec3 v2 = csg_triangles[8 * i + 2].xyz;
+        m = floatBitsToUint(csg_triangles[8 * i].w);
+        vec3 w = vec3(1.0 - hit.b1 - hit.b2, hit.b1, hit.b2);
+        p = v0 * w.x + v1 * w.y + v2 * w.z;
+        outward = normalize(cross(v1 - v0, v2 - v0));
+        vec3 ns = csg_triangles[8 * i + 3].xyz * w.x + csg_triangles[8 * i + 4].xyz * w.y + csg_triangles[8 * i + 5].xyz * w.z;
+        float ls = length(ns);
+        shading = ls > 0.0 && !isinf(ls) ? ns / ls : outward;
+        vec4 uv01 = csg_triangles[8 * i + 6];
+        uv = uv01.xy * w.x + uv01.zw * w.y + csg_triangles[8 * i + 7].xy * w.z;
+        bary = w;
+    }
+    if (!hit.triangle) shading = outward;
+    float sign = hit.flipped ? -1.0 : 1.0;
+    vec3 g = outward * sign;
+    vec3 n = shading * sign;
+    bool back = dot(g, ray_dir) > 0.0;
+    if (back) {
+        g = -g;
+        n = -n;
+    }
+#ifdef VIEWS
+    write_surface(p, n, back, g, bary, uv, 2u, uint(csg_object));
+    out_id.z = m;
+#endif
+    float depth = dot(p - eye, -camera_to_world[2]);
+    gl_FragDepth = clamp(near_plane * (far_plane - depth) / ((far_plane - near_plane) * depth), 0.0, 1.0);
+    // CSG hits carry no footprint: the finest texture level.
+    colour = vec4(shade(p, n, g, -ray_dir, m, albedo_at(m, uv, vec2(0.0), vec2(0.0))), 1.0);
+}
+"#
+    )
+}

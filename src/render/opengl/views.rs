@@ -82,6 +82,10 @@ impl Readback {
                 let s = scene.spheres.get(primitive as usize)?;
                 (PrimitiveKind::Sphere, s.object, s.material)
             }
+            3 => {
+                let c = scene.csgs.get(primitive as usize)?;
+                (PrimitiveKind::Csg, c.object, self.ids[i + 2])
+            }
             _ => return None,
         };
         let position = v(0);
