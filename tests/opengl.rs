@@ -1,10 +1,11 @@
 //! The `opengl` renderer against the brute-force ray caster on every
-//! built-in scene it can draw, with `--shadows none` (GL casts no shadow
-//! rays) and with `--shadows map` (GL's maps against the CPU's): at least
-//! 99% of pixels within 1e-3 relative. The rest lie on
-//! silhouettes, where GL's coverage (vertices snapped to 1/256 pixel,
-//! its own fill rule) and the ray test decide differently, and where GPU
-//! float (interpolated positions and normals, `pow`) rounds otherwise.
+//! built-in scene (CSG and the forests' copies included), with `--shadows
+//! none` (GL casts no shadow rays) and with `--shadows map` (GL's maps
+//! against the CPU's) where the scene allows maps: at least 99% of pixels
+//! within 1e-3 relative. The rest lie on silhouettes, where GL's coverage
+//! (vertices snapped to 1/256 pixel, its own fill rule) and the ray test
+//! decide differently, and where GPU float (interpolated positions and
+//! normals, `pow`) rounds otherwise.
 //!
 //! The reference pixels come from `raytrace:bvh`, which gives brute
 //! force's pixels exactly (tested with the BVH), in a fraction of the time.
