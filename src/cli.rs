@@ -833,7 +833,7 @@ fn cmd_list() -> Result<(), String> {
     for s in crate::scene::builtin::names() {
         let _ = writeln!(t, "  {s}");
     }
-    let _ = writeln!(t, "large scenes (instanced: raytrace and rasterize only):");
+    let _ = writeln!(t, "large scenes (instanced: raytrace:bvh, rasterize and opengl):");
     for s in crate::scene::builtin::large_names() {
         let _ = writeln!(t, "  {s}");
     }

@@ -376,9 +376,22 @@ fn an_operand_entered_before_the_near_plane_still_counts() {
 fn renderers_that_cannot_draw_csg_say_so() {
     let scene = builtin("csg");
     let settings = RenderSettings::for_scene(&scene);
-    for name in ["opengl", "rasterize:painter"] {
-        let e = renderer_by_name(name).unwrap().check(&scene, &settings).unwrap_err();
-        assert!(e.contains("csg"), "{name}: {e}");
+    let e = renderer_by_name("rasterize:painter").unwrap().check(&scene, &settings).unwrap_err();
+    assert!(e.contains("csg"), "{e}");
+    // opengl evaluates CSG in its fragment shader (untextured surfaces only).
+    let gl = renderer_by_name("opengl").unwrap();
+    if pinhole::render::opengl::driver().is_ok() {
+        let none = RenderSettings { shadows: ShadowMode::None, ..settings.clone() };
+        assert_eq!(gl.check(&scene, &none), Ok(()));
+        let mut textured = scene.clone();
+        let texture = builtin("textures").materials.iter().find_map(|m| m.texture.clone()).unwrap();
+        for m in &mut textured.materials {
+            m.texture = Some(texture.clone());
+        }
+        let e = gl.check(&textured, &none).unwrap_err();
+        assert!(e.contains("csg") && e.contains("textures") && !e.contains('\n'), "{e}");
+        let e = gl.check(&scene, &RenderSettings { shadows: ShadowMode::Map, ..settings.clone() }).unwrap_err();
+        assert!(e.contains("csg"), "{e}");
     }
     for shadows in [ShadowMode::Map, ShadowMode::Volume] {
         let s = RenderSettings { shadows, ..settings.clone() };

@@ -1,6 +1,6 @@
 //! What can draw a scene whose copies live in the two-level instance layer
-//! (`scene::instanced`): the BVH ray tracer and the rasterizers, with ray
-//! or no shadows. The rest read `Scene::triangles` alone, so they refuse
+//! (`scene::instanced`): the BVH ray tracer, the rasterizers and `opengl`
+//! (its copies instanced in GL), with ray or no shadows. The rest read `Scene::triangles` alone, so they refuse
 //! such a scene with one sentence instead of drawing it without its copies.
 
 use super::{debug::View, RenderSettings, ShadowMode};
@@ -19,7 +19,7 @@ pub fn check(renderer: &str, scene: &Scene, settings: &RenderSettings) -> Result
         ))
     };
     match renderer {
-        "raytrace:brute" | "opengl" => return why(renderer),
+        "raytrace:brute" => return why(renderer),
         _ => {}
     }
     match settings.shadows {

@@ -2,10 +2,13 @@
 //! go through a vertex shader, GL's fixed-function rasterizer and depth test
 //! and a fragment shader that computes `shade()` (`shaders`); spheres stay
 //! exact (a bounding cube whose fragments intersect the ray with the sphere
-//! and write `gl_FragDepth`). Runs in a headless EGL context (`context`),
+//! and write `gl_FragDepth`), and so do CSG objects (their bounding box,
+//! whose fragments evaluate the interval rule along the eye ray); the
+//! two-level layer's copies are instanced. Runs in a headless EGL context (`context`),
 //! so it works without a window, on Mesa's llvmpipe where there is no GPU.
 
 mod context;
+mod csg_data;
 mod pass;
 mod scene_data;
 mod shaders;
@@ -66,8 +69,11 @@ impl Renderer for OpenGl {
     }
 
     fn check(&self, scene: &Scene, settings: &RenderSettings) -> Result<(), String> {
-        if !scene.csgs.is_empty() {
-            return Err("the opengl renderer cannot draw csg objects (its shaders draw triangles and spheres only); use a raytrace or rasterize renderer".into());
+        crate::render::csg::check(scene, settings)?;
+        csg_data::build(&scene.csgs)?;
+        let csg_materials = scene.csgs.iter().flat_map(|c| c.spheres.iter().map(|s| s.material).chain(c.triangles.iter().map(|t| t.material)));
+        if let Some(m) = csg_materials.filter_map(|m| scene.materials.get(m as usize)).find(|m| m.texture.is_some() || m.normal_map.is_some()) {
+            return Err(format!("the opengl renderer draws csg objects without textures only (material \"{}\")", m.name));
         }
         unsupported(scene, settings)?;
         let max_samples = max_samples()?;

@@ -14,7 +14,7 @@ use glow::HasContext;
 pub struct State {
     /// The triangle and sphere programs, compiled on first use for each set
     /// of defines (shadow-map lookups, multisampling).
-    programs: Vec<(String, glow::Program, glow::Program)>,
+    programs: Vec<(String, Programs)>,
     background: glow::Program,
     maps: super::shadow_pass::ShadowPass,
     textures: super::textures::Textures,
@@ -26,7 +26,47 @@ pub struct State {
     light_buffer: glow::Buffer,
     /// The uploaded geometry: its fingerprint, triangle runs, sphere count.
     uploaded: Option<(u64, Vec<scene_data::Run>, usize)>,
+    /// The two-level layer's shared meshes (`scene_data::layer_geometry`)
+    /// and the copies' placements, one instance each.
+    layer_array: glow::VertexArray,
+    layer_buffer: glow::Buffer,
+    instance_buffer: glow::Buffer,
+    /// The layer uploaded (held, so its address names it) and each mesh's
+    /// first triangle and runs.
+    layer: Option<(std::sync::Arc<crate::scene::instanced::InstanceLayer>, Vec<(u32, Vec<scene_data::Run>)>)>,
+    /// The CSG objects' buffers (`csg_data`: objects, nodes, spheres,
+    /// triangles at bindings 6 to 9) and what they hold.
+    csg_buffers: [glow::Buffer; 4],
+    csg_uploaded: Option<super::csg_data::CsgData>,
     target: Option<Target>,
+}
+
+/// The programs compiled for one set of defines: triangles, spheres, and
+/// the layer's copies (triangles placed per instance).
+#[derive(Clone, Copy)]
+struct Programs {
+    triangles: glow::Program,
+    spheres: glow::Program,
+    copies: glow::Program,
+    csg: glow::Program,
+}
+
+/// Sets the triangle vertex layout (`scene_data::VERTEX_FLOATS`) on the
+/// bound vertex array, reading the bound array buffer.
+unsafe fn vertex_layout(gl: &glow::Context) {
+    let stride = (scene_data::VERTEX_FLOATS * 4) as i32;
+    unsafe {
+        for (location, offset) in [(0u32, 0i32), (1, 12), (2, 24)] {
+            gl.enable_vertex_attrib_array(location);
+            gl.vertex_attrib_pointer_f32(location, 3, glow::FLOAT, false, stride, offset);
+        }
+        gl.enable_vertex_attrib_array(3);
+        gl.vertex_attrib_pointer_i32(3, 1, glow::UNSIGNED_INT, stride, 36);
+        gl.enable_vertex_attrib_array(4);
+        gl.vertex_attrib_pointer_f32(4, 2, glow::FLOAT, false, stride, 40);
+        gl.enable_vertex_attrib_array(5);
+        gl.vertex_attrib_pointer_f32(5, 4, glow::FLOAT, false, stride, 48);
+    }
 }
 
 /// The framebuffer a pass draws into: RGBA32F colour and a 32-bit float
@@ -78,17 +118,23 @@ impl State {
             let vertex_buffer = gl.create_buffer()?;
             gl.bind_vertex_array(Some(vertex_array));
             gl.bind_buffer(glow::ARRAY_BUFFER, Some(vertex_buffer));
-            let stride = (scene_data::VERTEX_FLOATS * 4) as i32;
-            for (location, offset) in [(0u32, 0i32), (1, 12), (2, 24)] {
+            vertex_layout(gl);
+            let layer_array = gl.create_vertex_array()?;
+            let layer_buffer = gl.create_buffer()?;
+            let instance_buffer = gl.create_buffer()?;
+            gl.bind_vertex_array(Some(layer_array));
+            gl.bind_buffer(glow::ARRAY_BUFFER, Some(layer_buffer));
+            vertex_layout(gl);
+            gl.bind_buffer(glow::ARRAY_BUFFER, Some(instance_buffer));
+            let stride = (scene_data::INSTANCE_FLOATS * 4) as i32;
+            for location in 6..13u32 {
                 gl.enable_vertex_attrib_array(location);
-                gl.vertex_attrib_pointer_f32(location, 3, glow::FLOAT, false, stride, offset);
+                gl.vertex_attrib_pointer_f32(location, 3, glow::FLOAT, false, stride, (location as i32 - 6) * 12);
+                gl.vertex_attrib_divisor(location, 1);
             }
-            gl.enable_vertex_attrib_array(3);
-            gl.vertex_attrib_pointer_i32(3, 1, glow::UNSIGNED_INT, stride, 36);
-            gl.enable_vertex_attrib_array(4);
-            gl.vertex_attrib_pointer_f32(4, 2, glow::FLOAT, false, stride, 40);
-            gl.enable_vertex_attrib_array(5);
-            gl.vertex_attrib_pointer_f32(5, 4, glow::FLOAT, false, stride, 48);
+            gl.enable_vertex_attrib_array(13);
+            gl.vertex_attrib_pointer_i32(13, 3, glow::UNSIGNED_INT, stride, 84);
+            gl.vertex_attrib_divisor(13, 1);
             let cube_array = gl.create_vertex_array()?;
             let cube_buffer = gl.create_buffer()?;
             gl.bind_vertex_array(Some(cube_array));
@@ -101,7 +147,7 @@ impl State {
                 programs: Vec::new(),
                 background,
                 maps,
-                textures: Default::default(),
+                textures: super::textures::Textures::new(gl)?,
                 vertex_array,
                 vertex_buffer,
                 cube_array,
@@ -109,22 +155,50 @@ impl State {
                 material_buffer: gl.create_buffer()?,
                 light_buffer: gl.create_buffer()?,
                 uploaded: None,
+                layer_array,
+                layer_buffer,
+                instance_buffer,
+                layer: None,
+                csg_buffers: [gl.create_buffer()?, gl.create_buffer()?, gl.create_buffer()?, gl.create_buffer()?],
+                csg_uploaded: None,
                 target: None,
             })
         }
     }
 
-    /// The triangle and sphere programs compiled with `defines`.
-    unsafe fn programs(&mut self, gl: &glow::Context, defines: &str) -> Result<(glow::Program, glow::Program), String> {
-        if let Some((_, t, s)) = self.programs.iter().find(|p| p.0 == defines) {
-            return Ok((*t, *s));
+    /// The programs compiled with `defines`.
+    unsafe fn programs(&mut self, gl: &glow::Context, defines: &str) -> Result<Programs, String> {
+        if let Some((_, p)) = self.programs.iter().find(|p| p.0 == defines) {
+            return Ok(*p);
         }
         unsafe {
-            let t = compile(gl, shaders::TRIANGLE_VERTEX, &shaders::triangle_fragment(defines))?;
-            let s = compile(gl, shaders::SPHERE_VERTEX, &shaders::sphere_fragment(defines))?;
-            self.programs.push((defines.to_string(), t, s));
-            Ok((t, s))
+            let fragment = shaders::triangle_fragment(defines);
+            let p = Programs {
+                triangles: compile(gl, &shaders::triangle_vertex(defines), &fragment)?,
+                spheres: compile(gl, shaders::SPHERE_VERTEX, &shaders::sphere_fragment(defines))?,
+                copies: compile(gl, &shaders::triangle_vertex(&format!("{defines}#define INSTANCED 1\n")), &fragment)?,
+                csg: compile(gl, shaders::CSG_VERTEX, &shaders::csg_fragment(defines))?,
+            };
+            self.programs.push((defines.to_string(), p));
+            Ok(p)
         }
+    }
+
+    /// Uploads the layer's shared meshes unless they are there already;
+    /// returns each mesh's first triangle and runs.
+    unsafe fn upload_layer(&mut self, gl: &glow::Context, layer: &std::sync::Arc<crate::scene::instanced::InstanceLayer>) -> Vec<(u32, Vec<scene_data::Run>)> {
+        if let Some((l, meshes)) = &self.layer {
+            if std::sync::Arc::ptr_eq(l, layer) {
+                return meshes.clone();
+            }
+        }
+        let g = scene_data::layer_geometry(layer);
+        unsafe {
+            gl.bind_buffer(glow::ARRAY_BUFFER, Some(self.layer_buffer));
+            gl.buffer_data_u8_slice(glow::ARRAY_BUFFER, bytes(&g.vertices), glow::STATIC_DRAW);
+        }
+        self.layer = Some((layer.clone(), g.meshes.clone()));
+        g.meshes
     }
 
     /// The framebuffer to draw into and the one to read from (the same
@@ -219,7 +293,8 @@ pub(super) fn bytes(v: &[f32]) -> &[u8] {
 }
 
 /// Sets the uniforms both programs share.
-unsafe fn uniforms(gl: &glow::Context, program: glow::Program, job: &PassJob) {
+/// `environment`: the environment's texture handle (`Textures::handle`).
+unsafe fn uniforms(gl: &glow::Context, program: glow::Program, job: &PassJob, environment: (i32, i32)) {
     let view = job.view;
     let scene = &job.prepared.scene;
     let (w, h) = (view.width as f32, view.height as f32);
@@ -245,46 +320,31 @@ unsafe fn uniforms(gl: &glow::Context, program: glow::Program, job: &PassJob) {
         gl.uniform_1_i32(at("has_environment").as_ref(), scene.environment.is_some() as i32);
         gl.uniform_1_f32(at("environment_intensity").as_ref(), scene.environment.as_ref().map_or(0.0, |e| e.intensity));
         gl.uniform_1_i32(at("mirror_env").as_ref(), (job.settings.reflections == Reflections::Env && job.settings.max_depth > 0) as i32);
-        gl.uniform_1_i32(at("albedo_map").as_ref(), ALBEDO_UNIT as i32);
-        gl.uniform_1_i32(at("normal_map").as_ref(), NORMAL_UNIT as i32);
-        gl.uniform_1_i32(at("environment").as_ref(), ENVIRONMENT_UNIT as i32);
+        let (first, count) = environment;
+        gl.uniform_2_i32(at("environment").as_ref(), first, count);
     }
 }
 
-/// Texture units: 0 holds the shadow maps.
-const ALBEDO_UNIT: u32 = 1;
-const NORMAL_UNIT: u32 = 2;
-const ENVIRONMENT_UNIT: u32 = 3;
-
-/// Binds material `m`'s texture and normal map and sets what the
-/// fragment shader reads of them.
-unsafe fn material_textures(gl: &glow::Context, textures: &mut super::textures::Textures, program: glow::Program, job: &PassJob, m: u32) -> Result<(), String> {
-    let Some(material) = job.prepared.scene.materials.get(m as usize) else { return Ok(()) };
-    let filter = job.settings.texture_filter;
+/// Sets what the fragment shader reads of material `m`'s texture and
+/// normal map.
+unsafe fn material_textures(gl: &glow::Context, textures: &super::textures::Textures, program: glow::Program, job: &PassJob, m: u32) {
+    let Some(material) = job.prepared.scene.materials.get(m as usize) else { return };
     unsafe {
         let at = |name: &str| gl.get_uniform_location(program, name);
-        for (map, unit, flag) in [(&material.texture, ALBEDO_UNIT, "has_albedo_map"), (&material.normal_map, NORMAL_UNIT, "has_normal_map")] {
-            if let Some(t) = map {
-                let id = textures.get(gl, t)?;
-                super::textures::bind(gl, unit, id, filter, material.wrap, material.wrap);
-            }
-            gl.uniform_1_i32(at(flag).as_ref(), map.is_some() as i32);
+        for (map, name, flag) in [(&material.texture, "albedo_map", "has_albedo_map"), (&material.normal_map, "normal_map", "has_normal_map")] {
+            let (first, count) = map.as_ref().map_or((0, 0), |t| textures.handle(t));
+            gl.uniform_2_i32(at(name).as_ref(), first, count);
+            gl.uniform_1_i32(at(flag).as_ref(), (count > 0) as i32);
         }
+        let filter = match job.settings.texture_filter {
+            TextureFilter::Nearest => 0,
+            TextureFilter::Bilinear => 1,
+            TextureFilter::Trilinear => 2,
+        };
+        gl.uniform_1_i32(at("texture_filter").as_ref(), filter);
+        gl.uniform_1_i32(at("wrap_clamp").as_ref(), (material.wrap == Wrap::Clamp) as i32);
         gl.uniform_2_f32(at("uv_scale").as_ref(), material.uv_scale.x, material.uv_scale.y);
-        Ok(())
     }
-}
-
-/// Uploads and binds the environment (level 0, bilinear, repeating around
-/// the horizon and clamped at the poles, as `Environment::radiance` reads it).
-unsafe fn bind_environment(gl: &glow::Context, textures: &mut super::textures::Textures, scene: &crate::scene::Scene) -> Result<(), String> {
-    if let Some(env) = &scene.environment {
-        unsafe {
-            let id = textures.get(gl, &env.texture)?;
-            super::textures::bind(gl, ENVIRONMENT_UNIT, id, TextureFilter::Bilinear, Wrap::Repeat, Wrap::Clamp);
-        }
-    }
-    Ok(())
 }
 
 /// Draws `job`'s pass and stores its rows in `out`; with `probe` (a pixel
@@ -310,7 +370,8 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Opt
             .chain([scene.environment.as_ref().map(|e| &e.texture)])
             .flatten()
             .collect();
-        state.textures.retain(gl, &keep);
+        state.textures.prepare(gl, &keep)?;
+        let environment = scene.environment.as_ref().map_or((0, 0), |e| state.textures.handle(&e.texture));
         gl.bind_buffer_base(glow::SHADER_STORAGE_BUFFER, 2, Some(state.sphere_buffer));
         let mapped = job.settings.shadows == ShadowMode::Map;
         let first_faces = if mapped {
@@ -361,11 +422,10 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Opt
         gl.front_face(if y_down { glow::CW } else { glow::CCW });
         gl.cull_face(glow::BACK);
         if scene.environment.is_some() {
-            bind_environment(gl, &mut state.textures, scene)?;
             gl.disable(glow::DEPTH_TEST);
             gl.depth_mask(false);
             gl.use_program(Some(state.background));
-            uniforms(gl, state.background, job);
+            uniforms(gl, state.background, job, environment);
             gl.bind_vertex_array(Some(state.cube_array));
             gl.draw_arrays(glow::TRIANGLES, 0, 3);
             gl.enable(glow::DEPTH_TEST);
@@ -385,19 +445,19 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Opt
             if samples > 1 { "#define MSAA 1\n" } else { "" },
             if views { "#define VIEWS 1\n" } else { "" }
         );
-        let (triangles, spheres) = state.programs(gl, &defines)?;
+        let Programs { triangles, spheres, copies, csg } = state.programs(gl, &defines)?;
         if mapped {
             state.maps.bind_for_lookup(gl);
         }
         if !runs.is_empty() {
             gl.use_program(Some(triangles));
-            uniforms(gl, triangles, job);
+            uniforms(gl, triangles, job, environment);
             if mapped {
                 state.maps.lookup_uniforms(gl, triangles, job.settings);
             }
             gl.bind_vertex_array(Some(state.vertex_array));
             for scene_data::Run { first, count, two_sided, material } in runs {
-                material_textures(gl, &mut state.textures, triangles, job, material)?;
+                material_textures(gl, &state.textures, triangles, job, material);
                 if two_sided {
                     gl.disable(glow::CULL_FACE);
                 } else {
@@ -406,6 +466,9 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Opt
                 gl.draw_arrays(glow::TRIANGLES, (first * 3) as i32, (count * 3) as i32);
             }
         }
+        if let Some(layer) = &scene.layer {
+            draw_copies(gl, state, copies, job, layer, environment, mapped, y_down);
+        }
         if sphere_count > 0 {
             // Both sides of each sphere's bounding cube: whatever part of
             // the cube the near plane cuts off, the far side still covers
@@ -413,7 +476,7 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Opt
             gl.disable(glow::CULL_FACE);
             gl.enable(glow::DEPTH_CLAMP);
             gl.use_program(Some(spheres));
-            uniforms(gl, spheres, job);
+            uniforms(gl, spheres, job, environment);
             if mapped {
                 state.maps.lookup_uniforms(gl, spheres, job.settings);
             }
@@ -423,12 +486,15 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Opt
             while first < sphere_count {
                 let m = scene.spheres[first].material;
                 let count = scene.spheres[first..].iter().take_while(|s| s.material == m).count();
-                material_textures(gl, &mut state.textures, spheres, job, m)?;
+                material_textures(gl, &state.textures, spheres, job, m);
                 gl.uniform_1_i32(gl.get_uniform_location(spheres, "first_sphere").as_ref(), first as i32);
                 gl.draw_arrays_instanced(glow::TRIANGLES, 0, 36, count as i32);
                 first += count;
             }
             gl.disable(glow::DEPTH_CLAMP);
+        }
+        if !scene.csgs.is_empty() {
+            draw_csgs(gl, state, csg, job, environment)?;
         }
         gl.bind_vertex_array(None);
         if resolved != framebuffer {
@@ -495,6 +561,97 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Opt
         });
         // GL counts none of this; the counters stay zero.
         Ok((RayCounts::default(), readback))
+    }
+}
+
+/// Draws the CSG objects: each one's bounding box (both sides, depth
+/// clamped, as the spheres' cubes), whose fragments evaluate the object
+/// along their eye ray (`shaders::csg_fragment`).
+unsafe fn draw_csgs(gl: &glow::Context, state: &mut State, program: glow::Program, job: &PassJob, environment: (i32, i32)) -> Result<(), String> {
+    let scene = &job.prepared.scene;
+    let data = super::csg_data::build(&scene.csgs)?;
+    unsafe {
+        if state.csg_uploaded.as_ref() != Some(&data) {
+            for (buffer, floats) in state.csg_buffers.iter().zip([&data.objects, &data.nodes, &data.spheres, &data.triangles]) {
+                gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(*buffer));
+                gl.buffer_data_u8_slice(glow::SHADER_STORAGE_BUFFER, bytes(floats), glow::STATIC_DRAW);
+            }
+            state.csg_uploaded = Some(data);
+        }
+        for (i, buffer) in state.csg_buffers.iter().enumerate() {
+            gl.bind_buffer_base(glow::SHADER_STORAGE_BUFFER, 6 + i as u32, Some(*buffer));
+        }
+        gl.disable(glow::CULL_FACE);
+        gl.enable(glow::DEPTH_CLAMP);
+        gl.use_program(Some(program));
+        uniforms(gl, program, job, environment);
+        gl.bind_vertex_array(Some(state.cube_array));
+        for i in 0..scene.csgs.len() {
+            // Each surface's material is read per fragment; `check` lets
+            // through untextured ones only, so no texture is bound here.
+            material_textures(gl, &state.textures, program, job, u32::MAX);
+            gl.uniform_1_i32(gl.get_uniform_location(program, "csg_object").as_ref(), i as i32);
+            gl.draw_arrays(glow::TRIANGLES, 0, 36);
+        }
+        gl.disable(glow::DEPTH_CLAMP);
+    }
+    Ok(())
+}
+
+/// Draws the two-level layer's copies: each shared mesh once in GL's
+/// buffers, the copies left after culling each by its bounding sphere
+/// (`raster::cull::Frustum`, as the rasterizers cull them; with
+/// `cull_instances`) placed per instance, one instanced draw per run of a
+/// group of copies sharing mesh, material and mirroring.
+#[allow(clippy::too_many_arguments)]
+unsafe fn draw_copies(
+    gl: &glow::Context,
+    state: &mut State,
+    program: glow::Program,
+    job: &PassJob,
+    layer: &std::sync::Arc<crate::scene::instanced::InstanceLayer>,
+    environment: (i32, i32),
+    mapped: bool,
+    y_down: bool,
+) {
+    let scene = &job.prepared.scene;
+    let frustum = crate::render::raster::cull::Frustum::new(job.view);
+    let cull = job.settings.cull_instances;
+    // Copy k's record (its bounding sphere): the one whose triangles start at its base.
+    let info = |k: usize| {
+        let base = layer.instances[k].base as usize;
+        let i = scene.instances.partition_point(|r| r.triangles.start < base);
+        scene.instances.get(i).filter(|r| r.triangles.start == base)
+    };
+    unsafe {
+        let meshes = state.upload_layer(gl, layer);
+        let (floats, groups) = scene_data::layer_instances(layer, &meshes, |k| !cull || info(k).is_none_or(|r| frustum.may_see(job.view, r.center, r.radius)));
+        if groups.is_empty() {
+            return;
+        }
+        gl.bind_buffer(glow::ARRAY_BUFFER, Some(state.instance_buffer));
+        gl.buffer_data_u8_slice(glow::ARRAY_BUFFER, bytes(&floats), glow::STREAM_DRAW);
+        gl.use_program(Some(program));
+        uniforms(gl, program, job, environment);
+        if mapped {
+            state.maps.lookup_uniforms(gl, program, job.settings);
+        }
+        gl.bind_vertex_array(Some(state.layer_array));
+        for (group, first_instance, count) in groups {
+            let Some((mesh_first, runs)) = meshes.get(group.mesh as usize) else { continue };
+            // A mirroring placement turns the winding round.
+            gl.front_face(if y_down != group.flips { glow::CW } else { glow::CCW });
+            for run in runs {
+                material_textures(gl, &state.textures, program, job, group.material.unwrap_or(run.material));
+                if run.two_sided {
+                    gl.disable(glow::CULL_FACE);
+                } else {
+                    gl.enable(glow::CULL_FACE);
+                }
+                gl.draw_arrays_instanced_base_instance(glow::TRIANGLES, ((mesh_first + run.first) * 3) as i32, (run.count * 3) as i32, count as i32, first_instance);
+            }
+        }
+        gl.front_face(if y_down { glow::CW } else { glow::CCW });
     }
 }
 

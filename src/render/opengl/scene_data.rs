@@ -132,3 +132,94 @@ pub fn cube_corners() -> Vec<f32> {
     }
     out
 }
+
+/// The two-level layer's shared meshes (`scene::instanced`), each uploaded
+/// once in the vertex layout of `geometry` (no tangent frames: the layer
+/// keeps none), one after the other.
+pub struct LayerGeometry {
+    pub vertices: Vec<f32>,
+    /// Per mesh: its first triangle in `vertices` and its runs (first
+    /// triangle counted within the mesh).
+    pub meshes: Vec<(u32, Vec<Run>)>,
+}
+
+pub fn layer_geometry(layer: &crate::scene::instanced::InstanceLayer) -> LayerGeometry {
+    let total: usize = layer.meshes.iter().map(|m| m.len()).sum();
+    let mut vertices = Vec::with_capacity(total * 3 * VERTEX_FLOATS);
+    let mut meshes = Vec::with_capacity(layer.meshes.len());
+    let mut first = 0u32;
+    for mesh in &layer.meshes {
+        let mut runs: Vec<Run> = Vec::new();
+        for (i, t) in mesh.iter().enumerate() {
+            let face = t.geometric_normal();
+            for k in 0..3 {
+                vertices.extend_from_slice(&t.v[k].to_array());
+                vertices.extend_from_slice(&t.n[k].to_array());
+                vertices.extend_from_slice(&face.to_array());
+                vertices.push(f32::from_bits(t.material));
+                vertices.extend_from_slice(&t.uv[k].to_array());
+                vertices.extend_from_slice(&[0.0; 4]);
+            }
+            match runs.last_mut() {
+                Some(run) if run.two_sided == t.two_sided && run.material == t.material => run.count += 1,
+                _ => runs.push(Run { first: i as u32, count: 1, two_sided: t.two_sided, material: t.material }),
+            }
+        }
+        meshes.push((first, runs));
+        first += mesh.len() as u32;
+    }
+    LayerGeometry { vertices, meshes }
+}
+
+/// Floats per copy in the instance buffer: the placement's matrix (four
+/// columns of three), its normal matrix (three columns), then as bits: the
+/// copy's first virtual triangle less its mesh's first (so that adding the
+/// vertex's triangle number gives the virtual index), its material or
+/// `u32::MAX`, and 1 when the placement mirrors.
+pub const INSTANCE_FLOATS: usize = 24;
+
+/// A group of copies drawn with one instanced call per run: same mesh,
+/// same material override, same mirroring.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub struct CopyGroup {
+    pub mesh: u32,
+    pub material: Option<u32>,
+    pub flips: bool,
+}
+
+/// The copies `keep` lets through (by index), sorted by `CopyGroup` and
+/// within one by index, as instance-buffer floats; and per group its
+/// first instance and count.
+pub fn layer_instances(layer: &crate::scene::instanced::InstanceLayer, meshes: &[(u32, Vec<Run>)], keep: impl Fn(usize) -> bool) -> (Vec<f32>, Vec<(CopyGroup, u32, u32)>) {
+    let mut order: Vec<(CopyGroup, usize)> = Vec::new();
+    for (k, inst) in layer.instances.iter().enumerate() {
+        if !keep(k) {
+            continue;
+        }
+        let flips = inst.placement.matrix().determinant() < 0.0;
+        order.push((CopyGroup { mesh: inst.mesh, material: inst.material, flips }, k));
+    }
+    // Stable within a group: copies keep their index order (the id order).
+    order.sort_by_key(|(g, k)| (*g, *k));
+    let mut floats = Vec::with_capacity(order.len() * INSTANCE_FLOATS);
+    let mut groups: Vec<(CopyGroup, u32, u32)> = Vec::new();
+    for (i, (group, k)) in order.iter().enumerate() {
+        let inst = &layer.instances[*k];
+        let m = inst.placement.matrix();
+        // As `Placement::new` makes it.
+        let n = glam::Mat3::from_mat4(m).inverse().transpose();
+        for c in [m.x_axis, m.y_axis, m.z_axis, m.w_axis] {
+            floats.extend_from_slice(&c.truncate().to_array());
+        }
+        floats.extend_from_slice(&n.to_cols_array());
+        let mesh_first = meshes.get(inst.mesh as usize).map_or(0, |m| m.0);
+        floats.push(f32::from_bits(inst.base.wrapping_sub(mesh_first)));
+        floats.push(f32::from_bits(inst.material.unwrap_or(u32::MAX)));
+        floats.push(f32::from_bits(group.flips as u32));
+        match groups.last_mut() {
+            Some(g) if g.0 == *group => g.2 += 1,
+            _ => groups.push((*group, i as u32, 1)),
+        }
+    }
+    (floats, groups)
+}

@@ -26,49 +26,158 @@ layout(std430, binding = 1) readonly buffer Lights { vec4 lights[]; };
 
 const float PI = 3.14159265358979323846;
 
+// Every texture's pyramid (`textures`): texels as linear RGB triples, and
+// per level (first texel, width, height, 0), row 0 at the top. A texture
+// is (its first level, its level count). They are read texel by texel and
+// filtered here in float as `Texture::sample` filters: GL's own filtering
+// would blend with its fixed-point weights and pick levels its own way.
+layout(std430, binding = 4) readonly buffer Texels { float texel_data[]; };
+layout(std430, binding = 5) readonly buffer Levels { ivec4 level_info[]; };
+
 // The drawn material's texture and normal map (`Material::scaled`: uvs
-// times uv_scale; GL's t runs down from the top row, t = 1 - v), read by
-// GL's own filtering at the level of detail given.
+// times uv_scale).
 uniform bool has_albedo_map;
-uniform sampler2D albedo_map;
+uniform ivec2 albedo_map;
 uniform bool has_normal_map;
-uniform sampler2D normal_map;
+uniform ivec2 normal_map;
 uniform vec2 uv_scale;
+// TextureFilter: 0 nearest, 1 bilinear, 2 trilinear.
+uniform int texture_filter;
+// The material's Wrap: clamp to the edge texel, else repeat.
+uniform bool wrap_clamp;
 // Scene::miss_radiance: the latitude-longitude environment, else the background.
 uniform bool has_environment;
-uniform sampler2D environment;
+uniform ivec2 environment;
 uniform float environment_intensity;
 uniform vec3 background;
 // `--reflections env` with a depth to spare: mirrors look the environment up.
 uniform bool mirror_env;
 
-vec2 tex_coord(vec2 uv) {
-    vec2 s = uv * uv_scale;
-    return vec2(s.x, 1.0 - s.y);
+// asin and atan to float precision (Cephes' asinf and atanf): the
+// driver's own are approximations (llvmpipe's asin is off by up to about
+// 1e-4), enough to move a latitude across a texel's weight visibly.
+float precise_asin(float x) {
+    float a = abs(x);
+    if (a > 1.0) return x > 0.0 ? PI / 2.0 : -PI / 2.0;
+    float z;
+    float s;
+    bool wide = a > 0.5;
+    if (wide) {
+        z = 0.5 * (1.0 - a);
+        s = sqrt(z);
+    } else {
+        z = a * a;
+        s = a;
+    }
+    float r = ((((4.2163199048e-2 * z + 2.4181311049e-2) * z + 4.5470025998e-2) * z + 7.4953002686e-2) * z + 1.6666752422e-1) * z * s + s;
+    if (wide) r = PI / 2.0 - 2.0 * r;
+    return x < 0.0 ? -r : r;
+}
+
+float precise_atan(float x) {
+    float a = abs(x);
+    float y = 0.0;
+    if (a > 2.414213562373095) {
+        y = PI / 2.0;
+        a = -1.0 / a;
+    } else if (a > 0.4142135623730950) {
+        y = PI / 4.0;
+        a = (a - 1.0) / (a + 1.0);
+    }
+    float z = a * a;
+    y += (((8.05374449538e-2 * z - 1.38776856032e-1) * z + 1.99777106478e-1) * z - 3.33329491539e-1) * z * a + a;
+    return x < 0.0 ? -y : y;
+}
+
+// atan2(y, x) in (-pi, pi], as Rust's f32::atan2.
+float precise_atan2(float y, float x) {
+    if (x == 0.0) return y > 0.0 ? PI / 2.0 : (y < 0.0 ? -PI / 2.0 : 0.0);
+    float t = precise_atan(y / x);
+    if (x > 0.0) return t;
+    return y < 0.0 ? t - PI : t + PI;
+}
+
+// MipLevel::texel_uv's addressing: i.rem_euclid(n) or i.clamp(0, n - 1).
+int address(int i, int n, bool clamp_edge) {
+    if (clamp_edge) return clamp(i, 0, n - 1);
+    return i >= 0 ? i % n : (n - 1) - ((-(i + 1)) % n);
+}
+
+vec3 texel(ivec4 level, int x, int y, bool clamp_u, bool clamp_v) {
+    int i = 3 * (level.x + address(y, level.z, clamp_v) * level.y + address(x, level.y, clamp_u));
+    return vec3(texel_data[i], texel_data[i + 1], texel_data[i + 2]);
+}
+
+// glam's lerp: a (1 - s) + b s.
+vec3 lerp3(vec3 a, vec3 b, float s) {
+    return a * (1.0 - s) + b * s;
+}
+
+// MipLevel::position: texel-space x and y (row 0 at the top), or false
+// when not finite or far outside.
+bool level_position(vec2 uv, ivec4 level, out vec2 p) {
+    p = vec2(uv.x * float(level.y), (1.0 - uv.y) * float(level.z));
+    return !(any(isnan(p)) || any(isinf(p))) && abs(p.x) < 1e9 && abs(p.y) < 1e9;
+}
+
+// MipLevel::nearest on level 0.
+vec3 nearest_at(ivec2 t, vec2 uv, bool clamp_edge) {
+    ivec4 level = level_info[t.x];
+    vec2 p;
+    if (!level_position(uv, level, p)) return vec3(0.0);
+    return texel(level, int(floor(p.x)), int(floor(p.y)), clamp_edge, clamp_edge);
+}
+
+// MipLevel::bilinear_uv on level `l`.
+vec3 bilinear_at(ivec2 t, int l, vec2 uv, bool clamp_u, bool clamp_v) {
+    ivec4 level = level_info[t.x + l];
+    vec2 p;
+    if (!level_position(uv, level, p)) return vec3(0.0);
+    p -= 0.5;
+    vec2 p0 = floor(p);
+    vec2 f = p - p0;
+    int x = int(p0.x), y = int(p0.y);
+    vec3 top = lerp3(texel(level, x, y, clamp_u, clamp_v), texel(level, x + 1, y, clamp_u, clamp_v), f.x);
+    vec3 bottom = lerp3(texel(level, x, y + 1, clamp_u, clamp_v), texel(level, x + 1, y + 1, clamp_u, clamp_v), f.x);
+    return lerp3(top, bottom, f.y);
 }
 
 // Texture::level_of_detail: log2 of the longer pixel step in level-0
-// texels, 0 when magnified, the coarsest level when unknown. GL is handed
-// this lambda (textureLod) and does the rest: the level pair, their blend
-// and the bilinear reads. Left to derive lambda from the same gradients
-// (textureGrad), llvmpipe approximates the steps' lengths and agrees less.
-float level_of_detail(vec2 size, vec2 duv_dx, vec2 duv_dy) {
-    vec2 g = uv_scale * size;
-    float rho = max(length(duv_dx * g), length(duv_dy * g));
-    if (isnan(rho)) return 1000.0;
-    return rho <= 1.0 ? 0.0 : min(log2(rho), 1000.0);
+// texels, 0 when magnified, the coarsest level when unknown.
+float level_of_detail(ivec2 t, vec2 duv_dx, vec2 duv_dy) {
+    vec2 size = vec2(level_info[t.x].yz);
+    float top = float(t.y - 1);
+    float along_x = length(duv_dx * size);
+    float along_y = length(duv_dy * size);
+    if (isnan(along_x) || isnan(along_y)) return top;
+    float rho = max(along_x, along_y);
+    return rho <= 1.0 ? 0.0 : min(log2(rho), top);
+}
+
+// Texture::sample with the material's filter and wrap; `uv` and the
+// footprint unscaled (uv_scale applied here, as Material::scaled does).
+vec3 sample_texture(ivec2 t, vec2 uv, vec2 duv_dx, vec2 duv_dy) {
+    vec2 s = uv * uv_scale;
+    if (texture_filter == 0) return nearest_at(t, s, wrap_clamp);
+    if (texture_filter == 1) return bilinear_at(t, 0, s, wrap_clamp, wrap_clamp);
+    float lambda = level_of_detail(t, duv_dx * uv_scale, duv_dy * uv_scale);
+    float base = floor(lambda);
+    int fine = int(base);
+    float blend = lambda - base;
+    vec3 a = bilinear_at(t, fine, s, wrap_clamp, wrap_clamp);
+    if (blend == 0.0) return a;
+    int coarse = min(fine + 1, t.y - 1);
+    return lerp3(a, bilinear_at(t, coarse, s, wrap_clamp, wrap_clamp), blend);
 }
 
 vec3 albedo_at(uint m, vec2 uv, vec2 duv_dx, vec2 duv_dy) {
     vec3 k = materials[3u * m].xyz;
     if (!has_albedo_map) return k;
-    float lod = level_of_detail(vec2(textureSize(albedo_map, 0)), duv_dx, duv_dy);
-    return k * textureLod(albedo_map, tex_coord(uv), lod).rgb;
+    return k * sample_texture(albedo_map, uv, duv_dx, duv_dy);
 }
 
 vec3 normal_texel(vec2 uv, vec2 duv_dx, vec2 duv_dy) {
-    float lod = level_of_detail(vec2(textureSize(normal_map, 0)), duv_dx, duv_dy);
-    return textureLod(normal_map, tex_coord(uv), lod).rgb;
+    return sample_texture(normal_map, uv, duv_dx, duv_dy);
 }
 
 // normal_map::mapped_normal: n bent by the texel in the frame of tangent t
@@ -88,9 +197,10 @@ vec3 mapped_normal(vec3 n, vec3 t, float w, vec3 texel) {
 
 vec3 miss_radiance(vec3 dir) {
     if (!has_environment) return background;
-    float u = 0.5 + (dir.x == 0.0 && dir.z == 0.0 ? 0.0 : atan(dir.x, -dir.z)) * (0.5 / PI);
-    float v = 0.5 + asin(clamp(dir.y, -1.0, 1.0)) / PI;
-    vec3 c = textureLod(environment, vec2(u, 1.0 - v), 0.0).rgb * environment_intensity;
+    float u = 0.5 + (dir.x == 0.0 && dir.z == 0.0 ? 0.0 : precise_atan2(dir.x, -dir.z)) * (0.5 / PI);
+    float v = 0.5 + precise_asin(clamp(dir.y, -1.0, 1.0)) / PI;
+    // Environment::radiance: level 0, bilinear, repeating around, clamped at the poles.
+    vec3 c = bilinear_at(environment, 0, vec2(u, v), false, true) * environment_intensity;
     return any(isnan(c)) || any(isinf(c)) ? vec3(0.0) : c;
 }
 
@@ -235,13 +345,33 @@ vec3 shade(vec3 p, vec3 n, vec3 g, vec3 w_o, uint m, vec3 albedo) {
 }
 "#;
 
-pub const TRIANGLE_VERTEX: &str = r#"#version 450 core
+/// The triangles' vertex shader; with `INSTANCED` defined, the two-level
+/// layer's copies: each vertex of the shared mesh placed by the copy's
+/// matrix in the very order of operations `Placement::apply` uses
+/// (`precise`: no fused multiply-adds), so a copy's triangles land where
+/// flattening would put them.
+pub fn triangle_vertex(defines: &str) -> String {
+    format!(
+        "#version 450 core\n{defines}{}",
+        r#"
 layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;
 layout(location = 2) in vec3 face_normal;
 layout(location = 3) in uint material;
 layout(location = 4) in vec2 uv;
 layout(location = 5) in vec4 tangent;
+#ifdef INSTANCED
+// Per copy: the placement's matrix columns, its normal matrix columns,
+// (first virtual triangle less the mesh's first, material or ~0, mirrors).
+layout(location = 6) in vec3 m0;
+layout(location = 7) in vec3 m1;
+layout(location = 8) in vec3 m2;
+layout(location = 9) in vec3 m3;
+layout(location = 10) in vec3 n0;
+layout(location = 11) in vec3 n1;
+layout(location = 12) in vec3 n2;
+layout(location = 13) in uvec3 copy;
+#endif
 uniform vec3 eye;
 uniform mat3 world_to_camera;
 uniform vec2 half_extent;
@@ -260,25 +390,58 @@ out vec3 v_tangent;
 flat out float v_handedness;
 out vec3 v_corner;
 flat out uint v_primitive;
+
+// glam's normalize_or_zero.
+vec3 normalize_or_zero_v(vec3 v) {
+    float r = 1.0 / length(v);
+    return !isinf(r) && !isnan(r) && r > 0.0 ? v * r : vec3(0.0);
+}
+
 void main() {
-    vec3 c = world_to_camera * (position - eye);
+    int k = gl_VertexID % 3;
+#ifdef INSTANCED
+    // Mat4::transform_point3: ((x_axis x + y_axis y) + z_axis z) + w_axis.
+    precise vec3 p = m0 * position.x;
+    p = m1 * position.y + p;
+    p = m2 * position.z + p;
+    p = m3 + p;
+    precise vec3 nn = n0 * normal.x;
+    nn = n1 * normal.y + nn;
+    nn = n2 * normal.z + nn;
+    vec3 world_normal = normalize_or_zero_v(nn);
+    // The face normal of the placed corners is the normal matrix's image
+    // of the mesh's (mirrored corners are swapped back, so it keeps its side).
+    vec3 world_face = normalize(mat3(n0, n1, n2) * face_normal);
+    uint world_material = copy.y == 0xffffffffu ? material : copy.y;
+    // A mirroring placement swaps corners 1 and 2.
+    if (copy.z != 0u && k != 0) k = 3 - k;
+    uint primitive = copy.x + uint(gl_VertexID / 3);
+#else
+    vec3 p = position;
+    vec3 world_normal = normal;
+    vec3 world_face = face_normal;
+    uint world_material = material;
+    uint primitive = uint(gl_VertexID / 3);
+#endif
+    vec3 c = world_to_camera * (p - eye);
     float w = -c.z;
     // Reversed depth with glClipControl(ZERO_TO_ONE): near -> 1, far -> 0.
     float z = near_plane * (far_plane - w) / (far_plane - near_plane);
     gl_Position = vec4(c.x / half_extent.x + ndc_shift.x * w, (c.y / half_extent.y + ndc_shift.y * w) * (y_down ? -1.0 : 1.0), z, w);
-    v_position = position;
-    v_normal = normal;
-    v_face_normal = face_normal;
-    v_material = material;
+    v_position = p;
+    v_normal = world_normal;
+    v_face_normal = world_face;
+    v_material = world_material;
     v_uv = uv;
     v_tangent = tangent.xyz;
     v_handedness = tangent.w;
     // One-hot per corner: interpolated, the barycentric weights.
-    int k = gl_VertexID % 3;
     v_corner = vec3(k == 0, k == 1, k == 2);
-    v_primitive = uint(gl_VertexID / 3);
+    v_primitive = primitive;
 }
-"#;
+"#
+    )
+}
 
 pub fn triangle_fragment(defines: &str) -> String {
     format!(
@@ -413,7 +576,7 @@ void main() {
     vec3 o = (p - s.xyz) / s.w;
     float w = dot(p - eye, -camera_to_world[2]);
     // Scene::sphere_hit's uv: u around +y, v from the south pole up.
-    vec2 uv = vec2(0.5 + (o.x == 0.0 && o.z == 0.0 ? 0.0 : atan(o.z, o.x)) * (-0.5 / PI), 0.5 + asin(clamp(o.y, -1.0, 1.0)) / PI);
+    vec2 uv = vec2(0.5 + (o.x == 0.0 && o.z == 0.0 ? 0.0 : precise_atan2(o.z, o.x)) * (-0.5 / PI), 0.5 + precise_asin(clamp(o.y, -1.0, 1.0)) / PI);
     // Its footprint from the camera ray's differentials carried to the
     // tangent plane (Igehy), as the ray casters do: the 2x2 quad's
     // differences would straddle the silhouette and the u seam.
@@ -566,3 +729,322 @@ void main() {
     stored = t;
 }
 "#;
+
+/// A CSG object's bounding box, drawn as the spheres' cube is (both sides,
+/// depth clamped), so that every pixel whose eye ray can meet it gets a
+/// fragment.
+pub const CSG_VERTEX: &str = r#"#version 450 core
+layout(location = 0) in vec3 corner;
+layout(std430, binding = 6) readonly buffer CsgObjects { vec4 csg_objects[]; };
+uniform vec3 eye;
+uniform mat3 world_to_camera;
+uniform vec2 half_extent;
+uniform vec2 ndc_shift;
+uniform bool y_down;
+uniform float near_plane;
+uniform float far_plane;
+uniform int csg_object;
+void main() {
+    vec3 lo = csg_objects[3 * csg_object + 1].xyz;
+    vec3 hi = csg_objects[3 * csg_object + 2].xyz;
+    // A little larger than the bounds, so that the object is always inside.
+    vec3 half_size = (hi - lo) * 0.5;
+    vec3 grow = half_size * 0.01 + vec3(1e-4 * length(half_size) + 1e-6);
+    vec3 position = (lo + hi) * 0.5 + corner * (half_size + grow);
+    vec3 c = world_to_camera * (position - eye);
+    float w = -c.z;
+    float z = near_plane * (far_plane - w) / (far_plane - near_plane);
+    gl_Position = vec4(c.x / half_extent.x + ndc_shift.x * w, (c.y / half_extent.y + ndc_shift.y * w) * (y_down ? -1.0 : 1.0), z, w);
+}
+"#;
+
+/// The CSG objects (`render::csg` in GLSL): along the fragment's eye ray
+/// each operand's inside intervals over the whole line (a sphere's two
+/// roots; a closed mesh's crossings by the two-sided Möller-Trumbore test,
+/// counted into intervals), combined by a stack machine running the tree's
+/// postfix program (`csg_data`), each operation one sweep over the sorted
+/// boundaries of its two operands; the first boundary of the result with
+/// `0 < t < t_max` is the hit, shaded as `render::csg::surface_hit` makes it
+/// and written to `gl_FragDepth`. Lists are held in fixed arrays: an
+/// operand with more than `MAX_IV` intervals or a mesh crossed more than
+/// `MAX_CROSS` times along one ray loses the farthest.
+pub fn csg_fragment(defines: &str) -> String {
+    format!(
+        "#version 450 core\n{defines}#define PER_SAMPLE 1\n{COMMON}{}",
+        r#"
+layout(std430, binding = 6) readonly buffer CsgObjects { vec4 csg_objects[]; };
+layout(std430, binding = 7) readonly buffer CsgNodes { uvec4 csg_nodes[]; };
+layout(std430, binding = 8) readonly buffer CsgSpheres { vec4 csg_spheres[]; };
+layout(std430, binding = 9) readonly buffer CsgTriangles { vec4 csg_triangles[]; };
+uniform int csg_object;
+layout(location = 0) out vec4 colour;
+
+#define MAX_IV 8
+#define MAX_CROSS 16
+#define MAX_STACK 4
+#define MAX_EVENTS (4 * MAX_IV)
+
+// A boundary: t, then the surface (sphere index, or triangle index and the
+// weights of v1 and v2), its leaf and whether it is flipped.
+struct Bd { float t; float b1; float b2; int surface; bool triangle; int leaf; bool flipped; };
+
+Bd stack_enter[MAX_STACK][MAX_IV];
+Bd stack_exit[MAX_STACK][MAX_IV];
+int stack_count[MAX_STACK];
+
+vec3 ray_origin;
+vec3 ray_dir;
+
+// A sphere's interval over the whole line, as `sphere_interval`.
+bool sphere_interval(vec3 centre, float radius, out float t0, out float t1) {
+    vec3 f = ray_origin - centre;
+    float b = -dot(f, ray_dir);
+    vec3 l = f + ray_dir * b;
+    float dist = length(l);
+    float disc = (radius - dist) * (radius + dist);
+    if (!(disc >= 0.0)) return false;
+    float h = sqrt(disc);
+    t0 = b - h;
+    t1 = b + h;
+    return true;
+}
+
+// The two-sided Möller-Trumbore test over the whole line, as `crossing`.
+bool crossing(vec3 v0, vec3 e1, vec3 e2, out float t, out float b1, out float b2, out bool entering) {
+    vec3 p = cross(ray_dir, e2);
+    float det = dot(e1, p);
+    float epsilon = 8.0 * 1.1920929e-7 * length(e1) * length(e2);
+    if (!(abs(det) > epsilon)) return false;
+    float inv = 1.0 / det;
+    vec3 s = ray_origin - v0;
+    b1 = dot(s, p) * inv;
+    if (!(b1 >= 0.0 && b1 <= 1.0)) return false;
+    vec3 q = cross(s, e1);
+    b2 = dot(ray_dir, q) * inv;
+    if (b2 < 0.0 || b1 + b2 > 1.0) return false;
+    t = dot(e2, q) * inv;
+    entering = det > 0.0;
+    return !isnan(t) && !isinf(t);
+}
+
+// Sort order of crossings: by t, entries first at equal t (stable).
+bool crossing_before(Bd a, bool ea, Bd b, bool eb) {
+    return a.t < b.t || (a.t == b.t && ea && !eb);
+}
+
+// Pushes a mesh leaf's intervals (`mesh_intervals`) on stack slot `s`.
+void mesh_intervals(int s, int first, int end, int leaf, bool flipped) {
+    Bd cross_at[MAX_CROSS];
+    bool enters[MAX_CROSS];
+    int n = 0;
+    for (int i = first; i < end; i++) {
+        vec3 v0 = csg_triangles[8 * i].xyz;
+        vec3 v1 = csg_triangles[8 * i + 1].xyz;
+        vec3 v2 = csg_triangles[8 * i + 2].xyz;
+        float t, b1, b2;
+        bool entering;
+        if (!crossing(v0, v1 - v0, v2 - v0, t, b1, b2, entering)) continue;
+        Bd b = Bd(t, b1, b2, i, true, leaf, flipped);
+        // Insertion in sorted place (stable); past MAX_CROSS the farthest is lost.
+        int k = min(n, MAX_CROSS - 1);
+        if (n == MAX_CROSS && !crossing_before(b, entering, cross_at[k], enters[k])) continue;
+        while (k > 0 && crossing_before(b, entering, cross_at[k - 1], enters[k - 1])) {
+            cross_at[k] = cross_at[k - 1];
+            enters[k] = enters[k - 1];
+            k--;
+        }
+        cross_at[k] = b;
+        enters[k] = entering;
+        n = min(n + 1, MAX_CROSS);
+    }
+    int depth = 0;
+    bool started = false;
+    Bd start;
+    int count = 0;
+    for (int i = 0; i < n; i++) {
+        if (enters[i]) {
+            depth++;
+            if (depth == 1) {
+                start = cross_at[i];
+                started = true;
+            }
+        } else {
+            depth--;
+            if (depth == 0 && started && count < MAX_IV) {
+                stack_enter[s][count] = start;
+                stack_exit[s][count] = cross_at[i];
+                count++;
+                started = false;
+            } else if (depth == 0) {
+                started = false;
+            }
+            depth = max(depth, 0);
+        }
+    }
+    stack_count[s] = count;
+}
+
+bool op_inside(uint op, bool a, bool b) {
+    if (op == 2u) return a || b;
+    if (op == 3u) return a && b;
+    return a && !b;
+}
+
+// Combines stack slots `s` (a) and `s + 1` (b) into `s` by one sweep
+// (`combine`): events sorted by t, entries first, then a's first (stable).
+void combine(uint op, int s) {
+    Bd ev[MAX_EVENTS];
+    bool ev_b[MAX_EVENTS];
+    bool ev_enter[MAX_EVENTS];
+    int n = 0;
+    for (int side = 0; side < 2; side++) {
+        int slot = s + side;
+        for (int i = 0; i < stack_count[slot]; i++) {
+            for (int e = 0; e < 2; e++) {
+                Bd b = e == 0 ? stack_enter[slot][i] : stack_exit[slot][i];
+                bool entering = e == 0;
+                bool from_b = side == 1;
+                int k = n;
+                while (k > 0) {
+                    Bd p = ev[k - 1];
+                    bool before = b.t < p.t || (b.t == p.t && ((entering && !ev_enter[k - 1]) || (entering == ev_enter[k - 1] && !from_b && ev_b[k - 1])));
+                    if (!before) break;
+                    ev[k] = ev[k - 1];
+                    ev_b[k] = ev_b[k - 1];
+                    ev_enter[k] = ev_enter[k - 1];
+                    k--;
+                }
+                ev[k] = b;
+                ev_b[k] = from_b;
+                ev_enter[k] = entering;
+                n++;
+            }
+        }
+    }
+    int in_a = 0, in_b = 0;
+    bool started = false;
+    Bd start;
+    int count = 0;
+    for (int i = 0; i < n; i++) {
+        bool was = op_inside(op, in_a > 0, in_b > 0);
+        int d = ev_enter[i] ? 1 : -1;
+        if (ev_b[i]) in_b += d; else in_a += d;
+        bool now = op_inside(op, in_a > 0, in_b > 0);
+        if (!was && now) {
+            start = ev[i];
+            started = true;
+        } else if (was && !now) {
+            if (started && count < MAX_IV) {
+                stack_enter[s][count] = start;
+                stack_exit[s][count] = ev[i];
+                count++;
+            }
+            started = false;
+        }
+    }
+    stack_count[s] = count;
+}
+
+void main() {
+    vec3 d = camera_dir();
+    ray_dir = normalize(camera_to_world * d);
+    ray_origin = eye + camera_to_world * (d * near_plane);
+    float t_max = (far_plane - near_plane) * length(d);
+    uvec4 header = floatBitsToUint(csg_objects[3 * csg_object]);
+    int first = int(header.x), count = int(header.y);
+    int top = 0;
+    int leaf = 0;
+    for (int i = first; i < first + count; i++) {
+        uvec4 node = csg_nodes[i];
+        bool flipped = node.w != 0u;
+        if (node.x == 0u) {
+            if (top >= MAX_STACK) discard;
+            vec4 s = csg_spheres[2 * node.y];
+            float t0, t1;
+            if (sphere_interval(s.xyz, s.w, t0, t1)) {
+                stack_enter[top][0] = Bd(t0, 0.0, 0.0, int(node.y), false, leaf, flipped);
+                stack_exit[top][0] = Bd(t1, 0.0, 0.0, int(node.y), false, leaf, flipped);
+                stack_count[top] = 1;
+            } else {
+                stack_count[top] = 0;
+            }
+            top++;
+            leaf++;
+        } else if (node.x == 1u) {
+            if (top >= MAX_STACK) discard;
+            mesh_intervals(top, int(node.y), int(node.z), leaf, flipped);
+            top++;
+            leaf++;
+        } else {
+            if (top < 2) discard;
+            combine(node.x, top - 2);
+            top--;
+        }
+    }
+    if (top != 1) discard;
+    // first_boundary, for rays that start outside.
+    bool found = false;
+    Bd hit;
+    for (int i = 0; i < stack_count[0]; i++) {
+        Bd e = stack_enter[0][i];
+        if (e.t > 0.0) {
+            if (e.t < t_max) {
+                hit = e;
+                found = true;
+            }
+            break;
+        }
+    }
+    if (!found) discard;
+    // surface_hit.
+    vec3 p;
+    vec3 outward;
+    vec3 shading;
+    vec2 uv;
+    vec3 bary = vec3(0.0);
+    uint m;
+    if (!hit.triangle) {
+        vec4 s = csg_spheres[2 * hit.surface];
+        m = floatBitsToUint(csg_spheres[2 * hit.surface + 1].x);
+        p = ray_origin + ray_dir * hit.t;
+        vec3 o = (p - s.xyz) / s.w;
+        float lo = length(o);
+        outward = lo > 0.0 && !isinf(lo) ? o / lo : vec3(0.0, 1.0, 0.0);
+        uv = vec2(0.5 + precise_atan2(outward.z, outward.x) * -0.5 * (1.0 / PI), 0.5 + precise_asin(clamp(outward.y, -1.0, 1.0)) * (1.0 / PI));
+    } else {
+        int i = hit.surface;
+        vec3 v0 = csg_triangles[8 * i].xyz;
+        vec3 v1 = csg_triangles[8 * i + 1].xyz;
+        vec3 v2 = csg_triangles[8 * i + 2].xyz;
+        m = floatBitsToUint(csg_triangles[8 * i].w);
+        vec3 w = vec3(1.0 - hit.b1 - hit.b2, hit.b1, hit.b2);
+        p = v0 * w.x + v1 * w.y + v2 * w.z;
+        outward = normalize(cross(v1 - v0, v2 - v0));
+        vec3 ns = csg_triangles[8 * i + 3].xyz * w.x + csg_triangles[8 * i + 4].xyz * w.y + csg_triangles[8 * i + 5].xyz * w.z;
+        float ls = length(ns);
+        shading = ls > 0.0 && !isinf(ls) ? ns / ls : outward;
+        vec4 uv01 = csg_triangles[8 * i + 6];
+        uv = uv01.xy * w.x + uv01.zw * w.y + csg_triangles[8 * i + 7].xy * w.z;
+        bary = w;
+    }
+    if (!hit.triangle) shading = outward;
+    float sign = hit.flipped ? -1.0 : 1.0;
+    vec3 g = outward * sign;
+    vec3 n = shading * sign;
+    bool back = dot(g, ray_dir) > 0.0;
+    if (back) {
+        g = -g;
+        n = -n;
+    }
+#ifdef VIEWS
+    write_surface(p, n, back, g, bary, uv, 2u, uint(csg_object));
+    out_id.z = m;
+#endif
+    float depth = dot(p - eye, -camera_to_world[2]);
+    gl_FragDepth = clamp(near_plane * (far_plane - depth) / ((far_plane - near_plane) * depth), 0.0, 1.0);
+    // CSG hits carry no footprint: the finest texture level.
+    colour = vec4(shade(p, n, g, -ray_dir, m, albedo_at(m, uv, vec2(0.0), vec2(0.0))), 1.0);
+}
+"#
+    )
+}

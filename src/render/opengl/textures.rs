@@ -1,91 +1,99 @@
-//! The scene's textures as GL textures: each material texture, normal map
-//! and the environment uploaded once as RGBA32F with the CPU's own mip
-//! pyramid (one `glTexImage2D` per level, so GL filters the very texels
-//! `Texture::sample` reads), and the filter and wrap state a draw needs.
+//! The scene's textures as the shaders read them: every level of each
+//! material texture, normal map and the environment, the CPU's own pyramid,
+//! in one shader storage buffer of linear RGB floats, and a table of levels
+//! (where each starts, its width and height). The shaders address and
+//! filter the texels themselves, in float, as `Texture::sample` does
+//! (`shaders::sample_texture`); no sampler state, level selection or
+//! fixed-point filter weights of the driver take part.
 
-use crate::scene::texture::{Texture, TextureFilter, Wrap};
+use crate::scene::texture::Texture;
 use glow::HasContext;
 use std::sync::Arc;
 
-/// The texture unit uploads bind to; the draws use lower ones.
-const UPLOAD_UNIT: u32 = 7;
+/// Storage-buffer bindings of the texels and of the level table.
+pub const TEXEL_BINDING: u32 = 4;
+pub const LEVEL_BINDING: u32 = 5;
 
-/// Uploaded textures, kept while the scene holds them. The `Arc` held
-/// here keeps its address from being reused by another texture.
-#[derive(Default)]
+/// The uploaded textures: each one's first row in the level table and its
+/// level count. The `Arc` held here keeps its address from being reused
+/// by another texture.
 pub struct Textures {
-    uploaded: Vec<(Arc<Texture>, glow::Texture)>,
+    uploaded: Vec<(Arc<Texture>, i32, i32)>,
+    texels: glow::Buffer,
+    levels: glow::Buffer,
 }
 
 impl Textures {
-    /// The GL texture holding `t`, uploaded on first use.
-    pub unsafe fn get(&mut self, gl: &glow::Context, t: &Arc<Texture>) -> Result<glow::Texture, String> {
-        if let Some((_, id)) = self.uploaded.iter().find(|(u, _)| Arc::ptr_eq(u, t)) {
-            return Ok(*id);
+    pub unsafe fn new(gl: &glow::Context) -> Result<Textures, String> {
+        unsafe {
+            let t = Textures { uploaded: Vec::new(), texels: gl.create_buffer()?, levels: gl.create_buffer()? };
+            t.upload(gl)?;
+            Ok(t)
+        }
+    }
+
+    /// Makes the buffers hold exactly `keep` (a scene loaded or edited
+    /// since: rebuilt whole) and binds them.
+    pub unsafe fn prepare(&mut self, gl: &glow::Context, keep: &[&Arc<Texture>]) -> Result<(), String> {
+        let same = self.uploaded.len() == keep.len() && self.uploaded.iter().zip(keep).all(|((u, _, _), k)| Arc::ptr_eq(u, k));
+        if !same {
+            let mut first = 0;
+            self.uploaded = keep
+                .iter()
+                .map(|t| {
+                    let entry = ((*t).clone(), first, t.levels.len() as i32);
+                    first += t.levels.len() as i32;
+                    entry
+                })
+                .collect();
+            unsafe { self.upload(gl)? };
         }
         unsafe {
-            let id = gl.create_texture()?;
-            // A unit of its own, so that no texture bound for drawing is replaced.
-            gl.active_texture(glow::TEXTURE0 + UPLOAD_UNIT);
-            gl.bind_texture(glow::TEXTURE_2D, Some(id));
-            gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 4);
-            for (level, l) in t.levels.iter().enumerate() {
-                let mut texels = Vec::with_capacity(l.texels.len() * 4);
-                // Row 0 (the top) first: GL's t = 1 - v, as `MipLevel::position` reads.
-                for c in &l.texels {
-                    texels.extend_from_slice(&[c.x, c.y, c.z, 1.0]);
-                }
-                gl.tex_image_2d(
-                    glow::TEXTURE_2D,
-                    level as i32,
-                    glow::RGBA32F as i32,
-                    l.width as i32,
-                    l.height as i32,
-                    0,
-                    glow::RGBA,
-                    glow::FLOAT,
-                    glow::PixelUnpackData::Slice(Some(super::pass::bytes(&texels))),
-                );
-            }
-            gl.tex_parameter_i32(glow::TEXTURE_2D, glow::TEXTURE_BASE_LEVEL, 0);
-            gl.tex_parameter_i32(glow::TEXTURE_2D, glow::TEXTURE_MAX_LEVEL, t.levels.len() as i32 - 1);
-            self.uploaded.push((t.clone(), id));
-            Ok(id)
+            gl.bind_buffer_base(glow::SHADER_STORAGE_BUFFER, TEXEL_BINDING, Some(self.texels));
+            gl.bind_buffer_base(glow::SHADER_STORAGE_BUFFER, LEVEL_BINDING, Some(self.levels));
         }
+        Ok(())
     }
 
-    /// Forgets the textures no longer in `keep` (a scene replaced).
-    pub unsafe fn retain(&mut self, gl: &glow::Context, keep: &[&Arc<Texture>]) {
-        self.uploaded.retain(|(t, id)| {
-            let kept = keep.iter().any(|k| Arc::ptr_eq(k, t));
-            if !kept {
-                unsafe { gl.delete_texture(*id) };
+    /// `t`'s (first level, level count) for the shaders' `ivec2` texture
+    /// uniforms; (0, 0) when it is not uploaded.
+    pub fn handle(&self, t: &Arc<Texture>) -> (i32, i32) {
+        self.uploaded.iter().find(|(u, _, _)| Arc::ptr_eq(u, t)).map_or((0, 0), |&(_, first, count)| (first, count))
+    }
+
+    unsafe fn upload(&self, gl: &glow::Context) -> Result<(), String> {
+        let mut texels: Vec<f32> = Vec::new();
+        let mut levels: Vec<i32> = Vec::new();
+        for (t, _, _) in &self.uploaded {
+            for l in &t.levels {
+                levels.extend_from_slice(&[(texels.len() / 3) as i32, l.width as i32, l.height as i32, 0]);
+                // Row 0 (the top) first, as `MipLevel::texels` holds them.
+                for c in &l.texels {
+                    texels.extend_from_slice(&[c.x, c.y, c.z]);
+                }
             }
-            kept
-        });
-    }
-}
-
-/// Binds `texture` to `unit` with the filter and addressing the CPU's
-/// `Texture::sample` uses: nearest and bilinear read level 0 only
-/// (GL_NEAREST, GL_LINEAR), trilinear blends two levels
-/// (GL_LINEAR_MIPMAP_LINEAR, magnified: GL_LINEAR).
-pub unsafe fn bind(gl: &glow::Context, unit: u32, texture: glow::Texture, filter: TextureFilter, wrap_s: Wrap, wrap_t: Wrap) {
-    let (min, mag) = match filter {
-        TextureFilter::Nearest => (glow::NEAREST, glow::NEAREST),
-        TextureFilter::Bilinear => (glow::LINEAR, glow::LINEAR),
-        TextureFilter::Trilinear => (glow::LINEAR_MIPMAP_LINEAR, glow::LINEAR),
-    };
-    let address = |w: Wrap| match w {
-        Wrap::Repeat => glow::REPEAT,
-        Wrap::Clamp => glow::CLAMP_TO_EDGE,
-    } as i32;
-    unsafe {
-        gl.active_texture(glow::TEXTURE0 + unit);
-        gl.bind_texture(glow::TEXTURE_2D, Some(texture));
-        gl.tex_parameter_i32(glow::TEXTURE_2D, glow::TEXTURE_MIN_FILTER, min as i32);
-        gl.tex_parameter_i32(glow::TEXTURE_2D, glow::TEXTURE_MAG_FILTER, mag as i32);
-        gl.tex_parameter_i32(glow::TEXTURE_2D, glow::TEXTURE_WRAP_S, address(wrap_s));
-        gl.tex_parameter_i32(glow::TEXTURE_2D, glow::TEXTURE_WRAP_T, address(wrap_t));
+        }
+        if texels.len() / 3 > i32::MAX as usize / 3 {
+            return Err("the scene's textures are too large for the opengl renderer's texel buffer".into());
+        }
+        // GL refuses empty buffers as storage blocks.
+        if texels.is_empty() {
+            texels.resize(3, 0.0);
+        }
+        if levels.is_empty() {
+            levels.resize(4, 0);
+        }
+        unsafe {
+            let max = gl.get_parameter_i64(glow::MAX_SHADER_STORAGE_BLOCK_SIZE);
+            if (texels.len() * 4) as i64 > max {
+                return Err(format!("the scene's textures take {} MB, more than the driver's {} MB storage buffers", texels.len() * 4 >> 20, max >> 20));
+            }
+            gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(self.texels));
+            gl.buffer_data_u8_slice(glow::SHADER_STORAGE_BUFFER, super::pass::bytes(&texels), glow::STATIC_DRAW);
+            gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(self.levels));
+            let level_bytes = std::slice::from_raw_parts(levels.as_ptr().cast::<u8>(), std::mem::size_of_val(levels.as_slice()));
+            gl.buffer_data_u8_slice(glow::SHADER_STORAGE_BUFFER, level_bytes, glow::STATIC_DRAW);
+        }
+        Ok(())
     }
 }

@@ -72,12 +72,19 @@ impl Readback {
         let (kind, primitive) = (self.ids[i], self.ids[i + 1]);
         let (kind, object, material) = match kind {
             1 => {
-                let t = scene.triangles.get(primitive as usize)?;
+                if primitive as u64 >= scene.total_triangles() {
+                    return None;
+                }
+                let t = scene.triangle(primitive);
                 (PrimitiveKind::Triangle, t.object, t.material)
             }
             2 => {
                 let s = scene.spheres.get(primitive as usize)?;
                 (PrimitiveKind::Sphere, s.object, s.material)
+            }
+            3 => {
+                let c = scene.csgs.get(primitive as usize)?;
+                (PrimitiveKind::Csg, c.object, self.ids[i + 2])
             }
             _ => return None,
         };
