@@ -337,16 +337,15 @@ fn forest_renders_in_both_families_and_they_agree() {
     // Nearly all of the copies drawn are a few pixels tall here, made of
     // triangles far below a pixel: with every triangle snapped to the
     // sub-pixel grid, 4.8% of the pixels differed (`raster/small.rs`).
-    // The agreement rule's 99.5% holds, in both fixed-point variants, which
-    // give the same image.
+    // The agreement rule's 99.5% holds (`rasterize:tiled` draws the same
+    // triangles the same way: the forest-100 test below; 1280x720:
+    // tests/forest_memory.rs).
     let raster = frame("rasterize", &prepared, &settings);
     let drawn = raster.counts.instances_drawn;
     assert!((2000..5000).contains(&drawn) && drawn + raster.counts.instances_culled == 10_000, "{drawn} drawn");
     let d = differing(&ray.pixels, &raster.pixels);
     println!("forest 160x90: raytrace against rasterize: {} of {n} pixels differ; {drawn} copies drawn", d.len());
     assert!(d.len() as f64 <= 0.005 * n as f64, "rasterize: {} of {n} pixels differ", d.len());
-    let tiled = frame("rasterize:tiled", &prepared, &settings);
-    assert!(tiled.pixels == raster.pixels, "rasterize:tiled differs from rasterize:fixed");
 }
 
 #[test]
