@@ -363,3 +363,36 @@ fn forest_100_agrees_across_the_families_at_1280x720() {
         assert!(d.len() as f64 <= 1e-4 * n as f64, "{renderer}: {} of {n} pixels differ", d.len());
     }
 }
+
+#[test]
+fn grove_copies_out_of_view_cost_the_ray_tracer_the_log_of_their_count() {
+    // The grove scenes hold 100, 1,000 and 10,000 copies at one density; the
+    // view holds only copies among the first 100, so every frame is the same
+    // frame, and what more copies add is the depth of the BVH over them.
+    let mut per_ray = Vec::new();
+    let mut first: Option<Vec<[u32; 3]>> = None;
+    for (name, count) in [("grove-100", 100), ("grove-1000", 1_000), ("grove-10000", 10_000)] {
+        let prepared = PreparedScene::new(common::builtin(name));
+        assert_eq!(prepared.scene.instances.len(), count);
+        let mut settings = RenderSettings::for_scene(&prepared.scene);
+        (settings.width, settings.height) = (160, 90);
+        let f = frame("raytrace", &prepared, &settings);
+        let image = bits(&f.pixels);
+        match &first {
+            None => first = Some(image),
+            Some(a) => assert!(*a == image, "{name}: not the image of grove-100"),
+        }
+        let raster = frame("rasterize", &prepared, &settings);
+        assert_eq!(raster.counts.instances_drawn + raster.counts.instances_culled, count as u64);
+        assert!(raster.counts.instances_drawn < 100, "{name}: {} copies drawn", raster.counts.instances_drawn);
+        let c = f.counts;
+        per_ray.push(c.nodes as f64 / (c.primary + c.shadow) as f64);
+    }
+    println!("grove 160x90: BVH nodes visited per ray at 100, 1,000, 10,000 copies: {per_ray:?}");
+    // Each tenfold adds a few levels (log2 10 = 3.3) to the paths rays take
+    // through the BVH over the copies: more nodes, but nothing like tenfold.
+    for w in per_ray.windows(2) {
+        let added = w[1] - w[0];
+        assert!(added > 0.5 && added < 8.0, "{per_ray:?}");
+    }
+}
