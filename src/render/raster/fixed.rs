@@ -95,7 +95,9 @@ impl FixedTri {
     /// `small::LIMIT` units on both axes is kept for the ray test (`ray`),
     /// whatever its snapped area, with its float box grown by a pixel (as
     /// `rasterize:bbox` grows it) so that the 3D test can reach every sample
-    /// it would hit.
+    /// it would hit. Its edge functions are still those of its snapped
+    /// vertices (all zero when they are collinear), for the painter's
+    /// overlap test.
     pub fn new_or_small(st: &ScreenTri, off: [i64; 2], sample_off: Vec2, width: u32, height: u32) -> Option<FixedTri> {
         let v = st.p.map(|p| [snap(p.x), snap(p.y)]);
         let extent = |i: usize| v.iter().map(|p| p[i]).max().unwrap() - v.iter().map(|p| p[i]).min().unwrap();
@@ -103,7 +105,10 @@ impl FixedTri {
             return FixedTri::new(st, off, sample_off, width, height);
         }
         let bbox = st.bbox.grown(1, width, height);
-        Some(FixedTri { st: *st, v, a: [0; 3], b: [0; 3], bias: [1; 3], sample_off, bbox, wide: false, ray: true })
+        Some(match FixedTri::new(st, off, sample_off, width, height) {
+            Some(ft) => FixedTri { bbox, ray: true, ..ft },
+            None => FixedTri { st: *st, v, a: [0; 3], b: [0; 3], bias: [1; 3], sample_off, bbox, wide: false, ray: true },
+        })
     }
 
     /// Exact edge function k at the snapped sample point `(sx, sy)`.
@@ -136,21 +141,16 @@ impl FixedTri {
     }
 }
 
-/// Every triangle of the pass snapped (in order; dropped when degenerate after snapping).
-/// The pass's triangles set up and snapped, run by run (`setup::setup_pass_map`):
-/// the same list as `snap_triangles(&setup_pass(job), ..)`.
-pub fn setup_snapped(job: &crate::render::PassJob, sample_off: Vec2, width: u32, height: u32) -> Vec<FixedTri> {
-    let off = snap_offset(sample_off);
-    super::setup::setup_pass_map(job, |st| FixedTri::new(&st, off, sample_off, width, height))
-}
-
-/// `setup_snapped`, with the triangles too small for the grid kept for the
-/// ray test (`FixedTri::new_or_small`): the list `fixed` and `tiled` draw.
+/// The pass's triangles set up and snapped, run by run (`setup::setup_pass_map`),
+/// in order: those under half a pixel kept for the ray test, the others
+/// dropped when degenerate after snapping (`FixedTri::new_or_small`). The
+/// list `fixed`, `tiled` and the painter draw.
 pub fn setup_snapped_or_small(job: &crate::render::PassJob, sample_off: Vec2, width: u32, height: u32) -> Vec<FixedTri> {
     let off = snap_offset(sample_off);
     super::setup::setup_pass_map(job, |st| FixedTri::new_or_small(&st, off, sample_off, width, height))
 }
 
+/// Every triangle snapped (in order; dropped when degenerate after snapping).
 pub fn snap_triangles(tris: &[ScreenTri], sample_off: Vec2, width: u32, height: u32) -> Vec<FixedTri> {
     use rayon::prelude::*;
     let off = snap_offset(sample_off);

@@ -117,7 +117,7 @@ impl<'a> Layer<'a> {
                 // The order is made over the whole image, whatever rows this
                 // job renders, so a band shows what the frame shows.
                 let frame = job_at_offset(&job, offset, 0..h);
-                let fts = fixed::setup_snapped(&frame, offset, w, h);
+                let fts = fixed::setup_snapped_or_small(&frame, offset, w, h);
                 let (order, _) = painter::draw_order(&frame, &fts, &spheres);
                 let rects = order.iter().map(|p| match *p {
                     Paint::Triangle(t) => fts[t as usize].bbox,
@@ -204,7 +204,11 @@ impl<'a> Layer<'a> {
                         Paint::Triangle(t) => {
                             let ft = &fts[t as usize];
                             let mut tested = vb.begin_tests();
-                            fixed::raster(ft, rect, *off, &mut tested, |x, y, l| vb.triangle_fragment(&ft.st, x, y, l));
+                            if ft.ray {
+                                small::ray_test(vb, ft, rect, &mut tested);
+                            } else {
+                                fixed::raster(ft, rect, *off, &mut tested, |x, y, l| vb.triangle_fragment(&ft.st, x, y, l));
+                            }
                             vb.end_tests(tested);
                         }
                         Paint::Sphere(s) => {

@@ -1,5 +1,6 @@
 //! Triangles too small for the sub-pixel grid of the fixed-point variants
-//! (`fixed`, `tiled`): coverage and barycentrics by the ray casters' 3D test.
+//! (`fixed`, `tiled`, and the painter, which draws with `fixed`'s coverage):
+//! coverage and barycentrics by the ray casters' 3D test.
 //!
 //! Snapping moves each vertex by up to half a grid unit (1/512 pixel) on each
 //! axis. On a triangle a few units across that moves its edges by a good part
