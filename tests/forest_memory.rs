@@ -1,8 +1,9 @@
 //! `forest` at 1280x720 in both families, as the `pinhole` binary renders it:
 //! each run's peak resident memory stays under 1 GB, and the two images agree
 //! (at most 0.5% of the pixels differ by more than 1e-4 relative). One test in
-//! its own file, so no other test's process runs beside it; about 45 s on two
-//! cores, nearly all of it the rasterizer's setup of ~200 M triangles.
+//! its own file, so no other test's process runs beside it; 9 s on two idle
+//! cores (43 s while other builds shared them), nearly all of it the
+//! rasterizer's setup of ~200 M triangles.
 
 use std::process::Command;
 
