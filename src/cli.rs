@@ -507,7 +507,9 @@ fn cmd_render(scene_arg: &str, output: &Path, opts: &RenderOpts, stats: Option<&
     }
     crate::image_io::save_image(output, frame.width, frame.height, &frame.pixels, l.prepared.scene.render.exposure)?;
     if let Some(dest) = stats {
-        let j = stats_json(&l, render_ms, &frame.counts, l.settings.spp);
+        let mut j = stats_json(&l, render_ms, &frame.counts, l.settings.spp);
+        // After the frame and its image: the run's peak (null where unknown).
+        j["peak_rss_bytes"] = json!(peak_rss_bytes());
         write_json(dest, &j)?;
     }
     Ok(())

@@ -52,14 +52,16 @@ pub fn stress_names() -> Vec<&'static str> {
 /// The large scenes (`forest`): loadable by name, listed apart because
 /// only the renderers that draw the two-level instance layer draw them.
 pub fn large_names() -> Vec<&'static str> {
-    super::forest::SCENES.iter().map(|(n, _)| *n).collect()
+    super::forest::SCENES.iter().map(|(n, _, _)| *n).collect()
 }
 
 /// The TOML source of a built-in scene (stress and large scenes included).
 pub fn source(name: &str) -> Option<&'static str> {
-    if let Some(k) = super::forest::SCENES.iter().position(|(n, _)| *n == name) {
-        static TEXTS: [std::sync::OnceLock<String>; 3] = [const { std::sync::OnceLock::new() }; 3];
-        return Some(TEXTS[k].get_or_init(|| super::forest::source(super::forest::SCENES[k].1)).as_str());
+    if let Some(k) = super::forest::SCENES.iter().position(|(n, _, _)| *n == name) {
+        const N: usize = super::forest::SCENES.len();
+        static TEXTS: [std::sync::OnceLock<String>; N] = [const { std::sync::OnceLock::new() }; N];
+        let (_, count, layout) = super::forest::SCENES[k];
+        return Some(TEXTS[k].get_or_init(|| super::forest::source(count, layout)).as_str());
     }
     SCENES.iter().chain(STRESS_SCENES).find(|(n, _)| *n == name).map(|(_, s)| *s)
 }

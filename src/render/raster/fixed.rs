@@ -42,6 +42,10 @@ pub struct FixedTri {
     pub bbox: PixelRect,
     /// Needs i128 evaluation.
     pub wide: bool,
+    /// Too small for the sub-pixel grid (`small.rs`): coverage is decided by the
+    /// ray casters' 3D test instead of the edge functions (`a`, `b` and
+    /// `bias` are then unused), and `bbox` is the float box grown by a pixel.
+    pub ray: bool,
 }
 
 /// Smallest pixel index whose snapped sample `i * ONE + off` is >= `v`.
@@ -84,7 +88,27 @@ impl FixedTri {
         if bbox.is_empty() {
             return None;
         }
-        Some(FixedTri { st, v, a, b, bias, sample_off, bbox, wide })
+        Some(FixedTri { st, v, a, b, bias, sample_off, bbox, wide, ray: false })
+    }
+
+    /// `new`, except that a triangle whose snapped vertices span fewer than
+    /// `small::LIMIT` units on both axes is kept for the ray test (`ray`),
+    /// whatever its snapped area, with its float box grown by a pixel (as
+    /// `rasterize:bbox` grows it) so that the 3D test can reach every sample
+    /// it would hit. Its edge functions are still those of its snapped
+    /// vertices (all zero when they are collinear), for the painter's
+    /// overlap test.
+    pub fn new_or_small(st: &ScreenTri, off: [i64; 2], sample_off: Vec2, width: u32, height: u32) -> Option<FixedTri> {
+        let v = st.p.map(|p| [snap(p.x), snap(p.y)]);
+        let extent = |i: usize| v.iter().map(|p| p[i]).max().unwrap() - v.iter().map(|p| p[i]).min().unwrap();
+        if extent(0).max(extent(1)) >= super::small::LIMIT {
+            return FixedTri::new(st, off, sample_off, width, height);
+        }
+        let bbox = st.bbox.grown(1, width, height);
+        Some(match FixedTri::new(st, off, sample_off, width, height) {
+            Some(ft) => FixedTri { bbox, ray: true, ..ft },
+            None => FixedTri { st: *st, v, a: [0; 3], b: [0; 3], bias: [1; 3], sample_off, bbox, wide: false, ray: true },
+        })
     }
 
     /// Exact edge function k at the snapped sample point `(sx, sy)`.
@@ -117,14 +141,16 @@ impl FixedTri {
     }
 }
 
-/// Every triangle of the pass snapped (in order; dropped when degenerate after snapping).
-/// The pass's triangles set up and snapped, run by run (`setup::setup_pass_map`):
-/// the same list as `snap_triangles(&setup_pass(job), ..)`.
-pub fn setup_snapped(job: &crate::render::PassJob, sample_off: Vec2, width: u32, height: u32) -> Vec<FixedTri> {
+/// The pass's triangles set up and snapped, run by run (`setup::setup_pass_map`),
+/// in order: those under half a pixel kept for the ray test, the others
+/// dropped when degenerate after snapping (`FixedTri::new_or_small`). The
+/// list `fixed`, `tiled` and the painter draw.
+pub fn setup_snapped_or_small(job: &crate::render::PassJob, sample_off: Vec2, width: u32, height: u32) -> Vec<FixedTri> {
     let off = snap_offset(sample_off);
-    super::setup::setup_pass_map(job, |st| FixedTri::new(&st, off, sample_off, width, height))
+    super::setup::setup_pass_map(job, |st| FixedTri::new_or_small(&st, off, sample_off, width, height))
 }
 
+/// Every triangle snapped (in order; dropped when degenerate after snapping).
 pub fn snap_triangles(tris: &[ScreenTri], sample_off: Vec2, width: u32, height: u32) -> Vec<FixedTri> {
     use rayon::prelude::*;
     let off = snap_offset(sample_off);
@@ -216,6 +242,27 @@ mod tests {
         // Left edge x = 1 and top edge y = 1 are top-left; the hypotenuse is not.
         assert_eq!(ft.bias, [1, 0, 0]);
         assert_eq!(ft.bbox, PixelRect::new(1, 1, 5, 5));
+    }
+
+    #[test]
+    fn triangles_under_half_a_pixel_take_the_ray_test() {
+        let st = |p: [Vec2; 3]| ScreenTri::flat(0, p, Vec2::splat(0.5), 16, 16).unwrap();
+        let off = snap_offset(Vec2::splat(0.5));
+        let make = |p| FixedTri::new_or_small(&st(p), off, Vec2::splat(0.5), 16, 16);
+        // 0.49 px across: small, its box that of the float triangle grown by a pixel.
+        let tiny = make([Vec2::new(4.3, 4.3), Vec2::new(4.79, 4.3), Vec2::new(4.3, 4.79)]).unwrap();
+        assert!(tiny.ray);
+        assert_eq!(tiny.bbox, st(tiny.st.p).bbox.grown(1, 16, 16));
+        // A sliver whose snapped vertices are collinear (no area on the grid)
+        // is kept for the ray test, where `new` drops it.
+        let sliver = [Vec2::new(4.3, 4.5), Vec2::new(4.7, 4.5), Vec2::new(4.5, 4.5 + 0.3 / 256.0)];
+        assert!(FixedTri::new(&st(sliver), off, Vec2::splat(0.5), 16, 16).is_none());
+        assert!(make(sliver).unwrap().ray);
+        // Half a pixel along one axis: on the grid, exactly as `new` makes it.
+        let half = [Vec2::new(4.3, 4.3), Vec2::new(4.8, 4.3), Vec2::new(4.3, 4.8)];
+        let (a, b) = (make(half).unwrap(), FixedTri::new(&st(half), off, Vec2::splat(0.5), 16, 16).unwrap());
+        assert!(!a.ray);
+        assert_eq!((a.v, a.a, a.b, a.bias, a.bbox), (b.v, b.a, b.b, b.bias, b.bbox));
     }
 
     #[test]

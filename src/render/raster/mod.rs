@@ -7,6 +7,7 @@
 //! - `cull`: copies made by `instances` culled whole by their bounding spheres;
 //! - `setup`: camera space, back-face culling, near clipping (`clip`), projection;
 //! - `rect`: pixel rectangles and sample spans; `subpixel`: the fixed-point grid;
+//!   `small`: triangles too small for that grid, by the ray casters' test;
 //! - coverage loops, one per file: `naive` and `bbox` (the 3D ray test),
 //!   `barycentric`, `incremental`, `scanline`, `fixed`, `tiled`;
 //! - `painter`: the painter's algorithm's draw order (no depth buffer);
@@ -39,6 +40,7 @@ pub mod pass;
 pub mod rect;
 pub mod scanline;
 pub mod setup;
+pub mod small;
 pub mod sphere;
 pub mod stencil;
 pub mod subpixel;

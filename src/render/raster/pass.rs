@@ -29,7 +29,7 @@ use super::subpixel::snap_offset;
 use super::tiled::{self, RectCoverage, TileGrid};
 use super::vis_buffer::{DepthKey, FragmentRecorder, VisBuffer};
 use super::method::Method;
-use super::{barycentric, bbox, incremental, scanline};
+use super::{barycentric, bbox, incremental, scanline, small};
 use crate::math::{Radiance, Vec2};
 use crate::render::raytrace::bvh::BvhQuery;
 use crate::render::pixel_record::PixelTrace;
@@ -103,13 +103,13 @@ impl<'a> Layer<'a> {
                 Geometry::FloatTriangles { tris, bins }
             }
             Method::Fixed => {
-                let fts = fixed::setup_snapped(&job, offset, w, h);
+                let fts = fixed::setup_snapped_or_small(&job, offset, w, h);
                 let bins = bin_rows(fts.iter().map(|f| f.bbox), r0, r1, BAND_ROWS);
                 Geometry::FixedTriangles { fts, off: snap_offset(offset), bins }
             }
             Method::Tiled => {
                 let off = snap_offset(offset);
-                let fts = fixed::setup_snapped(&job, offset, w, h);
+                let fts = fixed::setup_snapped_or_small(&job, offset, w, h);
                 let bins = tiled::bin_tiles(&fts, grid, off);
                 Geometry::FixedTriangleTiles { fts, off, bins }
             }
@@ -117,7 +117,7 @@ impl<'a> Layer<'a> {
                 // The order is made over the whole image, whatever rows this
                 // job renders, so a band shows what the frame shows.
                 let frame = job_at_offset(&job, offset, 0..h);
-                let fts = fixed::setup_snapped(&frame, offset, w, h);
+                let fts = fixed::setup_snapped_or_small(&frame, offset, w, h);
                 let (order, _) = painter::draw_order(&frame, &fts, &spheres);
                 let rects = order.iter().map(|p| match *p {
                     Paint::Triangle(t) => fts[t as usize].bbox,
@@ -173,13 +173,29 @@ impl<'a> Layer<'a> {
                 let mut tested = vb.begin_tests();
                 for &i in &bins[region] {
                     let ft = &fts[i as usize];
-                    fixed::raster(ft, rect, *off, &mut tested, |x, y, l| vb.triangle_fragment(&ft.st, x, y, l));
+                    if ft.ray {
+                        small::ray_test(vb, ft, rect, &mut tested);
+                    } else {
+                        fixed::raster(ft, rect, *off, &mut tested, |x, y, l| vb.triangle_fragment(&ft.st, x, y, l));
+                    }
                 }
                 vb.end_tests(tested);
             }
             Geometry::FixedTriangleTiles { fts, off, bins } => {
                 let mut tested = vb.begin_tests();
-                tiled::tile_fragments(fts, &bins[region], rect, *off, &mut tested, |ft, x, y, l| vb.triangle_fragment(&ft.st, x, y, l));
+                // Runs of grid triangles go through the tile loop together;
+                // each small one, in its place, through the ray test.
+                let bin = &bins[region];
+                let mut start = 0;
+                for (j, &(i, _)) in bin.iter().enumerate() {
+                    let ft = &fts[i as usize];
+                    if ft.ray {
+                        tiled::tile_fragments(fts, &bin[start..j], rect, *off, &mut tested, |ft, x, y, l| vb.triangle_fragment(&ft.st, x, y, l));
+                        small::ray_test(vb, ft, rect, &mut tested);
+                        start = j + 1;
+                    }
+                }
+                tiled::tile_fragments(fts, &bin[start..], rect, *off, &mut tested, |ft, x, y, l| vb.triangle_fragment(&ft.st, x, y, l));
                 vb.end_tests(tested);
             }
             Geometry::Painted { fts, off, order, bins } => {
@@ -188,7 +204,11 @@ impl<'a> Layer<'a> {
                         Paint::Triangle(t) => {
                             let ft = &fts[t as usize];
                             let mut tested = vb.begin_tests();
-                            fixed::raster(ft, rect, *off, &mut tested, |x, y, l| vb.triangle_fragment(&ft.st, x, y, l));
+                            if ft.ray {
+                                small::ray_test(vb, ft, rect, &mut tested);
+                            } else {
+                                fixed::raster(ft, rect, *off, &mut tested, |x, y, l| vb.triangle_fragment(&ft.st, x, y, l));
+                            }
                             vb.end_tests(tested);
                         }
                         Paint::Sphere(s) => {

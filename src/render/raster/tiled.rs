@@ -89,7 +89,7 @@ pub fn bin_tiles(tris: &[FixedTri], grid: &TileGrid, off: [i64; 2]) -> Vec<Vec<(
         for ty in ty0..=ty1 {
             for tx in tx0..=tx1 {
                 let t = (ty * grid.nx + tx) as usize;
-                let class = if ft.wide || (tx0 == tx1 && ty0 == ty1) {
+                let class = if ft.wide || ft.ray || (tx0 == tx1 && ty0 == ty1) {
                     // A triangle inside one tile is classified per block anyway.
                     RectCoverage::Partial
                 } else {

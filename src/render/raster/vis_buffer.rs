@@ -278,6 +278,34 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         self.rec.fragment(f);
     }
 
+    /// A ray-triangle hit of a triangle too small for the sub-pixel grid
+    /// (`small.rs`), in a buffer of -1/z keys: depth-tested on the key of the
+    /// hit's view depth, keeping the ray test's barycentrics.
+    #[inline]
+    pub fn small_triangle_fragment(&mut self, x: u32, y: u32, tri: u32, t: f32, b1: f32, b2: f32) {
+        self.counts.samples_covered += 1;
+        let i = self.index(x, y);
+        self.count_work(i);
+        let p = self.job.sample_position(x, y);
+        let depth = self.job.view.near + t / self.job.view.camera_dir(p.x, p.y).length();
+        let key = self.enc.key(1.0 / depth);
+        let stored = self.depth[i];
+        let passed = self.paint || key < stored;
+        if passed {
+            self.depth[i] = key;
+            self.id[i] = PrimitiveId::triangle(tri);
+            self.payload[i] = [b1, b2];
+            if self.forward {
+                self.shade_now(i, x, y);
+            }
+        } else {
+            self.counts.depth_fails += 1;
+        }
+        if self.is_focus(x, y) {
+            self.record(PrimitiveKind::Triangle, tri, None, Vec3::new(1.0 - b1 - b2, b1, b2), key, stored, passed, i, x, y);
+        }
+    }
+
     /// A ray-triangle hit already known to be nearer than the pixel's stored
     /// depth (naive, bbox: the ray test's `t_max`).
     #[inline(always)]
