@@ -304,10 +304,48 @@ fn the_two_level_layer_renders_what_flattening_renders() {
     // What cannot draw the layer says so.
     let e = render::layer_support::check("raytrace:brute", &pl.scene, &RenderSettings::for_scene(&pl.scene)).unwrap_err();
     assert!(e.contains("raytrace:brute") && e.contains("copies"), "{e}");
-    let mut map = RenderSettings::for_scene(&pl.scene);
-    map.shadows = render::ShadowMode::Map;
-    assert!(render::layer_support::check("rasterize", &pl.scene, &map).is_err());
-    assert!(render::layer_support::check("rasterize", &pf.scene, &map).is_ok());
+    let mut volume = RenderSettings::for_scene(&pl.scene);
+    volume.shadows = render::ShadowMode::Volume;
+    assert!(render::layer_support::check("rasterize", &pl.scene, &volume).is_err());
+    assert!(render::layer_support::check("rasterize", &pf.scene, &volume).is_ok());
+}
+
+/// Shadow maps over the two-level layer: each light face draws the copies
+/// it may see (culled whole by bounding sphere) after the flattened
+/// triangles, in index order, so the maps, and the images, are the
+/// flattened scene's bit for bit, for a point light (six faces) and a
+/// directional one (its rectangle fitted to the copies' triangles).
+#[test]
+fn shadow_maps_draw_the_two_level_layer_as_flattening_does() {
+    use pinhole::scene::file::{parse_scene_with, TwoLevel};
+    let d = dir();
+    let point = instanced_text();
+    let sun = point.replace(
+        "type = \"point\"\nposition = [2.0, 5.0, 3.0]\npower = [300.0, 300.0, 300.0]",
+        "type = \"directional\"\ndirection = [-0.4, -1.0, -0.3]\nirradiance = [3.0, 3.0, 3.0]",
+    );
+    assert_ne!(sun, point, "the light was replaced");
+    for text in [point, sun] {
+        let flat = PreparedScene::new(parse_scene_with(&text, "t", &d, "t", TwoLevel::Never).unwrap());
+        let layered = PreparedScene::new(parse_scene_with(&text, "t", &d, "t", TwoLevel::Always).unwrap());
+        assert!(layered.scene.layer.is_some());
+        let mut settings = RenderSettings::for_scene(&flat.scene);
+        settings.shadows = render::ShadowMode::Map;
+        settings.shadow_map_size = 256;
+        assert!(render::layer_support::check("rasterize", &layered.scene, &settings).is_ok());
+        assert!(render::layer_support::check("opengl", &layered.scene, &settings).is_err(), "opengl's maps do not draw copies");
+        for renderer in ["raytrace", "rasterize", "rasterize:tiled"] {
+            let (a, b) = (frame(renderer, &flat, &settings), frame(renderer, &layered, &settings));
+            assert_eq!(bits(&a.pixels), bits(&b.pixels), "{renderer}: shadow maps over the layer differ from flattening");
+        }
+        // And the maps shadow something; the ground (the only flattened
+        // triangles) cannot shadow itself, so these are the copies' shadows.
+        let mut lit = settings.clone();
+        lit.shadows = render::ShadowMode::None;
+        let (with, without) = (frame("rasterize", &layered, &settings), frame("rasterize", &layered, &lit));
+        let darker = with.pixels.iter().zip(&without.pixels).filter(|(a, b)| a.x < b.x * 0.9).count();
+        assert!(darker > 20, "only {darker} pixels in shadow");
+    }
 }
 
 /// Pixels of `image` differing from `reference` by more than 1e-4 relative

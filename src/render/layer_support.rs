@@ -1,6 +1,7 @@
 //! What can draw a scene whose copies live in the two-level instance layer
 //! (`scene::instanced`): the BVH ray tracer, the rasterizers and `opengl`
-//! (its copies instanced in GL), with ray or no shadows. The rest read `Scene::triangles` alone, so they refuse
+//! (its copies instanced in GL), with ray or no shadows, and the CPU
+//! renderers with shadow maps too. The rest read `Scene::triangles` alone, so they refuse
 //! such a scene with one sentence instead of drawing it without its copies.
 
 use super::{debug::View, RenderSettings, ShadowMode};
@@ -13,7 +14,7 @@ pub fn check(renderer: &str, scene: &Scene, settings: &RenderSettings) -> Result
     }
     let why = |what: &str| {
         Err(format!(
-            "{what} cannot draw this scene's {} copies held as shared meshes (over {} triangles are not flattened); use raytrace or rasterize with --shadows ray or none",
+            "{what} cannot draw this scene's {} copies held as shared meshes (over {} triangles are not flattened); use raytrace or rasterize with --shadows ray, map or none",
             scene.layer.as_ref().map_or(0, |l| l.instances.len()),
             crate::scene::file::FLATTEN_LIMIT
         ))
@@ -23,9 +24,10 @@ pub fn check(renderer: &str, scene: &Scene, settings: &RenderSettings) -> Result
         _ => {}
     }
     match settings.shadows {
-        ShadowMode::Map => return why("--shadows map"),
+        // The CPU maps draw the copies (each culled whole per light face).
+        ShadowMode::Map if renderer == "opengl" => return why("opengl's --shadows map"),
         ShadowMode::Volume => return why("--shadows volume"),
-        ShadowMode::None | ShadowMode::Ray => {}
+        ShadowMode::None | ShadowMode::Ray | ShadowMode::Map => {}
     }
     match settings.view {
         View::Wireframe => why("--view wireframe"),

@@ -43,6 +43,7 @@
 //! them on first use.
 
 use super::raster::clip::{clip_near, triangle_vertices};
+use super::raster::cull::Frustum;
 use super::raster::fixed::{self, FixedTri};
 use super::raster::rect::{sample_span, PixelRect};
 use super::raster::setup::{bin_rows, ScreenTri};
@@ -392,6 +393,28 @@ pub fn light_views(scene: &Scene, light: &Light, size: u32) -> Vec<CameraView> {
 pub fn caster_bounds(scene: &Scene) -> Option<(Vec3, Vec3)> {
     let (lo, hi) = scene.bounds()?;
     let limit = 0.5 * (hi - lo).length();
+    // The two-level layer's copies triangle by triangle, placed as flattening
+    // places them, so the rectangle is the flattened scene's (min and max
+    // are exact, so the order does not matter). On the calling thread, as
+    // the maps may be built inside a parallel pass.
+    let layer_bounds = scene.layer.as_ref().map(|layer| {
+        layer
+            .instances
+            .iter()
+            .map(|inst| {
+                let mut b = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+                for local in 0..layer.meshes[inst.mesh as usize].len() {
+                    let (v, _) = layer.world_vertices(inst, local);
+                    let (tl, th) = (v[0].min(v[1]).min(v[2]), v[0].max(v[1]).max(v[2]));
+                    if (th - tl).length() <= limit {
+                        b.0 = b.0.min(tl);
+                        b.1 = b.1.max(th);
+                    }
+                }
+                b
+            })
+            .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |a, c| (a.0.min(c.0), a.1.max(c.1)))
+    });
     let mut b = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
     let mut add = |l: Vec3, h: Vec3| {
         if (h - l).length() <= limit {
@@ -405,6 +428,9 @@ pub fn caster_bounds(scene: &Scene) -> Option<(Vec3, Vec3)> {
     for s in &scene.spheres {
         add(s.center - Vec3::splat(s.radius), s.center + Vec3::splat(s.radius));
     }
+    if let Some((l, h)) = layer_bounds {
+        b = (b.0.min(l), b.1.max(h));
+    }
     (b.0.x <= b.1.x).then_some(b)
 }
 
@@ -413,23 +439,62 @@ fn draw_face(scene: &Scene, face: &mut Face, size: u32, parallel: bool) {
     let n = size as usize;
     face.depth = vec![f32::INFINITY; n * n];
     face.id = vec![PrimitiveId::NONE; n * n];
-    let view = &face.view;
-    let ortho = face.ortho;
+    let (view, ortho) = (&face.view.clone(), face.ortho);
     let mut tris = Vec::new();
     for (i, t) in scene.triangles.iter().enumerate() {
         setup_face_triangle(view, ortho, t, i as u32, size, &mut tris);
     }
-    let bins = bin_rows(tris.iter().map(|t| t.ft.bbox), 0, size, BAND);
+    // The two-level layer's copies after them, in index order, each culled
+    // whole by its bounding sphere against the face (a culled copy covers no
+    // texel) and drawn a batch of copies at a time, so the set-up pieces of
+    // a large layer never all sit in memory at once. Depth ties keep the
+    // first drawn, so batches drawn in index order give the flattened map.
+    if let Some(layer) = &scene.layer {
+        let frustum = (!ortho).then(|| Frustum::new(view));
+        let seen = |info: &crate::scene::InstanceInfo| match &frustum {
+            Some(f) => f.may_see(view, info.center, info.radius),
+            None => {
+                let c = view.to_camera(info.center);
+                let r = info.radius * (1.0 + 1e-4) + 1e-5 * c.length();
+                c.x.abs() - r <= view.half_x && c.y.abs() - r <= view.half_y
+            }
+        };
+        let infos = scene.instances.iter().filter(|i| i.triangles.start >= scene.triangles.len());
+        for (inst, info) in layer.instances.iter().zip(infos) {
+            // (A record that is not this copy's culls nothing.)
+            if info.triangles.start == inst.base as usize && !seen(info) {
+                continue;
+            }
+            for local in 0..layer.meshes[inst.mesh as usize].len() {
+                setup_face_triangle(view, ortho, &layer.world(inst, local), inst.base + local as u32, size, &mut tris);
+            }
+            if tris.len() >= LAYER_BATCH {
+                draw_pieces(face, &tris, &[], size, parallel);
+                tris.clear();
+            }
+        }
+    }
     let spheres: Vec<(u32, &Sphere, PixelRect)> = scene
         .spheres
         .iter()
         .enumerate()
         .filter_map(|(i, s)| sphere_rect(view, ortho, s, size).map(|r| (i as u32, s, r)))
         .collect();
+    draw_pieces(face, &tris, &spheres, size, parallel);
+}
+
+/// Set-up triangle pieces of the two-level layer drawn into a face at once.
+const LAYER_BATCH: usize = 1 << 20;
+
+/// Draws `tris` (binned by rows) and then `spheres` into `face`, band by band.
+fn draw_pieces(face: &mut Face, tris: &[FaceTri], spheres: &[(u32, &Sphere, PixelRect)], size: u32, parallel: bool) {
+    let n = size as usize;
+    let (view, ortho) = (&face.view, face.ortho);
+    let bins = bin_rows(tris.iter().map(|t| t.ft.bbox), 0, size, BAND);
     let band = |(b, (depth, id)): (usize, (&mut [f32], &mut [PrimitiveId]))| {
         let y0 = b as u32 * BAND;
         let rect = PixelRect::new(0, y0, size, (y0 + BAND).min(size));
-        draw_band(view, ortho, &tris, &bins[b], &spheres, rect, depth, id);
+        draw_band(view, ortho, tris, &bins[b], spheres, rect, depth, id);
     };
     let chunks = face.depth.chunks_mut(n * BAND as usize).zip(face.id.chunks_mut(n * BAND as usize));
     if parallel {
