@@ -107,27 +107,38 @@ pub(super) fn leaf_range(word: u32) -> (usize, usize) {
     (first, first + (word & 7) as usize + 1)
 }
 
+/// Asks the cache for the lines holding `bytes` bytes from `p`: a hint that
+/// never faults, whatever the address, and changes no result.
+#[inline(always)]
+fn prefetch(p: *const u8, bytes: usize) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        let mut offset = 0;
+        while offset < bytes {
+            // SAFETY: a prefetch never faults, whatever the address.
+            unsafe { _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(offset).cast()) };
+            offset += 64;
+        }
+        // The last byte's line, when `p` does not start a line.
+        // SAFETY: as above.
+        unsafe { _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(bytes - 1).cast()) };
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (p, bytes);
+}
+
 impl Bvh {
     /// Starts loading a child's node (both its cache lines) or its leaf's
     /// first primitives into the cache; a hint only, it changes no result.
     #[inline(always)]
     pub(super) fn prefetch_child(&self, word: u32) {
-        #[cfg(target_arch = "x86_64")]
-        {
-            use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-            let p: *const i8 = if word & LEAF_BIT == 0 {
-                self.nodes.as_ptr().wrapping_add(word as usize).cast()
-            } else {
-                self.prims.as_ptr().wrapping_add(leaf_range(word).0).cast()
-            };
-            // SAFETY: prefetching is a hint that never faults, whatever the address.
-            unsafe {
-                _mm_prefetch::<_MM_HINT_T0>(p);
-                _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(64));
-            }
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        let _ = word;
+        let p: *const u8 = if word & LEAF_BIT == 0 {
+            self.nodes.as_ptr().wrapping_add(word as usize).cast()
+        } else {
+            self.prims.as_ptr().wrapping_add(leaf_range(word).0).cast()
+        };
+        prefetch(p, 2 * 64);
     }
 
     /// Number of nodes: interior nodes plus leaves.
@@ -321,19 +332,10 @@ impl<'a> BvhQuery<'a> {
     /// Starts loading the scene's record of triangle `id` (a hint only).
     #[inline(always)]
     fn prefetch_triangle(&self, id: PrimitiveId) {
-        #[cfg(target_arch = "x86_64")]
         if id.kind() == PrimitiveKind::Triangle {
-            use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-            let p: *const i8 = self.prepared.scene.triangles.as_ptr().wrapping_add(id.index() as usize).cast();
-            // SAFETY: prefetching is a hint that never faults, whatever the address.
-            unsafe {
-                _mm_prefetch::<_MM_HINT_T0>(p);
-                _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(64));
-                _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(std::mem::size_of::<crate::scene::Triangle>() - 1));
-            }
+            let p = self.prepared.scene.triangles.as_ptr().wrapping_add(id.index() as usize);
+            prefetch(p.cast(), std::mem::size_of::<crate::scene::Triangle>());
         }
-        #[cfg(not(target_arch = "x86_64"))]
-        let _ = id;
     }
 
     /// The walk through the BVH over the flattened triangles and the spheres.
