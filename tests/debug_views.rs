@@ -39,7 +39,7 @@ fn at(img: &[Radiance], x: u32, y: u32) -> Vec3 {
 fn vertex_pixel(v: Vec3, inset: f32) -> (u32, u32) {
     let scene = builtin("one-triangle");
     let view = scene.camera.view(W, H);
-    let centroid = scene.triangles[0].v.iter().copied().sum::<Vec3>() / 3.0;
+    let centroid = scene.triangles.at(0).v.iter().copied().sum::<Vec3>() / 3.0;
     let (p, _) = view.project(v).unwrap();
     let (c, _) = view.project(centroid).unwrap();
     let q = p + (c - p).normalize() * inset;
@@ -64,7 +64,7 @@ fn raydir_red_grows_rightwards_and_green_upwards() {
 #[test]
 fn barycentric_vertices_are_pure_channels() {
     let scene = builtin("one-triangle");
-    let v = scene.triangles[0].v;
+    let v = scene.triangles.at(0).v;
     for r in renderers_with_views() {
         let img = render_view(r, "one-triangle", View::Barycentric);
         for (k, vertex) in v.iter().enumerate() {
@@ -83,7 +83,7 @@ fn depth_increases_with_distance() {
     // The triangle lies in the plane z = -2: its distance from the eye grows
     // away from the image centre, so the corner near v1 is deeper than the centre.
     let scene = builtin("one-triangle");
-    let v1 = scene.triangles[0].v[1];
+    let v1 = scene.triangles.at(0).v[1];
     for r in renderers_with_views() {
         let img = render_view(r, "one-triangle", View::Depth);
         let (x, y) = vertex_pixel(v1, 3.0);
@@ -102,10 +102,10 @@ fn depth_increases_with_distance() {
 #[test]
 fn normal_and_id_views() {
     let scene = builtin("one-triangle");
-    let n0 = scene.triangles[0].n[0];
+    let n0 = scene.triangles.at(0).n[0];
     for r in renderers_with_views() {
         let img = render_view(r, "one-triangle", View::Normal);
-        let (x, y) = vertex_pixel(scene.triangles[0].v[0], 2.0);
+        let (x, y) = vertex_pixel(scene.triangles.at(0).v[0], 2.0);
         let c = at(&img, x, y) * 2.0 - Vec3::ONE;
         assert!(c.dot(n0) > 0.98, "{r}: normal near v0 is {c}, expected {n0}");
         let ids = render_view(r, "triangle-ground", View::Id);

@@ -158,8 +158,8 @@ fn instance_placement_follows_the_objects_own() {
         "{HEAD}\n[[object]]\ntype = \"mesh\"\nfile = \"cube.obj\"\ntranslate = [0.0, 1.0, 0.0]\ninstances = [{{ scale = 2.0 }}, {{}}]\n"
     );
     let s = parse(&text, &d);
-    let cube: Vec<_> = s.triangles[2..].iter().collect();
-    let top = |tris: &[&pinhole::scene::Triangle]| tris.iter().flat_map(|t| t.v).map(|v| v.y).fold(f32::MIN, f32::max);
+    let cube: Vec<_> = s.triangles.range(2..s.triangles.len()).collect();
+    let top = |tris: &[pinhole::scene::Triangle]| tris.iter().flat_map(|t| t.v).map(|v| v.y).fold(f32::MIN, f32::max);
     // Copy 0: scale 2 of the lifted cube (y 1..2) gives y 2..4; copy 1: y 1..2.
     assert_eq!(top(&cube[..12]), 4.0);
     assert_eq!(top(&cube[12..]), 2.0);

@@ -40,8 +40,8 @@ fn flat_uses_the_face_normal() {
     // triangle with its vertex normals removed (so they default to the face normal).
     let scene = builtin("one-triangle");
     let mut plain = scene.clone();
-    let n = plain.triangles[0].geometric_normal();
-    plain.triangles[0].n = [n; 3];
+    let n = plain.triangles.at(0).geometric_normal();
+    plain.triangles.set(0, pinhole::scene::Triangle { n: [n; 3], ..plain.triangles.at(0) });
     let flat = render("raytrace:bvh", &PreparedScene::new(scene.clone()), &settings(&scene, Interpolation::Flat));
     let phong_plain = render("raytrace:bvh", &PreparedScene::new(plain), &settings(&scene, Interpolation::Phong));
     assert_eq!(flat, phong_plain);
@@ -60,8 +60,8 @@ fn gouraud_loses_the_interior_highlight_but_matches_at_vertices() {
     assert!(max_lum(&gouraud) < 0.8 * max_lum(&phong), "gouraud {} phong {}", max_lum(&gouraud), max_lum(&phong));
     // Next to a vertex both are the vertex's lighting.
     let view = scene.camera.view(s.width, s.height);
-    let centroid = scene.triangles[0].v.iter().copied().sum::<Vec3>() / 3.0;
-    for v in scene.triangles[0].v {
+    let centroid = scene.triangles.at(0).v.iter().copied().sum::<Vec3>() / 3.0;
+    for v in scene.triangles.at(0).v {
         let (p, _) = view.project(v).unwrap();
         let (c, _) = view.project(centroid).unwrap();
         let q = p + (c - p).normalize() * 2.0;

@@ -19,7 +19,7 @@ fn edges_in_scene_order_are_the_triangles_own() {
         assert_eq!(prepared.edges.len(), triangles.len(), "{name}");
         assert_eq!(prepared.edges.iter().len(), triangles.len(), "{name}");
         for (i, (t, e)) in triangles.iter().zip(prepared.edges.iter()).enumerate() {
-            let fresh = TriangleEdges::new(t);
+            let fresh = TriangleEdges::new(&t);
             assert!(same(e, &fresh) && same(&prepared.edges[i], &fresh), "{name}: triangle {i}");
         }
     }

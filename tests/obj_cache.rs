@@ -43,14 +43,14 @@ fn objects_sharing_an_obj_get_the_triangles_of_separate_loads() {
         let alone = scene_of(&[o]);
         let range = together.objects[i].triangles.clone();
         assert_eq!(range.len(), alone.triangles.len(), "object {}", i + 1);
-        for (a, b) in together.triangles[range].iter().zip(&alone.triangles) {
+        for (a, b) in together.triangles.range(range).zip(&alone.triangles) {
             let b = Triangle { object: i as u32, ..b.clone() };
-            assert_eq!(named(&together, a), named(&alone, &b), "object {}", i + 1);
+            assert_eq!(named(&together, &a), named(&alone, &b), "object {}", i + 1);
         }
     }
     // The placements really differ, so the comparison above is not vacuous.
     let (first, second) = (&together.objects[0].triangles, &together.objects[1].triangles);
-    assert_ne!(together.triangles[first.start].v, together.triangles[second.start].v);
+    assert_ne!(together.triangles.at(first.start).v, together.triangles.at(second.start).v);
 }
 
 #[test]

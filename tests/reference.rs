@@ -81,11 +81,16 @@ fn bound_catches_classic_bugs() {
 
     // A flipped ground: reversed winding on a single-sided quad faces away.
     let mut flipped = scene.clone();
-    for t in flipped.triangles.iter_mut() {
-        t.v.swap(1, 2);
-        t.n = t.n.map(|n| -n);
-        t.two_sided = false;
-    }
+    flipped.triangles = scene
+        .triangles
+        .iter()
+        .map(|mut t| {
+            t.v.swap(1, 2);
+            t.n = t.n.map(|n| -n);
+            t.two_sided = false;
+            t
+        })
+        .collect();
     let e = relative_rmse(&render("raytrace", &PreparedScene::new(flipped), &settings), &reference);
     assert!(e > BOUND, "a flipped normal went unnoticed ({e})");
 

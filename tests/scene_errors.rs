@@ -125,7 +125,7 @@ fn good_file_with_placement_and_mtl() {
         "[[object]]\ntype = \"mesh\"\nfile = \"m.obj\"\nscale = 2.0\nrotate_deg = [0.0, 90.0, 0.0]\ntranslate = [1.0, 0.0, 0.0]\n",
     );
     let s = load_scene_file(&p).unwrap();
-    let t = &s.triangles[0];
+    let t = &s.triangles.at(0);
     // (1,0,0) scaled by 2 -> (2,0,0), rotated 90 degrees about y -> (0,0,-2), translated -> (1,0,-2).
     assert!((t.v[1] - glam::Vec3::new(1.0, 0.0, -2.0)).length() < 1e-5, "{:?}", t.v);
     let m = &s.materials[t.material as usize];
@@ -142,7 +142,7 @@ fn bare_obj_is_framed() {
     let view = s.camera.view(s.render.width, s.render.height);
     assert!(s.camera.eye.z > 5.0, "camera on +z: {:?}", s.camera.eye);
     assert_eq!(s.lights.len(), 1);
-    for v in s.triangles[0].v {
+    for v in s.triangles.at(0).v {
         let (q, _) = view.project(v).expect("in front of the camera");
         assert!(q.x >= 0.0 && q.x <= s.render.width as f32 && q.y >= 0.0 && q.y <= s.render.height as f32, "{q}");
     }

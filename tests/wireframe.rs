@@ -21,7 +21,7 @@ fn settings(scene: &pinhole::scene::Scene, lines: LineAlgorithm) -> RenderSettin
 #[test]
 fn one_triangle_shows_its_three_edges_over_the_shaded_image() {
     let scene = builtin("one-triangle");
-    let v = scene.triangles[0].v;
+    let v = scene.triangles.at(0).v;
     let s = settings(&scene, LineAlgorithm::Float);
     let view = scene.camera.view(s.width, s.height);
     let prepared = PreparedScene::new(scene);

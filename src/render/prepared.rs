@@ -89,9 +89,12 @@ impl MemoryUse {
 }
 
 impl PreparedScene {
-    pub fn new(scene: Scene) -> PreparedScene {
+    pub fn new(mut scene: Scene) -> PreparedScene {
+        // Scenes made in code (or edited) may hold triangles pushed since
+        // loading; a no-op for scenes straight from a file.
+        scene.triangles.share_corners();
         let start = Instant::now();
-        let bvh = Bvh::build(&scene, &scene.triangles[..]);
+        let bvh = Bvh::build(&scene, &scene.triangles);
         let build_ms = start.elapsed().as_secs_f64() * 1e3;
         let instances = scene.layer.as_ref().map(|l| super::raytrace::instances::InstanceAccel::build(l));
         let build_ms = if instances.is_some() { start.elapsed().as_secs_f64() * 1e3 } else { build_ms };
@@ -124,7 +127,7 @@ impl PreparedScene {
     pub fn memory(&self) -> MemoryUse {
         use std::mem::size_of_val;
         MemoryUse {
-            scene_bytes: size_of_val(&self.scene.triangles[..])
+            scene_bytes: self.scene.triangles.memory_bytes()
                 + size_of_val(&self.scene.spheres[..])
                 + self.scene.layer.as_ref().map_or(0, |l| l.memory_bytes())
                 + self.scene.csgs.iter().map(|c| size_of_val(&c.triangles[..]) + size_of_val(&c.spheres[..])).sum::<usize>(),

@@ -548,7 +548,7 @@ mod tests {
         assert_eq!(shadow_origin(&scene, &hit, Vec3::Z, true), p);
         assert_eq!(shadow_origin(&scene, &hit, Vec3::new(0.0, 0.6, -0.8), true), lifted);
         assert_eq!(shadow_origin(&scene, &hit, Vec3::new(0.0, 0.6, -0.8), false), p, "no lift when it is turned off");
-        scene.triangles[0].n = [Vec3::Z; 3];
+        scene.triangles.set(0, Triangle { n: [Vec3::Z; 3], ..scene.triangles.at(0) });
         assert!((lifted_position(&scene, &hit) - p).length() < 1e-7);
     }
 

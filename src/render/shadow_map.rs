@@ -442,7 +442,7 @@ fn draw_face(scene: &Scene, face: &mut Face, size: u32, parallel: bool) {
     let (view, ortho) = (&face.view.clone(), face.ortho);
     let mut tris = Vec::new();
     for (i, t) in scene.triangles.iter().enumerate() {
-        setup_face_triangle(view, ortho, t, i as u32, size, &mut tris);
+        setup_face_triangle(view, ortho, &t, i as u32, size, &mut tris);
     }
     // The two-level layer's copies after them, in index order, each culled
     // whole by its bounding sphere against the face (a culled copy covers no

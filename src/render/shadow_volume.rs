@@ -123,7 +123,7 @@ impl LightVolume {
             .iter()
             .map(|&v| Triangle { v, n: [Vec3::Z; 3], uv: [Vec2::ZERO; 3], material: 0, object: 0, two_sided: true })
             .collect();
-        let edges: Vec<TriangleEdges> = holder.triangles.iter().map(TriangleEdges::new).collect();
+        let edges: Vec<TriangleEdges> = holder.triangles.iter().map(|t| TriangleEdges::new(&t)).collect();
         let bvh = Bvh::build(&holder, &edges);
         LightVolume { faces, edges, bvh }
     }
@@ -425,7 +425,7 @@ mod tests {
 
     fn scene_with(tris: Vec<Triangle>, light: Light) -> Scene {
         let mut s = Scene::default();
-        s.triangles = tris;
+        s.triangles = tris.into();
         s.lights.push(light);
         s
     }

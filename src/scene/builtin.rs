@@ -102,7 +102,7 @@ mod tests {
         assert_eq!((s.render.width, s.render.height), (800, 500));
         assert_eq!(s.camera.fov, super::super::Fov::X(90.0));
         assert_eq!(s.triangles.len(), 1);
-        assert_eq!(s.triangles[0].v[1], glam::Vec3::new(-1.9, -1.0, -2.0));
+        assert_eq!(s.triangles.at(0).v[1], glam::Vec3::new(-1.9, -1.0, -2.0));
         let g = load_builtin("triangle-ground").unwrap().unwrap();
         assert_eq!(g.triangles.len(), 4);
     }

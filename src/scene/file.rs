@@ -375,6 +375,8 @@ fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str, two_
         let texture = load_texture_as(&base.join(&env.file), Encoding::Srgb).map_err(|e| format!("{where_}: file: {e}"))?;
         scene.environment = Some(super::environment::Environment { texture: Arc::new(texture), intensity });
     }
+    // Each triangle was pushed with corners of its own; store each corner once.
+    scene.triangles.share_corners();
     Ok(scene)
 }
 
@@ -414,7 +416,7 @@ fn build_layer(scene: &mut Scene, layered: Layered) -> Result<(), String> {
 
 /// The centre of the bounding box of `tris` and the distance to its farthest vertex.
 fn bounding_sphere(tris: &[Triangle]) -> (Vec3, f32) {
-    let info = InstanceInfo::new(0, 0, 0..0, tris);
+    let info = InstanceInfo::new(0, 0, 0..0, tris.iter().cloned());
     (info.center, info.radius)
 }
 
@@ -565,7 +567,7 @@ fn add_object(
                     });
                 }
                 if let Some(index) = copy.index {
-                    scene.instances.push(InstanceInfo::new(object, index, start..scene.triangles.len(), &scene.triangles[start..]));
+                    scene.instances.push(InstanceInfo::new(object, index, start..scene.triangles.len(), scene.triangles.range(start..scene.triangles.len())));
                 }
             }
         }
@@ -657,7 +659,7 @@ fn add_object(
         other => return Err(format!("{where_}: unknown object type \"{other}\" (expected mesh, triangle, quad, sphere or csg)")),
     }
     // Placement (scale, translate) can carry in-range vertices out of range.
-    if let Some(t) = scene.triangles[first..].iter().find(|t| t.v.iter().any(|v| !(v.abs().max_element() <= MAX_COORDINATE))) {
+    if let Some(t) = scene.triangles.range(first..scene.triangles.len()).find(|t| t.v.iter().any(|v| !(v.abs().max_element() <= MAX_COORDINATE))) {
         let v = t.v.into_iter().find(|v| !(v.abs().max_element() <= MAX_COORDINATE)).unwrap_or_default();
         return Err(format!("{where_}: placed, a vertex lands at {v}; coordinates must be between -{MAX_COORDINATE:e} and {MAX_COORDINATE:e}"));
     }
@@ -771,7 +773,7 @@ fn csg_node(
             "sphere" | "mesh" => {
                 let (t0, s0, o0) = (scene.triangles.len(), scene.spheres.len(), scene.objects.len());
                 add_object(scene, d, object, &here, base, meshes, at, TwoLevel::Never, &mut Layered::default())?;
-                let mut tris: Vec<Triangle> = scene.triangles.drain(t0..).collect();
+                let mut tris: Vec<Triangle> = scene.triangles.split_off(t0);
                 let mut spheres: Vec<Sphere> = scene.spheres.drain(s0..).collect();
                 scene.objects.truncate(o0);
                 if let (None, Some(m)) = (&d.material, material) {

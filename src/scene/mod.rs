@@ -17,10 +17,12 @@ pub mod obj;
 pub mod recentre;
 pub mod tangents;
 pub mod texture;
+pub mod triangles;
 
 pub use camera::{Camera, CameraView, Fov};
 pub use material::Material;
 pub use texture::Texture;
+pub use triangles::Triangles;
 
 use crate::math::{Ray, Vec2, Vec3};
 
@@ -186,10 +188,10 @@ pub struct InstanceInfo {
 impl InstanceInfo {
     /// The record of copy `index` of `object`, whose world-space triangles are
     /// `tris`, found at `range` of `Scene::triangles`.
-    pub fn new(object: u32, index: u32, range: std::ops::Range<usize>, tris: &[Triangle]) -> InstanceInfo {
+    pub fn new(object: u32, index: u32, range: std::ops::Range<usize>, tris: impl Iterator<Item = Triangle> + Clone) -> InstanceInfo {
         let mut lo = Vec3::splat(f32::INFINITY);
         let mut hi = Vec3::splat(f32::NEG_INFINITY);
-        for t in tris {
+        for t in tris.clone() {
             for v in t.v {
                 lo = lo.min(v);
                 hi = hi.max(v);
@@ -197,7 +199,7 @@ impl InstanceInfo {
         }
         let (center, radius) = if lo.x <= hi.x {
             let center = (lo + hi) * 0.5;
-            let r2 = tris.iter().flat_map(|t| t.v).map(|v| (v - center).length_squared()).fold(0.0f32, f32::max);
+            let r2 = tris.flat_map(|t| t.v).map(|v| (v - center).length_squared()).fold(0.0f32, f32::max);
             // Grown a little, so that rounding in the distance never leaves a vertex outside.
             (center, r2.sqrt() * (1.0 + 1e-5) + 1e-6 * center.abs().max_element())
         } else {
@@ -241,7 +243,7 @@ pub struct Scene {
     pub render: RenderDefaults,
     pub lights: Vec<Light>,
     pub materials: Vec<Material>,
-    pub triangles: Vec<Triangle>,
+    pub triangles: Triangles,
     pub spheres: Vec<Sphere>,
     /// Constructive solid geometry objects, kept apart from the triangles
     /// and spheres (`render::csg` answers rays for them).
@@ -376,7 +378,7 @@ impl Scene {
     #[inline]
     pub fn triangle(&self, index: u32) -> std::borrow::Cow<'_, Triangle> {
         match self.triangles.get(index as usize) {
-            Some(t) => std::borrow::Cow::Borrowed(t),
+            Some(t) => std::borrow::Cow::Owned(t),
             None => {
                 let layer = self.layer.as_ref().expect("a triangle index past the scene's triangles");
                 let (inst, local) = layer.locate(index).expect("a triangle index past the two-level layer");
@@ -419,7 +421,7 @@ impl Scene {
         // A flattened triangle is read in place; only a copy of the
         // two-level layer is placed in world space first.
         match self.triangles.get(index as usize) {
-            Some(tri) => Self::hit_on(tri, index, b, t, ray),
+            Some(tri) => Self::hit_on(&tri, index, b, t, ray),
             None => Self::hit_on(&self.triangle(index), index, b, t, ray),
         }
     }

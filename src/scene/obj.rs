@@ -240,6 +240,7 @@ pub fn frame_bare_obj(path: &Path) -> Result<Scene, String> {
     scene.objects.push(ObjectInfo { name: scene.name.clone(), kind: "mesh".into(), triangles: 0..scene.triangles.len() });
     let (lo, hi) = scene.bounds().ok_or("the OBJ has no geometry")?;
     frame_camera(&mut scene, lo, hi);
+    scene.triangles.share_corners();
     Ok(scene)
 }
 

@@ -16,11 +16,7 @@ pub fn recentre_at_camera(scene: &mut Scene) {
 }
 
 fn translate_scene(scene: &mut Scene, by: Vec3) {
-    for t in &mut scene.triangles {
-        for v in &mut t.v {
-            *v += by;
-        }
-    }
+    scene.triangles.map_positions(|v| v + by);
     for s in &mut scene.spheres {
         s.center += by;
     }
@@ -45,8 +41,8 @@ mod tests {
         recentre_at_camera(&mut s);
         assert_eq!(s.camera.eye, Vec3::ZERO);
         assert_eq!(s.camera.target, before.camera.target - Vec3::new(1.0, 2.0, 3.0));
-        assert_eq!(s.triangles[0].v[1], before.triangles[0].v[1] - Vec3::new(1.0, 2.0, 3.0));
-        assert_eq!(s.triangles[0].n, before.triangles[0].n, "normals do not move");
+        assert_eq!(s.triangles.at(0).v[1], before.triangles.at(0).v[1] - Vec3::new(1.0, 2.0, 3.0));
+        assert_eq!(s.triangles.at(0).n, before.triangles.at(0).n, "normals do not move");
         match (&s.lights[0], &before.lights[0]) {
             (Light::Point { position: a, .. }, Light::Point { position: b, .. }) => assert_eq!(*a, *b - Vec3::new(1.0, 2.0, 3.0)),
             _ => panic!("triangle-ground has a point light"),

@@ -33,7 +33,7 @@ pub fn build_tangents(scene: &Scene) -> Vec<[Vec4; 3]> {
         })
         .collect();
     let key = |i: usize, k: usize| {
-        let t = &scene.triangles[i];
+        let t = &scene.triangles.at(i);
         let bits = |v: Vec3| v.to_array().map(f32::to_bits);
         (t.object, bits(t.v[k]), bits(t.n[k]), t.uv[k].to_array().map(f32::to_bits))
     };
@@ -54,7 +54,7 @@ pub fn build_tangents(scene: &Scene) -> Vec<[Vec4; 3]> {
             }
             std::array::from_fn(|k| {
                 let (t, b) = sums[&key(i, k)];
-                let n = scene.triangles[i].n[k];
+                let n = scene.triangles.at(i).n[k];
                 let t = (t - n * n.dot(t)).normalize_or_zero();
                 let w = if n.cross(t).dot(b) < 0.0 { -1.0 } else { 1.0 };
                 t.extend(w)
@@ -104,16 +104,18 @@ mod tests {
         let v = [Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(1.0, 1.0, 0.0), Vec3::new(0.0, 1.0, 0.0)];
         let uv = [Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0), Vec2::new(1.0, 1.0), Vec2::new(0.0, 1.0)];
         let tri = |a: usize, b: usize, c: usize| Triangle { v: [v[a], v[b], v[c]], n: [Vec3::Z; 3], uv: [uv[a], uv[b], uv[c]], material: 0, object: 0, two_sided: false };
-        scene.triangles = vec![tri(0, 1, 2), tri(0, 2, 3)];
+        scene.triangles = vec![tri(0, 1, 2), tri(0, 2, 3)].into();
         let t = build_tangents(&scene);
         for corner in t.iter().flatten() {
             assert!((corner.truncate() - Vec3::X).length() < 1e-6 && corner.w == 1.0, "{corner}");
         }
         // Mirrored u: the tangent turns to -x and the frame is left-handed.
-        for tri in &mut scene.triangles {
+        for i in 0..scene.triangles.len() {
+            let mut tri = scene.triangles.at(i);
             for uv in &mut tri.uv {
                 uv.x = 1.0 - uv.x;
             }
+            scene.triangles.set(i, tri);
         }
         let t = build_tangents(&scene);
         assert!((t[0][0].truncate() + Vec3::X).length() < 1e-6 && t[0][0].w == -1.0, "{}", t[0][0]);

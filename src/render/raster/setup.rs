@@ -208,7 +208,7 @@ pub fn setup_pass_map<T: Send>(job: &PassJob, keep: impl Fn(ScreenTri) -> Option
             match chunk.copy {
                 None => {
                     for i in chunk.range {
-                        setup_triangle_clipped(view, &scene.triangles[i], i as u32, job.offset, near_clip, frustum.as_ref(), &mut out);
+                        setup_triangle_clipped(view, &scene.triangles.at(i), i as u32, job.offset, near_clip, frustum.as_ref(), &mut out);
                     }
                 }
                 Some(k) => {

@@ -333,8 +333,8 @@ impl<'a> BvhQuery<'a> {
     #[inline(always)]
     fn prefetch_triangle(&self, id: PrimitiveId) {
         if id.kind() == PrimitiveKind::Triangle {
-            let p = self.prepared.scene.triangles.as_ptr().wrapping_add(id.index() as usize);
-            prefetch(p.cast(), std::mem::size_of::<crate::scene::Triangle>());
+            let p = self.prepared.scene.triangles.record_ptr(id.index() as usize);
+            prefetch(p, 20);
         }
     }
 
@@ -543,7 +543,7 @@ mod tests {
                 }
                 2 | 3 if !scene.triangles.is_empty() => {
                     // Aim at a vertex or a point on an edge of a random triangle.
-                    let t = &scene.triangles[rng.below(scene.triangles.len())];
+                    let t = &scene.triangles.at(rng.below(scene.triangles.len()));
                     let (a, b) = (rng.below(3), rng.below(3));
                     let s = if i % 5 == 2 { 0.0 } else { rng.f() };
                     let target = t.v[a] * (1.0 - s) + t.v[(a + 1 + b % 2) % 3] * s;
@@ -602,7 +602,7 @@ mod tests {
             if a.is_none() {
                 if let Some(Occluder { kind: PrimitiveKind::Triangle, index: k, .. }) = b {
                     let (t, b1, b2) = intersect_triangle(ray, &prepared.edges[k as usize], *t_max).unwrap();
-                    let v = prepared.scene.triangles[k as usize].v;
+                    let v = prepared.scene.triangles.at(k as usize).v;
                     if !accurate(ray, t, v[0] * (1.0 - b1 - b2) + v[1] * b1 + v[2] * b2) {
                         excused += 1;
                         continue;
@@ -657,7 +657,7 @@ mod tests {
                         let (lo, hi) = match kind {
                             PrimitiveKind::Triangle => {
                                 seen[p as usize] += 1;
-                                let v = scene.triangles[p as usize].v;
+                                let v = scene.triangles.at(p as usize).v;
                                 (v[0].min(v[1]).min(v[2]), v[0].max(v[1]).max(v[2]))
                             }
                             PrimitiveKind::Sphere => {
@@ -722,8 +722,8 @@ mod tests {
         // Three copies of one triangle and a sphere touching it: brute force
         // reports triangle 0; so must the BVH, however it orders the leaves.
         let mut scene = builtin::load_builtin("one-triangle").unwrap().unwrap();
-        let t = scene.triangles[0].clone();
-        scene.triangles = vec![t.clone(); 40];
+        let t = scene.triangles.at(0).clone();
+        scene.triangles = vec![t.clone(); 40].into();
         scene.spheres.clear();
         let prepared = PreparedScene::new(scene);
         let mut rng = Rng(7);
@@ -738,7 +738,7 @@ mod tests {
 
     fn soup_scene(tris: &[[[f32; 3]; 3]], spheres: &[([f32; 3], f32)], two_sided: bool) -> PreparedScene {
         let mut scene = builtin::load_builtin("one-triangle").unwrap().unwrap();
-        let template = scene.triangles[0].clone();
+        let template = scene.triangles.at(0).clone();
         scene.triangles = tris
             .iter()
             .map(|v| {

@@ -64,6 +64,16 @@ impl EdgeSource for SceneEdges {
 }
 
 /// The scene's triangles, their edges made as `TriangleEdges::new` makes them.
+impl EdgeSource for crate::scene::Triangles {
+    fn count(&self) -> usize {
+        self.len()
+    }
+    fn edges(&self, i: usize) -> TriangleEdges {
+        TriangleEdges::new(&self.at(i))
+    }
+}
+
+/// Triangles held apart from a scene, their edges made as for the scene's.
 impl EdgeSource for [Triangle] {
     fn count(&self) -> usize {
         self.len()
@@ -519,7 +529,7 @@ mod tests {
 
     fn build_with_threads(scene: &Scene, threads: usize) -> Bvh {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-        pool.install(|| Bvh::build(scene, &scene.triangles[..]))
+        pool.install(|| Bvh::build(scene, &scene.triangles))
     }
 
     /// Everything the traversal reads, as bits.

@@ -1,0 +1,313 @@
+//! The scene's flattened triangles, held as an indexed mesh: each triangle
+//! is three corner indices plus its material and object, and the corners
+//! (position, shading normal, uv) are shared by every triangle that has a
+//! corner with exactly the same bits. A closed mesh shares each corner
+//! about six ways, so this takes about 37 bytes per triangle where three
+//! corners of its own took 108.
+//!
+//! Renderers read a triangle as a `Triangle` value, assembled from its
+//! corners, so sharing never changes a number: `get(i)` returns exactly the
+//! `Triangle` that was pushed as triangle `i`.
+
+use super::Triangle;
+use crate::math::{Vec2, Vec3};
+use std::collections::HashMap;
+
+/// One corner's attributes, shared by the triangles that meet there.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Corner {
+    position: Vec3,
+    normal: Vec3,
+    uv: Vec2,
+}
+
+impl Corner {
+    /// The exact bits, so that only identical corners are merged (0.0 and
+    /// -0.0 stay apart).
+    fn key(&self) -> [u32; 8] {
+        let (p, n, uv) = (self.position, self.normal, self.uv);
+        [p.x, p.y, p.z, n.x, n.y, n.z, uv.x, uv.y].map(f32::to_bits)
+    }
+}
+
+/// One triangle: its corners, its material, and its object with the
+/// two-sided flag in the top bit (object indices stay far below 2^31).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Face {
+    corner: [u32; 3],
+    material: u32,
+    object_and_sides: u32,
+}
+
+const TWO_SIDED_BIT: u32 = 1 << 31;
+
+/// The scene's triangles in scene order (see the module comment).
+#[derive(Clone, Debug, Default)]
+pub struct Triangles {
+    corners: Vec<Corner>,
+    faces: Vec<Face>,
+    /// Corners pushed since the last `share_corners` (each triangle pushed
+    /// brings three corners of its own).
+    unshared_from: usize,
+}
+
+impl Triangles {
+    pub fn new() -> Triangles {
+        Triangles::default()
+    }
+
+    #[inline]
+    pub fn len(&self) -> usize {
+        self.faces.len()
+    }
+
+    #[inline]
+    pub fn is_empty(&self) -> bool {
+        self.faces.is_empty()
+    }
+
+    /// Triangle `i`, or `None` past the end.
+    #[inline]
+    pub fn get(&self, i: usize) -> Option<Triangle> {
+        self.faces.get(i).map(|f| self.assemble(f))
+    }
+
+    /// Triangle `i`; panics past the end, as indexing a slice does.
+    #[inline]
+    pub fn at(&self, i: usize) -> Triangle {
+        self.assemble(&self.faces[i])
+    }
+
+    /// The three vertex positions of triangle `i` (all that visibility reads).
+    #[inline]
+    pub fn positions(&self, i: usize) -> [Vec3; 3] {
+        self.faces[i].corner.map(|c| self.corners[c as usize].position)
+    }
+
+    /// Triangle `i`'s material index.
+    #[inline]
+    pub fn material(&self, i: usize) -> u32 {
+        self.faces[i].material
+    }
+
+    #[inline(always)]
+    fn assemble(&self, f: &Face) -> Triangle {
+        let [a, b, c] = f.corner.map(|k| self.corners[k as usize]);
+        Triangle {
+            v: [a.position, b.position, c.position],
+            n: [a.normal, b.normal, c.normal],
+            uv: [a.uv, b.uv, c.uv],
+            material: f.material,
+            object: f.object_and_sides & !TWO_SIDED_BIT,
+            two_sided: f.object_and_sides & TWO_SIDED_BIT != 0,
+        }
+    }
+
+    /// Where triangle `i`'s record lies in memory, for prefetching (its
+    /// corners are found only once it is read).
+    #[inline(always)]
+    pub fn record_ptr(&self, i: usize) -> *const u8 {
+        self.faces.as_ptr().wrapping_add(i).cast()
+    }
+
+    /// The triangles in order.
+    pub fn iter(&self) -> Iter<'_> {
+        Iter { store: self, faces: self.faces.iter() }
+    }
+
+    /// The triangles of `range`, in order; panics if it runs past the end.
+    pub fn range(&self, range: std::ops::Range<usize>) -> Iter<'_> {
+        Iter { store: self, faces: self.faces[range].iter() }
+    }
+
+    /// All triangles as values, for code that wants a slice.
+    pub fn to_vec(&self) -> Vec<Triangle> {
+        self.iter().collect()
+    }
+
+    /// Appends `t` with three corners of its own; `share_corners` merges
+    /// them with equal ones later.
+    pub fn push(&mut self, t: Triangle) {
+        debug_assert!(t.object & TWO_SIDED_BIT == 0, "object index {} too large", t.object);
+        let first = self.corners.len() as u32;
+        for k in 0..3 {
+            self.corners.push(Corner { position: t.v[k], normal: t.n[k], uv: t.uv[k] });
+        }
+        self.faces.push(Face {
+            corner: [first, first + 1, first + 2],
+            material: t.material,
+            object_and_sides: (t.object & !TWO_SIDED_BIT) | if t.two_sided { TWO_SIDED_BIT } else { 0 },
+        });
+    }
+
+    pub fn reserve(&mut self, triangles: usize) {
+        self.faces.reserve(triangles);
+        self.corners.reserve(3 * triangles);
+    }
+
+    pub fn clear(&mut self) {
+        self.faces.clear();
+        self.corners.clear();
+        self.unshared_from = 0;
+    }
+
+    /// Replaces triangle `i` by `t` (with corners of its own, so that the
+    /// triangles sharing its old corners keep them).
+    pub fn set(&mut self, i: usize, t: Triangle) {
+        let last = self.faces.len();
+        self.push(t);
+        self.faces.swap_remove(i);
+        debug_assert_eq!(self.faces.len(), last);
+    }
+
+    /// Removes and returns the triangles from `at` on.
+    pub fn split_off(&mut self, at: usize) -> Vec<Triangle> {
+        let tail: Vec<Triangle> = self.range(at..self.len()).collect();
+        self.faces.truncate(at);
+        tail
+    }
+
+    /// Keeps only the triangles `keep` accepts, in order (their corners stay).
+    pub fn retain(&mut self, mut keep: impl FnMut(&Triangle) -> bool) {
+        let faces = std::mem::take(&mut self.faces);
+        self.faces = faces.into_iter().filter(|f| keep(&self.assemble(f))).collect();
+    }
+
+    /// Moves every vertex position by `f` (each shared corner once).
+    pub fn map_positions(&mut self, mut f: impl FnMut(Vec3) -> Vec3) {
+        for c in &mut self.corners {
+            c.position = f(c.position);
+        }
+    }
+
+    /// Merges corners with identical bits, so that each is stored once; the
+    /// triangles read back unchanged. Cheap when nothing new was pushed.
+    pub fn share_corners(&mut self) {
+        if self.unshared_from == self.corners.len() {
+            return;
+        }
+        let mut index: HashMap<[u32; 8], u32> = HashMap::with_capacity(self.corners.len() / 4);
+        let mut kept: Vec<Corner> = Vec::with_capacity(self.corners.len() / 4);
+        let mut renumber = vec![0u32; self.corners.len()];
+        for (old, c) in self.corners.iter().enumerate() {
+            renumber[old] = *index.entry(c.key()).or_insert_with(|| {
+                kept.push(*c);
+                kept.len() as u32 - 1
+            });
+        }
+        for f in &mut self.faces {
+            f.corner = f.corner.map(|c| renumber[c as usize]);
+        }
+        kept.shrink_to_fit();
+        self.faces.shrink_to_fit();
+        self.corners = kept;
+        self.unshared_from = self.corners.len();
+    }
+
+    /// Bytes held: the corners and the triangle records.
+    pub fn memory_bytes(&self) -> usize {
+        std::mem::size_of_val(&self.corners[..]) + std::mem::size_of_val(&self.faces[..])
+    }
+}
+
+/// The triangles of a `Triangles`, in order, as values.
+#[derive(Clone)]
+pub struct Iter<'a> {
+    store: &'a Triangles,
+    faces: std::slice::Iter<'a, Face>,
+}
+
+impl Iterator for Iter<'_> {
+    type Item = Triangle;
+    #[inline]
+    fn next(&mut self) -> Option<Triangle> {
+        self.faces.next().map(|f| self.store.assemble(f))
+    }
+    #[inline]
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        self.faces.size_hint()
+    }
+}
+
+impl DoubleEndedIterator for Iter<'_> {
+    #[inline]
+    fn next_back(&mut self) -> Option<Triangle> {
+        self.faces.next_back().map(|f| self.store.assemble(f))
+    }
+}
+
+impl ExactSizeIterator for Iter<'_> {}
+
+impl<'a> IntoIterator for &'a Triangles {
+    type Item = Triangle;
+    type IntoIter = Iter<'a>;
+    fn into_iter(self) -> Iter<'a> {
+        self.iter()
+    }
+}
+
+impl PartialEq for Triangles {
+    fn eq(&self, other: &Triangles) -> bool {
+        self.len() == other.len() && self.iter().eq(other.iter())
+    }
+}
+
+impl FromIterator<Triangle> for Triangles {
+    fn from_iter<I: IntoIterator<Item = Triangle>>(iter: I) -> Triangles {
+        let mut t = Triangles::new();
+        t.extend(iter);
+        t
+    }
+}
+
+impl Extend<Triangle> for Triangles {
+    fn extend<I: IntoIterator<Item = Triangle>>(&mut self, iter: I) {
+        for t in iter {
+            self.push(t);
+        }
+    }
+}
+
+impl From<Vec<Triangle>> for Triangles {
+    fn from(v: Vec<Triangle>) -> Triangles {
+        v.into_iter().collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tri(v: [[f32; 3]; 3], object: u32, two_sided: bool) -> Triangle {
+        Triangle {
+            v: v.map(Vec3::from),
+            n: [Vec3::Z, Vec3::Y, Vec3::Z],
+            uv: [Vec2::ZERO, Vec2::X, Vec2::Y],
+            material: 3,
+            object,
+            two_sided,
+        }
+    }
+
+    #[test]
+    fn sharing_corners_stores_each_once_and_changes_no_triangle() {
+        // Two triangles of a quad share the diagonal's two corners; a third
+        // has the same position as one of them but -0.0 in its uv, so it is
+        // a different corner.
+        let a = tri([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0]], 1, false);
+        let b = Triangle { v: [a.v[0], a.v[2], Vec3::new(0.0, 1.0, 0.0)], n: [a.n[0], a.n[2], Vec3::Z], uv: [a.uv[0], a.uv[2], Vec2::Y], ..a.clone() };
+        let mut c = tri([[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [2.0, 2.0, 0.0]], 7, true);
+        c.uv[0] = Vec2::new(-0.0, 0.0);
+        let mut store: Triangles = vec![a.clone(), b.clone(), c.clone()].into();
+        assert_eq!(store.corners.len(), 9);
+        store.share_corners();
+        assert_eq!(store.corners.len(), 4 + 3, "the quad's 4 corners and the third triangle's 3");
+        assert_eq!(store.to_vec(), vec![a.clone(), b.clone(), c.clone()]);
+        assert!(store.at(2).two_sided && store.at(2).object == 7 && !store.at(0).two_sided);
+        assert_eq!(store.memory_bytes(), 7 * 32 + 3 * 20);
+        // Editing one triangle leaves its neighbour's shared corners alone.
+        let moved = Triangle { v: [Vec3::splat(5.0); 3], ..a.clone() };
+        store.set(0, moved.clone());
+        assert_eq!(store.to_vec(), vec![moved, b, c]);
+    }
+}
