@@ -161,7 +161,7 @@ impl InstanceAccel {
         }
         let mut stack: Vec<u32> = Vec::with_capacity(64);
         let mut word = bvh.root;
-        let mut leaf: [(TriangleEdges, PrimitiveId); 8] = [(TriangleEdges { v0: Vec3::ZERO, e1: Vec3::ZERO, e2: Vec3::ZERO, det_epsilon: 0.0, two_sided: false }, PrimitiveId::NONE); 8];
+        let mut leaf: [(TriangleEdges, PrimitiveId); 8] = [(TriangleEdges::ZERO, PrimitiveId::NONE); 8];
         loop {
             *visits += 1;
             if word & LEAF_BIT == 0 {

@@ -6,23 +6,40 @@ use crate::math::{Ray, Vec3};
 use crate::scene::{Sphere, Triangle};
 
 /// A triangle prepared for Möller-Trumbore: one vertex and two edges.
+/// Every BVH leaf slot holds one, so it is kept to 40 bytes: the two-sided
+/// flag rides in the sign bit of the determinant bound, which is never
+/// negative.
 #[derive(Clone, Copy, Debug)]
 pub struct TriangleEdges {
     pub v0: Vec3,
     pub e1: Vec3,
     pub e2: Vec3,
-    /// Determinants this small are rounding noise: the ray lies (nearly) in
-    /// the triangle's plane, and the weights computed from them are garbage.
-    pub det_epsilon: f32,
-    pub two_sided: bool,
+    /// `det_epsilon()`, negated for a two-sided triangle.
+    epsilon_and_sides: f32,
 }
 
 impl TriangleEdges {
+    /// Edges of nothing (a placeholder that no ray hits).
+    pub const ZERO: TriangleEdges = TriangleEdges { v0: Vec3::ZERO, e1: Vec3::ZERO, e2: Vec3::ZERO, epsilon_and_sides: 0.0 };
+
     pub fn new(t: &Triangle) -> TriangleEdges {
         let (e1, e2) = (t.v[1] - t.v[0], t.v[2] - t.v[0]);
         // det = -dir . (e1 x e2) carries a rounding error of a few ulps of |e1| |e2|.
         let det_epsilon = 8.0 * f32::EPSILON * e1.length() * e2.length();
-        TriangleEdges { v0: t.v[0], e1, e2, det_epsilon, two_sided: t.two_sided }
+        TriangleEdges { v0: t.v[0], e1, e2, epsilon_and_sides: if t.two_sided { -det_epsilon } else { det_epsilon } }
+    }
+
+    /// Determinants this small are rounding noise: the ray lies (nearly) in
+    /// the triangle's plane, and the weights computed from them are garbage.
+    #[inline(always)]
+    pub fn det_epsilon(&self) -> f32 {
+        self.epsilon_and_sides.abs()
+    }
+
+    /// Whether the triangle is hit from behind too.
+    #[inline(always)]
+    pub fn two_sided(&self) -> bool {
+        self.epsilon_and_sides.is_sign_negative()
     }
 }
 
@@ -52,12 +69,13 @@ pub fn intersect_triangle(ray: &Ray, tri: &TriangleEdges, t_max: f32) -> Triangl
     let p = ray.dir.cross(tri.e2);
     let det = tri.e1.dot(p);
     // det = -dir . (e1 x e2): positive when the ray meets the front face.
-    if tri.two_sided {
-        if !(det.abs() > tri.det_epsilon) {
+    let det_epsilon = tri.det_epsilon();
+    if tri.two_sided() {
+        if !(det.abs() > det_epsilon) {
             return Err(Miss::Parallel);
         }
-    } else if !(det > tri.det_epsilon) {
-        return Err(if det < -tri.det_epsilon { Miss::BackFace } else { Miss::Parallel });
+    } else if !(det > det_epsilon) {
+        return Err(if det < -det_epsilon { Miss::BackFace } else { Miss::Parallel });
     }
     let inv = 1.0 / det;
     let s = ray.origin - tri.v0;
@@ -91,9 +109,9 @@ pub fn intersect_triangle_lanes<L: Lane>(origin: V3<L>, dir: V3<L>, tri: &Triang
     let e2 = V3::splat(limit, tri.e2);
     let p = dir.cross(e2);
     let det = e1.dot(p);
-    let epsilon = limit.splat(tri.det_epsilon);
+    let epsilon = limit.splat(tri.det_epsilon());
     let front = det.gt(epsilon);
-    let facing = if tri.two_sided { front | (-det).gt(epsilon) } else { front };
+    let facing = if tri.two_sided() { front | (-det).gt(epsilon) } else { front };
     let inv = one / det;
     let s = origin - V3::splat(limit, tri.v0);
     let b1 = s.dot(p) * inv;
@@ -187,7 +205,11 @@ mod tests {
     }
 
     fn book_triangle() -> TriangleEdges {
-        tri([Vec3::new(0.0, 1.0, -2.0), Vec3::new(-1.9, -1.0, -2.0), Vec3::new(1.6, -0.5, -2.0)], false)
+        book_triangle_sided(false)
+    }
+
+    fn book_triangle_sided(two_sided: bool) -> TriangleEdges {
+        tri([Vec3::new(0.0, 1.0, -2.0), Vec3::new(-1.9, -1.0, -2.0), Vec3::new(1.6, -0.5, -2.0)], two_sided)
     }
 
     #[test]
@@ -223,9 +245,8 @@ mod tests {
     fn rays_in_the_plane_never_hit() {
         // A ray lying in the triangle's plane (z = -2) through its interior: the
         // determinant is rounding noise, and must not produce a hit elsewhere.
-        let mut t = book_triangle();
         for two_sided in [false, true] {
-            t.two_sided = two_sided;
+            let t = book_triangle_sided(two_sided);
             for dir in [Vec3::X, Vec3::new(0.6, 0.8, 0.0), Vec3::new(-0.28, 0.96, 1e-9)] {
                 let r = Ray::new(Vec3::new(-3.0, -0.2, -2.0), dir);
                 assert_eq!(intersect_triangle(&r, &t, 1e9), Err(Miss::Parallel), "{dir}");
@@ -267,8 +288,8 @@ mod tests {
 
     #[test]
     fn two_sided_hits_from_behind() {
-        let mut t = book_triangle();
-        t.two_sided = true;
+        let t = book_triangle_sided(true);
+        assert!(t.two_sided() && !book_triangle().two_sided() && t.det_epsilon() == book_triangle().det_epsilon());
         let r = Ray::new(Vec3::new(0.0, 0.0, -3.0), Vec3::Z);
         let (dist, _, _) = intersect_triangle(&r, &t, 1e9).unwrap();
         assert!((dist - 1.0).abs() < 1e-6);

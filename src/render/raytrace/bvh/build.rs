@@ -488,7 +488,7 @@ impl Bvh {
         nodes.shrink_to_fit();
         sphere_leaf_bounds.sort_unstable_by_key(|(first, _)| *first);
         // The primitive slots gathered while the binary tree is freed.
-        let dummy = TriangleEdges { v0: Vec3::ZERO, e1: Vec3::ZERO, e2: Vec3::ZERO, det_epsilon: 0.0, two_sided: false };
+        let dummy = TriangleEdges::ZERO;
         let ((), prims) = rayon::join(
             move || drop(tree),
             || {
