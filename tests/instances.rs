@@ -279,7 +279,7 @@ fn the_two_level_layer_renders_what_flattening_renders() {
     assert_eq!(flat.total_triangles(), layered.total_triangles());
     assert_eq!(layered.triangles.len(), 2);
     for i in 0..flat.triangles.len() as u32 {
-        assert_eq!(*flat.triangle(i), *layered.triangle(i), "triangle {i}");
+        assert_eq!(flat.triangle(i), layered.triangle(i), "triangle {i}");
     }
     let (pf, pl) = (PreparedScene::new(flat), PreparedScene::new(layered));
     let mut settings = RenderSettings::for_scene(&pf.scene);

@@ -70,7 +70,7 @@ pub fn transfer(rd: &RayDifferential, dir: Vec3, t: f32, n: Vec3) -> (Vec3, Vec3
 pub fn uv_change(scene: &Scene, hit: &SurfaceHit, dp: Vec3) -> Vec2 {
     match hit.kind {
         PrimitiveKind::Triangle => {
-            let tri = &*scene.triangle(hit.primitive);
+            let tri = &scene.triangle(hit.primitive);
             let (e1, e2) = (tri.v[1] - tri.v[0], tri.v[2] - tri.v[0]);
             let n = e1.cross(e2);
             let nn = n.dot(n);

@@ -393,7 +393,7 @@ pub fn shadow_origin(scene: &Scene, hit: &SurfaceHit, w_i: Vec3, lift: bool) -> 
 /// The hit point lifted onto the surface implied by the vertex normals
 /// (Hanika's construction); the hit point itself on flat triangles.
 pub fn lifted_position(scene: &Scene, hit: &SurfaceHit) -> Vec3 {
-    let tri = &*scene.triangle(hit.primitive);
+    let tri = &scene.triangle(hit.primitive);
     let side = if hit.back_face { -1.0 } else { 1.0 };
     let mut lifted = Vec3::ZERO;
     for k in 0..3 {
@@ -419,7 +419,7 @@ pub fn shade_gouraud<Q: SceneQuery, R: Recorder>(
         let w_o = (eye - hit.position).normalize_or_zero();
         return shade(sh, hit, w_o, 0);
     }
-    let tri = &*scene.triangle(hit.primitive);
+    let tri = &scene.triangle(hit.primitive);
     let side = if hit.back_face { -1.0 } else { 1.0 };
     let mut l_o = Vec3::ZERO;
     for k in 0..3 {

@@ -546,26 +546,26 @@ fn add_object(
             if o.instances.is_some() {
                 layered.flattened += loaded.triangles.len() * copies.len();
             }
-            scene.triangles.reserve(loaded.triangles.len() * copies.len());
+            scene.triangles.reserve_copies(&loaded.triangles, copies.len());
             for copy in &copies {
                 let start = scene.triangles.len();
-                for t in &loaded.triangles {
-                    let mut t = t.clone();
-                    t.material = match (copy.material, t.material) {
-                        (Some(m), _) => m,
-                        (None, u32::MAX) => fallback,
-                        (None, k) => mtl_index[k as usize],
-                    };
-                    t.object = object;
-                    t.two_sided = two_sided;
-                    // The object's own placement first, then the copy's:
-                    // each by the same arithmetic as a lone object's.
-                    let t = placement.apply(t);
-                    scene.triangles.push(match &copy.placement {
-                        Some(p) => p.apply(t),
-                        None => t,
-                    });
-                }
+                let material = |m: u32| match (copy.material, m) {
+                    (Some(m), _) => m,
+                    (None, u32::MAX) => fallback,
+                    (None, k) => mtl_index[k as usize],
+                };
+                // The object's own placement first, then the copy's: each by
+                // the same arithmetic as `Placement::apply` on a lone object,
+                // but once per shared corner.
+                let place = |p: Vec3, n: Vec3| {
+                    let (p, n) = placement.apply_corner(p, n);
+                    match &copy.placement {
+                        Some(c) => c.apply_corner(p, n),
+                        None => (p, n),
+                    }
+                };
+                let flips = placement.flips() != copy.placement.as_ref().is_some_and(|c| c.flips());
+                scene.triangles.append_copy(&loaded.triangles, place, flips, material, object, two_sided);
                 if let Some(index) = copy.index {
                     scene.instances.push(InstanceInfo::new(object, index, start..scene.triangles.len(), scene.triangles.range(start..scene.triangles.len())));
                 }
@@ -853,12 +853,28 @@ impl Placement {
 
     /// The triangle placed: vertices by the matrix, normals by its inverse
     /// transpose, corners reordered when the placement mirrors.
+    /// One corner's position and normal placed as `apply` places them (a
+    /// flat triangle's normal aside, which `apply` makes anew).
+    #[inline]
+    pub fn apply_corner(&self, p: Vec3, n: Vec3) -> (Vec3, Vec3) {
+        if self.identity {
+            return (p, n);
+        }
+        (self.matrix.transform_point3(p), (self.normal_matrix * n).normalize_or_zero())
+    }
+
+    /// Whether the placement mirrors, so that `apply` reverses windings.
+    pub fn flips(&self) -> bool {
+        !self.identity && self.flips
+    }
+
     pub fn apply(&self, mut t: Triangle) -> Triangle {
         if self.identity {
             return t;
         }
         // A mirroring scale flips the winding; swap two corners to keep fronts in front.
         let flips = self.flips;
+        let flat = t.is_flat();
         for k in 0..3 {
             t.v[k] = self.matrix.transform_point3(t.v[k]);
             t.n[k] = (self.normal_matrix * t.n[k]).normalize_or_zero();
@@ -867,6 +883,11 @@ impl Placement {
             t.v.swap(1, 2);
             t.n.swap(1, 2);
             t.uv.swap(1, 2);
+        }
+        // A flat triangle stays flat: its normal is the placed triangle's own
+        // (equal to the transformed one up to rounding).
+        if flat {
+            t.n = [t.geometric_normal(); 3];
         }
         t
     }

@@ -48,8 +48,22 @@ pub struct Triangle {
 
 impl Triangle {
     /// `(v1 - v0) x (v2 - v0)`, normalized: the front side (CCW winding).
+    #[inline(always)]
     pub fn geometric_normal(&self) -> Vec3 {
-        (self.v[1] - self.v[0]).cross(self.v[2] - self.v[0]).normalize()
+        Self::normal_of(&self.v)
+    }
+
+    /// The geometric normal of a triangle with vertices `v`.
+    #[inline(always)]
+    pub fn normal_of(v: &[Vec3; 3]) -> Vec3 {
+        (v[1] - v[0]).cross(v[2] - v[0]).normalize()
+    }
+
+    /// Flat-shaded: every corner's normal is exactly (bit for bit) the
+    /// geometric normal, so it can be recomputed instead of stored.
+    pub fn is_flat(&self) -> bool {
+        let g = self.geometric_normal().to_array().map(f32::to_bits);
+        self.n.iter().all(|n| n.to_array().map(f32::to_bits) == g)
     }
 
     pub fn area(&self) -> f32 {
@@ -376,14 +390,24 @@ impl Scene {
     /// Triangle `index` in world space: a flattened one, or one of the
     /// two-level layer made as flattening would make it.
     #[inline]
-    pub fn triangle(&self, index: u32) -> std::borrow::Cow<'_, Triangle> {
+    pub fn triangle(&self, index: u32) -> Triangle {
         match self.triangles.get(index as usize) {
-            Some(t) => std::borrow::Cow::Owned(t),
+            Some(t) => t,
             None => {
                 let layer = self.layer.as_ref().expect("a triangle index past the scene's triangles");
                 let (inst, local) = layer.locate(index).expect("a triangle index past the two-level layer");
-                std::borrow::Cow::Owned(layer.world(inst, local))
+                layer.world(inst, local)
             }
+        }
+    }
+
+    /// The vertex positions of `triangle(index)`, without its other attributes.
+    #[inline]
+    pub fn triangle_positions(&self, index: u32) -> [Vec3; 3] {
+        if (index as usize) < self.triangles.len() {
+            self.triangles.positions(index as usize)
+        } else {
+            self.triangle(index).v
         }
     }
 

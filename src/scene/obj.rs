@@ -7,7 +7,7 @@
 use super::assets::read_asset;
 use crate::input::{InputKind, MAX_COORDINATE, MAX_VALUE};
 use super::texture::load_texture;
-use super::{Camera, Fov, Light, Material, ObjectInfo, Scene, Triangle};
+use super::{Camera, Fov, Light, Material, ObjectInfo, Scene, Triangle, Triangles};
 use crate::math::{Vec2, Vec3};
 use serde::Deserialize;
 use std::path::Path;
@@ -25,7 +25,8 @@ pub enum NormalMode {
 
 pub struct LoadedMesh {
     /// `material` is an index into `materials`, or `u32::MAX` for "none given".
-    pub triangles: Vec<Triangle>,
+    /// Corners shared, so that each copy placed into a scene shares them too.
+    pub triangles: Triangles,
     pub materials: Vec<Material>,
     /// Triangles dropped because they have no area.
     pub degenerate: usize,
@@ -119,7 +120,7 @@ fn load_obj_unbounded(path: &Path, mode: NormalMode, textures: MtlTextures) -> R
         }
     };
 
-    let mut triangles = Vec::new();
+    let mut triangles = Triangles::new();
     let mut degenerate = 0;
     for model in &models {
         let m = &model.mesh;
@@ -170,7 +171,10 @@ fn load_obj_unbounded(path: &Path, mode: NormalMode, textures: MtlTextures) -> R
                 degenerate += 1;
                 continue;
             }
-            let geo = geo / len;
+            // The flat normal is made exactly as `Triangle::geometric_normal`
+            // makes it, so that the scene stores flat triangles' normals as
+            // a flag (`Triangles`).
+            let geo = Triangle::normal_of(&v);
             let corner = |k: usize| -> Vec3 {
                 if use_file_normals {
                     normals[m.normal_indices[3 * f + k] as usize].normalize_or(geo)
@@ -194,6 +198,7 @@ fn load_obj_unbounded(path: &Path, mode: NormalMode, textures: MtlTextures) -> R
     if triangles.is_empty() {
         return Err(format!("{name}: the OBJ has no triangles with area"));
     }
+    triangles.share_corners();
     Ok(LoadedMesh { triangles, materials, degenerate, warnings })
 }
 
@@ -229,7 +234,7 @@ pub fn frame_bare_obj(path: &Path) -> Result<Scene, String> {
     let fallback = scene.default_material_index();
     scene.triangles = mesh
         .triangles
-        .into_iter()
+        .iter()
         .map(|mut t| {
             if t.material == u32::MAX {
                 t.material = fallback;

@@ -5,13 +5,17 @@
 //! about six ways, so this takes about 37 bytes per triangle where three
 //! corners of its own took 108.
 //!
+//! A flat-shaded triangle (`Triangle::is_flat`: each corner's normal is the
+//! geometric normal, bit for bit) stores no normal: it is recomputed from
+//! the positions, so the corners of a flat mesh are shared too.
+//!
 //! Renderers read a triangle as a `Triangle` value, assembled from its
 //! corners, so sharing never changes a number: `get(i)` returns exactly the
 //! `Triangle` that was pushed as triangle `i`.
 
 use super::Triangle;
 use crate::math::{Vec2, Vec3};
-use std::collections::HashMap;
+use rustc_hash::FxHashMap;
 
 /// One corner's attributes, shared by the triangles that meet there.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -31,24 +35,29 @@ impl Corner {
 }
 
 /// One triangle: its corners, its material, and its object with the
-/// two-sided flag in the top bit (object indices stay far below 2^31).
+/// two-sided and flat flags in the top bits (object indices stay far below
+/// 2^30).
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Face {
     corner: [u32; 3],
     material: u32,
-    object_and_sides: u32,
+    object_and_flags: u32,
 }
 
 const TWO_SIDED_BIT: u32 = 1 << 31;
+/// The corners' normals are the geometric normal (stored as zero).
+const FLAT_BIT: u32 = 1 << 30;
+const FLAG_BITS: u32 = TWO_SIDED_BIT | FLAT_BIT;
 
 /// The scene's triangles in scene order (see the module comment).
 #[derive(Clone, Debug, Default)]
 pub struct Triangles {
     corners: Vec<Corner>,
     faces: Vec<Face>,
-    /// Corners pushed since the last `share_corners` (each triangle pushed
-    /// brings three corners of its own).
-    unshared_from: usize,
+    /// Ranges of corners pushed one triangle at a time since the last
+    /// `share_corners`: only these are looked for duplicates (a mesh copied
+    /// with `append_copy` keeps its sharing).
+    pending: Vec<std::ops::Range<usize>>,
 }
 
 impl Triangles {
@@ -84,6 +93,14 @@ impl Triangles {
         self.faces[i].corner.map(|c| self.corners[c as usize].position)
     }
 
+    /// The positions of triangle `i` and whether it is two-sided: what
+    /// visibility reads.
+    #[inline]
+    pub fn geometry(&self, i: usize) -> ([Vec3; 3], bool) {
+        let f = &self.faces[i];
+        (f.corner.map(|c| self.corners[c as usize].position), f.object_and_flags & TWO_SIDED_BIT != 0)
+    }
+
     /// Triangle `i`'s material index.
     #[inline]
     pub fn material(&self, i: usize) -> u32 {
@@ -93,13 +110,15 @@ impl Triangles {
     #[inline(always)]
     fn assemble(&self, f: &Face) -> Triangle {
         let [a, b, c] = f.corner.map(|k| self.corners[k as usize]);
+        let v = [a.position, b.position, c.position];
+        let n = if f.object_and_flags & FLAT_BIT != 0 { [Triangle::normal_of(&v); 3] } else { [a.normal, b.normal, c.normal] };
         Triangle {
-            v: [a.position, b.position, c.position],
-            n: [a.normal, b.normal, c.normal],
+            v,
+            n,
             uv: [a.uv, b.uv, c.uv],
             material: f.material,
-            object: f.object_and_sides & !TWO_SIDED_BIT,
-            two_sided: f.object_and_sides & TWO_SIDED_BIT != 0,
+            object: f.object_and_flags & !FLAG_BITS,
+            two_sided: f.object_and_flags & TWO_SIDED_BIT != 0,
         }
     }
 
@@ -128,16 +147,25 @@ impl Triangles {
     /// Appends `t` with three corners of its own; `share_corners` merges
     /// them with equal ones later.
     pub fn push(&mut self, t: Triangle) {
-        debug_assert!(t.object & TWO_SIDED_BIT == 0, "object index {} too large", t.object);
+        debug_assert!(t.object & FLAG_BITS == 0, "object index {} too large", t.object);
+        let flat = t.is_flat();
         let first = self.corners.len() as u32;
         for k in 0..3 {
-            self.corners.push(Corner { position: t.v[k], normal: t.n[k], uv: t.uv[k] });
+            let normal = if flat { Vec3::ZERO } else { t.n[k] };
+            self.corners.push(Corner { position: t.v[k], normal, uv: t.uv[k] });
         }
-        self.faces.push(Face {
-            corner: [first, first + 1, first + 2],
-            material: t.material,
-            object_and_sides: (t.object & !TWO_SIDED_BIT) | if t.two_sided { TWO_SIDED_BIT } else { 0 },
-        });
+        match self.pending.last_mut() {
+            Some(r) if r.end == first as usize => r.end += 3,
+            _ => self.pending.push(first as usize..first as usize + 3),
+        }
+        let flags = if t.two_sided { TWO_SIDED_BIT } else { 0 } | if flat { FLAT_BIT } else { 0 };
+        self.faces.push(Face { corner: [first, first + 1, first + 2], material: t.material, object_and_flags: (t.object & !FLAG_BITS) | flags });
+    }
+
+    /// Room for `copies` copies of `mesh` (`append_copy`).
+    pub fn reserve_copies(&mut self, mesh: &Triangles, copies: usize) {
+        self.faces.reserve(mesh.faces.len() * copies);
+        self.corners.reserve(mesh.corners.len() * copies);
     }
 
     pub fn reserve(&mut self, triangles: usize) {
@@ -148,7 +176,40 @@ impl Triangles {
     pub fn clear(&mut self) {
         self.faces.clear();
         self.corners.clear();
-        self.unshared_from = 0;
+        self.pending.clear();
+    }
+
+    /// Appends a copy of every triangle of `mesh`, keeping its shared
+    /// corners shared: each corner's position and normal pass through
+    /// `place` once, `flips` reverses every winding (a mirroring placement),
+    /// and each triangle takes the material `material` maps its own to, and
+    /// `object` and `two_sided`. Gives the triangles that pushing each of
+    /// `mesh`'s triangles, placed corner by corner, would give.
+    pub fn append_copy(
+        &mut self,
+        mesh: &Triangles,
+        place: impl Fn(Vec3, Vec3) -> (Vec3, Vec3),
+        flips: bool,
+        material: impl Fn(u32) -> u32,
+        object: u32,
+        two_sided: bool,
+    ) {
+        debug_assert!(object & FLAG_BITS == 0, "object index {object} too large");
+        let base = self.corners.len() as u32;
+        self.corners.extend(mesh.corners.iter().map(|c| {
+            let (position, normal) = place(c.position, c.normal);
+            // A flat triangle's corners hold no normal (zero), whatever the placement.
+            Corner { position, normal, uv: c.uv }
+        }));
+        let sides = if two_sided { TWO_SIDED_BIT } else { 0 };
+        self.faces.extend(mesh.faces.iter().map(|f| {
+            let mut corner = f.corner.map(|k| k + base);
+            if flips {
+                corner.swap(1, 2);
+            }
+            Face { corner, material: material(f.material), object_and_flags: object | sides | (f.object_and_flags & FLAT_BIT) }
+        }));
+        self.pending.extend(mesh.pending.iter().map(|r| r.start + base as usize..r.end + base as usize));
     }
 
     /// Replaces triangle `i` by `t` (with corners of its own, so that the
@@ -180,20 +241,31 @@ impl Triangles {
         }
     }
 
-    /// Merges corners with identical bits, so that each is stored once; the
-    /// triangles read back unchanged. Cheap when nothing new was pushed.
+    /// Merges the corners pushed one triangle at a time with identical
+    /// ones pushed so, so that each is stored once; the triangles read back
+    /// unchanged. Nothing to do when no triangle was pushed since.
     pub fn share_corners(&mut self) {
-        if self.unshared_from == self.corners.len() {
+        if self.pending.is_empty() {
             return;
         }
-        let mut index: HashMap<[u32; 8], u32> = HashMap::with_capacity(self.corners.len() / 4);
-        let mut kept: Vec<Corner> = Vec::with_capacity(self.corners.len() / 4);
+        let pending_corners: usize = self.pending.iter().map(|r| r.len()).sum();
+        let mut index: FxHashMap<[u32; 8], u32> = FxHashMap::with_capacity_and_hasher(pending_corners / 4, Default::default());
+        let mut kept: Vec<Corner> = Vec::with_capacity(self.corners.len() - pending_corners * 3 / 4);
         let mut renumber = vec![0u32; self.corners.len()];
+        let mut ranges = std::mem::take(&mut self.pending).into_iter().peekable();
         for (old, c) in self.corners.iter().enumerate() {
-            renumber[old] = *index.entry(c.key()).or_insert_with(|| {
+            while ranges.peek().is_some_and(|r| r.end <= old) {
+                ranges.next();
+            }
+            renumber[old] = if ranges.peek().is_some_and(|r| r.contains(&old)) {
+                *index.entry(c.key()).or_insert_with(|| {
+                    kept.push(*c);
+                    kept.len() as u32 - 1
+                })
+            } else {
                 kept.push(*c);
                 kept.len() as u32 - 1
-            });
+            };
         }
         for f in &mut self.faces {
             f.corner = f.corner.map(|c| renumber[c as usize]);
@@ -201,7 +273,6 @@ impl Triangles {
         kept.shrink_to_fit();
         self.faces.shrink_to_fit();
         self.corners = kept;
-        self.unshared_from = self.corners.len();
     }
 
     /// Bytes held: the corners and the triangle records.
@@ -305,6 +376,15 @@ mod tests {
         assert_eq!(store.to_vec(), vec![a.clone(), b.clone(), c.clone()]);
         assert!(store.at(2).two_sided && store.at(2).object == 7 && !store.at(0).two_sided);
         assert_eq!(store.memory_bytes(), 7 * 32 + 3 * 20);
+        // Flat triangles store no normals, so a flat quad's corners are
+        // shared too (and -0.0 still differs from 0.0).
+        let flat = |t: &Triangle| Triangle { n: [t.geometric_normal(); 3], ..t.clone() };
+        let (fa, fb, fc) = (flat(&a), flat(&b), flat(&c));
+        assert!(fa.is_flat() && !a.is_flat());
+        let mut flats: Triangles = vec![fa.clone(), fb.clone(), fc.clone()].into();
+        flats.share_corners();
+        assert_eq!(flats.corners.len(), 7);
+        assert_eq!(flats.to_vec(), vec![fa, fb, fc]);
         // Editing one triangle leaves its neighbour's shared corners alone.
         let moved = Triangle { v: [Vec3::splat(5.0); 3], ..a.clone() };
         store.set(0, moved.clone());

@@ -18,7 +18,7 @@ use crate::scene::{CameraView, Differentials, Scene};
 /// The derivatives at image position `(px, py)` of a sample of triangle
 /// `index` with perspective-correct barycentrics `b`.
 pub fn screen_differentials(scene: &Scene, view: &CameraView, index: u32, b: Vec3, px: f32, py: f32) -> Differentials {
-    let tri = &*scene.triangle(index);
+    let tri = &scene.triangle(index);
     let v = tri.v.map(|p| view.to_camera(p));
     let (e1, e2) = (v[1] - v[0], v[2] - v[0]);
     let n = e1.cross(e2);

@@ -181,7 +181,7 @@ pub fn draw_order(job: &PassJob, fts: &[FixedTri], spheres: &[Option<PixelRect>]
     let mut items: Vec<Item> = Vec::with_capacity(fts.len() + spheres.len());
     for (i, ft) in fts.iter().enumerate() {
         let depths = ft.st.inv_z.map(|w| 1.0 / w as f64);
-        let t = &*scene.triangle(ft.st.tri);
+        let t = &scene.triangle(ft.st.tri);
         let v = t.v.map(|p| f64v(view.to_camera(p)));
         let n = cross(sub(v[1], v[0]), sub(v[2], v[0]));
         let d = dot(n, v[0]);

@@ -208,7 +208,10 @@ pub fn setup_pass_map<T: Send>(job: &PassJob, keep: impl Fn(ScreenTri) -> Option
             match chunk.copy {
                 None => {
                     for i in chunk.range {
-                        setup_triangle_clipped(view, &scene.triangles.at(i), i as u32, job.offset, near_clip, frustum.as_ref(), &mut out);
+                        // Setup reads the vertices and the sidedness alone.
+                        let (v, two_sided) = scene.triangles.geometry(i);
+                        let t = Triangle { v, n: [Vec3::ZERO; 3], uv: [Vec2::ZERO; 3], material: 0, object: 0, two_sided };
+                        setup_triangle_clipped(view, &t, i as u32, job.offset, near_clip, frustum.as_ref(), &mut out);
                     }
                 }
                 Some(k) => {

@@ -457,7 +457,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             let t = match self.key {
                 DepthKey::RayT => self.depth[i],
                 DepthKey::NegInvZ => {
-                    let v = &scene.triangle(id.index()).v;
+                    let v = scene.triangle_positions(id.index());
                     let pos = v[0] * b.x + v[1] * b.y + v[2] * b.z;
                     (pos - ray.origin).dot(ray.dir)
                 }
