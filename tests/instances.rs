@@ -434,3 +434,60 @@ fn grove_copies_out_of_view_cost_the_ray_tracer_the_log_of_their_count() {
         assert!(added > 0.5 && added < 8.0, "{per_ray:?}");
     }
 }
+
+/// A mesh's copies are appended corner by corner from the OBJ's shared
+/// corners; they must be exactly the triangles that placing each of the
+/// OBJ's triangles alone gives (the object's placement, then the copy's),
+/// for smooth and flat normals, mirrored copies included.
+#[test]
+fn copies_placed_corner_by_corner_are_the_triangles_placed_one_by_one() {
+    use pinhole::scene::file::Placement;
+    use pinhole::scene::obj::{load_obj, MtlTextures, NormalMode};
+    use glam::Vec3;
+    let d = dir();
+    // (translate, rotate_deg, scale) of the object and of its two copies.
+    let object = (Vec3::new(0.1, 1.0, 0.0), Vec3::new(5.0, 10.0, 0.0), Vec3::splat(1.5));
+    let copies = [(Vec3::new(1.0, 0.0, 2.0), Vec3::new(0.0, 30.0, 10.0), Vec3::new(-0.6, 0.6, 0.7)), (Vec3::ZERO, Vec3::ZERO, Vec3::ONE)];
+    let f3 = |v: Vec3| format!("[{:?}, {:?}, {:?}]", v.x, v.y, v.z);
+    let list: Vec<String> = copies.iter().map(|(t, r, s)| format!("  {{ translate = {}, rotate_deg = {}, scale = {} }},", f3(*t), f3(*r), f3(*s))).collect();
+    for (mode, name) in [(NormalMode::Smooth, "smooth"), (NormalMode::Flat, "flat")] {
+        let text = format!(
+            "{HEAD}\n[[object]]\ntype = \"mesh\"\nfile = \"cube.obj\"\nnormals = \"{name}\"\nmaterial = \"red\"\ntranslate = {}\nrotate_deg = {}\nscale = {}\ninstances = [\n{}\n]\n",
+            f3(object.0),
+            f3(object.1),
+            f3(object.2),
+            list.join("\n")
+        );
+        let scene = parse(&text, &d);
+        let mesh = load_obj(&d.join("cube.obj"), mode, MtlTextures::None).unwrap();
+        let place_object = Placement::new(object.0, object.1, object.2);
+        let mut expected = Vec::new();
+        for (t, r, s) in copies {
+            let place_copy = Placement::new(t, r, s);
+            expected.extend(mesh.triangles.iter().map(|t| place_copy.apply(place_object.apply(t))));
+        }
+        // The ground quad comes first.
+        let got: Vec<_> = scene.triangles.range(2..scene.triangles.len()).collect();
+        assert_eq!(got.len(), expected.len(), "{name}");
+        let key = |t: &pinhole::scene::Triangle| (t.v, t.n, t.uv, t.two_sided).map_bits();
+        for (i, (g, e)) in got.iter().zip(&expected).enumerate() {
+            assert_eq!(key(g), key(e), "{name}: triangle {i}");
+        }
+        // Flat copies stay flat (their normals recomputed), smooth ones do not.
+        assert!(got.iter().all(|t| (name == "flat") == t.is_flat()), "{name}");
+    }
+}
+
+/// Bits of a triangle's attributes, so that 0.0 and -0.0 differ.
+trait MapBits {
+    fn map_bits(&self) -> Vec<u32>;
+}
+
+impl MapBits for ([glam::Vec3; 3], [glam::Vec3; 3], [glam::Vec2; 3], bool) {
+    fn map_bits(&self) -> Vec<u32> {
+        let mut out: Vec<u32> = self.0.iter().chain(&self.1).flat_map(|v| v.to_array()).map(f32::to_bits).collect();
+        out.extend(self.2.iter().flat_map(|v| v.to_array()).map(f32::to_bits));
+        out.push(self.3 as u32);
+        out
+    }
+}

@@ -366,9 +366,10 @@ mod tests {
         // has the same position as one of them but -0.0 in its uv, so it is
         // a different corner.
         let a = tri([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0]], 1, false);
-        let b = Triangle { v: [a.v[0], a.v[2], Vec3::new(0.0, 1.0, 0.0)], n: [a.n[0], a.n[2], Vec3::Z], uv: [a.uv[0], a.uv[2], Vec2::Y], ..a.clone() };
+        let b = Triangle { v: [a.v[0], a.v[2], Vec3::new(0.0, 1.0, 0.0)], n: [a.n[0], a.n[2], Vec3::Y], uv: [a.uv[0], a.uv[2], Vec2::Y], ..a.clone() };
         let mut c = tri([[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [2.0, 2.0, 0.0]], 7, true);
         c.uv[0] = Vec2::new(-0.0, 0.0);
+        assert!(!a.is_flat() && !b.is_flat() && !c.is_flat());
         let mut store: Triangles = vec![a.clone(), b.clone(), c.clone()].into();
         assert_eq!(store.corners.len(), 9);
         store.share_corners();
