@@ -442,8 +442,8 @@ impl Scene {
     /// rasterizer build their hits here, so identical visibility gives identical
     /// shading inputs.
     pub fn triangle_hit(&self, index: u32, b: Vec3, t: f32, ray: &Ray) -> SurfaceHit {
-        // A flattened triangle is read in place; only a copy of the
-        // two-level layer is placed in world space first.
+        // A flattened triangle is assembled from its shared corners; a copy
+        // of the two-level layer is placed in world space first.
         match self.triangles.get(index as usize) {
             Some(tri) => Self::hit_on(&tri, index, b, t, ray),
             None => Self::hit_on(&self.triangle(index), index, b, t, ray),
