@@ -121,6 +121,8 @@ fn load_obj_unbounded(path: &Path, mode: NormalMode, textures: MtlTextures) -> R
     };
 
     let mut triangles = Triangles::new();
+    // Per vertex of every model so far: the corner made for it, if any.
+    let mut vertex_corner: Vec<u32> = Vec::new();
     let mut degenerate = 0;
     for model in &models {
         let m = &model.mesh;
@@ -138,6 +140,8 @@ fn load_obj_unbounded(path: &Path, mode: NormalMode, textures: MtlTextures) -> R
                 pos[i]
             ));
         }
+        let corner_base = vertex_corner.len();
+        vertex_corner.resize(corner_base + pos.len(), u32::MAX);
         let normals: Vec<Vec3> = m.normals.chunks_exact(3).map(|p| Vec3::new(p[0], p[1], p[2])).collect();
         let uvs: Vec<Vec2> = m.texcoords.chunks_exact(2).map(|p| Vec2::new(p[0], p[1])).collect();
         let check = |idx: &[u32], len: usize, what: &str| -> Result<(), String> {
@@ -185,14 +189,15 @@ fn load_obj_unbounded(path: &Path, mode: NormalMode, textures: MtlTextures) -> R
                 }
             };
             let uv = |k: usize| if has_uvs { uvs[m.texcoord_indices[3 * f + k] as usize] } else { Vec2::ZERO };
-            triangles.push(Triangle {
-                v,
-                n: [corner(0), corner(1), corner(2)],
-                uv: [uv(0), uv(1), uv(2)],
-                material,
-                object: 0,
-                two_sided: false,
-            });
+            let t = Triangle { v, n: [corner(0), corner(1), corner(2)], uv: [uv(0), uv(1), uv(2)], material, object: 0, two_sided: false };
+            if has_uvs || use_file_normals {
+                triangles.push(t);
+            } else {
+                // Each corner is then a function of its vertex alone (bar a
+                // rare fallback normal, which `push_keyed` tells apart): find
+                // it by the vertex, not by hashing it.
+                triangles.push_keyed(t, [0, 1, 2].map(|k| corner_base + idx[k] as usize), &mut vertex_corner);
+            }
         }
     }
     if triangles.is_empty() {

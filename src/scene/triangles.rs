@@ -168,6 +168,30 @@ impl Triangles {
         self.corners.reserve(mesh.corners.len() * copies);
     }
 
+    /// Appends `t`, its corner k shared with the corner last made for
+    /// `keys[k]` (an index into `made`, the caller's record of corners by
+    /// key) when that one has exactly the same bits; otherwise made anew
+    /// and recorded. A loader whose corners are a function of some key
+    /// (an OBJ's vertex index) shares them so without hashing.
+    pub fn push_keyed(&mut self, t: Triangle, keys: [usize; 3], made: &mut [u32]) {
+        debug_assert!(t.object & FLAG_BITS == 0, "object index {} too large", t.object);
+        let flat = t.is_flat();
+        let mut corner = [0u32; 3];
+        for k in 0..3 {
+            let c = Corner { position: t.v[k], normal: if flat { Vec3::ZERO } else { t.n[k] }, uv: t.uv[k] };
+            let known = made[keys[k]];
+            corner[k] = if known != u32::MAX && self.corners[known as usize].key() == c.key() {
+                known
+            } else {
+                self.corners.push(c);
+                made[keys[k]] = self.corners.len() as u32 - 1;
+                made[keys[k]]
+            };
+        }
+        let flags = if t.two_sided { TWO_SIDED_BIT } else { 0 } | if flat { FLAT_BIT } else { 0 };
+        self.faces.push(Face { corner, material: t.material, object_and_flags: (t.object & !FLAG_BITS) | flags });
+    }
+
     pub fn reserve(&mut self, triangles: usize) {
         self.faces.reserve(triangles);
         self.corners.reserve(3 * triangles);
@@ -390,5 +414,31 @@ mod tests {
         let moved = Triangle { v: [Vec3::splat(5.0); 3], ..a.clone() };
         store.set(0, moved.clone());
         assert_eq!(store.to_vec(), vec![moved, b, c]);
+    }
+
+    #[test]
+    fn keyed_corners_are_shared_only_when_their_bits_agree() {
+        // A quad over vertices 0..4, then a triangle on vertex 0 whose normal
+        // there differs (a face-dependent fallback): it must get a corner of
+        // its own, and every triangle must read back as pushed.
+        let p = [Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y];
+        let smooth = |v: [usize; 3], n0: Vec3| Triangle {
+            v: v.map(|i| p[i]),
+            n: [n0, Vec3::Y, Vec3::Y],
+            uv: [Vec2::ZERO; 3],
+            material: 0,
+            object: 0,
+            two_sided: false,
+        };
+        let tris = [(smooth([0, 1, 2], Vec3::Y), [0, 1, 2]), (smooth([0, 2, 3], Vec3::Y), [0, 2, 3]), (smooth([0, 3, 1], Vec3::X), [0, 3, 1])];
+        let mut made = vec![u32::MAX; 4];
+        let mut store = Triangles::new();
+        for (t, keys) in &tris {
+            store.push_keyed(t.clone(), *keys, &mut made);
+        }
+        assert_eq!(store.to_vec(), tris.iter().map(|(t, _)| t.clone()).collect::<Vec<_>>());
+        assert_eq!(store.corners.len(), 4 + 1, "four shared vertices and one corner with another normal");
+        // Nothing is left for `share_corners` to do.
+        assert!(store.pending.is_empty());
     }
 }
