@@ -54,7 +54,8 @@ pub fn cast_pixel<Q: SceneQuery, R: Recorder>(job: &PassJob, query: &Q, x: u32, 
     counts.primary += 1;
     rec.ray(&ray, t_max, 0);
     let work_before = counts.nodes + counts.tests;
-    let hit = with_eye_differentials(job, p, &ray, query.closest(&ray, t_max, false, counts, rec));
+    let mut hit = query.closest(&ray, t_max, false, counts, rec);
+    with_eye_differentials(job, p, &ray, &mut hit);
     rec.closest(hit.as_ref());
     if job.settings.view == View::Cost {
         let c = cost_color((counts.nodes + counts.tests - work_before) as f32);
@@ -67,15 +68,13 @@ pub fn cast_pixel<Q: SceneQuery, R: Recorder>(job: &PassJob, query: &Q, x: u32, 
 /// The eye ray's hit at image position `p` with the ray's differentials
 /// carried to it (Igehy's transfer) and its normal map applied, when a
 /// texture can read them.
+/// In place, so that the (large) hit is not copied when there is nothing
+/// to add.
 #[inline]
-pub fn with_eye_differentials(job: &PassJob, p: Vec2, ray: &Ray, hit: Option<SurfaceHit>) -> Option<SurfaceHit> {
+pub fn with_eye_differentials(job: &PassJob, p: Vec2, ray: &Ray, hit: &mut Option<SurfaceHit>) {
     let scene = &job.prepared.scene;
-    match hit {
-        Some(h) if scene.has_textures() => {
-            let mut h = with_ray_differentials(scene, &RayDifferential::eye(job.view, p.x, p.y), ray, h);
-            crate::render::normal_map::apply(scene, job.settings.texture_filter, &mut h);
-            Some(h)
-        }
-        other => other,
+    if let Some(h) = hit.as_mut().filter(|_| scene.has_textures()) {
+        *h = with_ray_differentials(scene, &RayDifferential::eye(job.view, p.x, p.y), ray, *h);
+        crate::render::normal_map::apply(scene, job.settings.texture_filter, h);
     }
 }

@@ -460,7 +460,8 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
                     m &= m - 1;
                     let (tx, ty) = lane_xy(i);
                     let p = job.sample_position((x0 + tx) as u32, (y0 + ty) as u32);
-                    let hit = with_eye_differentials(job, p, &pk.rays[i], pk.hit(query, i));
+                    let mut hit = pk.hit(query, i);
+                    with_eye_differentials(job, p, &pk.rays[i], &mut hit);
                     band[ty * width + x0 + tx] = resolve_sample(job, query, &pk.rays[i], hit.as_ref(), job.pixel_index((x0 + tx) as u32, (y0 + ty) as u32), &mut counts, &mut NoRecord);
                 }
             }
@@ -507,7 +508,8 @@ fn shade_tile_batched(
         m &= m - 1;
         let (tx, ty) = lane_xy(i);
         let p = job.sample_position((x0 + tx) as u32, (y0 + ty) as u32);
-        hits[i] = with_eye_differentials(job, p, &pk.rays[i], pk.hit(query, i));
+        hits[i] = pk.hit(query, i);
+        with_eye_differentials(job, p, &pk.rays[i], &mut hits[i]);
         seen |= (hits[i].is_some() as u64) << i;
     }
     let shadows = settings.shadows == ShadowMode::Ray;
