@@ -82,6 +82,23 @@ impl Batch {
         self.len = 0;
     }
 
+    /// `push` of the hit `Scene::triangle_hit` gives for these arguments,
+    /// built in its lane.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    pub fn push_triangle(&mut self, interpolation: Interpolation, scene: &crate::scene::Scene, index: u32, b: Vec3, t: f32, ray: &crate::math::Ray, pixel: u32, slot: usize) {
+        let i = self.len;
+        let hit = &mut self.hits[i];
+        *hit = scene.triangle_hit(index, b, t, ray);
+        if interpolation == Interpolation::Flat {
+            hit.shading_normal = hit.geometric_normal;
+        }
+        self.w_o[i] = -ray.dir;
+        self.pixels[i] = pixel;
+        self.slots[i] = slot;
+        self.len += 1;
+    }
+
     /// Adds the sample of pixel index `pixel` (the random numbers' key)
     /// whose eye ray along `dir` sees `hit`, its result meant for `slot`.
     /// The batch must not be full.

@@ -452,16 +452,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
                 false => hit,
             })
         } else {
-            let [b1, b2] = self.payload[i];
-            let b = Vec3::new(1.0 - b1 - b2, b1, b2);
-            let t = match self.key {
-                DepthKey::RayT => self.depth[i],
-                DepthKey::NegInvZ => {
-                    let v = scene.triangle_positions(id.index());
-                    let pos = v[0] * b.x + v[1] * b.y + v[2] * b.z;
-                    (pos - ray.origin).dot(ray.dir)
-                }
-            };
+            let (b, t) = self.triangle_b_t(i, &ray);
             let mut hit = scene.triangle_hit(id.index(), b, t, &ray);
             if scene.has_textures() {
                 hit.diff = super::derivatives::screen_differentials(scene, self.job.view, id.index(), b, p.x, p.y);
@@ -470,6 +461,23 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             Some(hit)
         };
         (ray, hit)
+    }
+
+    /// The barycentric weights and the eye ray's `t` of the triangle sample
+    /// `i` sees.
+    #[inline]
+    fn triangle_b_t(&self, i: usize, ray: &Ray) -> (Vec3, f32) {
+        let [b1, b2] = self.payload[i];
+        let b = Vec3::new(1.0 - b1 - b2, b1, b2);
+        let t = match self.key {
+            DepthKey::RayT => self.depth[i],
+            DepthKey::NegInvZ => {
+                let v = self.job.prepared.scene.triangle_positions(self.id[i].index());
+                let pos = v[0] * b.x + v[1] * b.y + v[2] * b.z;
+                (pos - ray.origin).dot(ray.dir)
+            }
+        };
+        (b, t)
     }
 
     /// The far bound of pixel `(x, y)`'s eye ray (for the record).
@@ -598,6 +606,10 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         let r = self.rect;
         let interpolation = self.job.settings.interpolation;
         let mut batch = Batch::new();
+        let scene = &self.job.prepared.scene;
+        // A triangle seen without textures (the common case) has its hit
+        // built straight into the batch, not returned and copied.
+        let plain = !scene.has_textures();
         let mut i = 0;
         for (row, y) in (r.y0..r.y1).enumerate() {
             let line = row * out_stride + x_offset;
@@ -608,6 +620,18 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
                 } else {
                     self.counts.primary += 1;
                     self.counts.fragments_shaded += 1;
+                    let id = self.id[i];
+                    if plain && id.kind() == crate::scene::PrimitiveKind::Triangle {
+                        let p = self.job.sample_position(x, y);
+                        let ray = self.job.view.eye_ray(p.x, p.y);
+                        let (b, t) = self.triangle_b_t(i, &ray);
+                        batch.push_triangle(interpolation, scene, id.index(), b, t, &ray, self.job.pixel_index(x, y), slot);
+                        if batch.is_full() {
+                            self.shade_batch_into(&mut batch, out);
+                        }
+                        i += 1;
+                        continue;
+                    }
                     match self.eye_hit(i, x, y) {
                         (ray, Some(hit)) => {
                             batch.push(interpolation, &hit, ray.dir, self.job.pixel_index(x, y), slot);
