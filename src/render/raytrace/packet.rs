@@ -109,6 +109,19 @@ impl Packet {
         let (b1, b2) = self.bary[i];
         Some(query.prepared.scene.primitive_hit(id, self.best_t.0[i], b1, b2, &self.rays[i]))
     }
+
+    /// `hit`, written into `out`: the batched tile keeps its hits in an
+    /// array, and returning each (large) record to copy it there cost more.
+    #[inline]
+    pub fn hit_into(&self, query: &BvhQuery, i: usize, out: &mut Option<SurfaceHit>) {
+        let id = self.best_id[i];
+        if id.is_none() {
+            *out = None;
+            return;
+        }
+        let (b1, b2) = self.bary[i];
+        let _ = out.insert(query.prepared.scene.primitive_hit(id, self.best_t.0[i], b1, b2, &self.rays[i]));
+    }
 }
 
 /// The ranges of the packet's origins and inverse directions, per axis: a
@@ -508,7 +521,7 @@ fn shade_tile_batched(
         m &= m - 1;
         let (tx, ty) = lane_xy(i);
         let p = job.sample_position((x0 + tx) as u32, (y0 + ty) as u32);
-        hits[i] = pk.hit(query, i);
+        pk.hit_into(query, i, &mut hits[i]);
         with_eye_differentials(job, p, &pk.rays[i], &mut hits[i]);
         seen |= (hits[i].is_some() as u64) << i;
     }
