@@ -347,28 +347,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
     /// depth keys. The painter overwrites whatever is there.
     #[inline]
     pub fn sphere_fragment(&mut self, x: u32, y: u32, s: u32, t: f32, key: f32) {
-        self.counts.samples_covered += 1;
-        let i = self.index(x, y);
-        self.count_work(i);
-        let cur = self.id[i];
-        let stored = self.depth[i];
-        let nearer = if cur.is_none() || self.paint {
-            true
-        } else if cur.is_sphere() || cur.is_csg() {
-            t < self.payload[i][0]
-        } else {
-            key < self.depth[i]
-        };
-        if nearer {
-            self.depth[i] = key;
-            self.id[i] = PrimitiveId::sphere(s);
-            self.payload[i] = [t, 0.0];
-            if self.forward {
-                self.shade_now(i, x, y);
-            }
-        } else {
-            self.counts.depth_fails += 1;
-        }
+        let (i, stored, nearer) = self.analytic_fragment(x, y, PrimitiveId::sphere(s), t, key, None);
         if self.is_focus(x, y) {
             self.record(PrimitiveKind::Sphere, s, None, Vec3::ZERO, key, stored, nearer, i, x, y);
         }
@@ -380,7 +359,23 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
     /// against triangles).
     #[inline]
     pub fn csg_fragment(&mut self, x: u32, y: u32, c: u32, b: Boundary, key: f32) {
-        let t = b.t;
+        let (i, stored, nearer) = self.analytic_fragment(x, y, PrimitiveId::csg(c), b.t, key, Some(b));
+        if self.is_focus(x, y) {
+            // The winning surface's barycentrics when it is an operand triangle.
+            let bary = match b.surface {
+                SurfaceRef::Triangle { b1, b2, .. } => Vec3::new(1.0 - b1 - b2, b1, b2),
+                SurfaceRef::Sphere(_) => Vec3::ZERO,
+            };
+            self.record(PrimitiveKind::Csg, c, None, bary, key, stored, nearer, i, x, y);
+        }
+    }
+
+    /// The depth test and store that sphere and CSG fragments share, for
+    /// surface `id` met at ray parameter `t` with depth key `key` (and, for
+    /// a CSG object, the boundary its A-buffer resolved). Returns the
+    /// sample's index, the key it held before and whether `id` won.
+    #[inline]
+    fn analytic_fragment(&mut self, x: u32, y: u32, id: PrimitiveId, t: f32, key: f32, boundary: Option<Boundary>) -> (usize, f32, bool) {
         self.counts.samples_covered += 1;
         let i = self.index(x, y);
         self.count_work(i);
@@ -391,27 +386,22 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         } else if cur.is_sphere() || cur.is_csg() {
             t < self.payload[i][0]
         } else {
-            key < self.depth[i]
+            key < stored
         };
         if nearer {
             self.depth[i] = key;
-            self.id[i] = PrimitiveId::csg(c);
+            self.id[i] = id;
             self.payload[i] = [t, 0.0];
-            self.csg[i] = b;
+            if let Some(b) = boundary {
+                self.csg[i] = b;
+            }
             if self.forward {
                 self.shade_now(i, x, y);
             }
         } else {
             self.counts.depth_fails += 1;
         }
-        if self.is_focus(x, y) {
-            // The winning surface's barycentrics when it is an operand triangle.
-            let bary = match b.surface {
-                SurfaceRef::Triangle { b1, b2, .. } => Vec3::new(1.0 - b1 - b2, b1, b2),
-                SurfaceRef::Sphere(_) => Vec3::ZERO,
-            };
-            self.record(PrimitiveKind::Csg, c, None, bary, key, stored, nearer, i, x, y);
-        }
+        (i, stored, nearer)
     }
 
     fn shade_now(&mut self, i: usize, x: u32, y: u32) {
