@@ -101,12 +101,6 @@ impl Triangles {
         (f.corner.map(|c| self.corners[c as usize].position), f.object_and_flags & TWO_SIDED_BIT != 0)
     }
 
-    /// Triangle `i`'s material index.
-    #[inline]
-    pub fn material(&self, i: usize) -> u32 {
-        self.faces[i].material
-    }
-
     #[inline(always)]
     fn assemble(&self, f: &Face) -> Triangle {
         let [a, b, c] = f.corner.map(|k| self.corners[k as usize]);
@@ -190,11 +184,6 @@ impl Triangles {
         }
         let flags = if t.two_sided { TWO_SIDED_BIT } else { 0 } | if flat { FLAT_BIT } else { 0 };
         self.faces.push(Face { corner, material: t.material, object_and_flags: (t.object & !FLAG_BITS) | flags });
-    }
-
-    pub fn reserve(&mut self, triangles: usize) {
-        self.faces.reserve(triangles);
-        self.corners.reserve(3 * triangles);
     }
 
     pub fn clear(&mut self) {

@@ -27,25 +27,33 @@ pub struct Run {
     pub material: u32,
 }
 
+/// Appends triangle `i`'s three vertices (position, normal, face normal,
+/// material, uv, tangent) and counts it into `runs`, its draws of one
+/// sidedness and material.
+fn push_triangle(vertices: &mut Vec<f32>, runs: &mut Vec<Run>, i: u32, t: &crate::scene::Triangle, tangents: [glam::Vec4; 3]) {
+    let face = t.geometric_normal();
+    for k in 0..3 {
+        vertices.extend_from_slice(&t.v[k].to_array());
+        vertices.extend_from_slice(&t.n[k].to_array());
+        vertices.extend_from_slice(&face.to_array());
+        vertices.push(f32::from_bits(t.material));
+        vertices.extend_from_slice(&t.uv[k].to_array());
+        vertices.extend_from_slice(&tangents[k].to_array());
+    }
+    match runs.last_mut() {
+        Some(run) if run.two_sided == t.two_sided && run.material == t.material => run.count += 1,
+        _ => runs.push(Run { first: i, count: 1, two_sided: t.two_sided, material: t.material }),
+    }
+}
+
+/// The scene's flattened triangles as vertex data and draw runs.
 pub fn geometry(scene: &Scene) -> Geometry {
     let mut vertices = Vec::with_capacity(scene.triangles.len() * 3 * VERTEX_FLOATS);
     let mut runs: Vec<Run> = Vec::new();
     for (i, t) in scene.triangles.iter().enumerate() {
-        let face = t.geometric_normal();
-        for k in 0..3 {
-            vertices.extend_from_slice(&t.v[k].to_array());
-            vertices.extend_from_slice(&t.n[k].to_array());
-            vertices.extend_from_slice(&face.to_array());
-            vertices.push(f32::from_bits(t.material));
-            vertices.extend_from_slice(&t.uv[k].to_array());
-            // The handedness of the first corner on all three (`tangent_at`).
-            let tangent = scene.tangents.get(i).map_or(glam::Vec4::ZERO, |c| c[k].truncate().extend(c[0].w));
-            vertices.extend_from_slice(&tangent.to_array());
-        }
-        match runs.last_mut() {
-            Some(run) if run.two_sided == t.two_sided && run.material == t.material => run.count += 1,
-            _ => runs.push(Run { first: i as u32, count: 1, two_sided: t.two_sided, material: t.material }),
-        }
+        // The handedness of the first corner on all three (`tangent_at`).
+        let tangents = scene.tangents.get(i).map_or([glam::Vec4::ZERO; 3], |c| c.map(|ck| ck.truncate().extend(c[0].w)));
+        push_triangle(&mut vertices, &mut runs, i as u32, &t, tangents);
     }
     let mut spheres = Vec::with_capacity(scene.spheres.len() * 8);
     for s in &scene.spheres {
@@ -151,19 +159,7 @@ pub fn layer_geometry(layer: &crate::scene::instanced::InstanceLayer) -> LayerGe
     for mesh in &layer.meshes {
         let mut runs: Vec<Run> = Vec::new();
         for (i, t) in mesh.iter().enumerate() {
-            let face = t.geometric_normal();
-            for k in 0..3 {
-                vertices.extend_from_slice(&t.v[k].to_array());
-                vertices.extend_from_slice(&t.n[k].to_array());
-                vertices.extend_from_slice(&face.to_array());
-                vertices.push(f32::from_bits(t.material));
-                vertices.extend_from_slice(&t.uv[k].to_array());
-                vertices.extend_from_slice(&[0.0; 4]);
-            }
-            match runs.last_mut() {
-                Some(run) if run.two_sided == t.two_sided && run.material == t.material => run.count += 1,
-                _ => runs.push(Run { first: i as u32, count: 1, two_sided: t.two_sided, material: t.material }),
-            }
+            push_triangle(&mut vertices, &mut runs, i as u32, t, [glam::Vec4::ZERO; 3]);
         }
         meshes.push((first, runs));
         first += mesh.len() as u32;
