@@ -20,7 +20,9 @@
 
 use super::intersect::TriangleEdges;
 use super::traverse::{test_leaf, BestHit, ChildOrder, PreparedRay};
+use crate::math::lanes::simd_level;
 use crate::math::Ray;
+use fearless_simd::dispatch;
 use crate::render::pixel_record::Recorder;
 use crate::render::{Occluder, PreparedScene, RayCounts, SceneQuery};
 use crate::scene::{PrimitiveId, PrimitiveKind, SurfaceHit};
@@ -353,7 +355,14 @@ impl<'a> BvhQuery<'a> {
             self.traverse_with::<ANY, R, _>(ray, t_max, inside, counts, rec, &mut Vec::new())
         } else {
             let mut stack = ArrayStack { items: [const { std::mem::MaybeUninit::uninit() }; STACK], len: 0 };
-            self.traverse_with::<ANY, R, _>(ray, t_max, inside, counts, rec, &mut stack)
+            // Compiled once per SIMD level: the walk is the same scalar and
+            // four-wide arithmetic (so the same hits, bit for bit), but with
+            // the wider instruction sets it keeps its values in registers
+            // instead of copying them around.
+            dispatch!(simd_level(), simd => {
+                let _ = simd;
+                self.traverse_with::<ANY, R, _>(ray, t_max, inside, counts, rec, &mut stack)
+            })
         }
     }
 
