@@ -12,27 +12,15 @@ fn register_font() {
 /// Draws error (log) against frame time (log), one line per renderer, each
 /// point labelled with its spp. Returns PNG bytes.
 pub fn draw_spp_png(points: &[SweepPoint], title: &str, width: u32, height: u32) -> Result<Vec<u8>, String> {
-    register_font();
-    let mut buf = vec![255u8; (width * height * 3) as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut buf, (width, height)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| e.to_string())?;
-        let (xmin, xmax) = bounds(points.iter().map(|p| p.ms));
-        let (ymin, ymax) = bounds(points.iter().map(|p| p.rel_rmse.max(1e-6)));
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 22))
-            .margin(16)
-            .x_label_area_size(44)
-            .y_label_area_size(70)
-            .build_cartesian_2d((xmin..xmax).log_scale(), (ymin..ymax).log_scale())
-            .map_err(|e| e.to_string())?;
-        chart
-            .configure_mesh()
-            .x_desc("frame time (ms, log)")
-            .y_desc("rmse / mean radiance (log)")
-            .label_style(("sans-serif", 14))
-            .draw()
-            .map_err(|e| e.to_string())?;
+    let frame = Frame {
+        title,
+        size: (width, height),
+        x: bounds(points.iter().map(|p| p.ms)),
+        y: bounds(points.iter().map(|p| p.rel_rmse.max(1e-6))),
+        y_desc: "rmse / mean radiance (log)".to_string(),
+        legend: SeriesLabelPosition::MiddleRight,
+    };
+    frame.draw(|chart| {
         let mut names: Vec<&str> = points.iter().map(|p| p.renderer.as_str()).collect();
         names.dedup();
         for (i, name) in names.iter().enumerate() {
@@ -51,16 +39,74 @@ pub fn draw_spp_png(points: &[SweepPoint], title: &str, width: u32, height: u32)
                 }))
                 .map_err(|e| e.to_string())?;
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 15))
-            .draw()
-            .map_err(|e| e.to_string())?;
-        root.present().map_err(|e| e.to_string())?;
+        Ok(())
+    })
+}
+
+/// The log-log chart on a log x axis of frame times.
+type LogChart<'a, 'b> = ChartContext<'a, BitMapBackend<'b>, Cartesian2d<LogCoord<f64>, LogCoord<f64>>>;
+
+/// What every chart here shares: a white image of `size`, a title, error
+/// (log) against frame time (log) over the ranges `x` and `y`, and a legend.
+struct Frame<'t> {
+    title: &'t str,
+    size: (u32, u32),
+    x: (f64, f64),
+    y: (f64, f64),
+    y_desc: String,
+    legend: SeriesLabelPosition,
+}
+
+impl Frame<'_> {
+    /// Draws the axes, lets `series` add the chart's own series, then the
+    /// legend. Returns PNG bytes.
+    fn draw(self, series: impl FnOnce(&mut LogChart) -> Result<(), String>) -> Result<Vec<u8>, String> {
+        register_font();
+        let (width, height) = self.size;
+        let mut buf = vec![255u8; (width * height * 3) as usize];
+        {
+            let root = BitMapBackend::with_buffer(&mut buf, (width, height)).into_drawing_area();
+            root.fill(&WHITE).map_err(|e| e.to_string())?;
+            let mut chart = ChartBuilder::on(&root)
+                .caption(self.title, ("sans-serif", 20))
+                .margin(16)
+                .x_label_area_size(44)
+                .y_label_area_size(70)
+                .build_cartesian_2d((self.x.0..self.x.1).log_scale(), (self.y.0..self.y.1).log_scale())
+                .map_err(|e| e.to_string())?;
+            chart
+                .configure_mesh()
+                .x_desc("frame time (ms, log)")
+                .y_desc(self.y_desc)
+                .x_label_formatter(&|v| short_number(*v))
+                .y_label_formatter(&|v| short_number(*v))
+                .label_style(("sans-serif", 14))
+                .draw()
+                .map_err(|e| e.to_string())?;
+            series(&mut chart)?;
+            chart
+                .configure_series_labels()
+                .position(self.legend)
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .label_font(("sans-serif", 14))
+                .draw()
+                .map_err(|e| e.to_string())?;
+            root.present().map_err(|e| e.to_string())?;
+        }
+        crate::image_io::encode_png(width, height, &buf)
     }
-    crate::image_io::encode_png(width, height, &buf)
+}
+
+/// The names of `points`' groups, in the order they first appear.
+fn groups(points: &[Measurement]) -> Vec<&str> {
+    let mut groups: Vec<&str> = Vec::new();
+    for p in points {
+        if !groups.contains(&p.group.as_str()) {
+            groups.push(&p.group);
+        }
+    }
+    groups
 }
 
 /// Axis numbers with two significant digits (log axes otherwise print
@@ -86,44 +132,24 @@ fn bounds(values: impl Iterator<Item = f64>) -> (f64, f64) {
 /// Pareto front as a line through the configurations worth choosing, each
 /// of those labelled. Returns PNG bytes.
 pub fn draw_methods_png(points: &[Measurement], metric: ErrorMetric, title: &str, width: u32, height: u32) -> Result<Vec<u8>, String> {
-    register_font();
     let err = |p: &Measurement| metric.of(p).max(1e-6);
     let front = super::measure::pareto_front(points, metric);
-    let mut buf = vec![255u8; (width * height * 3) as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut buf, (width, height)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| e.to_string())?;
-        let (xmin, xmax) = bounds(points.iter().map(|p| p.ms));
-        let (ymin, ymax) = bounds(points.iter().map(err));
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 20))
-            .margin(16)
-            .x_label_area_size(44)
-            .y_label_area_size(70)
-            .build_cartesian_2d((xmin..xmax).log_scale(), (ymin..ymax).log_scale())
-            .map_err(|e| e.to_string())?;
-        chart
-            .configure_mesh()
-            .x_desc("frame time (ms, log)")
-            .y_desc(format!("{} (log)", metric.axis_name()))
-            .x_label_formatter(&|v| short_number(*v))
-            .y_label_formatter(&|v| short_number(*v))
-            .label_style(("sans-serif", 14))
-            .draw()
-            .map_err(|e| e.to_string())?;
+    let frame = Frame {
+        title,
+        size: (width, height),
+        x: bounds(points.iter().map(|p| p.ms)),
+        y: bounds(points.iter().map(err)),
+        y_desc: format!("{} (log)", metric.axis_name()),
+        legend: SeriesLabelPosition::LowerLeft,
+    };
+    frame.draw(|chart| {
         let front_line: Vec<(f64, f64)> = front.iter().map(|&i| (points[i].ms, err(&points[i]))).collect();
         chart
             .draw_series(LineSeries::new(front_line, BLACK.mix(0.5).stroke_width(1)))
             .map_err(|e| e.to_string())?
             .label("Pareto front")
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.mix(0.5).stroke_width(1)));
-        let mut groups: Vec<&str> = Vec::new();
-        for p in points {
-            if !groups.contains(&p.group.as_str()) {
-                groups.push(&p.group);
-            }
-        }
-        for (gi, group) in groups.iter().enumerate() {
+        for (gi, group) in groups(points).iter().enumerate() {
             let color = Palette99::pick(gi).to_rgba();
             chart
                 .draw_series(points.iter().filter(|p| p.group == *group).map(|p| Circle::new((p.ms, err(p)), 5, color.filled())))
@@ -140,54 +166,25 @@ pub fn draw_methods_png(points: &[Measurement], metric: ErrorMetric, title: &str
                 EmptyElement::at((p.ms, err(p))) + Text::new(p.label.clone(), (8, dy), ("sans-serif", 12))
             }))
             .map_err(|e| e.to_string())?;
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerLeft)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 14))
-            .draw()
-            .map_err(|e| e.to_string())?;
-        root.present().map_err(|e| e.to_string())?;
-    }
-    crate::image_io::encode_png(width, height, &buf)
+        Ok(())
+    })
 }
 
 /// The curves chart (`--sweep gi`): one line per group through its points in
 /// the order they were measured, each point labelled with the knob that moves it, and each
 /// peer series as a dashed black line with crosses. Returns PNG bytes.
 pub fn draw_curves_png(points: &[Measurement], peers: &[super::gi_sweep::PeerPoint], metric: ErrorMetric, title: &str, width: u32, height: u32) -> Result<Vec<u8>, String> {
-    register_font();
     let err = |p: &Measurement| metric.of(p).max(1e-6);
-    let mut buf = vec![255u8; (width * height * 3) as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut buf, (width, height)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| e.to_string())?;
-        let (xmin, xmax) = bounds(points.iter().map(|p| p.ms).chain(peers.iter().map(|p| p.ms)));
-        let (ymin, ymax) = bounds(points.iter().map(err).chain(peers.iter().map(|p| p.rel_rmse.max(1e-6))));
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 20))
-            .margin(16)
-            .x_label_area_size(44)
-            .y_label_area_size(70)
-            .build_cartesian_2d((xmin..xmax).log_scale(), (ymin..ymax).log_scale())
-            .map_err(|e| e.to_string())?;
-        chart
-            .configure_mesh()
-            .x_desc("frame time (ms, log)")
-            .y_desc(format!("{} (log)", metric.axis_name()))
-            .x_label_formatter(&|v| short_number(*v))
-            .y_label_formatter(&|v| short_number(*v))
-            .label_style(("sans-serif", 14))
-            .draw()
-            .map_err(|e| e.to_string())?;
-        let mut groups: Vec<&str> = Vec::new();
-        for p in points {
-            if !groups.contains(&p.group.as_str()) {
-                groups.push(&p.group);
-            }
-        }
-        for (gi, group) in groups.iter().enumerate() {
+    let frame = Frame {
+        title,
+        size: (width, height),
+        x: bounds(points.iter().map(|p| p.ms).chain(peers.iter().map(|p| p.ms))),
+        y: bounds(points.iter().map(err).chain(peers.iter().map(|p| p.rel_rmse.max(1e-6)))),
+        y_desc: format!("{} (log)", metric.axis_name()),
+        legend: SeriesLabelPosition::UpperRight,
+    };
+    frame.draw(|chart| {
+        for (gi, group) in groups(points).iter().enumerate() {
             let color = Palette99::pick(gi).to_rgba();
             // In the sweep's order, which is the order of the knob (samples,
             // photons): a costlier knob setting is not always slower.
@@ -229,15 +226,6 @@ pub fn draw_curves_png(points: &[Measurement], peers: &[super::gi_sweep::PeerPoi
                 }))
                 .map_err(|e| e.to_string())?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 14))
-            .draw()
-            .map_err(|e| e.to_string())?;
-        root.present().map_err(|e| e.to_string())?;
-    }
-    crate::image_io::encode_png(width, height, &buf)
+        Ok(())
+    })
 }
