@@ -28,7 +28,7 @@ use crate::render::debug::View;
 use crate::render::shade::cast_shadow_ray;
 use crate::render::pixel_record::NoRecord;
 use crate::render::shade_batch::{self, Batch};
-use crate::render::{resolve_sample, with_shading_hit, Occluder, PassJob, RayCounts, ShadowMode};
+use crate::render::{miss_without_ray, resolve_sample, with_shading_hit, Occluder, PassJob, RayCounts, ShadowMode};
 use crate::scene::{PrimitiveId, Sphere, SurfaceHit};
 use fearless_simd::{dispatch, f32x8, mask32x8, Select, Simd, SimdBase};
 use glam::{Vec3, Vec4};
@@ -50,9 +50,22 @@ struct Lanes([f32; P]);
 /// so a group's rays are as close together as they can be.
 #[inline(always)]
 pub fn lane_xy(i: usize) -> (usize, usize) {
-    let (g, q) = (i / 4, i % 4);
-    (2 * (g % (TILE_W / 2)) + (q & 1), 2 * (g / (TILE_W / 2)) + (q >> 1))
+    let (x, y) = LANE_XY[i];
+    (x as usize, y as usize)
 }
+
+/// `lane_xy` for every lane, worked out once: a tile asks for it several
+/// times per lane.
+const LANE_XY: [(u8, u8); P] = {
+    let mut table = [(0u8, 0u8); P];
+    let mut i = 0;
+    while i < P {
+        let (g, q) = (i / 4, i % 4);
+        table[i] = ((2 * (g % (TILE_W / 2)) + (q & 1)) as u8, (2 * (g / (TILE_W / 2)) + (q >> 1)) as u8);
+        i += 1;
+    }
+    table
+};
 
 /// The rays of one packet and their traversal state, structure of arrays.
 pub struct Packet {
@@ -449,7 +462,12 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
             let mut pk = Packet::new();
             let mut shadow_pk = Packet::new();
             let mut hits = [None; P];
-            let mut blocked = TileShadows { tile: vec![0; scene.lights.len()], batch: vec![0; scene.lights.len()] };
+            let mut context = TileContext {
+                tile: vec![0; scene.lights.len()],
+                batch: vec![0; scene.lights.len()],
+                textured: scene.has_textures(),
+                background: miss_without_ray(job),
+            };
             for x0 in (0..width).step_by(TILE_W) {
                 let mut valid = 0u64;
                 for i in 0..P {
@@ -464,7 +482,7 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
                 counts.primary += valid.count_ones() as u64;
                 query.closest_packet(&mut pk, valid, &mut counts);
                 if batched {
-                    shade_tile_batched(job, query, &pk, valid, &mut shadow_pk, &mut blocked, &mut hits, band, (x0, y0), width, &mut counts);
+                    shade_tile_batched(job, query, &pk, valid, &mut shadow_pk, &mut context, &mut hits, band, (x0, y0), width, &mut counts);
                     continue;
                 }
                 let mut m = valid;
@@ -486,11 +504,18 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
         })
 }
 
-/// Which shadow rays of a tile are blocked, per light: lane bits of the
-/// tile, and of the batch being shaded. Kept per band so no tile allocates.
-struct TileShadows {
+/// What shading a tile needs beside its hits: which shadow rays are
+/// blocked, per light (lane bits of the tile, and of the batch being
+/// shaded; kept per band so no tile allocates), and what holds for the
+/// whole pass.
+struct TileContext {
     tile: Vec<u64>,
     batch: Vec<u8>,
+    /// Whether hits need ray differentials (`with_eye_differentials`).
+    textured: bool,
+    /// What a sample that sees nothing shows, when no ray is needed for it
+    /// (`miss_without_ray`).
+    background: Option<Radiance>,
 }
 
 /// Shades one traced tile in batches of eight (`shade_batch`): first the
@@ -504,14 +529,14 @@ fn shade_tile_batched(
     pk: &Packet,
     valid: u64,
     shadow_pk: &mut Packet,
-    shadows_of: &mut TileShadows,
+    context: &mut TileContext,
     hits: &mut [Option<SurfaceHit>; P],
     band: &mut [Radiance],
     (x0, y0): (usize, usize),
     width: usize,
     counts: &mut RayCounts,
 ) {
-    let TileShadows { tile: blocked, batch: lane_blocked } = shadows_of;
+    let TileContext { tile: blocked, batch: lane_blocked, textured, background } = context;
     let scene = &query.prepared.scene;
     let settings = job.settings;
     let mut seen = 0u64;
@@ -519,10 +544,12 @@ fn shade_tile_batched(
     while m != 0 {
         let i = m.trailing_zeros() as usize;
         m &= m - 1;
-        let (tx, ty) = lane_xy(i);
-        let p = job.sample_position((x0 + tx) as u32, (y0 + ty) as u32);
         pk.hit_into(query, i, &mut hits[i]);
-        with_eye_differentials(job, p, &pk.rays[i], &mut hits[i]);
+        if *textured {
+            let (tx, ty) = lane_xy(i);
+            let p = job.sample_position((x0 + tx) as u32, (y0 + ty) as u32);
+            with_eye_differentials(job, p, &pk.rays[i], &mut hits[i]);
+        }
         seen |= (hits[i].is_some() as u64) << i;
     }
     let shadows = settings.shadows == ShadowMode::Ray;
@@ -584,7 +611,12 @@ fn shade_tile_batched(
                     flush(&mut batch, band, counts);
                 }
             }
-            None => band[ty * width + x0 + tx] = resolve_sample(job, query, &pk.rays[i], None, pixel, counts, &mut NoRecord),
+            None => {
+                band[ty * width + x0 + tx] = match background {
+                    Some(value) => *value,
+                    None => resolve_sample(job, query, &pk.rays[i], None, pixel, counts, &mut NoRecord),
+                }
+            }
         }
     }
     flush(&mut batch, band, counts);
