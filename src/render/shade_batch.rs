@@ -13,7 +13,8 @@ use super::shade::{self, Incidence, Shading};
 use super::{debug::View, gi::PathState, Interpolation, PassJob, RayCounts, SceneQuery, ShadowMode};
 use crate::math::lanes::{mask_bits, mask_from_bits, simd_level, V3};
 use crate::math::{Radiance, Vec3};
-use crate::scene::SurfaceHit;
+use crate::scene::hit_lanes::TriangleHitInput;
+use crate::scene::{Scene, SurfaceHit};
 use fearless_simd::{dispatch, f32x8, Simd, SimdFrom};
 
 /// Samples per batch.
@@ -53,6 +54,12 @@ pub struct Batch {
     pixels: [u32; LANES],
     /// The caller's index for each lane's result.
     pub slots: [usize; LANES],
+    /// Triangle hits pushed but not built yet: their inputs and lanes.
+    pending_inputs: [TriangleHitInput; LANES],
+    pending_lanes: [usize; LANES],
+    pending: usize,
+    /// Whether the pending hits are flat-shaded.
+    pending_flat: bool,
 }
 
 impl Default for Batch {
@@ -63,7 +70,17 @@ impl Default for Batch {
 
 impl Batch {
     pub fn new() -> Batch {
-        Batch { len: 0, hits: [UNUSED_HIT; LANES], w_o: [Vec3::ZERO; LANES], pixels: [0; LANES], slots: [0; LANES] }
+        Batch {
+            len: 0,
+            hits: [UNUSED_HIT; LANES],
+            w_o: [Vec3::ZERO; LANES],
+            pixels: [0; LANES],
+            slots: [0; LANES],
+            pending_inputs: [TriangleHitInput::default(); LANES],
+            pending_lanes: [0; LANES],
+            pending: 0,
+            pending_flat: false,
+        }
     }
 
     pub fn len(&self) -> usize {
@@ -80,23 +97,37 @@ impl Batch {
 
     pub fn clear(&mut self) {
         self.len = 0;
+        self.pending = 0;
     }
 
-    /// `push` of the hit `Scene::triangle_hit` gives for these arguments,
-    /// built in its lane.
+    /// `push` of the hit `Scene::triangle_hit` gives for these arguments.
+    /// The record is built later, with the batch's other pending triangle
+    /// hits, eight at a time (`build_pending`, before shading).
     #[allow(clippy::too_many_arguments)]
     #[inline]
-    pub fn push_triangle(&mut self, interpolation: Interpolation, scene: &crate::scene::Scene, index: u32, b: Vec3, t: f32, ray: &crate::math::Ray, pixel: u32, slot: usize) {
+    pub fn push_triangle(&mut self, interpolation: Interpolation, index: u32, b: Vec3, t: f32, ray: &crate::math::Ray, pixel: u32, slot: usize) {
         let i = self.len;
-        let hit = &mut self.hits[i];
-        *hit = scene.triangle_hit(index, b, t, ray);
-        if interpolation == Interpolation::Flat {
-            hit.shading_normal = hit.geometric_normal;
-        }
+        self.pending_inputs[self.pending] = TriangleHitInput { index, b, t, dir: ray.dir };
+        self.pending_lanes[self.pending] = i;
+        self.pending += 1;
+        self.pending_flat = interpolation == Interpolation::Flat;
         self.w_o[i] = -ray.dir;
         self.pixels[i] = pixel;
         self.slots[i] = slot;
         self.len += 1;
+    }
+
+    /// Builds the records `push_triangle` left pending.
+    pub fn build_pending(&mut self, scene: &Scene) {
+        let Batch { hits, pending_inputs, pending_lanes, pending, pending_flat, .. } = self;
+        let flat = *pending_flat;
+        scene.triangle_hits(&pending_inputs[..*pending], |k, mut hit| {
+            if flat {
+                hit.shading_normal = hit.geometric_normal;
+            }
+            hits[pending_lanes[k]] = hit;
+        });
+        *pending = 0;
     }
 
     /// Adds the sample of pixel index `pixel` (the random numbers' key)
@@ -122,6 +153,7 @@ impl Batch {
 /// for every lane the light illuminates; otherwise shadow rays are cast
 /// here.
 pub fn shade_batch<Q: SceneQuery>(job: &PassJob, query: &Q, batch: &Batch, blocked: Option<&[u8]>, counts: &mut RayCounts) -> [Radiance; LANES] {
+    assert!(batch.pending == 0, "shade_batch on a batch with hits not built (`build_pending`)");
     let scene = &job.prepared.scene;
     let settings = job.settings;
     let n = batch.len;

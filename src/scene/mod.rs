@@ -9,6 +9,7 @@ pub mod csg;
 pub mod environment;
 pub mod file;
 pub mod forest;
+pub mod hit_lanes;
 pub mod instanced;
 pub mod load;
 pub mod mesh_cache;
@@ -22,7 +23,7 @@ pub mod triangles;
 pub use camera::{Camera, CameraView, Fov};
 pub use material::Material;
 pub use texture::Texture;
-pub use triangles::Triangles;
+pub use triangles::{StoredTriangle, Triangles};
 
 use crate::math::{Ray, Vec2, Vec3};
 

@@ -49,6 +49,18 @@ const TWO_SIDED_BIT: u32 = 1 << 31;
 const FLAT_BIT: u32 = 1 << 30;
 const FLAG_BITS: u32 = TWO_SIDED_BIT | FLAT_BIT;
 
+/// A triangle's attributes as the store keeps them (`Triangles::stored`).
+#[derive(Clone, Copy, Debug)]
+pub struct StoredTriangle {
+    pub v: [Vec3; 3],
+    /// The corners' shading normals; `None` for a flat triangle, whose
+    /// normals are its geometric normal.
+    pub n: Option<[Vec3; 3]>,
+    pub uv: [Vec2; 3],
+    pub material: u32,
+    pub object: u32,
+}
+
 /// The scene's triangles in scene order (see the module comment).
 #[derive(Clone, Debug, Default)]
 pub struct Triangles {
@@ -114,6 +126,22 @@ impl Triangles {
             object: f.object_and_flags & !FLAG_BITS,
             two_sided: f.object_and_flags & TWO_SIDED_BIT != 0,
         }
+    }
+
+    /// Triangle `i` as stored, without working out a flat triangle's
+    /// normal (`Triangle::normal_of` its positions); `None` past the end.
+    /// For code that computes that normal itself, several triangles at once.
+    #[inline]
+    pub fn stored(&self, i: usize) -> Option<StoredTriangle> {
+        let f = self.faces.get(i)?;
+        let [a, b, c] = f.corner.map(|k| self.corners[k as usize]);
+        Some(StoredTriangle {
+            v: [a.position, b.position, c.position],
+            n: (f.object_and_flags & FLAT_BIT == 0).then_some([a.normal, b.normal, c.normal]),
+            uv: [a.uv, b.uv, c.uv],
+            material: f.material,
+            object: f.object_and_flags & !FLAG_BITS,
+        })
     }
 
     /// Where triangle `i`'s record lies in memory, for prefetching (its

@@ -598,7 +598,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         let mut batch = Batch::new();
         let scene = &self.job.prepared.scene;
         // A triangle seen without textures (the common case) has its hit
-        // built straight into the batch, not returned and copied.
+        // built in the batch (eight at a time), not returned and copied.
         let plain = !scene.has_textures();
         let mut i = 0;
         for (row, y) in (r.y0..r.y1).enumerate() {
@@ -615,7 +615,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
                         let p = self.job.sample_position(x, y);
                         let ray = self.job.view.eye_ray(p.x, p.y);
                         let (b, t) = self.triangle_b_t(i, &ray);
-                        batch.push_triangle(interpolation, scene, id.index(), b, t, &ray, self.job.pixel_index(x, y), slot);
+                        batch.push_triangle(interpolation, id.index(), b, t, &ray, self.job.pixel_index(x, y), slot);
                         if batch.is_full() {
                             self.shade_batch_into(&mut batch, out);
                         }
@@ -644,6 +644,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         if batch.is_empty() {
             return;
         }
+        batch.build_pending(&self.job.prepared.scene);
         let values = shade_batch::shade_batch(self.job, self.query, batch, None, &mut self.counts);
         for (j, value) in values.iter().enumerate().take(batch.len()) {
             out[batch.slots[j]] = *value;
@@ -679,3 +680,4 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         }
     }
 }
+

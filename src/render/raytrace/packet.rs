@@ -29,7 +29,8 @@ use crate::render::shade::cast_shadow_ray;
 use crate::render::pixel_record::NoRecord;
 use crate::render::shade_batch::{self, Batch};
 use crate::render::{miss_without_ray, resolve_sample, with_shading_hit, Occluder, PassJob, RayCounts, ShadowMode};
-use crate::scene::{PrimitiveId, Sphere, SurfaceHit};
+use crate::scene::hit_lanes::{TriangleHitInput, HIT_LANES};
+use crate::scene::{PrimitiveId, PrimitiveKind, Sphere, SurfaceHit};
 use fearless_simd::{dispatch, f32x8, mask32x8, Select, Simd, SimdBase};
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
@@ -123,17 +124,38 @@ impl Packet {
         Some(query.prepared.scene.primitive_hit(id, self.best_t.0[i], b1, b2, &self.rays[i]))
     }
 
-    /// `hit`, written into `out`: the batched tile keeps its hits in an
-    /// array, and returning each (large) record to copy it there cost more.
-    #[inline]
-    pub fn hit_into(&self, query: &BvhQuery, i: usize, out: &mut Option<SurfaceHit>) {
-        let id = self.best_id[i];
-        if id.is_none() {
-            *out = None;
-            return;
+    /// `hit` of every lane in `valid`, written into `out`: triangle hits
+    /// are built eight at a time (`Scene::triangle_hits`), the others one
+    /// by one.
+    pub fn hits_into(&self, query: &BvhQuery, valid: u64, out: &mut [Option<SurfaceHit>; P]) {
+        let scene = &query.prepared.scene;
+        let mut inputs = [TriangleHitInput::default(); HIT_LANES];
+        let mut lanes = [0usize; HIT_LANES];
+        let mut n = 0;
+        let build = |inputs: &[TriangleHitInput], lanes: &[usize], out: &mut [Option<SurfaceHit>; P]| {
+            scene.triangle_hits(inputs, |k, hit| out[lanes[k]] = Some(hit));
+        };
+        let mut m = valid;
+        while m != 0 {
+            let i = m.trailing_zeros() as usize;
+            m &= m - 1;
+            let id = self.best_id[i];
+            if id.is_none() {
+                out[i] = None;
+            } else if id.kind() == PrimitiveKind::Triangle {
+                let (b1, b2) = self.bary[i];
+                inputs[n] = TriangleHitInput { index: id.index(), b: Vec3::new(1.0 - b1 - b2, b1, b2), t: self.best_t.0[i], dir: self.rays[i].dir };
+                lanes[n] = i;
+                n += 1;
+                if n == HIT_LANES {
+                    build(&inputs, &lanes, out);
+                    n = 0;
+                }
+            } else {
+                out[i] = self.hit(query, i);
+            }
         }
-        let (b1, b2) = self.bary[i];
-        let _ = out.insert(query.prepared.scene.primitive_hit(id, self.best_t.0[i], b1, b2, &self.rays[i]));
+        build(&inputs[..n], &lanes[..n], out);
     }
 }
 
@@ -540,11 +562,11 @@ fn shade_tile_batched(
     let scene = &query.prepared.scene;
     let settings = job.settings;
     let mut seen = 0u64;
+    pk.hits_into(query, valid, hits);
     let mut m = valid;
     while m != 0 {
         let i = m.trailing_zeros() as usize;
         m &= m - 1;
-        pk.hit_into(query, i, &mut hits[i]);
         if *textured {
             let (tx, ty) = lane_xy(i);
             let p = job.sample_position((x0 + tx) as u32, (y0 + ty) as u32);
