@@ -600,11 +600,22 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         // A triangle seen without textures (the common case) has its hit
         // built in the batch (eight at a time), not returned and copied.
         let plain = !scene.has_textures();
+        // What an empty pixel shows when no ray is needed for it (most of a
+        // frame): `resolve`'s answer there without its per-pixel checks.
+        let background = miss_without_ray(self.job);
         let mut i = 0;
         for (row, y) in (r.y0..r.y1).enumerate() {
             let line = row * out_stride + x_offset;
             for (col, x) in (r.x0..r.x1).enumerate() {
                 let slot = line + col;
+                if let (true, Some(value)) = (self.id[i].is_none(), background) {
+                    if !self.is_focus(x, y) && self.job.is_active(x, y) {
+                        self.counts.primary += 1;
+                        out[slot] = value;
+                        i += 1;
+                        continue;
+                    }
+                }
                 if self.id[i].is_none() || self.is_focus(x, y) || !self.job.is_active(x, y) {
                     out[slot] = self.resolve(i, x, y);
                 } else {
