@@ -507,15 +507,15 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
                     shade_tile_batched(job, query, &pk, valid, &mut shadow_pk, &mut context, &mut hits, band, (x0, y0), width, &mut counts);
                     continue;
                 }
+                pk.hits_into(query, valid, &mut hits);
                 let mut m = valid;
                 while m != 0 {
                     let i = m.trailing_zeros() as usize;
                     m &= m - 1;
                     let (tx, ty) = lane_xy(i);
                     let p = job.sample_position((x0 + tx) as u32, (y0 + ty) as u32);
-                    let mut hit = pk.hit(query, i);
-                    with_eye_differentials(job, p, &pk.rays[i], &mut hit);
-                    band[ty * width + x0 + tx] = resolve_sample(job, query, &pk.rays[i], hit.as_ref(), job.pixel_index((x0 + tx) as u32, (y0 + ty) as u32), &mut counts, &mut NoRecord);
+                    with_eye_differentials(job, p, &pk.rays[i], &mut hits[i]);
+                    band[ty * width + x0 + tx] = resolve_sample(job, query, &pk.rays[i], hits[i].as_ref(), job.pixel_index((x0 + tx) as u32, (y0 + ty) as u32), &mut counts, &mut NoRecord);
                 }
             }
             counts
