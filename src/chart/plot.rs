@@ -63,6 +63,9 @@ impl Frame<'_> {
     fn draw(self, series: impl FnOnce(&mut LogChart) -> Result<(), String>) -> Result<Vec<u8>, String> {
         register_font();
         let (width, height) = self.size;
+        // Points are labelled to their right: the axis runs on past the
+        // last point far enough (on its log scale) to hold a label.
+        let x_end = self.x.1 * 3.0;
         let mut buf = vec![255u8; (width * height * 3) as usize];
         {
             let root = BitMapBackend::with_buffer(&mut buf, (width, height)).into_drawing_area();
@@ -72,7 +75,7 @@ impl Frame<'_> {
                 .margin(16)
                 .x_label_area_size(44)
                 .y_label_area_size(70)
-                .build_cartesian_2d((self.x.0..self.x.1).log_scale(), (self.y.0..self.y.1).log_scale())
+                .build_cartesian_2d((self.x.0..x_end).log_scale(), (self.y.0..self.y.1).log_scale())
                 .map_err(|e| e.to_string())?;
             chart
                 .configure_mesh()
