@@ -58,8 +58,6 @@ pub struct Batch {
     pending_inputs: [TriangleHitInput; LANES],
     pending_lanes: [usize; LANES],
     pending: usize,
-    /// Whether the pending hits are flat-shaded.
-    pending_flat: bool,
 }
 
 impl Default for Batch {
@@ -79,7 +77,6 @@ impl Batch {
             pending_inputs: [TriangleHitInput::default(); LANES],
             pending_lanes: [0; LANES],
             pending: 0,
-            pending_flat: false,
         }
     }
 
@@ -103,26 +100,24 @@ impl Batch {
     /// `push` of the hit `Scene::triangle_hit` gives for these arguments.
     /// The record is built later, with the batch's other pending triangle
     /// hits, eight at a time (`build_pending`, before shading).
-    #[allow(clippy::too_many_arguments)]
     #[inline]
-    pub fn push_triangle(&mut self, interpolation: Interpolation, index: u32, b: Vec3, t: f32, ray: &crate::math::Ray, pixel: u32, slot: usize) {
+    pub fn push_triangle(&mut self, index: u32, b: Vec3, t: f32, ray: &crate::math::Ray, pixel: u32, slot: usize) {
         let i = self.len;
         self.pending_inputs[self.pending] = TriangleHitInput { index, b, t, dir: ray.dir };
         self.pending_lanes[self.pending] = i;
         self.pending += 1;
-        self.pending_flat = interpolation == Interpolation::Flat;
         self.w_o[i] = -ray.dir;
         self.pixels[i] = pixel;
         self.slots[i] = slot;
         self.len += 1;
     }
 
-    /// Builds the records `push_triangle` left pending.
-    pub fn build_pending(&mut self, scene: &Scene) {
-        let Batch { hits, pending_inputs, pending_lanes, pending, pending_flat, .. } = self;
-        let flat = *pending_flat;
+    /// Builds the records `push_triangle` left pending, as `push` hands
+    /// them to `shade()` with `interpolation`.
+    pub fn build_pending(&mut self, scene: &Scene, interpolation: Interpolation) {
+        let Batch { hits, pending_inputs, pending_lanes, pending, .. } = self;
         scene.triangle_hits(&pending_inputs[..*pending], |k, mut hit| {
-            if flat {
+            if interpolation == Interpolation::Flat {
                 hit.shading_normal = hit.geometric_normal;
             }
             hits[pending_lanes[k]] = hit;

@@ -23,7 +23,7 @@ pub mod triangles;
 pub use camera::{Camera, CameraView, Fov};
 pub use material::Material;
 pub use texture::Texture;
-pub use triangles::{StoredTriangle, Triangles};
+pub use triangles::Triangles;
 
 use crate::math::{Ray, Vec2, Vec3};
 

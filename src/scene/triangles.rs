@@ -115,15 +115,13 @@ impl Triangles {
 
     #[inline(always)]
     fn assemble(&self, f: &Face) -> Triangle {
-        let [a, b, c] = f.corner.map(|k| self.corners[k as usize]);
-        let v = [a.position, b.position, c.position];
-        let n = if f.object_and_flags & FLAT_BIT != 0 { [Triangle::normal_of(&v); 3] } else { [a.normal, b.normal, c.normal] };
+        let s = self.stored_face(f);
         Triangle {
-            v,
-            n,
-            uv: [a.uv, b.uv, c.uv],
-            material: f.material,
-            object: f.object_and_flags & !FLAG_BITS,
+            v: s.v,
+            n: s.n.unwrap_or_else(|| [Triangle::normal_of(&s.v); 3]),
+            uv: s.uv,
+            material: s.material,
+            object: s.object,
             two_sided: f.object_and_flags & TWO_SIDED_BIT != 0,
         }
     }
@@ -133,15 +131,19 @@ impl Triangles {
     /// For code that computes that normal itself, several triangles at once.
     #[inline]
     pub fn stored(&self, i: usize) -> Option<StoredTriangle> {
-        let f = self.faces.get(i)?;
+        self.faces.get(i).map(|f| self.stored_face(f))
+    }
+
+    #[inline(always)]
+    fn stored_face(&self, f: &Face) -> StoredTriangle {
         let [a, b, c] = f.corner.map(|k| self.corners[k as usize]);
-        Some(StoredTriangle {
+        StoredTriangle {
             v: [a.position, b.position, c.position],
             n: (f.object_and_flags & FLAT_BIT == 0).then_some([a.normal, b.normal, c.normal]),
             uv: [a.uv, b.uv, c.uv],
             material: f.material,
             object: f.object_and_flags & !FLAG_BITS,
-        })
+        }
     }
 
     /// Where triangle `i`'s record lies in memory, for prefetching (its

@@ -608,15 +608,13 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             let line = row * out_stride + x_offset;
             for (col, x) in (r.x0..r.x1).enumerate() {
                 let slot = line + col;
-                if let (true, Some(value)) = (self.id[i].is_none(), background) {
-                    if !self.is_focus(x, y) && self.job.is_active(x, y) {
-                        self.counts.primary += 1;
-                        out[slot] = value;
-                        i += 1;
-                        continue;
-                    }
-                }
-                if self.id[i].is_none() || self.is_focus(x, y) || !self.job.is_active(x, y) {
+                let empty = self.id[i].is_none();
+                // Neither the recorded pixel nor one this pass leaves out.
+                let ordinary = !self.is_focus(x, y) && self.job.is_active(x, y);
+                if let (true, Some(value)) = (empty && ordinary, background) {
+                    self.counts.primary += 1;
+                    out[slot] = value;
+                } else if empty || !ordinary {
                     out[slot] = self.resolve(i, x, y);
                 } else {
                     self.counts.primary += 1;
@@ -626,7 +624,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
                         let p = self.job.sample_position(x, y);
                         let ray = self.job.view.eye_ray(p.x, p.y);
                         let (b, t) = self.triangle_b_t(i, &ray);
-                        batch.push_triangle(interpolation, id.index(), b, t, &ray, self.job.pixel_index(x, y), slot);
+                        batch.push_triangle(id.index(), b, t, &ray, self.job.pixel_index(x, y), slot);
                         if batch.is_full() {
                             self.shade_batch_into(&mut batch, out);
                         }
@@ -655,7 +653,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         if batch.is_empty() {
             return;
         }
-        batch.build_pending(&self.job.prepared.scene);
+        batch.build_pending(&self.job.prepared.scene, self.job.settings.interpolation);
         let values = shade_batch::shade_batch(self.job, self.query, batch, None, &mut self.counts);
         for (j, value) in values.iter().enumerate().take(batch.len()) {
             out[batch.slots[j]] = *value;
@@ -691,4 +689,3 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         }
     }
 }
-
