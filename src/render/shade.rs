@@ -277,6 +277,33 @@ pub fn refraction(hit: &SurfaceHit, material: &Material, w_o: Vec3) -> (f32, Opt
     (fresnel, refracted)
 }
 
+/// The two delta lobes of a surface seen from `w_o`: mirror reflection
+/// (the material's mirror weight plus the Fresnel-reflected part of its
+/// transmission) and refraction (the rest of the transmission, unless the
+/// light is totally reflected).
+struct DeltaLobes {
+    reflect_dir: Vec3,
+    reflect_weight: Vec3,
+    /// Direction and weight.
+    refract: Option<(Vec3, Vec3)>,
+}
+
+impl DeltaLobes {
+    #[inline]
+    fn at(hit: &SurfaceHit, material: &Material, w_o: Vec3) -> DeltaLobes {
+        let n = hit.geometric_normal;
+        let cos_o = w_o.dot(n).clamp(-1.0, 1.0);
+        let mut reflect_weight = material.mirror;
+        let mut refract = None;
+        if material.transmission != Vec3::ZERO {
+            let (fresnel, dir) = refraction(hit, material, w_o);
+            reflect_weight += material.transmission * fresnel;
+            refract = dir.map(|d| (d, material.transmission * (1.0 - fresnel)));
+        }
+        DeltaLobes { reflect_dir: (2.0 * cos_o * n - w_o).normalize(), reflect_weight, refract }
+    }
+}
+
 /// Path tracing's delta lobes: one of mirror reflection and refraction,
 /// chosen in proportion to its weight, instead of both.
 fn secondary_sampled<Q: SceneQuery, R: Recorder>(
@@ -287,23 +314,12 @@ fn secondary_sampled<Q: SceneQuery, R: Recorder>(
     depth: u32,
 ) -> Radiance {
     let Shading { settings, .. } = *sh;
-    let n = hit.geometric_normal;
-    let cos_o = w_o.dot(n).clamp(-1.0, 1.0);
-    let mut reflect_weight = material.mirror;
-    let mut refract = None;
-    if material.transmission != Vec3::ZERO {
-        let (fresnel, dir) = refraction(hit, material, w_o);
-        reflect_weight += material.transmission * fresnel;
-        refract = dir.map(|d| (d, material.transmission * (1.0 - fresnel)));
-    }
+    let DeltaLobes { reflect_dir, reflect_weight, refract } = DeltaLobes::at(hit, material, w_o);
     let refract_weight = refract.map_or(Vec3::ZERO, |r| r.1);
     let (take_reflection, scale) = gi::choose_lobe(reflect_weight, refract_weight, &mut sh.path.rng);
     let (ray, weight, inside) = match refract {
         Some((dir, w)) if !take_reflection => (hit.spawn_ray_back(dir, settings.shadow_bump), w * scale, true),
-        _ if reflect_weight != Vec3::ZERO => {
-            let dir = (2.0 * cos_o * n - w_o).normalize();
-            (hit.spawn_ray_front(dir, settings.shadow_bump), reflect_weight * scale, false)
-        }
+        _ if reflect_weight != Vec3::ZERO => (hit.spawn_ray_front(reflect_dir, settings.shadow_bump), reflect_weight * scale, false),
         _ => return Vec3::ZERO,
     };
     let Some((survive, _)) = gi::roulette(depth, sh.path.throughput * weight, &mut sh.path.rng) else {
@@ -447,19 +463,12 @@ fn secondary<Q: SceneQuery, R: Recorder>(
     depth: u32,
 ) -> Radiance {
     let Shading { settings, .. } = *sh;
-    let n = hit.geometric_normal;
-    let cos_o = w_o.dot(n).clamp(-1.0, 1.0);
-    let reflect_dir = (2.0 * cos_o * n - w_o).normalize();
-    let mut reflect_weight = material.mirror;
+    let DeltaLobes { reflect_dir, reflect_weight, refract } = DeltaLobes::at(hit, material, w_o);
     let mut result = Vec3::ZERO;
-    if material.transmission != Vec3::ZERO {
-        let (fresnel, refracted) = refraction(hit, material, w_o);
-        reflect_weight += material.transmission * fresnel;
-        if let Some(dir) = refracted {
-            let ray = hit.spawn_ray_back(dir, settings.shadow_bump);
-            let rd = differentials::refracted(hit);
-            result += material.transmission * (1.0 - fresnel) * radiance_along(sh, &ray, Some(&rd), depth + 1, true);
-        }
+    if let Some((dir, weight)) = refract {
+        let ray = hit.spawn_ray_back(dir, settings.shadow_bump);
+        let rd = differentials::refracted(hit);
+        result += weight * radiance_along(sh, &ray, Some(&rd), depth + 1, true);
     }
     if reflect_weight != Vec3::ZERO {
         result += reflect_weight * reflection(sh, hit, reflect_dir, -w_o, depth);
