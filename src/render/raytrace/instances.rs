@@ -19,7 +19,7 @@ use crate::math::Ray;
 use crate::render::pixel_record::Recorder;
 use crate::scene::instanced::InstanceLayer;
 use crate::scene::{PrimitiveId, Scene, Triangle};
-use glam::{Mat4, Vec3, Vec4};
+use glam::{Mat4, Vec3};
 
 /// Growth of the mesh BVHs' boxes, relative to the mesh's largest extent.
 const MESH_GROW: f32 = 1e-3;
@@ -48,11 +48,10 @@ pub struct InstanceAccel {
 }
 
 fn grow_planes(bvh: &mut Bvh, by: f32) {
-    let g = Vec4::splat(by);
     for n in bvh.nodes.iter_mut() {
         for axis in 0..3 {
-            n.planes[2 * axis] -= g;
-            n.planes[2 * axis + 1] += g;
+            n.planes[2 * axis].iter_mut().for_each(|p| *p -= by);
+            n.planes[2 * axis + 1].iter_mut().for_each(|p| *p += by);
         }
     }
     bvh.root_bounds.min -= Vec3::splat(by);
@@ -166,7 +165,7 @@ impl InstanceAccel {
             *visits += 1;
             if word & LEAF_BIT == 0 {
                 let node = &bvh.nodes[word as usize];
-                let (mut mask, _) = r.slab4(&node.planes, node.valid, best.t);
+                let (mut mask, _) = r.slab8(&node.planes, node.valid, best.t);
                 while mask != 0 {
                     stack.push(node.child[mask.trailing_zeros() as usize]);
                     mask &= mask - 1;

@@ -1,5 +1,5 @@
 //! Eye rays traced as packets: the rays of a TILE_W x TILE_H pixel tile walk
-//! the 4-wide BVH together. Each node is fetched once per packet and its four
+//! the 8-wide BVH together. Each node is fetched once per packet and its eight
 //! child boxes are tested against eight rays at a time, and each leaf
 //! triangle against eight rays at a time (one SIMD lane per ray, at the
 //! widest level the CPU has: `math::lanes::simd_level`), so the per-ray
@@ -18,7 +18,7 @@
 //! packet too, and the tile is shaded eight samples at a time from those
 //! answers (`shade_tile_batched`, `shade_batch`).
 
-use super::bvh::{leaf_range, BvhQuery, Node4, LEAF_BIT, STACK};
+use super::bvh::{leaf_range, BvhQuery, Node8, LEAF_BIT, STACK};
 use super::{cast_pass, with_eye_differentials};
 use super::intersect::{intersect_triangle_lanes, TriangleEdges};
 use super::traverse::{test_leaf, BestHit, ChildOrder, PreparedRay, SLAB_WIDEN};
@@ -32,7 +32,7 @@ use crate::render::{miss_without_ray, resolve_sample, with_shading_hit, Occluder
 use crate::scene::hit_lanes::{TriangleHitInput, HIT_LANES};
 use crate::scene::{PrimitiveId, PrimitiveKind, Sphere, SurfaceHit};
 use fearless_simd::{dispatch, f32x8, mask32x8, Select, Simd, SimdBase};
-use glam::{Vec3, Vec4};
+use glam::Vec3;
 use rayon::prelude::*;
 use std::mem::MaybeUninit;
 
@@ -164,10 +164,10 @@ impl Packet {
 /// Floating-point operations are monotone, so the bounds hold for the
 /// computed values too, not only the exact ones.
 struct PacketBounds {
-    o_lo: [Vec4; 3],
-    o_hi: [Vec4; 3],
-    inv_lo: [Vec4; 3],
-    inv_hi: [Vec4; 3],
+    o_lo: [f32; 3],
+    o_hi: [f32; 3],
+    inv_lo: [f32; 3],
+    inv_hi: [f32; 3],
 }
 
 impl PacketBounds {
@@ -191,28 +191,23 @@ impl PacketBounds {
                 }
             }
         }
-        let s = |v: f32| Vec4::splat(v);
         let (lo, hi) = (lo.map(horizontal_min), hi.map(horizontal_max));
-        PacketBounds {
-            o_lo: [s(lo[0]), s(lo[1]), s(lo[2])],
-            o_hi: [s(hi[0]), s(hi[1]), s(hi[2])],
-            inv_lo: [s(lo[3]), s(lo[4]), s(lo[5])],
-            inv_hi: [s(hi[3]), s(hi[4]), s(hi[5])],
-        }
+        PacketBounds { o_lo: [lo[0], lo[1], lo[2]], o_hi: [hi[0], hi[1], hi[2]], inv_lo: [lo[3], lo[4], lo[5]], inv_hi: [hi[3], hi[4], hi[5]] }
     }
 
     /// The children of `node` (bit mask) that some ray of the packet, with
     /// far end at most `far_max`, may meet: a superset of every ray's own
-    /// `PreparedRay::slab4` mask. NaNs never cull.
+    /// slab test's mask. NaNs never cull.
     #[inline(always)]
-    fn children_possible(&self, node: &Node4, far_max: f32) -> u32 {
-        let mut entry = Vec4::ZERO;
-        let mut exit = Vec4::INFINITY;
+    fn children_possible<S: Simd>(&self, simd: S, node: &Node8, far_max: f32) -> u32 {
+        let mut entry = f32x8::splat(simd, 0.0);
+        let mut exit = f32x8::splat(simd, f32::INFINITY);
         for a in 0..3 {
-            let (p0, p1) = (node.planes[2 * a], node.planes[2 * a + 1]);
-            let (il, ih) = (self.inv_lo[a], self.inv_hi[a]);
-            let (a0l, a0h) = (p0 - self.o_hi[a], p0 - self.o_lo[a]);
-            let (a1l, a1h) = (p1 - self.o_hi[a], p1 - self.o_lo[a]);
+            let (p0, p1) = (f32x8::from_slice(simd, &node.planes[2 * a]), f32x8::from_slice(simd, &node.planes[2 * a + 1]));
+            let (il, ih) = (f32x8::splat(simd, self.inv_lo[a]), f32x8::splat(simd, self.inv_hi[a]));
+            let (ol, oh) = (f32x8::splat(simd, self.o_lo[a]), f32x8::splat(simd, self.o_hi[a]));
+            let (a0l, a0h) = (p0 - oh, p0 - ol);
+            let (a1l, a1h) = (p1 - oh, p1 - ol);
             let (q0, q1, q2, q3) = (a0l * il, a0l * ih, a0h * il, a0h * ih);
             let (r0, r1, r2, r3) = (a1l * il, a1l * ih, a1h * il, a1h * ih);
             let near = q0.min(q1).min(q2.min(q3)).min(r0.min(r1).min(r2.min(r3)));
@@ -221,9 +216,9 @@ impl PacketBounds {
             exit = exit.min(far);
         }
         let entry = entry * (1.0 - SLAB_WIDEN);
-        let exit = (exit * (1.0 + SLAB_WIDEN)).min(Vec4::splat(far_max));
+        let exit = (exit * (1.0 + SLAB_WIDEN)).min(far_max);
         // Culled only where entry > exit is certain (false for NaN).
-        !entry.cmpgt(exit).bitmask() & node.valid
+        !(mask_bits(entry.simd_gt(exit)) as u32) & node.valid
     }
 }
 
@@ -287,8 +282,8 @@ impl BvhQuery<'_> {
                 // Every ray of this entry is done.
             } else if word & LEAF_BIT == 0 {
                 let node = &bvh.nodes[word as usize];
-                let mut child_mask = [0u64; 4];
-                let mut child_near = [f32::INFINITY; 4];
+                let mut child_mask = [0u64; 8];
+                let mut child_near = [f32::INFINITY; 8];
                 // The groups of eight lanes with an active ray, and their lanes'
                 // far ends (-inf in inactive lanes, so their box tests fail).
                 let mut groups = [(0usize, f32x8::splat(simd, 0.0)); P / 8];
@@ -307,12 +302,12 @@ impl BvhQuery<'_> {
                     n_groups += 1;
                 }
                 // Interval test: the children no ray of the packet can meet.
-                let mut valid_children = bounds.children_possible(node, far_max);
+                let mut valid_children = bounds.children_possible(simd, node, far_max);
                 while valid_children != 0 {
                     let c = valid_children.trailing_zeros() as usize;
                     valid_children &= valid_children - 1;
                     // Child c's box in every lane, against eight rays at a time.
-                    let planes: [f32x8<S>; 6] = std::array::from_fn(|k| f32x8::splat(simd, node.planes[k].as_ref()[c]));
+                    let planes: [f32x8<S>; 6] = std::array::from_fn(|k| f32x8::splat(simd, node.planes[k][c]));
                     let mut near = f32x8::splat(simd, f32::INFINITY);
                     let mut bits_all = 0u64;
                     for &(g, t_far) in &groups[..n_groups] {
@@ -324,8 +319,8 @@ impl BvhQuery<'_> {
                     child_near[c] = horizontal_min(near);
                 }
                 // Nearest child next (its nearest ray's entry); the others pushed farthest first.
-                let mut order = ChildOrder::new();
-                for c in 0..4 {
+                let mut order = ChildOrder::<_, 8>::new();
+                for c in 0..8 {
                     if child_mask[c] != 0 {
                         order.insert((node.child[c], child_mask[c]), child_near[c]);
                     }

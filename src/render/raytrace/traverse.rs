@@ -15,9 +15,9 @@ pub const SLAB_WIDEN: f32 = 1.0e-5;
 
 /// Four slab tests at once, lane by lane: ray `origin + t / inv` against the
 /// box with planes (min x, max x, min y, max y, min z, max z), within
-/// [0, t_far]. The lanes may be four boxes and one ray (single rays) or one
-/// box and four rays (packets): the arithmetic is the same. Returns which
-/// lanes meet their box and where they enter it.
+/// [0, t_far]: four of a node's boxes and one ray (`PreparedRay::slab8`,
+/// a half at a time). Returns which lanes meet their box and where they
+/// enter it.
 #[inline(always)]
 pub fn slab_test(planes: &[Vec4; 6], origin: &[Vec4; 3], inv: &[Vec4; 3], t_far: Vec4) -> (BVec4A, Vec4) {
     let p = planes;
@@ -49,13 +49,22 @@ impl PreparedRay {
         PreparedRay { origin: [Vec4::splat(ray.origin.x), Vec4::splat(ray.origin.y), Vec4::splat(ray.origin.z)], inv: inv.map(Vec4::splat) }
     }
 
-    /// Which of a node's four child boxes (`planes`, slots used as in
-    /// `valid`) the ray meets within [0, t_far], as a bit mask, and where it
-    /// enters each.
+    /// Which of a node's eight child boxes (`planes`, slots used as in
+    /// `valid`) the ray meets within [0, t_far], as a bit mask, and where
+    /// it enters each: `slab_test` on each half of the node. (The hot walk
+    /// uses the eight-lane `bvh::slab8_lanes`, the same arithmetic.)
     #[inline(always)]
-    pub fn slab4(&self, planes: &[Vec4; 6], valid: u32, t_far: f32) -> (u32, Vec4) {
-        let (hit, tn) = slab_test(planes, &self.origin, &self.inv, Vec4::splat(t_far));
-        (hit.bitmask() & valid, tn)
+    pub fn slab8(&self, planes: &[[f32; 8]; 6], valid: u32, t_far: f32) -> (u32, [f32; 8]) {
+        let mut mask = 0;
+        let mut t_enter = [0.0; 8];
+        for half in 0..2 {
+            let lanes = 4 * half..4 * half + 4;
+            let p = [0, 1, 2, 3, 4, 5].map(|k| Vec4::from_slice(&planes[k][lanes.clone()]));
+            let (hit, tn) = slab_test(&p, &self.origin, &self.inv, Vec4::splat(t_far));
+            mask |= hit.bitmask() << (4 * half);
+            t_enter[lanes].copy_from_slice(&tn.to_array());
+        }
+        (mask & valid, t_enter)
     }
 
     /// The slab test for one box (the root's).
@@ -77,22 +86,22 @@ impl PreparedRay {
 /// with the nearest and pushes the others farthest first (they then pop
 /// nearest first). Insertion sort by descending entry distance; of equal
 /// distances the one added last comes out as the nearer.
-pub struct ChildOrder<T> {
-    items: [(T, f32); 4],
+pub struct ChildOrder<T, const N: usize = 4> {
+    items: [(T, f32); N],
     len: usize,
 }
 
-impl<T: Copy + Default> Default for ChildOrder<T> {
+impl<T: Copy + Default, const N: usize> Default for ChildOrder<T, N> {
     #[inline(always)]
-    fn default() -> ChildOrder<T> {
+    fn default() -> ChildOrder<T, N> {
         ChildOrder::new()
     }
 }
 
-impl<T: Copy + Default> ChildOrder<T> {
+impl<T: Copy + Default, const N: usize> ChildOrder<T, N> {
     #[inline(always)]
-    pub fn new() -> ChildOrder<T> {
-        ChildOrder { items: [(T::default(), 0.0); 4], len: 0 }
+    pub fn new() -> ChildOrder<T, N> {
+        ChildOrder { items: [(T::default(), 0.0); N], len: 0 }
     }
 
     /// Adds a child the ray (or packet) enters at `t_enter`.
@@ -199,20 +208,23 @@ mod tests {
     #[test]
     fn slab_test_by_hand() {
         // Four unit boxes along +x at 1, 3, 5 and 7; a ray along +x from the origin.
+        // ... and four more at 9 to 15, the last of them off the axis.
         let planes = [
-            Vec4::new(1.0, 3.0, 5.0, 7.0),
-            Vec4::new(2.0, 4.0, 6.0, 8.0),
-            Vec4::splat(-0.5),
-            Vec4::splat(0.5),
-            Vec4::splat(-0.5),
-            Vec4::splat(0.5),
+            [1.0, 3.0, 5.0, 7.0, 9.0, 11.0, 13.0, 15.0],
+            [2.0, 4.0, 6.0, 8.0, 10.0, 12.0, 14.0, 16.0],
+            [-0.5; 8],
+            [0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, -0.1],
+            [-0.5; 8],
+            [0.5; 8],
         ];
         let ray = PreparedRay::new(&Ray::new(Vec3::ZERO, Vec3::X));
-        let (mask, tn) = ray.slab4(&planes, 0b1111, 5.5);
+        let (mask, tn) = ray.slab8(&planes, 0xff, 5.5);
         assert_eq!(mask, 0b0111, "boxes entered before t = 5.5");
-        assert_eq!(tn.x, 1.0 * (1.0 - SLAB_WIDEN));
-        assert_eq!(tn.z, 5.0 * (1.0 - SLAB_WIDEN));
-        assert_eq!(ray.slab4(&planes, 0b0101, 100.0).0, 0b0101, "unused slots never hit");
+        assert_eq!(tn[0], 1.0 * (1.0 - SLAB_WIDEN));
+        assert_eq!(tn[2], 5.0 * (1.0 - SLAB_WIDEN));
+        assert_eq!(ray.slab8(&planes, 0xff, 100.0).0, 0b0111_1111, "the box off the axis is missed");
+        assert_eq!(ray.slab8(&planes, 0b0101_0101, 100.0).0, 0b0101_0101, "unused slots never hit");
+        assert_eq!(ray.slab8(&planes, 0xff, 100.0).1[5], 11.0 * (1.0 - SLAB_WIDEN));
         assert!(ray.slab1(Vec3::new(1.0, -0.5, -0.5), Vec3::new(2.0, 0.5, 0.5), 1.5));
         assert!(!ray.slab1(Vec3::new(1.0, 0.6, -0.5), Vec3::new(2.0, 1.5, 0.5), 10.0));
     }
