@@ -154,15 +154,21 @@ enum BuildNode {
 }
 
 impl BuildNode {
-    /// The primitive slots below this node: a subtree's leaves cover one
-    /// contiguous range. (first, count)
+    /// The primitive slots below this node, (first, count): a subtree's
+    /// leaves cover one contiguous range, from its leftmost leaf's first
+    /// slot to its rightmost leaf's last (two walks down its sides).
     fn span(&self) -> (u32, u32) {
-        match self {
-            BuildNode::Leaf { first, count, .. } => (*first, *count),
-            BuildNode::Inner { kids, .. } => {
-                let (first, a) = kids[0].span();
-                (first, a + kids[1].span().1)
-            }
+        let mut left = self;
+        while let BuildNode::Inner { kids, .. } = left {
+            left = &kids[0];
+        }
+        let mut right = self;
+        while let BuildNode::Inner { kids, .. } = right {
+            right = &kids[1];
+        }
+        match (left, right) {
+            (BuildNode::Leaf { first, .. }, BuildNode::Leaf { first: last, count, .. }) => (*first, last + count - first),
+            _ => unreachable!("the walks end at leaves"),
         }
     }
 
