@@ -449,7 +449,7 @@ impl<'a> BvhQuery<'a> {
                         word = node.child[near];
                         continue 'walk;
                     }
-                    let mut order = ChildOrder::<_, 8>::new();
+                    let mut order = ChildOrder::new();
                     let mut m = mask;
                     while m != 0 {
                         let i = m.trailing_zeros() as usize;

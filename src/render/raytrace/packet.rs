@@ -319,7 +319,7 @@ impl BvhQuery<'_> {
                     child_near[c] = horizontal_min(near);
                 }
                 // Nearest child next (its nearest ray's entry); the others pushed farthest first.
-                let mut order = ChildOrder::<_, 8>::new();
+                let mut order = ChildOrder::new();
                 for c in 0..8 {
                     if child_mask[c] != 0 {
                         order.insert((node.child[c], child_mask[c]), child_near[c]);

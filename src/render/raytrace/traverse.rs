@@ -86,22 +86,23 @@ impl PreparedRay {
 /// with the nearest and pushes the others farthest first (they then pop
 /// nearest first). Insertion sort by descending entry distance; of equal
 /// distances the one added last comes out as the nearer.
-pub struct ChildOrder<T, const N: usize = 4> {
-    items: [(T, f32); N],
+pub struct ChildOrder<T> {
+    /// Room for a node's eight children.
+    items: [(T, f32); 8],
     len: usize,
 }
 
-impl<T: Copy + Default, const N: usize> Default for ChildOrder<T, N> {
+impl<T: Copy + Default> Default for ChildOrder<T> {
     #[inline(always)]
-    fn default() -> ChildOrder<T, N> {
+    fn default() -> ChildOrder<T> {
         ChildOrder::new()
     }
 }
 
-impl<T: Copy + Default, const N: usize> ChildOrder<T, N> {
+impl<T: Copy + Default> ChildOrder<T> {
     #[inline(always)]
-    pub fn new() -> ChildOrder<T, N> {
-        ChildOrder { items: [(T::default(), 0.0); N], len: 0 }
+    pub fn new() -> ChildOrder<T> {
+        ChildOrder { items: [(T::default(), 0.0); 8], len: 0 }
     }
 
     /// Adds a child the ray (or packet) enters at `t_enter`.
