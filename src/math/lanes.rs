@@ -258,15 +258,24 @@ impl<L: Lane> V3<L> {
     pub fn div(self, s: L) -> Self {
         V3 { x: self.x / s, y: self.y / s, z: self.z / s }
     }
-    /// glam's `normalize_or_zero`: times `1 / length`, zero where that is
+    /// glam's `normalize`: times `1 / length`.
+    #[inline(always)]
+    pub fn normalize(self) -> Self {
+        self.scale(self.x.splat(1.0) / self.length())
+    }
+    /// glam's `normalize_or`: times `1 / length`, `fallback` where that is
     /// not a positive finite number.
     #[inline(always)]
-    pub fn normalize_or_zero(self) -> Self {
+    pub fn normalize_or(self, fallback: Self) -> Self {
         let rcp = self.x.splat(1.0) / self.length();
         let ok = rcp.gt(self.x.splat(0.0)) & rcp.lt(self.x.splat(f32::INFINITY));
-        let n = self.scale(rcp);
+        V3::select(ok, self.scale(rcp), fallback)
+    }
+    /// glam's `normalize_or_zero`.
+    #[inline(always)]
+    pub fn normalize_or_zero(self) -> Self {
         let zero = self.x.splat(0.0);
-        V3 { x: L::select(ok, n.x, zero), y: L::select(ok, n.y, zero), z: L::select(ok, n.z, zero) }
+        self.normalize_or(V3 { x: zero, y: zero, z: zero })
     }
     /// Per lane `if mask { a } else { b }`.
     #[inline(always)]

@@ -97,21 +97,6 @@ impl Gathered {
     }
 }
 
-/// `glam`'s `Vec3::normalize`: times `1 / length`.
-#[inline(always)]
-fn normalize<L: Lane>(v: V3<L>) -> V3<L> {
-    v.scale(v.x.splat(1.0) / v.length())
-}
-
-/// `glam`'s `Vec3::normalize_or`: times `1 / length`, or `fallback` where
-/// that is not a positive finite number.
-#[inline(always)]
-fn normalize_or<L: Lane>(v: V3<L>, fallback: V3<L>) -> V3<L> {
-    let rcp = v.x.splat(1.0) / v.length();
-    let ok = rcp.gt(v.x.splat(0.0)) & rcp.lt(v.x.splat(f32::INFINITY));
-    V3::select(ok, v.scale(rcp), fallback)
-}
-
 /// `a b0 + b b1 + c b2`, as `hit_on` interpolates.
 #[inline(always)]
 fn interpolate<L: Lane>(a: V3<L>, b: V3<L>, c: V3<L>, w: &[L; 3]) -> V3<L> {
@@ -126,12 +111,12 @@ fn triangle_hits8<S: Simd>(simd: S, scene: &Scene, inputs: &[TriangleHitInput], 
     let w = [f32x8::simd_from(simd, g.b[0]), f32x8::simd_from(simd, g.b[1]), f32x8::simd_from(simd, g.b[2])];
     let (v0, v1, v2) = (V3::gather(simd, &g.v[0]), V3::gather(simd, &g.v[1]), V3::gather(simd, &g.v[2]));
     // `Triangle::geometric_normal`, then `hit_on`'s steps in order.
-    let geometric = normalize((v1 - v0).cross(v2 - v0));
+    let geometric = (v1 - v0).cross(v2 - v0).normalize();
     let flat = mask_from_bits(simd, g.flat);
     let n0 = V3::select(flat, geometric, V3::gather(simd, &g.n[0]));
     let n1 = V3::select(flat, geometric, V3::gather(simd, &g.n[1]));
     let n2 = V3::select(flat, geometric, V3::gather(simd, &g.n[2]));
-    let shading = normalize_or(interpolate(n0, n1, n2, &w), geometric);
+    let shading = interpolate(n0, n1, n2, &w).normalize_or(geometric);
     let back = geometric.dot(V3::gather(simd, &g.dir)).gt(w[0].splat(0.0));
     let geometric = V3::select(back, -geometric, geometric).scatter();
     let shading = V3::select(back, -shading, shading).scatter();

@@ -22,7 +22,7 @@
 //! walk waits on.
 
 use super::intersect::TriangleEdges;
-use super::traverse::{test_leaf, BestHit, ChildOrder, PreparedRay, SLAB_WIDEN};
+use super::traverse::{slab_test8, test_leaf, BestHit, ChildOrder, PreparedRay};
 use crate::math::lanes::{mask_bits, simd_level};
 use fearless_simd::{f32x8, Simd, SimdBase};
 use crate::math::Ray;
@@ -262,21 +262,22 @@ impl Bvh {
     }
 }
 
-/// `traverse::slab_test` for one ray against the eight boxes of `node`, in
-/// eight lanes: which it meets within [0, t_far] (bits of the used slots),
-/// and where it enters each.
+/// One ray against the eight boxes of `node` (`traverse::slab_test8`):
+/// which it meets within [0, t_far] (bits of the used slots), and where it
+/// enters each.
 #[inline(always)]
 fn slab8_lanes<S: Simd>(simd: S, node: &Node8, origin: &[f32x8<S>; 3], inv: &[f32x8<S>; 3], t_far: f32) -> (u32, f32x8<S>) {
     let p = &node.planes;
-    let x0 = (f32x8::from_slice(simd, &p[0]) - origin[0]) * inv[0];
-    let x1 = (f32x8::from_slice(simd, &p[1]) - origin[0]) * inv[0];
-    let y0 = (f32x8::from_slice(simd, &p[2]) - origin[1]) * inv[1];
-    let y1 = (f32x8::from_slice(simd, &p[3]) - origin[1]) * inv[1];
-    let z0 = (f32x8::from_slice(simd, &p[4]) - origin[2]) * inv[2];
-    let z1 = (f32x8::from_slice(simd, &p[5]) - origin[2]) * inv[2];
-    let tn = x0.min(x1).max(y0.min(y1)).max(z0.min(z1)).max(0.0) * (1.0 - SLAB_WIDEN);
-    let tf = (x0.max(x1).min(y0.max(y1)).min(z0.max(z1)) * (1.0 + SLAB_WIDEN)).min(t_far);
-    (mask_bits(tn.simd_le(tf)) as u32 & node.valid, tn)
+    let planes = [
+        f32x8::from_slice(simd, &p[0]),
+        f32x8::from_slice(simd, &p[1]),
+        f32x8::from_slice(simd, &p[2]),
+        f32x8::from_slice(simd, &p[3]),
+        f32x8::from_slice(simd, &p[4]),
+        f32x8::from_slice(simd, &p[5]),
+    ];
+    let (hit, tn) = slab_test8(&planes, origin, inv, f32x8::splat(simd, t_far));
+    (mask_bits(hit) as u32 & node.valid, tn)
 }
 
 /// The traversal stack: on the machine stack for ordinary trees.

@@ -21,7 +21,7 @@
 use super::bvh::{leaf_range, BvhQuery, Node8, LEAF_BIT, STACK};
 use super::{cast_pass, with_eye_differentials};
 use super::intersect::{intersect_triangle_lanes, TriangleEdges};
-use super::traverse::{test_leaf, BestHit, ChildOrder, PreparedRay, SLAB_WIDEN};
+use super::traverse::{slab_test8, test_leaf, BestHit, ChildOrder, PreparedRay, SLAB_WIDEN};
 use crate::math::lanes::{mask_bits, mask_from_bits, simd_level, V3};
 use crate::math::{Radiance, Ray};
 use crate::render::debug::View;
@@ -311,7 +311,7 @@ impl BvhQuery<'_> {
                     let mut near = f32x8::splat(simd, f32::INFINITY);
                     let mut bits_all = 0u64;
                     for &(g, t_far) in &groups[..n_groups] {
-                        let (hit, tn) = slab_test8(simd, &planes, pk, 8 * g, t_far);
+                        let (hit, tn) = slab_test_rays8(simd, &planes, pk, 8 * g, t_far);
                         bits_all |= (mask_bits(hit) as u64) << (8 * g);
                         near = near.min(hit.select(tn, f32x8::splat(simd, f32::INFINITY)));
                     }
@@ -349,22 +349,24 @@ impl BvhQuery<'_> {
     }
 }
 
-/// `traverse::slab_test` for the eight rays of lanes `start..start + 8`
-/// against one box: the same arithmetic, eight wide. (The box tests only
-/// prune: the padded boxes and `SLAB_WIDEN` keep every true hit, so they
-/// need not match the single ray's bit for bit, but they do.)
+/// The eight rays of lanes `start..start + 8` against one box
+/// (`traverse::slab_test8`). (The box tests only prune: the padded boxes
+/// and `SLAB_WIDEN` keep every true hit, so they need not match the single
+/// ray's bit for bit, but they do.)
 #[inline(always)]
-fn slab_test8<S: Simd>(simd: S, p: &[f32x8<S>; 6], pk: &Packet, start: usize, t_far: f32x8<S>) -> (mask32x8<S>, f32x8<S>) {
-    let o = |a: usize| f32x8::from_slice(simd, &pk.origin[a].0[start..start + 8]);
-    let inv = |a: usize| f32x8::from_slice(simd, &pk.inv[a].0[start..start + 8]);
-    let (ox, oy, oz) = (o(0), o(1), o(2));
-    let (ix, iy, iz) = (inv(0), inv(1), inv(2));
-    let (x0, x1) = ((p[0] - ox) * ix, (p[1] - ox) * ix);
-    let (y0, y1) = ((p[2] - oy) * iy, (p[3] - oy) * iy);
-    let (z0, z1) = ((p[4] - oz) * iz, (p[5] - oz) * iz);
-    let tn = x0.min(x1).max(y0.min(y1)).max(z0.min(z1)).max(0.0) * (1.0 - SLAB_WIDEN);
-    let tf = (x0.max(x1).min(y0.max(y1)).min(z0.max(z1)) * (1.0 + SLAB_WIDEN)).min(t_far);
-    (tn.simd_le(tf), tn)
+fn slab_test_rays8<S: Simd>(simd: S, p: &[f32x8<S>; 6], pk: &Packet, start: usize, t_far: f32x8<S>) -> (mask32x8<S>, f32x8<S>) {
+    let lanes = start..start + 8;
+    let origin = [
+        f32x8::from_slice(simd, &pk.origin[0].0[lanes.clone()]),
+        f32x8::from_slice(simd, &pk.origin[1].0[lanes.clone()]),
+        f32x8::from_slice(simd, &pk.origin[2].0[lanes.clone()]),
+    ];
+    let inv = [
+        f32x8::from_slice(simd, &pk.inv[0].0[lanes.clone()]),
+        f32x8::from_slice(simd, &pk.inv[1].0[lanes.clone()]),
+        f32x8::from_slice(simd, &pk.inv[2].0[lanes]),
+    ];
+    slab_test8(p, &origin, &inv, t_far)
 }
 
 #[inline(always)]

@@ -7,6 +7,7 @@ use super::intersect::{intersect_sphere, intersect_triangle, TriangleEdges};
 use crate::math::Ray;
 use crate::render::pixel_record::{PrimitiveTest, Recorder};
 use crate::scene::{PrimitiveId, PrimitiveKind, Sphere};
+use fearless_simd::{f32x8, mask32x8, Simd, SimdBase};
 use glam::{BVec4A, Vec3, Vec4};
 
 /// The slab test's far distance is stretched by this factor (and the near
@@ -27,6 +28,20 @@ pub fn slab_test(planes: &[Vec4; 6], origin: &[Vec4; 3], inv: &[Vec4; 3], t_far:
     let tn = x0.min(x1).max(y0.min(y1)).max(z0.min(z1)).max(Vec4::ZERO) * (1.0 - SLAB_WIDEN);
     let tf = (x0.max(x1).min(y0.max(y1)).min(z0.max(z1)) * (1.0 + SLAB_WIDEN)).min(t_far);
     (tn.cmple(tf), tn)
+}
+
+/// `slab_test` eight lanes wide, with the same arithmetic: eight of a
+/// node's boxes against one ray (the single-ray walk), or one box against
+/// eight rays (packets).
+#[inline(always)]
+pub fn slab_test8<S: Simd>(planes: &[f32x8<S>; 6], origin: &[f32x8<S>; 3], inv: &[f32x8<S>; 3], t_far: f32x8<S>) -> (mask32x8<S>, f32x8<S>) {
+    let p = planes;
+    let (x0, x1) = ((p[0] - origin[0]) * inv[0], (p[1] - origin[0]) * inv[0]);
+    let (y0, y1) = ((p[2] - origin[1]) * inv[1], (p[3] - origin[1]) * inv[1]);
+    let (z0, z1) = ((p[4] - origin[2]) * inv[2], (p[5] - origin[2]) * inv[2]);
+    let tn = x0.min(x1).max(y0.min(y1)).max(z0.min(z1)).max(0.0) * (1.0 - SLAB_WIDEN);
+    let tf = (x0.max(x1).min(y0.max(y1)).min(z0.max(z1)) * (1.0 + SLAB_WIDEN)).min(t_far);
+    (tn.simd_le(tf), tn)
 }
 
 /// A ray prepared for slab tests: origin and inverse direction, each
@@ -52,7 +67,7 @@ impl PreparedRay {
     /// Which of a node's eight child boxes (`planes`, slots used as in
     /// `valid`) the ray meets within [0, t_far], as a bit mask, and where
     /// it enters each: `slab_test` on each half of the node. (The hot walk
-    /// uses the eight-lane `bvh::slab8_lanes`, the same arithmetic.)
+    /// uses `slab_test8`, the same arithmetic in eight lanes.)
     #[inline(always)]
     pub fn slab8(&self, planes: &[[f32; 8]; 6], valid: u32, t_far: f32) -> (u32, [f32; 8]) {
         let mut mask = 0;
