@@ -12,6 +12,7 @@ use pinhole::render::raytrace::bvh::{Bvh, BvhQuery};
 use pinhole::render::raytrace::bvh_renderer::BvhRayTracer;
 use pinhole::render::raytrace::packet::{self, Packet, TILE_H, TILE_W};
 use pinhole::render::pixel_record::NoRecord;
+use pinhole::render::sampling::{cosine_hemisphere, from_local, SampleRng};
 use pinhole::render::{debug::View, PassJob, PreparedScene, RayCounts, RenderSettings, Renderer, SceneQuery, ShadowMode};
 use pinhole::math::{Radiance, Vec2};
 use rayon::prelude::*;
@@ -93,6 +94,44 @@ fn main() {
                 .sum();
         });
 
+        // Incoherent rays: from each primary hit one cosine-sampled direction,
+        // the first bounce of a path tracer; traced one at a time, one thread
+        // (what `--gi path` spends most of its walk time on).
+        let mut bounce_rays = Vec::new();
+        for y in 0..h {
+            for x in 0..w {
+                let (px, py) = (x as f32 + 0.5, y as f32 + 0.5);
+                let ray = view.eye_ray(px, py);
+                if let Some(hit) = query.closest(&ray, view.far_t(px, py), false, &mut RayCounts::default(), &mut NoRecord) {
+                    let mut rng = SampleRng::for_pixel(x + y * w, 0, 0);
+                    let dir = from_local(cosine_hemisphere(rng.next_2d()), hit.geometric_normal);
+                    bounce_rays.push(hit.spawn_ray_front(dir, 1e-4));
+                }
+            }
+        }
+        // For a peer's walk over the same rays: PINHOLE_DUMP_RAYS=DIR writes
+        // DIR/NAME.tris (9 f32 per triangle) and DIR/NAME.rays (origin and
+        // direction, 6 f32 per ray).
+        if let Ok(dir) = std::env::var("PINHOLE_DUMP_RAYS") {
+            let stem = Path::new(&path).file_stem().unwrap().to_string_lossy().to_string();
+            let mut tris = Vec::new();
+            for t in prepared.scene.triangles.iter() {
+                for v in t.v {
+                    tris.extend(v.to_array());
+                }
+            }
+            let rays: Vec<f32> = bounce_rays.iter().flat_map(|r| r.origin.to_array().into_iter().chain(r.dir.to_array())).collect();
+            let bytes = |v: &[f32]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
+            std::fs::write(format!("{dir}/{stem}.tris"), bytes(&tris)).expect("write tris");
+            std::fs::write(format!("{dir}/{stem}.rays"), bytes(&rays)).expect("write rays");
+        }
+        let mut bounce_hits = 0u64;
+        let mut bounce_counts = RayCounts::default();
+        let bounce = best_of(reps, || {
+            bounce_counts = RayCounts::default();
+            bounce_hits = bounce_rays.iter().map(|r| query.closest(r, f32::INFINITY, false, &mut bounce_counts, &mut NoRecord).is_some() as u64).sum();
+        });
+
         let cancel = AtomicBool::new(false);
         let mut out = vec![Radiance::ZERO; (w * h) as usize];
         let mut pass = |view_kind: View, shadows: ShadowMode| {
@@ -108,7 +147,8 @@ fn main() {
         let (shaded, sc) = pass(View::Shaded, ShadowMode::Ray);
         println!(
             "pinhole {} tris={} {}x{} threads={} nodes={} depth={} build_ms={:.1} bare_ms={:.1} bare_mrays_per_s={:.2} hits={} packet_ms={:.1} packet_mrays_per_s={:.2} packet_hits={} \
-             depth_view_ms={:.1} depth_view_mrays_per_s={:.2} nodes_per_ray={:.1} tests_per_ray={:.1} shaded_ms={:.1} shaded_mrays_per_s={:.2} (primary+shadow)",
+             depth_view_ms={:.1} depth_view_mrays_per_s={:.2} nodes_per_ray={:.1} tests_per_ray={:.1} \
+             bounce_rays={} bounce_ns_per_ray_1_thread={:.1} bounce_hits={} bounce_nodes_per_ray={:.2} bounce_tests_per_ray={:.2} shaded_ms={:.1} shaded_mrays_per_s={:.2} (primary+shadow)",
             Path::new(&path).file_stem().unwrap().to_string_lossy(),
             prepared.edges.len(),
             w,
@@ -127,6 +167,11 @@ fn main() {
             rays / depth / 1e6,
             dc.nodes as f64 / rays,
             dc.tests as f64 / rays,
+            bounce_rays.len(),
+            bounce * 1e9 / bounce_rays.len() as f64,
+            bounce_hits,
+            bounce_counts.nodes as f64 / bounce_rays.len() as f64,
+            bounce_counts.tests as f64 / bounce_rays.len() as f64,
             shaded * 1e3,
             (sc.primary + sc.shadow) as f64 / shaded / 1e6,
         );

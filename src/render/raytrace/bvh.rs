@@ -116,25 +116,27 @@ pub(super) fn leaf_range(word: u32) -> (usize, usize) {
     (first, first + (word & 7) as usize + 1)
 }
 
-/// Asks the cache for the lines holding `bytes` bytes from `p`: a hint that
+/// Asks the cache for the `lines` lines of 64 bytes from `p`: a hint that
 /// never faults, whatever the address, and changes no result.
 #[inline(always)]
-fn prefetch(p: *const u8, bytes: usize) {
+fn prefetch_lines(p: *const u8, lines: usize) {
     #[cfg(target_arch = "x86_64")]
-    {
+    for line in 0..lines {
         use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-        let mut offset = 0;
-        while offset < bytes {
-            // SAFETY: a prefetch never faults, whatever the address.
-            unsafe { _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(offset).cast()) };
-            offset += 64;
-        }
-        // The last byte's line, when `p` does not start a line.
-        // SAFETY: as above.
-        unsafe { _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(bytes - 1).cast()) };
+        // SAFETY: a prefetch never faults, whatever the address.
+        unsafe { _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(64 * line).cast()) };
     }
     #[cfg(not(target_arch = "x86_64"))]
-    let _ = (p, bytes);
+    let _ = (p, lines);
+}
+
+/// Asks the cache for the lines holding `bytes` bytes from `p`, which need
+/// not start a line (as `prefetch_lines`).
+#[inline(always)]
+fn prefetch(p: *const u8, bytes: usize) {
+    prefetch_lines(p, bytes.div_ceil(64));
+    // The last byte's line, when `p` does not start a line.
+    prefetch_lines(p.wrapping_add(bytes - 1), 1);
 }
 
 impl Bvh {
@@ -142,13 +144,12 @@ impl Bvh {
     /// first primitives into the cache; a hint only, it changes no result.
     #[inline(always)]
     pub(super) fn prefetch_child(&self, word: u32) {
-        let p: *const u8 = if word & LEAF_BIT == 0 {
-            self.nodes.as_ptr().wrapping_add(word as usize).cast()
+        if word & LEAF_BIT == 0 {
+            // A node fills whole cache lines (`align(64)`): no extra line for its end.
+            prefetch_lines(self.nodes.as_ptr().wrapping_add(word as usize).cast(), std::mem::size_of::<Node8>() / 64);
         } else {
-            self.prims.as_ptr().wrapping_add(leaf_range(word).0).cast()
-        };
-        let bytes = if word & LEAF_BIT == 0 { std::mem::size_of::<Node8>() } else { 2 * 64 };
-        prefetch(p, bytes);
+            prefetch(self.prims.as_ptr().wrapping_add(leaf_range(word).0).cast(), 2 * 64);
+        }
     }
 
     /// Number of nodes: interior nodes plus leaves.

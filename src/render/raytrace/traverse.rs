@@ -8,7 +8,7 @@ use crate::math::Ray;
 use crate::render::pixel_record::{PrimitiveTest, Recorder};
 use crate::scene::{PrimitiveId, PrimitiveKind, Sphere};
 use fearless_simd::{f32x8, mask32x8, Simd, SimdBase};
-use glam::{BVec4A, Vec3, Vec4};
+use glam::{BVec4A, Vec3, Vec3A, Vec4};
 
 /// The slab test's far distance is stretched by this factor (and the near
 /// one shrunk) to absorb its rounding and that of the primitive tests.
@@ -55,13 +55,12 @@ impl PreparedRay {
     #[inline(always)]
     pub fn new(ray: &Ray) -> PreparedRay {
         // A zero (or denormal) component gets a huge finite inverse, so the
-        // slab test never computes 0 * inf.
-        let fix = |d: f32| {
-            let inv = 1.0 / d;
-            if inv.is_finite() { inv } else { f32::MAX.copysign(d) }
-        };
-        let inv = [fix(ray.dir.x), fix(ray.dir.y), fix(ray.dir.z)];
-        PreparedRay { origin: [Vec4::splat(ray.origin.x), Vec4::splat(ray.origin.y), Vec4::splat(ray.origin.z)], inv: inv.map(Vec4::splat) }
+        // slab test never computes 0 * inf. (One three-lane division: every
+        // single ray pays for this before its first node.)
+        let dir = Vec3A::from(ray.dir);
+        let inv = Vec3A::ONE / dir;
+        let inv = Vec3A::select(inv.is_finite_mask(), inv, Vec3A::splat(f32::MAX).copysign(dir));
+        PreparedRay { origin: [Vec4::splat(ray.origin.x), Vec4::splat(ray.origin.y), Vec4::splat(ray.origin.z)], inv: [Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z)] }
     }
 
     /// Which of a node's eight child boxes (`planes`, slots used as in
@@ -82,18 +81,18 @@ impl PreparedRay {
         (mask & valid, t_enter)
     }
 
-    /// The slab test for one box (the root's).
+    /// The slab test for one box (the root's), the three axes in lanes:
+    /// each axis's entry and exit are computed as `slab_test` does, then
+    /// the latest entry (not before 0) is compared with the earliest exit
+    /// (not after `t_far`).
     #[inline(always)]
     pub fn slab1(&self, min: Vec3, max: Vec3, t_far: f32) -> bool {
-        let mut t = (0.0f32, t_far);
-        for axis in 0..3 {
-            let o = self.origin[axis].x;
-            let inv = self.inv[axis].x;
-            let (a, b) = ((min[axis] - o) * inv, (max[axis] - o) * inv);
-            t.0 = t.0.max(a.min(b) * (1.0 - SLAB_WIDEN));
-            t.1 = t.1.min(a.max(b) * (1.0 + SLAB_WIDEN));
-        }
-        t.0 <= t.1
+        let origin = Vec3A::new(self.origin[0].x, self.origin[1].x, self.origin[2].x);
+        let inv = Vec3A::new(self.inv[0].x, self.inv[1].x, self.inv[2].x);
+        let (a, b) = ((Vec3A::from(min) - origin) * inv, (Vec3A::from(max) - origin) * inv);
+        let enter = (a.min(b) * (1.0 - SLAB_WIDEN)).max_element().max(0.0);
+        let leave = (a.max(b) * (1.0 + SLAB_WIDEN)).min_element().min(t_far);
+        enter <= leave
     }
 }
 
