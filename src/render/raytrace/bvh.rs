@@ -424,6 +424,12 @@ impl<'a> BvhQuery<'a> {
                 let node = &bvh.nodes[word as usize];
                 let (mask, tn) = slab8_lanes(simd, node, &origin, &inv, best.t);
                 if mask != 0 {
+                    if mask & (mask - 1) == 0 {
+                        // One child (the most common case): it is read at
+                        // once, so asking the cache for it first gains nothing.
+                        word = node.child[mask.trailing_zeros() as usize];
+                        continue 'walk;
+                    }
                     // Ask for every child the ray enters now: the walk is a
                     // chain of dependent loads that miss the cache, and the
                     // bookkeeping below can hide part of the next one.
@@ -431,10 +437,6 @@ impl<'a> BvhQuery<'a> {
                     while m != 0 {
                         bvh.prefetch_child(node.child[m.trailing_zeros() as usize]);
                         m &= m - 1;
-                    }
-                    if mask & (mask - 1) == 0 {
-                        word = node.child[mask.trailing_zeros() as usize];
-                        continue 'walk;
                     }
                     let tn: [f32; 8] = tn.into();
                     if mask.count_ones() == 2 {
