@@ -289,11 +289,11 @@ impl BvhQuery<'_> {
                 let mut groups = [(0usize, f32x8::splat(simd, 0.0)); P / 8];
                 let mut n_groups = 0;
                 let mut far_max = f32::NEG_INFINITY;
-                for g in 0..P / 8 {
+                let mut pending = mask;
+                while pending != 0 {
+                    let g = pending.trailing_zeros() as usize / 8;
+                    pending &= !(0xff << (8 * g));
                     let gmask = (mask >> (8 * g)) as u8;
-                    if gmask == 0 {
-                        continue;
-                    }
                     let active = mask_from_bits(simd, gmask);
                     let best = f32x8::from_slice(simd, &pk.best_t.0[8 * g..8 * g + 8]);
                     let far = active.select(best, f32x8::splat(simd, f32::NEG_INFINITY));
@@ -419,11 +419,11 @@ fn test_leaf_packet<S: Simd, const ANY: bool>(
             }
             continue;
         }
-        for g in 0..P / 8 {
+        let mut groups = active;
+        while groups != 0 {
+            let g = groups.trailing_zeros() as usize / 8;
+            groups &= !(0xff << (8 * g));
             let lanes = (active >> (8 * g)) as u8;
-            if lanes == 0 {
-                continue;
-            }
             let base = 8 * g;
             let origin = V3::load(simd, [&pk.origin[0].0, &pk.origin[1].0, &pk.origin[2].0], base);
             let dir = V3::load(simd, [&pk.dir[0].0, &pk.dir[1].0, &pk.dir[2].0], base);
