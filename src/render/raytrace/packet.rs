@@ -31,7 +31,7 @@ use crate::render::shade_batch::{self, Batch};
 use crate::render::{miss_without_ray, resolve_sample, with_shading_hit, Occluder, PassJob, RayCounts, ShadowMode};
 use crate::scene::hit_lanes::{TriangleHitInput, HIT_LANES};
 use crate::scene::{PrimitiveId, PrimitiveKind, Sphere, SurfaceHit};
-use fearless_simd::{dispatch, f32x8, mask32x8, Select, Simd, SimdBase};
+use fearless_simd::{dispatch, f32x8, mask32x8, Select, Simd, SimdBase, SimdFrom};
 use glam::Vec3;
 use rayon::prelude::*;
 use std::mem::MaybeUninit;
@@ -488,16 +488,7 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
                 background: miss_without_ray(job),
             };
             for x0 in (0..width).step_by(TILE_W) {
-                let mut valid = 0u64;
-                for i in 0..P {
-                    let (tx, ty) = lane_xy(i);
-                    if x0 + tx < width && ty < rows && job.is_active((x0 + tx) as u32, (y0 + ty) as u32) {
-                        let p = job.sample_position((x0 + tx) as u32, (y0 + ty) as u32);
-                        pk.rays[i] = job.view.eye_ray(p.x, p.y);
-                        pk.t_max[i] = job.view.far_t(p.x, p.y);
-                        valid |= 1 << i;
-                    }
-                }
+                let valid = eye_rays_into(job, &mut pk, (x0, y0), width, rows);
                 counts.primary += valid.count_ones() as u64;
                 query.closest_packet(&mut pk, valid, &mut counts);
                 if batched {
@@ -521,6 +512,47 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
             a += b;
             a
         })
+}
+
+/// The eye rays of the tile at `(x0, y0)` (`rows` rows of the band, the
+/// image `width` wide) into `pk`, for the lanes on an active pixel, which it
+/// returns. Made eight at a time with `CameraView::eye_ray_lanes`: the same
+/// rays a pixel replay makes one at a time.
+fn eye_rays_into(job: &PassJob, pk: &mut Packet, (x0, y0): (usize, usize), width: usize, rows: usize) -> u64 {
+    dispatch!(simd_level(), simd => eye_rays_eight_wide(simd, job, pk, (x0, y0), width, rows))
+}
+
+#[inline(always)]
+fn eye_rays_eight_wide<S: Simd>(simd: S, job: &PassJob, pk: &mut Packet, (x0, y0): (usize, usize), width: usize, rows: usize) -> u64 {
+    let mut valid = 0u64;
+    for g in 0..P / 8 {
+        let (mut px, mut py) = ([0.0f32; 8], [0.0f32; 8]);
+        let mut group = 0u8;
+        for k in 0..8 {
+            let (tx, ty) = lane_xy(8 * g + k);
+            let (x, y) = ((x0 + tx) as u32, (y0 + ty) as u32);
+            let p = job.sample_position(x, y);
+            (px[k], py[k]) = (p.x, p.y);
+            if x0 + tx < width && ty < rows && job.is_active(x, y) {
+                group |= 1 << k;
+            }
+        }
+        if group == 0 {
+            continue;
+        }
+        let (px, py) = (f32x8::simd_from(simd, px), f32x8::simd_from(simd, py));
+        let (origin, dir) = job.view.eye_ray_lanes(px, py);
+        let far: [f32; 8] = job.view.far_t_lanes(px, py).into();
+        let (origin, dir) = (origin.scatter(), dir.scatter());
+        for k in 0..8 {
+            if group & (1 << k) != 0 {
+                pk.rays[8 * g + k] = Ray::new(origin[k], dir[k]);
+                pk.t_max[8 * g + k] = far[k];
+            }
+        }
+        valid |= (group as u64) << (8 * g);
+    }
+    valid
 }
 
 /// What shading a tile needs beside its hits: which shadow rays are
