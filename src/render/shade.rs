@@ -75,8 +75,9 @@ pub fn albedo_at(material: &Material, hit: &SurfaceHit, settings: &RenderSetting
 
 /// The term `shade()` starts from, before the lights: the constant ambient,
 /// dimmed by ambient occlusion with `--gi ao`; zero when indirect light is
-/// traced or mapped instead.
-#[inline]
+/// traced or mapped instead. Always inlined: for most frames it is one
+/// product, cheaper than the call the compiler sometimes left around it.
+#[inline(always)]
 pub fn ambient_term<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &SurfaceHit, albedo: Vec3) -> Radiance {
     let Shading { scene, query, settings, .. } = *sh;
     match settings.gi.mode {

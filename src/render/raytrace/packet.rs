@@ -21,7 +21,7 @@
 use super::bvh::{leaf_range, BvhQuery, Node8, LEAF_BIT, STACK};
 use super::{cast_pass, with_eye_differentials};
 use super::intersect::{intersect_triangle_lanes, TriangleEdges};
-use super::traverse::{slab_test8, test_leaf, BestHit, ChildOrder, PreparedRay, SLAB_WIDEN};
+use super::traverse::{slab_test8, test_leaf, BestHit, ChildOrder, SLAB_WIDEN};
 use crate::math::lanes::{mask_bits, mask_from_bits, simd_level, V3};
 use crate::math::{Radiance, Ray};
 use crate::render::debug::View;
@@ -31,7 +31,7 @@ use crate::render::shade_batch::{self, Batch};
 use crate::render::{miss_without_ray, resolve_sample, with_shading_hit, Occluder, PassJob, RayCounts, ShadowMode};
 use crate::scene::hit_lanes::{TriangleHitInput, HIT_LANES};
 use crate::scene::{PrimitiveId, PrimitiveKind, Sphere, SurfaceHit};
-use fearless_simd::{dispatch, f32x8, mask32x8, Select, Simd, SimdBase, SimdFrom};
+use fearless_simd::{dispatch, f32x8, mask32x8, Select, Simd, SimdBase, SimdFloat, SimdFrom};
 use glam::Vec3;
 use rayon::prelude::*;
 use std::mem::MaybeUninit;
@@ -85,6 +85,51 @@ pub struct Packet {
 }
 
 impl Packet {
+    /// Lays out the rays of lanes `8 g..8 g + 8` for the traversal (origins,
+    /// directions and inverse directions as lanes, each far end as its
+    /// best `t` and limit) and returns which of them enter the tree's root
+    /// box. The same inverse and root test as a single ray's
+    /// (`PreparedRay::new`, `slab1`), eight rays at a time; lanes without a
+    /// ray are laid out too and left out by the caller.
+    #[inline(always)]
+    fn prepare_group<S: Simd>(&mut self, simd: S, g: usize, bvh: &crate::render::raytrace::bvh::Bvh) -> u8 {
+        let lanes = 8 * g..8 * g + 8;
+        let rays = &self.rays[lanes.clone()];
+        let mut columns = [[0.0f32; 8]; 6];
+        for (k, ray) in rays.iter().enumerate() {
+            for a in 0..3 {
+                columns[a][k] = ray.origin[a];
+                columns[3 + a][k] = ray.dir[a];
+            }
+        }
+        let t_max = f32x8::from_slice(simd, &self.t_max[lanes.clone()]);
+        let (one, huge) = (f32x8::splat(simd, 1.0), f32x8::splat(simd, f32::MAX));
+        let mut origin = [one; 3];
+        let mut inv = [one; 3];
+        for a in 0..3 {
+            origin[a] = f32x8::simd_from(simd, columns[a]);
+            let dir = f32x8::simd_from(simd, columns[3 + a]);
+            // A zero (or denormal) component gets a huge finite inverse, as
+            // in `PreparedRay::new`.
+            let raw = one / dir;
+            inv[a] = raw.is_finite().select(raw, huge.copysign(dir));
+            self.origin[a].0[lanes.clone()].copy_from_slice(&columns[a]);
+            self.dir[a].0[lanes.clone()].copy_from_slice(&columns[3 + a]);
+            inv[a].store_slice(&mut self.inv[a].0[lanes.clone()]);
+        }
+        self.best_t.0[lanes.clone()].copy_from_slice(&self.t_max[lanes.clone()]);
+        self.limit[lanes.clone()].copy_from_slice(&self.t_max[lanes]);
+        if bvh.prims.is_empty() {
+            return 0;
+        }
+        // The root box against the eight rays: `slab_test8`'s entry and exit
+        // are `slab1`'s (scaling by the widening factor commutes with max and
+        // min), so each ray enters the root exactly when it would alone.
+        let (min, max) = (bvh.root_bounds.min, bvh.root_bounds.max);
+        let planes = [f32x8::splat(simd, min.x), f32x8::splat(simd, max.x), f32x8::splat(simd, min.y), f32x8::splat(simd, max.y), f32x8::splat(simd, min.z), f32x8::splat(simd, max.z)];
+        mask_bits(slab_test8(&planes, &origin, &inv, t_max).0)
+    }
+
     pub fn new() -> Box<Packet> {
         let ray = Ray::new(Vec3::ZERO, Vec3::Z);
         let zero = Lanes([0.0; P]);
@@ -244,23 +289,12 @@ impl BvhQuery<'_> {
         let bvh = &self.prepared.bvh;
         debug_assert!(!bvh.deep);
         let spheres = &self.prepared.scene.spheres;
+        pk.best_id = [PrimitiveId::NONE; P];
         let mut mask = 0u64;
-        for i in 0..P {
-            pk.best_id[i] = PrimitiveId::NONE;
-            if valid & 1 << i == 0 {
-                continue;
-            }
-            let r = PreparedRay::new(&pk.rays[i]);
-            for a in 0..3 {
-                pk.origin[a].0[i] = r.origin[a].x;
-                pk.dir[a].0[i] = pk.rays[i].dir[a];
-                pk.inv[a].0[i] = r.inv[a].x;
-            }
-            let t_max = pk.t_max[i];
-            pk.best_t.0[i] = t_max;
-            pk.limit[i] = t_max;
-            if !bvh.prims.is_empty() && r.slab1(bvh.root_bounds.min, bvh.root_bounds.max, t_max) {
-                mask |= 1 << i;
+        for g in 0..P / 8 {
+            let lanes = (valid >> (8 * g)) as u8;
+            if lanes != 0 {
+                mask |= ((pk.prepare_group(simd, g, bvh) & lanes) as u64) << (8 * g);
             }
         }
         if mask == 0 {
