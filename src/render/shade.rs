@@ -92,30 +92,19 @@ pub fn ambient_term<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &Su
     }
 }
 
+/// Whether `after_direct` can add anything to a surface of `material`: a
+/// frame without traced or mapped indirect light adds nothing to most
+/// surfaces, and its batches skip the call.
+#[inline(always)]
+pub fn adds_after_direct(settings: &RenderSettings, material: &Material) -> bool {
+    matches!(settings.gi.mode, GiMode::Path | GiMode::Photons) || material.has_secondary()
+}
+
 /// What `shade()` adds after direct light, in this order: traced or mapped
 /// indirect light, then mirror reflection and refraction. `l_o` is the
 /// ambient term plus direct light.
-#[inline(always)]
+#[inline]
 pub fn after_direct<Q: SceneQuery, R: Recorder>(
-    sh: &mut Shading<Q, R>,
-    hit: &SurfaceHit,
-    material: &Material,
-    albedo: Vec3,
-    w_o: Vec3,
-    depth: u32,
-    l_o: Radiance,
-) -> Radiance {
-    // Most surfaces of a frame without indirect light add nothing: they
-    // return here, without a call.
-    if !matches!(sh.settings.gi.mode, GiMode::Path | GiMode::Photons) && !material.has_secondary() {
-        sh.rec.shaded(depth, l_o);
-        return l_o;
-    }
-    indirect_and_secondary(sh, hit, material, albedo, w_o, depth, l_o)
-}
-
-/// `after_direct` where there is something to add.
-fn indirect_and_secondary<Q: SceneQuery, R: Recorder>(
     sh: &mut Shading<Q, R>,
     hit: &SurfaceHit,
     material: &Material,

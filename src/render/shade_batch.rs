@@ -184,6 +184,10 @@ pub fn shade_batch<Q: SceneQuery>(job: &PassJob, query: &Q, batch: &Batch, block
     for i in 0..n {
         let hit = &batch.hits[i];
         let material = &scene.materials[hit.material as usize];
+        if !shade::adds_after_direct(settings, material) {
+            out[i] = direct[i];
+            continue;
+        }
         let mut sh = Shading { scene, query, settings, path: &mut paths[i], counts: &mut *counts, rec: &mut NoRecord };
         out[i] = shade::after_direct(&mut sh, hit, material, albedo[i], w_o[i], 0, direct[i]);
     }
