@@ -347,6 +347,16 @@ impl<S: Simd> V3<f32x8<S>> {
             z: f32x8::from_slice(simd, &xyz[2][start..start + 8]),
         }
     }
+    /// Lanes from coordinate arrays (`[x, y, z]`, eight lanes each).
+    #[inline(always)]
+    pub fn from_soa(simd: S, xyz: &[[f32; 8]; 3]) -> Self {
+        V3 { x: f32x8::simd_from(simd, xyz[0]), y: f32x8::simd_from(simd, xyz[1]), z: f32x8::simd_from(simd, xyz[2]) }
+    }
+    /// The lanes as coordinate arrays (`[x, y, z]`).
+    #[inline(always)]
+    pub fn to_soa(self) -> [[f32; 8]; 3] {
+        [self.x.into(), self.y.into(), self.z.into()]
+    }
     /// Eight vectors gathered into lanes.
     #[inline(always)]
     pub fn gather(simd: S, v: &[glam::Vec3; 8]) -> Self {

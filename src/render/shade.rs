@@ -8,8 +8,8 @@ use super::pixel_record::{LightSample, Recorder};
 use super::differentials::{self, RayDifferential};
 use super::{RayCounts, Reflections, RenderSettings, SceneQuery, ShadowMode};
 use crate::math::lanes::V3;
-use crate::math::{Radiance, Ray, Vec3};
-use crate::scene::{Light, Material, Scene, SurfaceHit};
+use crate::math::{Radiance, Ray, Vec2, Vec3};
+use crate::scene::{Differentials, Light, Material, Scene, SurfaceHit};
 #[cfg(test)]
 use std::f32::consts::PI;
 
@@ -58,33 +58,37 @@ pub fn shade<Q: SceneQuery, R: Recorder>(
 ) -> Radiance {
     let Shading { scene, .. } = *sh;
     let material = &scene.materials[hit.material as usize];
-    let albedo = albedo_at(material, hit, sh.settings);
-    let ambient = ambient_term(sh, hit, albedo);
+    let albedo = albedo_at(material, hit.uv, &hit.diff, sh.settings);
+    let ambient = ambient_term(sh, || *hit, albedo);
     let surface = surface_lane(material, albedo, hit.position, hit.shading_normal, w_o);
     let mut visibility = ShadowQueries { sh: &mut *sh, hit, depth, pending: PendingShadow::default() };
     let direct: Vec3 = lighting::direct_light(&scene.lights, &surface, ambient.into(), &mut visibility).into();
     after_direct(sh, hit, material, albedo, w_o, depth, direct)
 }
 
-/// The diffuse albedo `shade()` lights at `hit`: the material's texture
-/// read at the hit's uv with its footprint and the chosen filter.
+/// The diffuse albedo `shade()` lights at a hit with texture coordinates
+/// `uv` and differentials `diff`: the material's texture read there with
+/// the footprint and the chosen filter.
 #[inline]
-pub fn albedo_at(material: &Material, hit: &SurfaceHit, settings: &RenderSettings) -> Vec3 {
-    material.albedo(hit.uv, &hit.diff.footprint(), settings.texture_filter)
+pub fn albedo_at(material: &Material, uv: Vec2, diff: &Differentials, settings: &RenderSettings) -> Vec3 {
+    material.albedo(uv, &diff.footprint(), settings.texture_filter)
 }
 
 /// The term `shade()` starts from, before the lights: the constant ambient,
 /// dimmed by ambient occlusion with `--gi ao`; zero when indirect light is
-/// traced or mapped instead. Always inlined: for most frames it is one
-/// product, cheaper than the call the compiler sometimes left around it.
+/// traced or mapped instead. `hit` gives the surface's record, asked for
+/// only where rays leave it (ambient occlusion), so that batches, which
+/// keep their surfaces in lanes, assemble no record otherwise. Always
+/// inlined: for most frames it is one product, cheaper than the call the
+/// compiler sometimes left around it.
 #[inline(always)]
-pub fn ambient_term<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &SurfaceHit, albedo: Vec3) -> Radiance {
+pub fn ambient_term<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: impl FnOnce() -> SurfaceHit, albedo: Vec3) -> Radiance {
     let Shading { scene, query, settings, .. } = *sh;
     match settings.gi.mode {
         GiMode::None => albedo * scene.render.ambient,
         // The constant ambient term, dimmed where nearby geometry hides the sky.
         GiMode::Ao if scene.render.ambient != Vec3::ZERO && albedo != Vec3::ZERO => {
-            let open = gi::ambient_occlusion(query, hit, &settings.gi, settings.shadow_bump, &mut sh.path.rng, sh.counts, sh.rec);
+            let open = gi::ambient_occlusion(query, &hit(), &settings.gi, settings.shadow_bump, &mut sh.path.rng, sh.counts, sh.rec);
             albedo * scene.render.ambient * open
         }
         // Traced or mapped indirect light replaces the constant.
@@ -385,16 +389,6 @@ impl Incidence {
         let leaving = SurfaceHit { position: shadow_origin(scene, hit, self.w_i, lift), ..*hit };
         (leaving.spawn_ray_along(self.w_i, bump), self.distance - bump)
     }
-}
-
-/// The shadow ray `shade()` casts towards `light` when it shades `hit`, if
-/// it casts one (with `ShadowMode::Ray`): `shade()`'s own steps for one
-/// light (`Incidence::of`, `illuminates`, `shadow_ray`), for the BVH's
-/// packets, which trace these rays ahead of `shade()`.
-#[inline]
-pub fn cast_shadow_ray(scene: &Scene, hit: &SurfaceHit, light: &Light, bump: f32, lift: bool) -> Option<(Ray, f32)> {
-    let incidence = Incidence::of(light, hit.position, hit.shading_normal)?;
-    incidence.illuminates().then(|| incidence.shadow_ray(scene, hit, bump, lift))
 }
 
 /// Where a shadow ray towards `w_i` leaves a surface point. Normally the hit

@@ -11,10 +11,10 @@ use super::lighting::{self, IncidenceLanes, LightVisibility, SurfaceLanes};
 use super::pixel_record::NoRecord;
 use super::shade::{self, Incidence, Shading};
 use super::{debug::View, gi::PathState, Interpolation, PassJob, RayCounts, SceneQuery, ShadowMode};
-use crate::math::lanes::{mask_bits, mask_from_bits, simd_level, V3};
-use crate::math::{Radiance, Vec3};
-use crate::scene::hit_lanes::TriangleHitInput;
-use crate::scene::{Scene, SurfaceHit};
+use crate::math::lanes::{mask_bits, mask_from_bits, simd_level, Lane, V3};
+use crate::math::{Radiance, Ray, Vec2, Vec3};
+use crate::scene::hit_lanes::{EyeSamples, Floats, HitLanes, TriangleHitInput};
+use crate::scene::{CameraView, Light, PrimitiveKind, Scene, SurfaceHit};
 use fearless_simd::{dispatch, f32x8, Simd, SimdFrom};
 
 /// Samples per batch.
@@ -29,35 +29,24 @@ pub fn batchable(job: &PassJob) -> bool {
         && matches!(job.settings.shadows, ShadowMode::Ray | ShadowMode::None)
 }
 
-/// What a lane holds before a sample is pushed into it (never shaded).
-const UNUSED_HIT: SurfaceHit = SurfaceHit {
-    position: Vec3::ZERO,
-    geometric_normal: Vec3::Z,
-    shading_normal: Vec3::Z,
-    barycentric: Vec3::ZERO,
-    uv: crate::math::Vec2::ZERO,
-    t: 0.0,
-    kind: crate::scene::PrimitiveKind::Triangle,
-    primitive: 0,
-    object: 0,
-    material: 0,
-    back_face: false,
-    diff: crate::scene::Differentials::ZERO,
-};
-
 /// Up to eight samples that see a surface, with where their results go.
 pub struct Batch {
     len: usize,
-    /// The surfaces as `shade()` is handed them (flat shading's normal applied).
-    hits: [SurfaceHit; LANES],
-    w_o: [Vec3; LANES],
+    /// The surfaces as `shade()` is handed them (flat shading's normal
+    /// applied), in lanes.
+    hits: HitLanes,
+    /// Unit directions towards the eye, in lanes.
+    w_o: [Floats; 3],
     pixels: [u32; LANES],
     /// The caller's index for each lane's result.
     pub slots: [usize; LANES],
-    /// Triangle hits pushed but not built yet: their inputs and lanes.
-    pending_inputs: [TriangleHitInput; LANES],
+    /// Eye samples pushed but not built yet, and their lanes.
+    pending: EyeSamples,
     pending_lanes: [usize; LANES],
-    pending: usize,
+    /// Ray casters' triangle hits pushed but not built yet, and their lanes.
+    pending_rays: [TriangleHitInput; LANES],
+    pending_ray_lanes: [usize; LANES],
+    pending_ray_count: usize,
 }
 
 impl Default for Batch {
@@ -70,13 +59,15 @@ impl Batch {
     pub fn new() -> Batch {
         Batch {
             len: 0,
-            hits: [UNUSED_HIT; LANES],
-            w_o: [Vec3::ZERO; LANES],
+            hits: HitLanes::new(),
+            w_o: [[0.0; LANES], [0.0; LANES], [1.0; LANES]],
             pixels: [0; LANES],
             slots: [0; LANES],
-            pending_inputs: [TriangleHitInput::default(); LANES],
+            pending: EyeSamples::default(),
             pending_lanes: [0; LANES],
-            pending: 0,
+            pending_rays: [TriangleHitInput::default(); LANES],
+            pending_ray_lanes: [0; LANES],
+            pending_ray_count: 0,
         }
     }
 
@@ -94,35 +85,130 @@ impl Batch {
 
     pub fn clear(&mut self) {
         self.len = 0;
-        self.pending = 0;
+        self.pending.len = 0;
+        self.pending_ray_count = 0;
     }
 
-    /// `push` of the hit `Scene::triangle_hit` gives for these arguments.
-    /// The record is built later, with the batch's other pending triangle
-    /// hits, eight at a time (`build_pending`, before shading).
+    /// Sample `i`'s surface as `shade()` is handed it.
+    pub fn hit(&self, i: usize) -> SurfaceHit {
+        self.hits.get(i)
+    }
+
+    /// `push` of the hit `Scene::triangle_hit` builds from `input` (a ray
+    /// caster's hit, `input.dir` its ray's direction). The record is built
+    /// later, with the batch's other pending hits, eight at a time
+    /// (`build_pending`, before shading).
     #[inline]
-    pub fn push_triangle(&mut self, index: u32, b: Vec3, t: f32, ray: &crate::math::Ray, pixel: u32, slot: usize) {
+    pub fn push_ray_triangle(&mut self, input: TriangleHitInput, pixel: u32, slot: usize) {
         let i = self.len;
-        self.pending_inputs[self.pending] = TriangleHitInput { index, b, t, dir: ray.dir };
-        self.pending_lanes[self.pending] = i;
-        self.pending += 1;
-        self.w_o[i] = -ray.dir;
+        self.pending_rays[self.pending_ray_count] = input;
+        self.pending_ray_lanes[self.pending_ray_count] = i;
+        self.pending_ray_count += 1;
+        (self.w_o[0][i], self.w_o[1][i], self.w_o[2][i]) = (-input.dir.x, -input.dir.y, -input.dir.z);
         self.pixels[i] = pixel;
         self.slots[i] = slot;
         self.len += 1;
     }
 
-    /// Builds the records `push_triangle` left pending, as `push` hands
-    /// them to `shade()` with `interpolation`.
-    pub fn build_pending(&mut self, scene: &Scene, interpolation: Interpolation) {
-        let Batch { hits, pending_inputs, pending_lanes, pending, .. } = self;
-        scene.triangle_hits(&pending_inputs[..*pending], |k, mut hit| {
-            if interpolation == Interpolation::Flat {
-                hit.shading_normal = hit.geometric_normal;
+    /// `push` of the hit a rasterizer's eye sample at image position `p`
+    /// sees on triangle `index` with weights b1 and b2: the record
+    /// `Scene::triangle_hit` gives for the sample's eye ray, with `t` the
+    /// hit's distance along it. The record is built later, with the
+    /// batch's other pending samples, eight at a time (`build_pending`,
+    /// before shading).
+    #[inline]
+    pub fn push_eye_triangle(&mut self, index: u32, (b1, b2): (f32, f32), p: Vec2, pixel: u32, slot: usize) {
+        let i = self.len;
+        self.pending_lanes[self.pending.len] = i;
+        self.pending.push(index, b1, b2, p);
+        self.pixels[i] = pixel;
+        self.slots[i] = slot;
+        self.len += 1;
+    }
+
+    /// Builds the records `push_eye_triangle` left pending, as `push` hands
+    /// them to `shade()` with `interpolation`; `view` makes the eye rays.
+    pub fn build_pending(&mut self, scene: &Scene, view: &CameraView, interpolation: Interpolation) {
+        self.build_pending_rays(scene, interpolation);
+        let n = self.pending.len;
+        if n == 0 {
+            return;
+        }
+        let mut dirs = [[0.0; LANES]; 3];
+        if n == self.len {
+            // Every lane is pending (the common case): built in place.
+            scene.triangle_eye_hits(view, &self.pending, &mut self.hits, &mut dirs);
+            for a in 0..3 {
+                self.w_o[a] = dirs[a].map(|d| -d);
             }
-            hits[pending_lanes[k]] = hit;
+            if interpolation == Interpolation::Flat {
+                self.hits.shading_normal = self.hits.geometric_normal;
+            }
+        } else {
+            let mut built = HitLanes::new();
+            scene.triangle_eye_hits(view, &self.pending, &mut built, &mut dirs);
+            for k in 0..n {
+                let i = self.pending_lanes[k];
+                self.hits.copy_lane(i, &built, k);
+                for a in 0..3 {
+                    self.w_o[a][i] = -dirs[a][k];
+                    if interpolation == Interpolation::Flat {
+                        self.hits.shading_normal[a][i] = self.hits.geometric_normal[a][i];
+                    }
+                }
+            }
+        }
+        self.pending.len = 0;
+    }
+
+    /// The shadow rays `shade()` casts from the batch's surfaces towards
+    /// `light` (with `ShadowMode::Ray`: `Incidence::of`, `illuminates` and
+    /// `shadow_ray`, eight lanes at a time), each handed to `put` with its
+    /// lane and far end: what the packets trace ahead of shading.
+    pub fn shadow_rays(&self, scene: &Scene, light: &Light, bump: f32, lift: bool, mut put: impl FnMut(usize, Ray, f32)) {
+        if self.len == 0 {
+            return;
+        }
+        let (rays, lit) = dispatch!(simd_level(), simd => {
+            let inc = lighting::incidence(light, V3::from_soa(simd, &self.hits.position), V3::from_soa(simd, &self.hits.shading_normal));
+            (ShadowRays::new(&self.hits, &inc, bump, lift), mask_bits(inc.illuminates()))
         });
-        *pending = 0;
+        let mut m = lit & ((1u32 << self.len) - 1) as u8;
+        while m != 0 {
+            let i = m.trailing_zeros() as usize;
+            m &= m - 1;
+            let (ray, t_max) = rays.get(scene, &self.hits, i);
+            put(i, ray, t_max);
+        }
+    }
+
+    /// The part of `build_pending` for `push_ray_triangle`'s hits.
+    fn build_pending_rays(&mut self, scene: &Scene, interpolation: Interpolation) {
+        let n = self.pending_ray_count;
+        if n == 0 {
+            return;
+        }
+        let inputs = &self.pending_rays[..n];
+        if n == self.len {
+            // Every lane is pending (the common case): built in place.
+            scene.triangle_hits(inputs, &mut self.hits);
+            if interpolation == Interpolation::Flat {
+                self.hits.shading_normal = self.hits.geometric_normal;
+            }
+        } else {
+            let mut built = HitLanes::new();
+            scene.triangle_hits(inputs, &mut built);
+            for k in 0..n {
+                let i = self.pending_ray_lanes[k];
+                self.hits.copy_lane(i, &built, k);
+                if interpolation == Interpolation::Flat {
+                    for a in 0..3 {
+                        self.hits.shading_normal[a][i] = self.hits.geometric_normal[a][i];
+                    }
+                }
+            }
+        }
+        self.pending_ray_count = 0;
     }
 
     /// Adds the sample of pixel index `pixel` (the random numbers' key)
@@ -131,11 +217,11 @@ impl Batch {
     #[inline]
     pub fn push(&mut self, interpolation: Interpolation, hit: &SurfaceHit, dir: Vec3, pixel: u32, slot: usize) {
         let i = self.len;
-        self.hits[i] = match interpolation {
-            Interpolation::Flat => SurfaceHit { shading_normal: hit.geometric_normal, ..*hit },
-            _ => *hit,
-        };
-        self.w_o[i] = -dir;
+        match interpolation {
+            Interpolation::Flat => self.hits.set(i, &SurfaceHit { shading_normal: hit.geometric_normal, ..*hit }),
+            _ => self.hits.set(i, hit),
+        }
+        (self.w_o[0][i], self.w_o[1][i], self.w_o[2][i]) = (-dir.x, -dir.y, -dir.z);
         self.pixels[i] = pixel;
         self.slots[i] = slot;
         self.len += 1;
@@ -148,74 +234,85 @@ impl Batch {
 /// for every lane the light illuminates; otherwise shadow rays are cast
 /// here.
 pub fn shade_batch<Q: SceneQuery>(job: &PassJob, query: &Q, batch: &Batch, blocked: Option<&[u8]>, counts: &mut RayCounts) -> [Radiance; LANES] {
-    assert!(batch.pending == 0, "shade_batch on a batch with hits not built (`build_pending`)");
+    assert!(batch.pending.len == 0 && batch.pending_ray_count == 0, "shade_batch on a batch with hits not built (`build_pending`)");
     let scene = &job.prepared.scene;
     let settings = job.settings;
     let n = batch.len;
+    let hits = &batch.hits;
     let mut paths: [PathState; LANES] = std::array::from_fn(|i| {
         PathState::new(batch.pixels[i], job.sample, settings.spp, &settings.gi, job.photons)
     });
-    let mut ambient = [Vec3::ZERO; LANES];
-    let mut albedo = [Vec3::ZERO; LANES];
-    let mut glossy = [Vec3::ZERO; LANES];
-    let mut sharpness = [1.0f32; LANES];
     // Lanes past `len` repeat lane 0's geometry (so their arithmetic stays
     // tame) with a black material; their results are dropped.
-    let mut position = [batch.hits[0].position; LANES];
-    let mut normal = [batch.hits[0].shading_normal; LANES];
-    let mut w_o = [batch.w_o[0]; LANES];
-    for i in 0..n {
-        let hit = &batch.hits[i];
-        let material = &scene.materials[hit.material as usize];
-        albedo[i] = shade::albedo_at(material, hit, settings);
-        let mut sh = Shading { scene, query, settings, path: &mut paths[i], counts: &mut *counts, rec: &mut NoRecord };
-        ambient[i] = shade::ambient_term(&mut sh, hit, albedo[i]);
-        glossy[i] = material.glossy;
-        sharpness[i] = material.sharpness;
-        position[i] = hit.position;
-        normal[i] = hit.shading_normal;
-        w_o[i] = batch.w_o[i];
+    let mut surface = SurfaceArrays {
+        position: hits.position,
+        normal: hits.shading_normal,
+        w_o: batch.w_o,
+        albedo: [[0.0; LANES]; 3],
+        glossy: [[0.0; LANES]; 3],
+        sharpness: [1.0; LANES],
+        ambient: [[0.0; LANES]; 3],
+    };
+    for i in n..LANES {
+        for a in 0..3 {
+            surface.position[a][i] = hits.position[a][0];
+            surface.normal[a][i] = hits.shading_normal[a][0];
+            surface.w_o[a][i] = batch.w_o[a][0];
+        }
     }
-    let inputs = DirectInputs { position, normal, w_o, albedo, glossy, sharpness, ambient };
-    let mut visibility = BatchVisibility { job, query, hits: &batch.hits, live: ((1u32 << n) - 1) as u8, blocked, counts: &mut *counts };
-    let direct = dispatch!(simd_level(), simd => direct_light8(simd, job, &inputs, &mut visibility));
+    let mut albedo = [Vec3::ZERO; LANES];
+    for i in 0..n {
+        let material = &scene.materials[hits.material[i] as usize];
+        albedo[i] = shade::albedo_at(material, Vec2::new(hits.uv[0][i], hits.uv[1][i]), &hits.diff[i], settings);
+        let mut sh = Shading { scene, query, settings, path: &mut paths[i], counts: &mut *counts, rec: &mut NoRecord };
+        let ambient = shade::ambient_term(&mut sh, || hits.get(i), albedo[i]);
+        for (a, (v, g)) in [(albedo[i].x, material.glossy.x), (albedo[i].y, material.glossy.y), (albedo[i].z, material.glossy.z)].into_iter().enumerate() {
+            surface.albedo[a][i] = v;
+            surface.glossy[a][i] = g;
+        }
+        (surface.ambient[0][i], surface.ambient[1][i], surface.ambient[2][i]) = (ambient.x, ambient.y, ambient.z);
+        surface.sharpness[i] = material.sharpness;
+    }
+    let mut visibility = BatchVisibility { job, query, hits, live: ((1u32 << n) - 1) as u8, blocked, counts: &mut *counts };
+    let direct = dispatch!(simd_level(), simd => direct_light8(simd, job, &surface, &mut visibility));
 
     let mut out = [Radiance::ZERO; LANES];
     for i in 0..n {
-        let hit = &batch.hits[i];
-        let material = &scene.materials[hit.material as usize];
+        let material = &scene.materials[hits.material[i] as usize];
         if !shade::adds_after_direct(settings, material) {
             out[i] = direct[i];
             continue;
         }
+        let hit = hits.get(i);
+        let w_o = Vec3::new(batch.w_o[0][i], batch.w_o[1][i], batch.w_o[2][i]);
         let mut sh = Shading { scene, query, settings, path: &mut paths[i], counts: &mut *counts, rec: &mut NoRecord };
-        out[i] = shade::after_direct(&mut sh, hit, material, albedo[i], w_o[i], 0, direct[i]);
+        out[i] = shade::after_direct(&mut sh, &hit, material, albedo[i], w_o, 0, direct[i]);
     }
     out
 }
 
-/// The per-lane values `direct_light8` gathers into vectors.
-struct DirectInputs {
-    position: [Vec3; LANES],
-    normal: [Vec3; LANES],
-    w_o: [Vec3; LANES],
-    albedo: [Vec3; LANES],
-    glossy: [Vec3; LANES],
-    sharpness: [f32; LANES],
-    ambient: [Vec3; LANES],
+/// What `direct_light8` loads as lanes, one array per coordinate.
+struct SurfaceArrays {
+    position: [Floats; 3],
+    normal: [Floats; 3],
+    w_o: [Floats; 3],
+    albedo: [Floats; 3],
+    glossy: [Floats; 3],
+    sharpness: Floats,
+    ambient: [Floats; 3],
 }
 
 #[inline(always)]
-fn direct_light8<S: Simd, Q: SceneQuery>(simd: S, job: &PassJob, inputs: &DirectInputs, visibility: &mut BatchVisibility<Q>) -> [Radiance; LANES] {
+fn direct_light8<S: Simd, Q: SceneQuery>(simd: S, job: &PassJob, inputs: &SurfaceArrays, visibility: &mut BatchVisibility<Q>) -> [Radiance; LANES] {
     let surface = SurfaceLanes {
-        position: V3::gather(simd, &inputs.position),
-        normal: V3::gather(simd, &inputs.normal),
-        w_o: V3::gather(simd, &inputs.w_o),
-        albedo: V3::gather(simd, &inputs.albedo),
-        glossy: V3::gather(simd, &inputs.glossy),
+        position: V3::from_soa(simd, &inputs.position),
+        normal: V3::from_soa(simd, &inputs.normal),
+        w_o: V3::from_soa(simd, &inputs.w_o),
+        albedo: V3::from_soa(simd, &inputs.albedo),
+        glossy: V3::from_soa(simd, &inputs.glossy),
         sharpness: f32x8::simd_from(simd, inputs.sharpness),
     };
-    let start = V3::gather(simd, &inputs.ambient);
+    let start = V3::from_soa(simd, &inputs.ambient);
     lighting::direct_light(&job.prepared.scene.lights, &surface, start, visibility).scatter()
 }
 
@@ -225,7 +322,7 @@ fn direct_light8<S: Simd, Q: SceneQuery>(simd: S, job: &PassJob, inputs: &Direct
 struct BatchVisibility<'b, 'j, Q> {
     job: &'b PassJob<'j>,
     query: &'b Q,
-    hits: &'b [SurfaceHit; LANES],
+    hits: &'b HitLanes,
     /// The lanes that hold samples.
     live: u8,
     blocked: Option<&'b [u8]>,
@@ -243,31 +340,85 @@ impl<S: Simd, Q: SceneQuery> LightVisibility<f32x8<S>> for BatchVisibility<'_, '
             self.counts.shadow += (mask_bits(lit) & self.live).count_ones() as u64;
             return mask_from_bits(simd, !blocked[light]);
         }
-        let visible = self.cast_shadow_rays(inc.w_i.scatter(), inc.distance.into(), inc.incident.scatter(), inc.cos_theta.into(), mask_bits(lit) & self.live);
+        let settings = self.job.settings;
+        let rays = ShadowRays::new(self.hits, inc, settings.shadow_bump, settings.terminator_lift);
+        let visible = self.cast_shadow_rays(&rays, mask_bits(lit) & self.live);
         mask_from_bits(simd, visible)
     }
 }
 
 impl<Q: SceneQuery> BatchVisibility<'_, '_, Q> {
-    /// Casts the shadow rays of the lanes in `lit` towards the light that
-    /// arrives as given; the lanes it reaches unblocked.
+    /// Casts the shadow rays of the lanes in `lit`; the lanes whose light
+    /// arrives unblocked.
     #[inline(never)]
-    fn cast_shadow_rays(&mut self, w_i: [Vec3; LANES], distance: [f32; LANES], incident: [Vec3; LANES], cos_theta: [f32; LANES], lit: u8) -> u8 {
-        let settings = self.job.settings;
+    fn cast_shadow_rays(&mut self, rays: &ShadowRays, lit: u8) -> u8 {
         let scene = &self.job.prepared.scene;
         let mut visible = 0u8;
         let mut m = lit;
         while m != 0 {
             let i = m.trailing_zeros() as usize;
             m &= m - 1;
-            let incidence = Incidence { w_i: w_i[i], distance: distance[i], incident: incident[i], cos_theta: cos_theta[i] };
-            let (ray, t_max) = incidence.shadow_ray(scene, &self.hits[i], settings.shadow_bump, settings.terminator_lift);
+            let (ray, t_max) = rays.get(scene, self.hits, i);
             self.counts.shadow += 1;
             if self.query.occluder(&ray, t_max, self.counts, &mut NoRecord).is_none() {
                 visible |= 1 << i;
             }
         }
         visible
+    }
+}
+
+/// The shadow rays of a batch's surfaces towards one light, worked out
+/// eight at a time with `Incidence::shadow_ray`'s arithmetic: the origin
+/// bumped along the direction, the far end short of the light. Where the
+/// origin is lifted off a triangle (`shadow_origin`), the lane is left to
+/// `Incidence::shadow_ray` itself.
+struct ShadowRays {
+    origin: [Floats; 3],
+    w_i: [Floats; 3],
+    distance: Floats,
+    t_max: Floats,
+    bump: f32,
+    /// Lanes whose origin `shadow_origin` lifts.
+    lifted: u8,
+}
+
+impl ShadowRays {
+    #[inline(always)]
+    fn new<S: Simd>(hits: &HitLanes, inc: &IncidenceLanes<f32x8<S>>, bump: f32, lift: bool) -> ShadowRays {
+        let simd = inc.distance.simd;
+        let position = V3::from_soa(simd, &hits.position);
+        let bump_lanes = inc.distance.splat(bump);
+        let mut lifted = 0;
+        if lift {
+            let mut triangles = 0u8;
+            for (i, kind) in hits.kind.iter().enumerate() {
+                triangles |= ((*kind == PrimitiveKind::Triangle) as u8) << i;
+            }
+            let facing = V3::from_soa(simd, &hits.geometric_normal).dot(inc.w_i).gt(bump_lanes.splat(0.0));
+            lifted = triangles & !mask_bits(facing);
+        }
+        ShadowRays {
+            origin: (position + inc.w_i.scale(bump_lanes)).to_soa(),
+            w_i: inc.w_i.to_soa(),
+            distance: inc.distance.into(),
+            t_max: (inc.distance - bump_lanes).into(),
+            bump,
+            lifted,
+        }
+    }
+
+    /// Lane `i`'s ray and far end, as `Incidence::shadow_ray` gives them
+    /// for surface `i` of `hits`.
+    #[inline]
+    fn get(&self, scene: &Scene, hits: &HitLanes, i: usize) -> (Ray, f32) {
+        let lane = |a: &[Floats; 3]| Vec3::new(a[0][i], a[1][i], a[2][i]);
+        if self.lifted & 1 << i != 0 {
+            // Only the direction and distance matter to `shadow_ray`.
+            let incidence = Incidence { w_i: lane(&self.w_i), distance: self.distance[i], incident: Vec3::ZERO, cos_theta: 0.0 };
+            return incidence.shadow_ray(scene, &hits.get(i), self.bump, true);
+        }
+        (Ray::new(lane(&self.origin), lane(&self.w_i)), self.t_max[i])
     }
 }
 

@@ -1,10 +1,15 @@
-//! `Scene::triangle_hit` for up to eight hits at once. A hit record costs
-//! two square roots and two divisions in a chain (the geometric normal,
-//! then the shading normal), which one hit at a time leaves the CPU
+//! Surface records for up to eight hits at once, in lanes (`HitLanes`:
+//! structure of arrays), as batches shade them. A triangle hit's record
+//! costs two square roots and two divisions in a chain (the geometric
+//! normal, then the shading normal), which one hit at a time leaves the CPU
 //! waiting on; here each step runs eight lanes wide (`math::lanes`), with
-//! the same operations in the same order as `triangle_hit`, so every lane's
-//! record is bit for bit the one `triangle_hit` builds.
+//! the same operations in the same order as `triangle_hit`, so every lane
+//! is bit for bit the record `triangle_hit` builds. The records stay in
+//! lanes for shading; `HitLanes::get` assembles one as a `SurfaceHit` where
+//! one-sample code needs it.
 
+use super::camera::CameraView;
+use super::triangles::CornerLanes;
 use super::{Differentials, PrimitiveKind, Scene, SurfaceHit, Triangle};
 use crate::math::lanes::{mask_bits, mask_from_bits, simd_level, Lane, V3};
 use crate::math::{Vec2, Vec3};
@@ -12,6 +17,9 @@ use fearless_simd::{dispatch, f32x8, Simd, SimdFrom};
 
 /// Most hits one call builds.
 pub const HIT_LANES: usize = 8;
+
+/// Eight floats, one per lane.
+pub type Floats = [f32; HIT_LANES];
 
 /// What a triangle hit's record is built from: the triangle, the
 /// barycentric weights of its corners, the ray's parameter and direction.
@@ -23,78 +31,218 @@ pub struct TriangleHitInput {
     pub dir: Vec3,
 }
 
+/// Eye samples that see a triangle, as a rasterizer's buffers hold them:
+/// the triangle, its barycentric weights b1 and b2 (b0 = 1 - b1 - b2) and
+/// the sample's image position, whose eye ray is worked out in lanes.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct EyeSamples {
+    pub len: usize,
+    pub index: [u32; HIT_LANES],
+    pub b1: Floats,
+    pub b2: Floats,
+    pub px: Floats,
+    pub py: Floats,
+}
+
+impl EyeSamples {
+    #[inline(always)]
+    pub fn push(&mut self, index: u32, b1: f32, b2: f32, p: Vec2) {
+        let k = self.len;
+        self.index[k] = index;
+        self.b1[k] = b1;
+        self.b2[k] = b2;
+        self.px[k] = p.x;
+        self.py[k] = p.y;
+        self.len += 1;
+    }
+}
+
+/// Up to eight `SurfaceHit`s, field by field (lane i of each array is hit
+/// i's), so that shading loads them as vectors.
+#[derive(Clone, Copy, Debug)]
+pub struct HitLanes {
+    pub position: [Floats; 3],
+    pub geometric_normal: [Floats; 3],
+    pub shading_normal: [Floats; 3],
+    pub barycentric: [Floats; 3],
+    pub uv: [Floats; 2],
+    pub t: Floats,
+    pub kind: [PrimitiveKind; HIT_LANES],
+    pub primitive: [u32; HIT_LANES],
+    pub object: [u32; HIT_LANES],
+    pub material: [u32; HIT_LANES],
+    /// Bit i: hit i is seen from the back.
+    pub back_face: u8,
+    pub diff: [Differentials; HIT_LANES],
+}
+
+impl Default for HitLanes {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl HitLanes {
+    /// Lanes that hold a tame placeholder (unit normals along z).
+    pub const fn new() -> HitLanes {
+        let zero = [0.0; HIT_LANES];
+        let one = [1.0; HIT_LANES];
+        HitLanes {
+            position: [zero; 3],
+            geometric_normal: [zero, zero, one],
+            shading_normal: [zero, zero, one],
+            barycentric: [zero; 3],
+            uv: [zero; 2],
+            t: zero,
+            kind: [PrimitiveKind::Triangle; HIT_LANES],
+            primitive: [0; HIT_LANES],
+            object: [0; HIT_LANES],
+            material: [0; HIT_LANES],
+            back_face: 0,
+            diff: [Differentials::ZERO; HIT_LANES],
+        }
+    }
+
+    /// Hit `i` as a record.
+    #[inline]
+    pub fn get(&self, i: usize) -> SurfaceHit {
+        let v3 = |a: &[Floats; 3]| Vec3::new(a[0][i], a[1][i], a[2][i]);
+        SurfaceHit {
+            position: v3(&self.position),
+            geometric_normal: v3(&self.geometric_normal),
+            shading_normal: v3(&self.shading_normal),
+            barycentric: v3(&self.barycentric),
+            uv: Vec2::new(self.uv[0][i], self.uv[1][i]),
+            t: self.t[i],
+            kind: self.kind[i],
+            primitive: self.primitive[i],
+            object: self.object[i],
+            material: self.material[i],
+            back_face: self.back_face & 1 << i != 0,
+            diff: self.diff[i],
+        }
+    }
+
+    /// Makes hit `i` the record `h`.
+    #[inline]
+    pub fn set(&mut self, i: usize, h: &SurfaceHit) {
+        let put = |a: &mut [Floats; 3], v: Vec3| {
+            a[0][i] = v.x;
+            a[1][i] = v.y;
+            a[2][i] = v.z;
+        };
+        put(&mut self.position, h.position);
+        put(&mut self.geometric_normal, h.geometric_normal);
+        put(&mut self.shading_normal, h.shading_normal);
+        put(&mut self.barycentric, h.barycentric);
+        self.uv[0][i] = h.uv.x;
+        self.uv[1][i] = h.uv.y;
+        self.t[i] = h.t;
+        self.kind[i] = h.kind;
+        self.primitive[i] = h.primitive;
+        self.object[i] = h.object;
+        self.material[i] = h.material;
+        self.back_face = (self.back_face & !(1 << i)) | (h.back_face as u8) << i;
+        self.diff[i] = h.diff;
+    }
+
+    /// Makes hit `i` hit `k` of `from`.
+    #[inline]
+    pub fn copy_lane(&mut self, i: usize, from: &HitLanes, k: usize) {
+        for a in 0..3 {
+            self.position[a][i] = from.position[a][k];
+            self.geometric_normal[a][i] = from.geometric_normal[a][k];
+            self.shading_normal[a][i] = from.shading_normal[a][k];
+            self.barycentric[a][i] = from.barycentric[a][k];
+        }
+        self.uv[0][i] = from.uv[0][k];
+        self.uv[1][i] = from.uv[1][k];
+        self.t[i] = from.t[k];
+        self.kind[i] = from.kind[k];
+        self.primitive[i] = from.primitive[k];
+        self.object[i] = from.object[k];
+        self.material[i] = from.material[k];
+        self.back_face = (self.back_face & !(1 << i)) | ((from.back_face >> k) & 1) << i;
+        self.diff[i] = from.diff[k];
+    }
+}
+
 impl Scene {
-    /// `triangle_hit` for each of `inputs` (at most `HIT_LANES`), handed to
-    /// `put` with its position in `inputs`.
-    pub fn triangle_hits(&self, inputs: &[TriangleHitInput], mut put: impl FnMut(usize, SurfaceHit)) {
+    /// `triangle_hit` for each of `inputs` (at most `HIT_LANES`), written to
+    /// the lane of `out` of its position in `inputs`; lanes past them hold
+    /// copies of lane 0.
+    pub fn triangle_hits(&self, inputs: &[TriangleHitInput], out: &mut HitLanes) {
         assert!(inputs.len() <= HIT_LANES);
         if inputs.is_empty() {
             return;
         }
-        dispatch!(simd_level(), simd => triangle_hits8(simd, self, inputs, &mut put));
-    }
-}
-
-/// The lanes' inputs, gathered from the scene (structure of arrays).
-struct Gathered {
-    v: [[Vec3; HIT_LANES]; 3],
-    n: [[Vec3; HIT_LANES]; 3],
-    /// The corners' texture coordinates, u and v apart.
-    u: [[f32; HIT_LANES]; 3],
-    v_coord: [[f32; HIT_LANES]; 3],
-    /// Bit i set when lane i's triangle is flat: its normals are the geometric one.
-    flat: u8,
-    b: [[f32; HIT_LANES]; 3],
-    dir: [Vec3; HIT_LANES],
-    material: [u32; HIT_LANES],
-    object: [u32; HIT_LANES],
-}
-
-impl Gathered {
-    /// Lanes past `inputs` repeat lane 0 (their results are dropped).
-    #[inline(always)]
-    fn new(scene: &Scene, inputs: &[TriangleHitInput]) -> Gathered {
-        let mut g = Gathered {
-            v: [[Vec3::ZERO; HIT_LANES]; 3],
-            n: [[Vec3::ZERO; HIT_LANES]; 3],
-            u: [[0.0; HIT_LANES]; 3],
-            v_coord: [[0.0; HIT_LANES]; 3],
-            flat: 0,
-            b: [[0.0; HIT_LANES]; 3],
-            dir: [Vec3::ZERO; HIT_LANES],
-            material: [0; HIT_LANES],
-            object: [0; HIT_LANES],
-        };
-        for lane in 0..HIT_LANES {
-            let input = if lane < inputs.len() { &inputs[lane] } else { &inputs[0] };
-            let (v, n, uv) = match scene.triangles.stored(input.index as usize) {
-                Some(s) => {
-                    g.flat |= (s.n.is_none() as u8) << lane;
-                    g.material[lane] = s.material;
-                    g.object[lane] = s.object;
-                    (s.v, s.n.unwrap_or([Vec3::ZERO; 3]), s.uv)
-                }
-                // A copy of the two-level layer, placed in world space.
-                None => {
-                    let tri: Triangle = scene.triangle(input.index);
-                    g.material[lane] = tri.material;
-                    g.object[lane] = tri.object;
-                    (tri.v, tri.n, tri.uv)
-                }
-            };
-            for k in 0..3 {
-                g.v[k][lane] = v[k];
-                g.n[k][lane] = n[k];
-                g.u[k][lane] = uv[k].x;
-                g.v_coord[k][lane] = uv[k].y;
-            }
-            g.b[0][lane] = input.b.x;
-            g.b[1][lane] = input.b.y;
-            g.b[2][lane] = input.b.z;
-            g.dir[lane] = input.dir;
+        let mut index = [inputs[0].index; HIT_LANES];
+        let (mut b1, mut b2, mut t) = ([inputs[0].b.y; HIT_LANES], [inputs[0].b.z; HIT_LANES], [inputs[0].t; HIT_LANES]);
+        let mut b0 = [inputs[0].b.x; HIT_LANES];
+        let mut dir = [[inputs[0].dir.x; HIT_LANES], [inputs[0].dir.y; HIT_LANES], [inputs[0].dir.z; HIT_LANES]];
+        for (k, input) in inputs.iter().enumerate() {
+            index[k] = input.index;
+            (b0[k], b1[k], b2[k], t[k]) = (input.b.x, input.b.y, input.b.z, input.t);
+            (dir[0][k], dir[1][k], dir[2][k]) = (input.dir.x, input.dir.y, input.dir.z);
         }
-        g
+        out.t = t;
+        dispatch!(simd_level(), simd => {
+            let w = [f32x8::simd_from(simd, b0), f32x8::simd_from(simd, b1), f32x8::simd_from(simd, b2)];
+            triangle_hits8(simd, self, &index, inputs.len(), w, V3::from_soa(simd, &dir), out);
+        });
     }
+
+    /// For each eye sample of `samples`, the record of where its eye ray
+    /// (`view.eye_ray`) meets its triangle, as `triangle_hit` builds it with
+    /// `t` the hit position's distance along the ray; written to the lane of
+    /// `out` of its position in `samples`, and the eye ray's directions to
+    /// `dirs`. Lanes past them hold copies of lane 0.
+    pub fn triangle_eye_hits(&self, view: &CameraView, samples: &EyeSamples, out: &mut HitLanes, dirs: &mut [Floats; 3]) {
+        let n = samples.len;
+        assert!(n <= HIT_LANES);
+        if n == 0 {
+            return;
+        }
+        let mut s = *samples;
+        for k in n..HIT_LANES {
+            (s.index[k], s.b1[k], s.b2[k], s.px[k], s.py[k]) = (s.index[0], s.b1[0], s.b2[0], s.px[0], s.py[0]);
+        }
+        dispatch!(simd_level(), simd => triangle_eye_hits8(simd, self, view, &s, out, dirs));
+    }
+}
+
+#[inline(always)]
+fn triangle_eye_hits8<S: Simd>(simd: S, scene: &Scene, view: &CameraView, s: &EyeSamples, out: &mut HitLanes, dirs: &mut [Floats; 3]) {
+    let (b1, b2) = (f32x8::simd_from(simd, s.b1), f32x8::simd_from(simd, s.b2));
+    // The rasterizers' weights, as `Vec3::new(1 - b1 - b2, b1, b2)`.
+    let w = [b1.splat(1.0) - b1 - b2, b1, b2];
+    let (origin, dir) = view.eye_ray_lanes(f32x8::simd_from(simd, s.px), f32x8::simd_from(simd, s.py));
+    let position = triangle_hits8(simd, scene, &s.index, s.len, w, dir, out);
+    // The eye ray's parameter at the hit: `(position - origin) . dir`.
+    out.t = (position - origin).dot(dir).into();
+    *dirs = dir.to_soa();
+}
+
+/// The corners of triangles `index` in lanes; lanes at or past `n` repeat
+/// lane 0 (their results are dropped).
+#[inline(always)]
+fn gather_corners(scene: &Scene, index: &[u32; HIT_LANES], n: usize) -> CornerLanes {
+    let mut c = CornerLanes::default();
+    for lane in 0..HIT_LANES {
+        let i = if lane < n { index[lane] } else { index[0] };
+        if !scene.triangles.write_lane(i as usize, lane, &mut c) {
+            // A copy of the two-level layer, placed in world space.
+            let tri: Triangle = scene.triangle(i);
+            c.material[lane] = tri.material;
+            c.object[lane] = tri.object;
+            for k in 0..3 {
+                (c.v[k][0][lane], c.v[k][1][lane], c.v[k][2][lane]) = (tri.v[k].x, tri.v[k].y, tri.v[k].z);
+                (c.n[k][0][lane], c.n[k][1][lane], c.n[k][2][lane]) = (tri.n[k].x, tri.n[k].y, tri.n[k].z);
+                (c.uv[k][0][lane], c.uv[k][1][lane]) = (tri.uv[k].x, tri.uv[k].y);
+            }
+        }
+    }
+    c
 }
 
 /// `a b0 + b b1 + c b2`, as `hit_on` interpolates.
@@ -103,46 +251,42 @@ fn interpolate<L: Lane>(a: V3<L>, b: V3<L>, c: V3<L>, w: &[L; 3]) -> V3<L> {
     a.scale(w[0]) + b.scale(w[1]) + c.scale(w[2])
 }
 
+/// Builds every field of `out` but `t` for triangles `index` (lanes at or
+/// past `n` repeat lane 0) hit with weights `w` by rays along `dir`;
+/// returns the hit positions.
 // No closures or `array::map` below: they would be compiled apart from
 // this function, without the SIMD level `dispatch` compiles it for.
 #[inline(always)]
-fn triangle_hits8<S: Simd>(simd: S, scene: &Scene, inputs: &[TriangleHitInput], put: &mut impl FnMut(usize, SurfaceHit)) {
-    let g = Gathered::new(scene, inputs);
-    let w = [f32x8::simd_from(simd, g.b[0]), f32x8::simd_from(simd, g.b[1]), f32x8::simd_from(simd, g.b[2])];
-    let (v0, v1, v2) = (V3::gather(simd, &g.v[0]), V3::gather(simd, &g.v[1]), V3::gather(simd, &g.v[2]));
+fn triangle_hits8<S: Simd>(simd: S, scene: &Scene, index: &[u32; HIT_LANES], n: usize, w: [f32x8<S>; 3], dir: V3<f32x8<S>>, out: &mut HitLanes) -> V3<f32x8<S>> {
+    let c = gather_corners(scene, index, n);
+    let (v0, v1, v2) = (V3::from_soa(simd, &c.v[0]), V3::from_soa(simd, &c.v[1]), V3::from_soa(simd, &c.v[2]));
     // `Triangle::geometric_normal`, then `hit_on`'s steps in order.
     let geometric = (v1 - v0).cross(v2 - v0).normalize();
-    let flat = mask_from_bits(simd, g.flat);
-    let n0 = V3::select(flat, geometric, V3::gather(simd, &g.n[0]));
-    let n1 = V3::select(flat, geometric, V3::gather(simd, &g.n[1]));
-    let n2 = V3::select(flat, geometric, V3::gather(simd, &g.n[2]));
+    let flat = mask_from_bits(simd, c.flat);
+    let n0 = V3::select(flat, geometric, V3::from_soa(simd, &c.n[0]));
+    let n1 = V3::select(flat, geometric, V3::from_soa(simd, &c.n[1]));
+    let n2 = V3::select(flat, geometric, V3::from_soa(simd, &c.n[2]));
     let shading = interpolate(n0, n1, n2, &w).normalize_or(geometric);
-    let back = geometric.dot(V3::gather(simd, &g.dir)).gt(w[0].splat(0.0));
-    let geometric = V3::select(back, -geometric, geometric).scatter();
-    let shading = V3::select(back, -shading, shading).scatter();
-    let position = interpolate(v0, v1, v2, &w).scatter();
-    let u: [f32; HIT_LANES] = (f32x8::simd_from(simd, g.u[0]) * w[0] + f32x8::simd_from(simd, g.u[1]) * w[1] + f32x8::simd_from(simd, g.u[2]) * w[2]).into();
-    let v: [f32; HIT_LANES] = (f32x8::simd_from(simd, g.v_coord[0]) * w[0] + f32x8::simd_from(simd, g.v_coord[1]) * w[1] + f32x8::simd_from(simd, g.v_coord[2]) * w[2]).into();
-    let back = mask_bits(back);
-    for (lane, input) in inputs.iter().enumerate() {
-        put(
-            lane,
-            SurfaceHit {
-                position: position[lane],
-                geometric_normal: geometric[lane],
-                shading_normal: shading[lane],
-                barycentric: input.b,
-                uv: Vec2::new(u[lane], v[lane]),
-                t: input.t,
-                kind: PrimitiveKind::Triangle,
-                primitive: input.index,
-                object: g.object[lane],
-                material: g.material[lane],
-                back_face: back & 1 << lane != 0,
-                diff: Differentials::ZERO,
-            },
-        );
+    let back = geometric.dot(dir).gt(w[0].splat(0.0));
+    out.geometric_normal = V3::select(back, -geometric, geometric).to_soa();
+    out.shading_normal = V3::select(back, -shading, shading).to_soa();
+    let position = interpolate(v0, v1, v2, &w);
+    out.position = position.to_soa();
+    out.barycentric = [w[0].into(), w[1].into(), w[2].into()];
+    for a in 0..2 {
+        let (uv0, uv1, uv2) = (f32x8::simd_from(simd, c.uv[0][a]), f32x8::simd_from(simd, c.uv[1][a]), f32x8::simd_from(simd, c.uv[2][a]));
+        out.uv[a] = (uv0 * w[0] + uv1 * w[1] + uv2 * w[2]).into();
     }
+    out.kind = [PrimitiveKind::Triangle; HIT_LANES];
+    out.primitive = *index;
+    for lane in n..HIT_LANES {
+        out.primitive[lane] = index[0];
+    }
+    out.object = c.object;
+    out.material = c.material;
+    out.back_face = mask_bits(back);
+    out.diff = [Differentials::ZERO; HIT_LANES];
+    position
 }
 
 #[cfg(test)]
@@ -189,17 +333,60 @@ mod tests {
                         TriangleHitInput { index, b: Vec3::new(1.0 - b1 - b2, b1, b2), t: next(&mut state) * 10.0, dir: if c % 2 == 0 { dir } else { -dir } }
                     })
                     .collect();
-                let mut got = vec![None; inputs.len()];
-                scene.triangle_hits(&inputs, |lane, hit| got[lane] = Some(hit));
-                for (input, hit) in inputs.iter().zip(&got) {
+                let mut got = HitLanes::new();
+                scene.triangle_hits(&inputs, &mut got);
+                for (lane, input) in inputs.iter().enumerate() {
                     let ray = Ray::new(Vec3::ZERO, input.dir);
                     let expected = scene.triangle_hit(input.index, input.b, input.t, &ray);
-                    assert_eq!(key(hit.as_ref().unwrap()), key(&expected), "{name}: triangle {}", input.index);
+                    assert_eq!(key(&got.get(lane)), key(&expected), "{name}: triangle {}", input.index);
                     compared += 1;
                     layer_compared += (input.index as usize >= scene.triangles.len()) as usize;
                 }
             }
         }
         assert!(compared > 10_000 && layer_compared > 100, "{compared} records compared, {layer_compared} of layer copies");
+    }
+
+    /// A rasterizer's eye samples built in lanes give, bit for bit, the
+    /// record a one-sample replay builds: the eye ray of `eye_ray`, `t` the
+    /// hit position's distance along it (`VisBuffer::triangle_b_t`), then
+    /// `triangle_hit`; and the eye rays' directions.
+    #[test]
+    fn eye_samples_in_lanes_are_the_replays_records() {
+        let key = |h: &SurfaceHit| {
+            let v = [h.position, h.geometric_normal, h.shading_normal, h.barycentric];
+            (v.map(|v| v.to_array().map(f32::to_bits)), h.uv.to_array().map(f32::to_bits), h.t.to_bits(), h.primitive, h.object, h.material, h.back_face)
+        };
+        let mut compared = 0;
+        let mut state = 11u64;
+        for name in builtin::names().into_iter().chain(["forest-100"]) {
+            let scene = builtin::load_builtin(name).unwrap().unwrap();
+            let total = scene.triangles.len() + scene.layer.as_ref().map_or(0, |l| l.triangle_count().min(20_000) as usize);
+            let view = scene.camera.view(97, 61);
+            let step = (total / 1000).max(1);
+            let indices: Vec<u32> = (0..total).step_by(step).map(|i| i as u32).collect();
+            for chunk in indices.chunks(1 + compared % HIT_LANES) {
+                let mut samples = EyeSamples::default();
+                for &index in chunk {
+                    // Weights with full mantissas, as interpolation makes them
+                    // (sums and differences of them round).
+                    let (b1, b2) = (next(&mut state).powi(3) * 0.6, next(&mut state) * 0.3 + 0.0123);
+                    samples.push(index, b1, b2, Vec2::new(next(&mut state) * 97.0, next(&mut state) * 61.0));
+                }
+                let (mut got, mut dirs) = (HitLanes::new(), [[0.0; HIT_LANES]; 3]);
+                scene.triangle_eye_hits(&view, &samples, &mut got, &mut dirs);
+                for k in 0..chunk.len() {
+                    let ray = view.eye_ray(samples.px[k], samples.py[k]);
+                    let b = Vec3::new(1.0 - samples.b1[k] - samples.b2[k], samples.b1[k], samples.b2[k]);
+                    let v = scene.triangle_positions(samples.index[k]);
+                    let t = (v[0] * b.x + v[1] * b.y + v[2] * b.z - ray.origin).dot(ray.dir);
+                    let expected = scene.triangle_hit(samples.index[k], b, t, &ray);
+                    assert_eq!(key(&got.get(k)), key(&expected), "{name}: triangle {}", samples.index[k]);
+                    assert_eq!([dirs[0][k], dirs[1][k], dirs[2][k]].map(f32::to_bits), ray.dir.to_array().map(f32::to_bits));
+                    compared += 1;
+                }
+            }
+        }
+        assert!(compared > 3000, "only {compared} records compared");
     }
 }

@@ -49,6 +49,20 @@ const TWO_SIDED_BIT: u32 = 1 << 31;
 const FLAT_BIT: u32 = 1 << 30;
 const FLAG_BITS: u32 = TWO_SIDED_BIT | FLAT_BIT;
 
+/// The corners of up to eight triangles in lanes, `[corner][axis][lane]`
+/// (`Triangles::write_lane`).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct CornerLanes {
+    pub v: [[[f32; 8]; 3]; 3],
+    /// Shading normals; not written for flat triangles.
+    pub n: [[[f32; 8]; 3]; 3],
+    pub uv: [[[f32; 8]; 2]; 3],
+    /// Bit i set when lane i's triangle is flat: its normals are the geometric one.
+    pub flat: u8,
+    pub material: [u32; 8],
+    pub object: [u32; 8],
+}
+
 /// A triangle's attributes as the store keeps them (`Triangles::stored`).
 #[derive(Clone, Copy, Debug)]
 pub struct StoredTriangle {
@@ -144,6 +158,27 @@ impl Triangles {
             material: f.material,
             object: f.object_and_flags & !FLAG_BITS,
         }
+    }
+
+    /// Writes stored triangle `i` into lane `lane` of `out` (code that
+    /// builds several hits at once); `false` past the end. A flat
+    /// triangle's normals are left as they were, its lane marked flat.
+    #[inline(always)]
+    pub fn write_lane(&self, i: usize, lane: usize, out: &mut CornerLanes) -> bool {
+        let Some(f) = self.faces.get(i) else { return false };
+        let flat = f.object_and_flags & FLAT_BIT != 0;
+        for (k, &c) in f.corner.iter().enumerate() {
+            let c = &self.corners[c as usize];
+            (out.v[k][0][lane], out.v[k][1][lane], out.v[k][2][lane]) = (c.position.x, c.position.y, c.position.z);
+            if !flat {
+                (out.n[k][0][lane], out.n[k][1][lane], out.n[k][2][lane]) = (c.normal.x, c.normal.y, c.normal.z);
+            }
+            (out.uv[k][0][lane], out.uv[k][1][lane]) = (c.uv.x, c.uv.y);
+        }
+        out.flat = (out.flat & !(1 << lane)) | (flat as u8) << lane;
+        out.material[lane] = f.material;
+        out.object[lane] = f.object_and_flags & !FLAG_BITS;
+        true
     }
 
     /// Where triangle `i`'s record lies in memory, for prefetching (its

@@ -599,32 +599,37 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         let scene = &self.job.prepared.scene;
         // A triangle seen without textures (the common case) has its hit
         // built in the batch (eight at a time), not returned and copied.
-        let plain = !scene.has_textures();
+        // Its eye ray's parameter comes from the hit's position, as
+        // `triangle_b_t` works it out from -1/z keys; ray-parameter keys are
+        // that parameter itself, and go through `eye_hit`.
+        let plain = !scene.has_textures() && self.key == DepthKey::NegInvZ;
         // What an empty pixel shows when no ray is needed for it (most of a
         // frame): `resolve`'s answer there without its per-pixel checks.
         let background = miss_without_ray(self.job);
+        // No pixel is recorded or left out by this pass: `ordinary` below
+        // holds everywhere, without its per-pixel lookups.
+        let all_ordinary = !R::ENABLED && self.job.active.is_none();
+        // Counted here, added once at the end (`resolve` counts its own).
+        let (mut primary, mut shaded) = (0u64, 0u64);
         let mut i = 0;
         for (row, y) in (r.y0..r.y1).enumerate() {
             let line = row * out_stride + x_offset;
             for (col, x) in (r.x0..r.x1).enumerate() {
                 let slot = line + col;
-                let empty = self.id[i].is_none();
+                let id = self.id[i];
                 // Neither the recorded pixel nor one this pass leaves out.
-                let ordinary = !self.is_focus(x, y) && self.job.is_active(x, y);
-                if let (true, Some(value)) = (empty && ordinary, background) {
-                    self.counts.primary += 1;
+                let ordinary = all_ordinary || (!self.is_focus(x, y) && self.job.is_active(x, y));
+                if let (true, Some(value)) = (id.is_none() && ordinary, background) {
+                    primary += 1;
                     out[slot] = value;
-                } else if empty || !ordinary {
+                } else if id.is_none() || !ordinary {
                     out[slot] = self.resolve(i, x, y);
                 } else {
-                    self.counts.primary += 1;
-                    self.counts.fragments_shaded += 1;
-                    let id = self.id[i];
+                    primary += 1;
+                    shaded += 1;
                     if plain && id.kind() == crate::scene::PrimitiveKind::Triangle {
-                        let p = self.job.sample_position(x, y);
-                        let ray = self.job.view.eye_ray(p.x, p.y);
-                        let (b, t) = self.triangle_b_t(i, &ray);
-                        batch.push_triangle(id.index(), b, t, &ray, self.job.pixel_index(x, y), slot);
+                        let [b1, b2] = self.payload[i];
+                        batch.push_eye_triangle(id.index(), (b1, b2), self.job.sample_position(x, y), self.job.pixel_index(x, y), slot);
                         if batch.is_full() {
                             self.shade_batch_into(&mut batch, out);
                         }
@@ -645,6 +650,8 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             }
         }
         self.shade_batch_into(&mut batch, out);
+        self.counts.primary += primary;
+        self.counts.fragments_shaded += shaded;
         std::mem::take(&mut self.counts)
     }
 
@@ -653,7 +660,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         if batch.is_empty() {
             return;
         }
-        batch.build_pending(&self.job.prepared.scene, self.job.settings.interpolation);
+        batch.build_pending(&self.job.prepared.scene, self.job.view, self.job.settings.interpolation);
         let values = shade_batch::shade_batch(self.job, self.query, batch, None, &mut self.counts);
         for (j, value) in values.iter().enumerate().take(batch.len()) {
             out[batch.slots[j]] = *value;

@@ -25,11 +25,10 @@ use super::traverse::{slab_test8, test_leaf, BestHit, ChildOrder, SLAB_WIDEN};
 use crate::math::lanes::{mask_bits, mask_from_bits, simd_level, V3};
 use crate::math::{Radiance, Ray};
 use crate::render::debug::View;
-use crate::render::shade::cast_shadow_ray;
 use crate::render::pixel_record::NoRecord;
 use crate::render::shade_batch::{self, Batch};
-use crate::render::{miss_without_ray, resolve_sample, with_shading_hit, Occluder, PassJob, RayCounts, ShadowMode};
-use crate::scene::hit_lanes::{TriangleHitInput, HIT_LANES};
+use crate::render::{miss_without_ray, resolve_sample, Occluder, PassJob, RayCounts, ShadowMode};
+use crate::scene::hit_lanes::{HitLanes, TriangleHitInput, HIT_LANES};
 use crate::scene::{PrimitiveId, PrimitiveKind, Sphere, SurfaceHit};
 use fearless_simd::{dispatch, f32x8, mask32x8, Select, Simd, SimdBase, SimdFloat, SimdFrom};
 use glam::Vec3;
@@ -177,8 +176,12 @@ impl Packet {
         let mut inputs = [TriangleHitInput::default(); HIT_LANES];
         let mut lanes = [0usize; HIT_LANES];
         let mut n = 0;
-        let build = |inputs: &[TriangleHitInput], lanes: &[usize], out: &mut [Option<SurfaceHit>; P]| {
-            scene.triangle_hits(inputs, |k, hit| out[lanes[k]] = Some(hit));
+        let mut built = HitLanes::new();
+        let mut build = |inputs: &[TriangleHitInput], lanes: &[usize], out: &mut [Option<SurfaceHit>; P]| {
+            scene.triangle_hits(inputs, &mut built);
+            for (k, &lane) in lanes.iter().enumerate() {
+                out[lane] = Some(built.get(k));
+            }
         };
         let mut m = valid;
         while m != 0 {
@@ -520,13 +523,14 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
                 batch: vec![0; scene.lights.len()],
                 textured: scene.has_textures(),
                 background: miss_without_ray(job),
+                batches: (0..P / shade_batch::LANES).map(|_| Batch::new()).collect(),
             };
             for x0 in (0..width).step_by(TILE_W) {
                 let valid = eye_rays_into(job, &mut pk, (x0, y0), width, rows);
                 counts.primary += valid.count_ones() as u64;
                 query.closest_packet(&mut pk, valid, &mut counts);
                 if batched {
-                    shade_tile_batched(job, query, &pk, valid, &mut shadow_pk, &mut context, &mut hits, band, (x0, y0), width, &mut counts);
+                    shade_tile_batched(job, query, &pk, valid, &mut shadow_pk, &mut context, band, (x0, y0), width, &mut counts);
                     continue;
                 }
                 pk.hits_into(query, valid, &mut hits);
@@ -601,12 +605,15 @@ struct TileContext {
     /// What a sample that sees nothing shows, when no ray is needed for it
     /// (`miss_without_ray`).
     background: Option<Radiance>,
+    /// The tile's surfaces in batches of eight, in lane order.
+    batches: Vec<Batch>,
 }
 
-/// Shades one traced tile in batches of eight (`shade_batch`): first the
-/// tile's shadow rays towards every light go as one packet per light, then
-/// the lanes that see a surface are shaded eight at a time, each light's
-/// visibility read from its packet.
+/// Shades one traced tile in batches of eight (`shade_batch`): the lanes
+/// that see a surface are put into batches in lane order (a triangle's
+/// record built in its batch, eight at a time), then the tile's shadow rays
+/// towards every light go as one packet per light, then the batches are
+/// shaded, each light's visibility read from its packet.
 #[allow(clippy::too_many_arguments)]
 fn shade_tile_batched(
     job: &PassJob,
@@ -615,43 +622,60 @@ fn shade_tile_batched(
     valid: u64,
     shadow_pk: &mut Packet,
     context: &mut TileContext,
-    hits: &mut [Option<SurfaceHit>; P],
     band: &mut [Radiance],
     (x0, y0): (usize, usize),
     width: usize,
     counts: &mut RayCounts,
 ) {
-    let TileContext { tile: blocked, batch: lane_blocked, textured, background } = context;
+    let TileContext { tile: blocked, batch: lane_blocked, textured, background, batches } = context;
     let scene = &query.prepared.scene;
     let settings = job.settings;
-    let mut seen = 0u64;
-    pk.hits_into(query, valid, hits);
+    let mut filled = 0;
     let mut m = valid;
     while m != 0 {
         let i = m.trailing_zeros() as usize;
         m &= m - 1;
-        if *textured {
-            let (tx, ty) = lane_xy(i);
-            let p = job.sample_position((x0 + tx) as u32, (y0 + ty) as u32);
-            with_eye_differentials(job, p, &pk.rays[i], &mut hits[i]);
+        let (tx, ty) = lane_xy(i);
+        let (x, y) = ((x0 + tx) as u32, (y0 + ty) as u32);
+        let pixel = job.pixel_index(x, y);
+        let id = pk.best_id[i];
+        if id.is_none() {
+            band[ty * width + x0 + tx] = match background {
+                Some(value) => *value,
+                None => resolve_sample(job, query, &pk.rays[i], None, pixel, counts, &mut NoRecord),
+            };
+            continue;
         }
-        seen |= (hits[i].is_some() as u64) << i;
+        let batch = &mut batches[filled / shade_batch::LANES];
+        if id.kind() == PrimitiveKind::Triangle && !*textured {
+            let (b1, b2) = pk.bary[i];
+            let input = TriangleHitInput { index: id.index(), b: Vec3::new(1.0 - b1 - b2, b1, b2), t: pk.best_t.0[i], dir: pk.rays[i].dir };
+            batch.push_ray_triangle(input, pixel, i);
+        } else {
+            let mut hit = pk.hit(query, i);
+            if *textured {
+                with_eye_differentials(job, job.sample_position(x, y), &pk.rays[i], &mut hit);
+            }
+            let hit = hit.expect("a lane with an id has a hit");
+            batch.push(settings.interpolation, &hit, pk.rays[i].dir, pixel, i);
+        }
+        filled += 1;
+    }
+    let batches = &mut batches[..filled.div_ceil(shade_batch::LANES)];
+    for batch in batches.iter_mut() {
+        batch.build_pending(scene, job.view, settings.interpolation);
     }
     let shadows = settings.shadows == ShadowMode::Ray;
     if shadows {
         for (k, light) in scene.lights.iter().enumerate() {
             let mut cast = 0u64;
-            let mut m = seen;
-            while m != 0 {
-                let i = m.trailing_zeros() as usize;
-                m &= m - 1;
-                let Some(h) = &hits[i] else { continue };
-                let shadow_ray = with_shading_hit(settings.interpolation, h, |h| cast_shadow_ray(scene, h, light, settings.shadow_bump, settings.terminator_lift));
-                if let Some((ray, t_max)) = shadow_ray.flatten() {
+            for batch in batches.iter() {
+                batch.shadow_rays(scene, light, settings.shadow_bump, settings.terminator_lift, |j, ray, t_max| {
+                    let i = batch.slots[j];
                     shadow_pk.rays[i] = ray;
                     shadow_pk.t_max[i] = t_max;
                     cast |= 1 << i;
-                }
+                });
             }
             blocked[k] = 0;
             if cast != 0 {
@@ -665,46 +689,17 @@ fn shade_tile_batched(
             }
         }
     }
-    let write = |band: &mut [Radiance], i: usize, value: Radiance| {
-        let (tx, ty) = lane_xy(i);
-        band[ty * width + x0 + tx] = value;
-    };
-    let mut batch = Batch::new();
-    let mut flush = |batch: &mut Batch, band: &mut [Radiance], counts: &mut RayCounts| {
-        if batch.is_empty() {
-            return;
-        }
+    for batch in batches.iter_mut() {
         for (k, bits) in lane_blocked.iter_mut().enumerate() {
             *bits = (0..batch.len()).fold(0u8, |acc, j| acc | (((blocked[k] >> batch.slots[j]) & 1) as u8) << j);
         }
         let values = shade_batch::shade_batch(job, query, batch, shadows.then_some(&lane_blocked[..]), counts);
         for j in 0..batch.len() {
-            write(band, batch.slots[j], values[j]);
+            let (tx, ty) = lane_xy(batch.slots[j]);
+            band[ty * width + x0 + tx] = values[j];
         }
         batch.clear();
-    };
-    let mut m = valid;
-    while m != 0 {
-        let i = m.trailing_zeros() as usize;
-        m &= m - 1;
-        let (tx, ty) = lane_xy(i);
-        let pixel = job.pixel_index((x0 + tx) as u32, (y0 + ty) as u32);
-        match &hits[i] {
-            Some(h) => {
-                batch.push(settings.interpolation, h, pk.rays[i].dir, pixel, i);
-                if batch.is_full() {
-                    flush(&mut batch, band, counts);
-                }
-            }
-            None => {
-                band[ty * width + x0 + tx] = match background {
-                    Some(value) => *value,
-                    None => resolve_sample(job, query, &pk.rays[i], None, pixel, counts, &mut NoRecord),
-                }
-            }
-        }
     }
-    flush(&mut batch, band, counts);
 }
 
 #[cfg(test)]
@@ -712,7 +707,7 @@ mod tests {
     use super::*;
     use crate::math::Vec2;
     use crate::render::pixel_record::NoRecord;
-    use crate::render::{Interpolation, PreparedScene, SceneQuery};
+    use crate::render::{with_shading_hit, Interpolation, PreparedScene, SceneQuery};
     use crate::scene::builtin;
 
     /// Every lane's hit is bit for bit the single-ray hit, on every builtin
@@ -754,9 +749,11 @@ mod tests {
         }
     }
 
-    /// The shadow ray the pre-pass traces is, bit for bit, the one `shade()`
-    /// then asks for, so the packet's answer is used (were they to differ,
-    /// the frame would still be right, only slower: no image test sees it).
+    /// The shadow ray the pre-pass traces (`Batch::shadow_rays`, eight
+    /// lanes at a time) is, bit for bit, the one `shade()` then asks for, so
+    /// the packet's answer is used (were they to differ, the frame would
+    /// still be right, only slower: no image test sees it). With and without
+    /// the terminator lift, whose lanes are worked out one at a time.
     #[test]
     fn the_pre_pass_traces_the_shadow_ray_shade_casts() {
         use crate::render::shade::shade;
@@ -764,30 +761,50 @@ mod tests {
         use crate::render::RenderSettings;
         let bits = |(r, t): (Ray, f32)| (r.origin.to_array().map(f32::to_bits), r.dir.to_array().map(f32::to_bits), t.to_bits());
         let mut compared = 0;
+        let mut lifted = 0;
         for name in builtin::names() {
             let prepared = PreparedScene::new(builtin::load_builtin(name).unwrap().unwrap());
             let Some(light) = prepared.scene.lights.first() else { continue };
             let query = BvhQuery::new(&prepared);
-            let (w, h) = (23u32, 17u32);
+            let (w, h) = (47u32, 35u32);
             let view = prepared.scene.camera.view(w, h);
-            for interpolation in [Interpolation::Phong, Interpolation::Flat] {
-                let settings = RenderSettings { interpolation, shadows: ShadowMode::Ray, ..RenderSettings::for_scene(&prepared.scene) };
+            for (interpolation, lift) in [(Interpolation::Phong, true), (Interpolation::Flat, true), (Interpolation::Phong, false)] {
+                let settings = RenderSettings { interpolation, shadows: ShadowMode::Ray, terminator_lift: lift, ..RenderSettings::for_scene(&prepared.scene) };
+                let mut batch = Batch::new();
+                let mut expected = Vec::new();
+                let mut check = |batch: &mut Batch, expected: &mut Vec<Option<(Ray, f32)>>| {
+                    let mut got = [None; shade_batch::LANES];
+                    batch.shadow_rays(&prepared.scene, light, settings.shadow_bump, settings.terminator_lift, |j, ray, t_max| got[j] = Some((ray, t_max)));
+                    for (j, e) in expected.iter().enumerate() {
+                        assert_eq!(got[j].map(bits), e.map(bits), "{name} {interpolation:?} lift {lift} lane {j}");
+                        compared += e.is_some() as u32;
+                        if let Some((ray, _)) = e {
+                            let hit = batch.hit(j);
+                            lifted += (ray.origin != hit.position + ray.dir * settings.shadow_bump) as u32;
+                        }
+                    }
+                    batch.clear();
+                    expected.clear();
+                };
                 for (x, y) in (0..w).flat_map(|x| (0..h).map(move |y| (x, y))) {
                     let ray = view.eye_ray(x as f32 + 0.5, y as f32 + 0.5);
                     let Some(hit) = query.closest(&ray, view.far_t(x as f32 + 0.5, y as f32 + 0.5), false, &mut RayCounts::default(), &mut NoRecord) else { continue };
-                    let expected = with_shading_hit(interpolation, &hit, |h| cast_shadow_ray(&prepared.scene, h, light, settings.shadow_bump, settings.terminator_lift)).flatten();
                     let mut trace = PixelTrace::new();
                     with_shading_hit(interpolation, &hit, |h| {
                         let mut path = crate::render::gi::PathState::new(0, 0, 1, &settings.gi, None);
                         let mut sh = crate::render::shade::Shading { scene: &prepared.scene, query: &query, settings: &settings, path: &mut path, counts: &mut RayCounts::default(), rec: &mut trace };
                         shade(&mut sh, h, -ray.dir, 0)
                     });
-                    let cast = trace.lights.iter().find(|l| l.light == 0).and_then(|l| l.shadow_ray);
-                    assert_eq!(expected.map(bits), cast.map(bits), "{name} {interpolation:?} pixel ({x}, {y})");
-                    compared += expected.is_some() as u32;
+                    expected.push(trace.lights.iter().find(|l| l.light == 0).and_then(|l| l.shadow_ray));
+                    batch.push(interpolation, &hit, ray.dir, 0, 0);
+                    if batch.is_full() {
+                        check(&mut batch, &mut expected);
+                    }
                 }
+                check(&mut batch, &mut expected);
             }
         }
+        assert!(lifted > 0, "no lifted origin compared");
         assert!(compared > 1000, "only {compared} shadow rays compared");
     }
 }
