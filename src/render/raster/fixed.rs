@@ -160,7 +160,21 @@ pub fn snap_triangles(tris: &[ScreenTri], sample_off: Vec2, width: u32, height: 
 /// Visits the covered samples of `ft` inside `rect`, stepping the integer edge
 /// functions by additions, with their screen-space weights.
 #[inline]
-pub fn raster<C: TestCounter, F: FnMut(u32, u32, [f32; 3])>(ft: &FixedTri, rect: PixelRect, off: [i64; 2], tested: &mut C, emit: F) {
+pub fn raster<C: TestCounter, F: FnMut(u32, u32, [f32; 3])>(ft: &FixedTri, rect: PixelRect, off: [i64; 2], tested: &mut C, mut emit: F) {
+    raster_rows(ft, rect, off, tested, |x0, y, bits| {
+        let mut m = bits;
+        while m != 0 {
+            let x = x0 + m.trailing_zeros();
+            m &= m - 1;
+            emit(x, y, ft.weights(x, y));
+        }
+    });
+}
+
+/// `raster` a row at a time: for each run of up to eight pixels of a row,
+/// the first pixel `(x0, y)` and its covered samples as bits (bit k: pixel
+/// `x0 + k`), in the same order. For code that takes a row of samples at once.
+pub fn raster_rows<C: TestCounter, F: FnMut(u32, u32, u8)>(ft: &FixedTri, rect: PixelRect, off: [i64; 2], tested: &mut C, emit: F) {
     if ft.wide {
         raster_in::<i128, C, F>(ft, rect, off, tested, emit)
     } else {
@@ -169,7 +183,7 @@ pub fn raster<C: TestCounter, F: FnMut(u32, u32, [f32; 3])>(ft: &FixedTri, rect:
 }
 
 #[inline(always)]
-fn raster_in<T: EdgeInt, C: TestCounter, F: FnMut(u32, u32, [f32; 3])>(ft: &FixedTri, rect: PixelRect, off: [i64; 2], tested: &mut C, mut emit: F) {
+fn raster_in<T: EdgeInt, C: TestCounter, F: FnMut(u32, u32, u8)>(ft: &FixedTri, rect: PixelRect, off: [i64; 2], tested: &mut C, mut emit: F) {
     let Some(r) = tested_rect(&ft.bbox, &rect, tested) else {
         return;
     };
@@ -179,13 +193,22 @@ fn raster_in<T: EdgeInt, C: TestCounter, F: FnMut(u32, u32, [f32; 3])>(ft: &Fixe
     let mut row: [T; 3] = ft.edges_at_pixel(r.x0, r.y0, off);
     for y in r.y0..r.y1 {
         let mut e = row;
-        for x in r.x0..r.x1 {
-            if e[0] >= bias[0] && e[1] >= bias[1] && e[2] >= bias[2] {
-                emit(x, y, ft.weights(x, y));
+        let mut x0 = r.x0;
+        while x0 < r.x1 {
+            let n = (r.x1 - x0).min(8);
+            let mut bits = 0u8;
+            for k in 0..n {
+                if e[0] >= bias[0] && e[1] >= bias[1] && e[2] >= bias[2] {
+                    bits |= 1 << k;
+                }
+                e[0] = e[0] + step_x[0];
+                e[1] = e[1] + step_x[1];
+                e[2] = e[2] + step_x[2];
             }
-            e[0] = e[0] + step_x[0];
-            e[1] = e[1] + step_x[1];
-            e[2] = e[2] + step_x[2];
+            if bits != 0 {
+                emit(x0, y, bits);
+            }
+            x0 += n;
         }
         row[0] = row[0] + step_y[0];
         row[1] = row[1] + step_y[1];

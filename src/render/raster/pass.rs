@@ -176,7 +176,7 @@ impl<'a> Layer<'a> {
                     if ft.ray {
                         small::ray_test(vb, ft, rect, &mut tested);
                     } else {
-                        fixed::raster(ft, rect, *off, &mut tested, |x, y, l| vb.triangle_fragment(&ft.st, x, y, l));
+                        fixed::raster_rows(ft, rect, *off, &mut tested, |x0, y, bits| vb.triangle_row(ft, x0, y, bits));
                     }
                 }
                 vb.end_tests(tested);
@@ -190,12 +190,12 @@ impl<'a> Layer<'a> {
                 for (j, &(i, _)) in bin.iter().enumerate() {
                     let ft = &fts[i as usize];
                     if ft.ray {
-                        tiled::tile_fragments(fts, &bin[start..j], rect, *off, &mut tested, |ft, x, y, l| vb.triangle_fragment(&ft.st, x, y, l));
+                        tiled::tile_fragment_rows(fts, &bin[start..j], rect, *off, &mut tested, |ft, x0, y, bits| vb.triangle_row(ft, x0, y, bits));
                         small::ray_test(vb, ft, rect, &mut tested);
                         start = j + 1;
                     }
                 }
-                tiled::tile_fragments(fts, &bin[start..], rect, *off, &mut tested, |ft, x, y, l| vb.triangle_fragment(&ft.st, x, y, l));
+                tiled::tile_fragment_rows(fts, &bin[start..], rect, *off, &mut tested, |ft, x0, y, bits| vb.triangle_row(ft, x0, y, bits));
                 vb.end_tests(tested);
             }
             Geometry::Painted { fts, off, order, bins } => {

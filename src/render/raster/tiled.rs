@@ -115,6 +115,29 @@ pub fn tile_fragments<F: FnMut(&FixedTri, u32, u32, [f32; 3])>(
     tested: &mut impl TestCounter,
     mut emit: F,
 ) {
+    tile_fragment_rows(tris, bin, tile, off, tested, |ft, x0, y, bits| {
+        let mut m = bits;
+        while m != 0 {
+            let x = x0 + m.trailing_zeros();
+            m &= m - 1;
+            emit(ft, x, y, ft.weights(x, y));
+        }
+    });
+}
+
+/// `tile_fragments` a row at a time: for each run of covered samples, the
+/// triangle, the first sample's pixel `(x0, y)` and the covered samples of
+/// pixels `x0..x0 + 8` in that row as bits (bit k: pixel `x0 + k`), in the
+/// same order. For code that takes a row of samples at once.
+#[inline]
+pub fn tile_fragment_rows<F: FnMut(&FixedTri, u32, u32, u8)>(
+    tris: &[FixedTri],
+    bin: &[(u32, RectCoverage)],
+    tile: PixelRect,
+    off: [i64; 2],
+    tested: &mut impl TestCounter,
+    mut emit: F,
+) {
     for &(i, class) in bin {
         let ft = &tris[i as usize];
         let r = ft.bbox.intersect(&tile);
@@ -122,7 +145,7 @@ pub fn tile_fragments<F: FnMut(&FixedTri, u32, u32, [f32; 3])>(
             continue;
         }
         if ft.wide {
-            fixed::raster(ft, r, off, tested, |x, y, l| emit(ft, x, y, l));
+            fixed::raster_rows(ft, r, off, tested, |x0, y, bits| emit(ft, x0, y, bits));
             continue;
         }
         let step_x = [0, 1, 2].map(|k| ft.a[k] * ONE);
@@ -144,10 +167,9 @@ pub fn tile_fragments<F: FnMut(&FixedTri, u32, u32, [f32; 3])>(
                 tested.add(br);
                 if c == RectCoverage::Accept {
                     // Every sample covered: no edge function is needed.
+                    let bits = ((1u32 << br.width()) - 1) as u8;
                     for y in br.y0..br.y1 {
-                        for x in br.x0..br.x1 {
-                            emit(ft, x, y, ft.weights(x, y));
-                        }
+                        emit(ft, br.x0, y, bits);
                     }
                     continue;
                 }
@@ -168,11 +190,11 @@ pub fn tile_fragments<F: FnMut(&FixedTri, u32, u32, [f32; 3])>(
                         row[k] += step_y[k];
                     }
                 }
-                while mask != 0 {
-                    let bit = mask.trailing_zeros();
-                    mask &= mask - 1;
-                    let (x, y) = (br.x0 + bit % BLOCK, br.y0 + bit / BLOCK);
-                    emit(ft, x, y, ft.weights(x, y));
+                for dy in 0..br.height() {
+                    let bits = (mask >> (BLOCK * dy)) as u8;
+                    if bits != 0 {
+                        emit(ft, br.x0, br.y0 + dy, bits);
+                    }
                 }
             }
         }

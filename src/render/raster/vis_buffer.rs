@@ -15,7 +15,11 @@
 //! keys are still written, for the fragment record.
 
 use crate::render::differentials::{with_ray_differentials, RayDifferential};
-use super::depth_format::DepthEncoding;
+use super::depth_format::{DepthEncoding, DepthFormat};
+use super::fixed::FixedTri;
+use crate::math::lanes::{mask_bits, simd_level};
+use fearless_simd::{dispatch, f32x8, Simd, SimdBase, SimdFrom};
+use glam::Vec2;
 use super::rect::{PixelRect, TestCounter};
 use super::setup::ScreenTri;
 use crate::math::{Radiance, Ray, Vec3};
@@ -31,6 +35,19 @@ use crate::scene::{PrimitiveId, PrimitiveKind, SurfaceHit};
 /// What `VisBuffer::csg` holds where no CSG object won.
 const NO_BOUNDARY: Boundary = Boundary { t: 0.0, surface: SurfaceRef::Sphere(0), leaf: 0, flipped: false };
 
+
+/// `setup::edge_function(a, b, q)` for eight samples `q`:
+/// (b.x - a.x)(q.y - a.y) - (b.y - a.y)(q.x - a.x).
+#[inline(always)]
+fn edge_lanes<S: Simd>(simd: S, a: Vec2, b: Vec2, qx: f32x8<S>, qy: f32x8<S>) -> f32x8<S> {
+    f32x8::splat(simd, b.x - a.x) * (qy - f32x8::splat(simd, a.y)) - f32x8::splat(simd, b.y - a.y) * (qx - f32x8::splat(simd, a.x))
+}
+
+/// `l0 c0 + l1 c1 + l2 c2`, summed left to right as the scalar code does.
+#[inline(always)]
+fn weighted_lanes<S: Simd>(simd: S, l: &[f32x8<S>; 3], c: [f32; 3]) -> f32x8<S> {
+    l[0] * f32x8::splat(simd, c[0]) + l[1] * f32x8::splat(simd, c[1]) + l[2] * f32x8::splat(simd, c[2])
+}
 
 /// What a depth key measures.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -259,6 +276,73 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             let screen = st.affine_weights(l);
             let [b1, b2] = st.bary_at(l, inv_z);
             self.record(PrimitiveKind::Triangle, st.tri, Some(screen), Vec3::new(1.0 - b1 - b2, b1, b2), key, stored, passed, i, x, y);
+        }
+    }
+
+    /// The covered samples `bits` (bit k: pixel `x0 + k`) of row `y` of
+    /// snapped triangle `ft`: `triangle_fragment` for each, with its
+    /// screen-space weights, in order. Where nothing but the depth test and
+    /// the visibility store happens (early depth, float keys, perspective
+    /// interpolation, no cost view, nothing recorded: most frames), the row
+    /// is done eight samples at a time with the same arithmetic
+    /// (`triangle_row8`).
+    #[inline]
+    pub fn triangle_row(&mut self, ft: &FixedTri, x0: u32, y: u32, bits: u8) {
+        let i = self.index(x0, y);
+        let plain = !R::ENABLED
+            && !self.paint
+            && !self.forward
+            && self.work.is_empty()
+            && !self.job.settings.affine
+            && self.enc.format == DepthFormat::F32
+            && i + 8 <= self.depth.len();
+        if plain && bits.count_ones() > 1 {
+            dispatch!(simd_level(), simd => self.triangle_row8(simd, ft, x0, y, bits, i));
+            return;
+        }
+        let mut m = bits;
+        while m != 0 {
+            let x = x0 + m.trailing_zeros();
+            m &= m - 1;
+            self.triangle_fragment(&ft.st, x, y, ft.weights(x, y));
+        }
+    }
+
+    /// `triangle_row` eight samples at a time, from buffer index `i` (pixel
+    /// `x0`): `screen_weights`, `inv_z_at`, the F32 key, the depth test and
+    /// `bary_at` in lanes, each with the scalar code's operations in its
+    /// order, so every stored value is the one `triangle_fragment` stores.
+    #[inline(always)]
+    fn triangle_row8<S: Simd>(&mut self, simd: S, ft: &FixedTri, x0: u32, y: u32, bits: u8, i: usize) {
+        let st = &ft.st;
+        let xs: [f32; 8] = std::array::from_fn(|k| (x0 + k as u32) as f32);
+        let qx = f32x8::simd_from(simd, xs) + f32x8::splat(simd, ft.sample_off.x);
+        let qy = f32x8::splat(simd, y as f32 + ft.sample_off.y);
+        let p = &st.p;
+        let inv_area = f32x8::splat(simd, st.inv_area);
+        let l = [
+            edge_lanes(simd, p[1], p[2], qx, qy) * inv_area,
+            edge_lanes(simd, p[2], p[0], qx, qy) * inv_area,
+            edge_lanes(simd, p[0], p[1], qx, qy) * inv_area,
+        ];
+        let inv_z = weighted_lanes(simd, &l, st.inv_z);
+        let key = -inv_z;
+        let stored = f32x8::from_slice(simd, &self.depth[i..i + 8]);
+        let passed = mask_bits(key.simd_lt(stored)) & bits;
+        // `bary_at`: (bz0 l0 + bz1 l1 + bz2 l2) / inv_z, its y and z.
+        let b1 = weighted_lanes(simd, &l, [st.bz[0].y, st.bz[1].y, st.bz[2].y]) / inv_z;
+        let b2 = weighted_lanes(simd, &l, [st.bz[0].z, st.bz[1].z, st.bz[2].z]) / inv_z;
+        let (key, b1, b2): ([f32; 8], [f32; 8], [f32; 8]) = (key.into(), b1.into(), b2.into());
+        self.counts.samples_covered += bits.count_ones() as u64;
+        self.counts.depth_fails += (bits & !passed).count_ones() as u64;
+        let id = PrimitiveId::triangle(st.tri);
+        let mut m = passed;
+        while m != 0 {
+            let k = m.trailing_zeros() as usize;
+            m &= m - 1;
+            self.depth[i + k] = key[k];
+            self.id[i + k] = id;
+            self.payload[i + k] = [b1[k], b2[k]];
         }
     }
 
