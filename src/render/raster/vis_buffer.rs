@@ -695,12 +695,26 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         let all_ordinary = !R::ENABLED && self.job.active.is_none();
         // Counted here, added once at the end (`resolve` counts its own).
         let (mut primary, mut shaded) = (0u64, 0u64);
-        let mut i = 0;
+        // Where that holds and no ray is needed, a row's empty pixels are
+        // filled at once; the loop below then only skips them.
+        let fill = if all_ordinary { background } else { None };
         for (row, y) in (r.y0..r.y1).enumerate() {
             let line = row * out_stride + x_offset;
+            let start = row * self.stride;
+            if let Some(value) = fill {
+                for (o, id) in out[line..line + self.stride].iter_mut().zip(&self.id[start..start + self.stride]) {
+                    if id.is_none() {
+                        *o = value;
+                        primary += 1;
+                    }
+                }
+            }
             for (col, x) in (r.x0..r.x1).enumerate() {
-                let slot = line + col;
+                let (i, slot) = (start + col, line + col);
                 let id = self.id[i];
+                if fill.is_some() && id.is_none() {
+                    continue;
+                }
                 // Neither the recorded pixel nor one this pass leaves out.
                 let ordinary = all_ordinary || (!self.is_focus(x, y) && self.job.is_active(x, y));
                 if let (true, Some(value)) = (id.is_none() && ordinary, background) {
@@ -717,7 +731,6 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
                         if batch.is_full() {
                             self.shade_batch_into(&mut batch, out);
                         }
-                        i += 1;
                         continue;
                     }
                     match self.eye_hit(i, x, y) {
@@ -730,7 +743,6 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
                         (_, None) => out[slot] = self.shade(i, x, y),
                     }
                 }
-                i += 1;
             }
         }
         self.shade_batch_into(&mut batch, out);
