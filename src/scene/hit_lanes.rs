@@ -304,16 +304,19 @@ mod tests {
         ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
     }
 
+    /// What two records must share: every field's bits.
+    #[allow(clippy::type_complexity)]
+    fn record_bits(h: &SurfaceHit) -> ([[u32; 3]; 4], [u32; 2], u32, u32, u32, u32, bool) {
+        let v = [h.position, h.geometric_normal, h.shading_normal, h.barycentric];
+        (v.map(|v| v.to_array().map(f32::to_bits)), h.uv.to_array().map(f32::to_bits), h.t.to_bits(), h.primitive, h.object, h.material, h.back_face)
+    }
+
     /// Every lane's record equals `triangle_hit`'s bit for bit, on every
     /// built-in scene's triangles (flat and smooth, two-sided, with uvs,
     /// copies of the two-level layer), seen from both sides, in batches of
     /// one to eight.
     #[test]
     fn eight_lanes_build_the_records_triangle_hit_builds() {
-        let key = |h: &SurfaceHit| {
-            let v = [h.position, h.geometric_normal, h.shading_normal, h.barycentric];
-            (v.map(|v| v.to_array().map(f32::to_bits)), h.uv.to_array().map(f32::to_bits), h.t.to_bits(), h.primitive, h.object, h.material, h.back_face)
-        };
         let mut compared = 0;
         let mut layer_compared = 0;
         let mut state = 7u64;
@@ -338,7 +341,7 @@ mod tests {
                 for (lane, input) in inputs.iter().enumerate() {
                     let ray = Ray::new(Vec3::ZERO, input.dir);
                     let expected = scene.triangle_hit(input.index, input.b, input.t, &ray);
-                    assert_eq!(key(&got.get(lane)), key(&expected), "{name}: triangle {}", input.index);
+                    assert_eq!(record_bits(&got.get(lane)), record_bits(&expected), "{name}: triangle {}", input.index);
                     compared += 1;
                     layer_compared += (input.index as usize >= scene.triangles.len()) as usize;
                 }
@@ -353,10 +356,6 @@ mod tests {
     /// `triangle_hit`; and the eye rays' directions.
     #[test]
     fn eye_samples_in_lanes_are_the_replays_records() {
-        let key = |h: &SurfaceHit| {
-            let v = [h.position, h.geometric_normal, h.shading_normal, h.barycentric];
-            (v.map(|v| v.to_array().map(f32::to_bits)), h.uv.to_array().map(f32::to_bits), h.t.to_bits(), h.primitive, h.object, h.material, h.back_face)
-        };
         let mut compared = 0;
         let mut state = 11u64;
         for name in builtin::names().into_iter().chain(["forest-100"]) {
@@ -381,7 +380,7 @@ mod tests {
                     let v = scene.triangle_positions(samples.index[k]);
                     let t = (v[0] * b.x + v[1] * b.y + v[2] * b.z - ray.origin).dot(ray.dir);
                     let expected = scene.triangle_hit(samples.index[k], b, t, &ray);
-                    assert_eq!(key(&got.get(k)), key(&expected), "{name}: triangle {}", samples.index[k]);
+                    assert_eq!(record_bits(&got.get(k)), record_bits(&expected), "{name}: triangle {}", samples.index[k]);
                     assert_eq!([dirs[0][k], dirs[1][k], dirs[2][k]].map(f32::to_bits), ray.dir.to_array().map(f32::to_bits));
                     compared += 1;
                 }

@@ -162,13 +162,24 @@ pub fn snap_triangles(tris: &[ScreenTri], sample_off: Vec2, width: u32, height: 
 #[inline]
 pub fn raster<C: TestCounter, F: FnMut(u32, u32, [f32; 3])>(ft: &FixedTri, rect: PixelRect, off: [i64; 2], tested: &mut C, mut emit: F) {
     raster_rows(ft, rect, off, tested, |x0, y, bits| {
-        let mut m = bits;
-        while m != 0 {
-            let x = x0 + m.trailing_zeros();
-            m &= m - 1;
+        for x in row_pixels(x0, bits) {
             emit(x, y, ft.weights(x, y));
         }
     });
+}
+
+/// The pixels of a row run (`raster_rows`): `x0 + k` for each set bit k of
+/// `bits`, in order.
+#[inline(always)]
+pub fn row_pixels(x0: u32, bits: u8) -> impl Iterator<Item = u32> {
+    let mut m = bits;
+    std::iter::from_fn(move || {
+        (m != 0).then(|| {
+            let k = m.trailing_zeros();
+            m &= m - 1;
+            x0 + k
+        })
+    })
 }
 
 /// `raster` a row at a time: for each run of up to eight pixels of a row,

@@ -116,10 +116,7 @@ pub fn tile_fragments<F: FnMut(&FixedTri, u32, u32, [f32; 3])>(
     mut emit: F,
 ) {
     tile_fragment_rows(tris, bin, tile, off, tested, |ft, x0, y, bits| {
-        let mut m = bits;
-        while m != 0 {
-            let x = x0 + m.trailing_zeros();
-            m &= m - 1;
+        for x in fixed::row_pixels(x0, bits) {
             emit(ft, x, y, ft.weights(x, y));
         }
     });

@@ -300,10 +300,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             dispatch!(simd_level(), simd => self.triangle_row8(simd, ft, x0, y, bits, i));
             return;
         }
-        let mut m = bits;
-        while m != 0 {
-            let x = x0 + m.trailing_zeros();
-            m &= m - 1;
+        for x in super::fixed::row_pixels(x0, bits) {
             self.triangle_fragment(&ft.st, x, y, ft.weights(x, y));
         }
     }
