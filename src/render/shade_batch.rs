@@ -89,7 +89,9 @@ impl Batch {
         self.pending_ray_count = 0;
     }
 
-    /// Sample `i`'s surface as `shade()` is handed it.
+    /// Sample `i`'s surface as `shade()` is handed it (for tests; shading
+    /// assembles records from `hits` itself).
+    #[cfg(test)]
     pub fn hit(&self, i: usize) -> SurfaceHit {
         self.hits.get(i)
     }

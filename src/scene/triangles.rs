@@ -63,7 +63,8 @@ pub struct CornerLanes {
     pub object: [u32; 8],
 }
 
-/// A triangle's attributes as the store keeps them (`Triangles::stored`).
+/// A triangle's attributes as the store keeps them (`assemble` works out a
+/// flat triangle's normals from them).
 #[derive(Clone, Copy, Debug)]
 pub struct StoredTriangle {
     pub v: [Vec3; 3],
@@ -138,14 +139,6 @@ impl Triangles {
             object: s.object,
             two_sided: f.object_and_flags & TWO_SIDED_BIT != 0,
         }
-    }
-
-    /// Triangle `i` as stored, without working out a flat triangle's
-    /// normal (`Triangle::normal_of` its positions); `None` past the end.
-    /// For code that computes that normal itself, several triangles at once.
-    #[inline]
-    pub fn stored(&self, i: usize) -> Option<StoredTriangle> {
-        self.faces.get(i).map(|f| self.stored_face(f))
     }
 
     #[inline(always)]
