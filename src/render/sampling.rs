@@ -26,7 +26,15 @@ pub struct SampleRng {
 }
 
 /// `SampleRng::grid` for `spp` samples.
+#[inline(always)]
 fn grid_side(spp: u32) -> u32 {
+    // Every stream of a frame asks this (one per sample and lane, even
+    // where nothing is drawn), so the common counts skip the square root:
+    // 4^k is the square of 2^k, and other powers of two are no squares.
+    if spp.is_power_of_two() {
+        let k = spp.trailing_zeros();
+        return if k % 2 == 0 { 1 << (k / 2) } else { 0 };
+    }
     let n = (spp as f32).sqrt().round() as u32;
     if n * n == spp { n } else { 0 }
 }
@@ -125,16 +133,13 @@ fn over(x: f32, n: u32) -> f32 {
 /// distinct value below `len` (Kensler, "Correlated Multi-Jittered
 /// Sampling", 2013: invertible hashing on the next power of two, walked
 /// until it lands below `len`).
+#[inline(always)]
 pub fn permute(mut i: u32, len: u32, key: u32) -> u32 {
     if len <= 1 {
         return 0;
     }
-    let mut w = len - 1;
-    w |= w >> 1;
-    w |= w >> 2;
-    w |= w >> 4;
-    w |= w >> 8;
-    w |= w >> 16;
+    // All ones up to the highest bit of len - 1 (len >= 2 here).
+    let w = u32::MAX >> (len - 1).leading_zeros();
     let p = key;
     loop {
         i ^= p;
@@ -155,7 +160,8 @@ pub fn permute(mut i: u32, len: u32, key: u32) -> u32 {
         i = i.wrapping_mul(0xc860a3df);
         i &= w;
         i ^= i >> 5;
-        if i < len {
+        // A power of two is never left: i <= w = len - 1 already.
+        if len.is_power_of_two() || i < len {
             // `% len`, without a division when `len` is a power of two.
             let i = i.wrapping_add(p);
             return if len.is_power_of_two() { i & w } else { i % len };
@@ -271,6 +277,15 @@ mod tests {
                 let x = r.next_f32() * n as f32 + r.next_f32();
                 assert_eq!(over(x, n).to_bits(), (x / n as f32).to_bits(), "{x} / {n}");
             }
+        }
+    }
+
+    #[test]
+    fn grid_side_is_the_square_root_of_squares_only() {
+        for spp in 1..=70_000u32 {
+            let root = (1..=spp).take_while(|r| r * r <= spp).last().unwrap();
+            let expected = if root * root == spp { root } else { 0 };
+            assert_eq!(grid_side(spp), expected, "spp {spp}");
         }
     }
 

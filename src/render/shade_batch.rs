@@ -137,26 +137,16 @@ impl Batch {
             return;
         }
         let mut dirs = [[0.0; LANES]; 3];
-        if n == self.len {
-            // Every lane is pending (the common case): built in place.
-            scene.triangle_eye_hits(view, &self.pending, &mut self.hits, &mut dirs);
+        let lanes = &self.pending_lanes[..n];
+        let pending = &self.pending;
+        if place_built(&mut self.hits, self.len, lanes, interpolation, |out| scene.triangle_eye_hits(view, pending, out, &mut dirs)) {
             for a in 0..3 {
                 self.w_o[a] = dirs[a].map(|d| -d);
             }
-            if interpolation == Interpolation::Flat {
-                self.hits.shading_normal = self.hits.geometric_normal;
-            }
         } else {
-            let mut built = HitLanes::new();
-            scene.triangle_eye_hits(view, &self.pending, &mut built, &mut dirs);
-            for k in 0..n {
-                let i = self.pending_lanes[k];
-                self.hits.copy_lane(i, &built, k);
+            for (k, &i) in lanes.iter().enumerate() {
                 for a in 0..3 {
                     self.w_o[a][i] = -dirs[a][k];
-                    if interpolation == Interpolation::Flat {
-                        self.hits.shading_normal[a][i] = self.hits.geometric_normal[a][i];
-                    }
                 }
             }
         }
@@ -167,6 +157,7 @@ impl Batch {
     /// `light` (with `ShadowMode::Ray`: `Incidence::of`, `illuminates` and
     /// `shadow_ray`, eight lanes at a time), each handed to `put` with its
     /// lane and far end: what the packets trace ahead of shading.
+    #[inline]
     pub fn shadow_rays(&self, scene: &Scene, light: &Light, bump: f32, lift: bool, mut put: impl FnMut(usize, Ray, f32)) {
         if self.len == 0 {
             return;
@@ -191,25 +182,7 @@ impl Batch {
             return;
         }
         let inputs = &self.pending_rays[..n];
-        if n == self.len {
-            // Every lane is pending (the common case): built in place.
-            scene.triangle_hits(inputs, &mut self.hits);
-            if interpolation == Interpolation::Flat {
-                self.hits.shading_normal = self.hits.geometric_normal;
-            }
-        } else {
-            let mut built = HitLanes::new();
-            scene.triangle_hits(inputs, &mut built);
-            for k in 0..n {
-                let i = self.pending_ray_lanes[k];
-                self.hits.copy_lane(i, &built, k);
-                if interpolation == Interpolation::Flat {
-                    for a in 0..3 {
-                        self.hits.shading_normal[a][i] = self.hits.geometric_normal[a][i];
-                    }
-                }
-            }
-        }
+        place_built(&mut self.hits, self.len, &self.pending_ray_lanes[..n], interpolation, |out| scene.triangle_hits(inputs, out));
         self.pending_ray_count = 0;
     }
 
@@ -228,6 +201,36 @@ impl Batch {
         self.slots[i] = slot;
         self.len += 1;
     }
+}
+
+/// Puts surfaces that `build` makes in its lanes `0..lanes.len()` into
+/// lanes `lanes` of `hits` (a batch of `len` samples): built in place when
+/// they are all of the batch's lanes, in order (the common case), else built
+/// aside and copied lane by lane. Flat interpolation then shades them with
+/// the geometric normal, as `Batch::push` does. True when built in place
+/// (lane k of what `build` made is lane k of the batch).
+#[inline(always)]
+fn place_built(hits: &mut HitLanes, len: usize, lanes: &[usize], interpolation: Interpolation, build: impl FnOnce(&mut HitLanes)) -> bool {
+    let flat = interpolation == Interpolation::Flat;
+    if lanes.len() == len {
+        debug_assert!(lanes.iter().enumerate().all(|(k, &i)| k == i), "pending lanes are pushed in order");
+        build(hits);
+        if flat {
+            hits.shading_normal = hits.geometric_normal;
+        }
+        return true;
+    }
+    let mut built = HitLanes::new();
+    build(&mut built);
+    for (k, &i) in lanes.iter().enumerate() {
+        hits.copy_lane(i, &built, k);
+        if flat {
+            for a in 0..3 {
+                hits.shading_normal[a][i] = hits.geometric_normal[a][i];
+            }
+        }
+    }
+    false
 }
 
 /// Shades the batch's samples (depth 0, the eye's surfaces) and returns

@@ -268,7 +268,7 @@ fn layer_buffers<'j, 'a, Q: SceneQuery>(layers: &'j [Layer<'a>], query: &'j Q, r
         .map(|l| {
             let mut vb = VisBuffer::new(&l.job, query, rect, key, forward);
             vb.sample = l.sample;
-            vb.paint = l.method == Method::Painter;
+            vb.set_painter(l.method == Method::Painter);
             vb
         })
         .collect()
@@ -374,7 +374,7 @@ pub fn replay_pixel(method: Method, job: &PassJob, x: u32, y: u32, rec: &mut Pix
         .map(|l| {
             let mut vb = VisBuffer::with_recorder(&l.job, &query, rect, key, forward, PixelTrace::new(), (x, y));
             vb.sample = l.sample;
-            vb.paint = l.method == Method::Painter;
+            vb.set_painter(l.method == Method::Painter);
             vb
         })
         .collect();

@@ -6,6 +6,7 @@
 use super::clip::{clip_frustum, clip_near, side_planes, triangle_vertices, ClipMode, FrustumClip};
 use super::rect::{sample_span, PixelRect};
 use super::subpixel;
+use crate::math::lanes::Lane;
 use crate::math::{Vec2, Vec3};
 use crate::render::PassJob;
 use crate::scene::{CameraView, Triangle};
@@ -16,7 +17,22 @@ use rayon::prelude::*;
 /// side of every edge of a triangle with positive area.
 #[inline(always)]
 pub fn edge_function(a: Vec2, b: Vec2, p: Vec2) -> f32 {
-    (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x)
+    edge_function_lanes(a, b, p.x, p.y)
+}
+
+/// `edge_function` at lanes of sample positions `(qx, qy)`: written once
+/// over the lane type, so the scalar rasterizer and the eight-sample rows
+/// of the visibility buffer compute the same bits.
+#[inline(always)]
+pub fn edge_function_lanes<L: Lane>(a: Vec2, b: Vec2, qx: L, qy: L) -> L {
+    qx.splat(b.x - a.x) * (qy - qx.splat(a.y)) - qx.splat(b.y - a.y) * (qx - qx.splat(a.x))
+}
+
+/// `l0 c0 + l1 c1 + l2 c2`, summed left to right: screen-space weights
+/// applied to a per-vertex attribute.
+#[inline(always)]
+fn weighted<L: Lane>(l: &[L; 3], c: [f32; 3]) -> L {
+    l[0] * l[0].splat(c[0]) + l[1] * l[1].splat(c[1]) + l[2] * l[2].splat(c[2])
 }
 
 /// A projected (clipped) triangle ready to rasterize.
@@ -73,15 +89,28 @@ impl ScreenTri {
     /// Interpolated 1 / view depth for screen-space weights `l`.
     #[inline(always)]
     pub fn inv_z_at(&self, l: [f32; 3]) -> f32 {
-        l[0] * self.inv_z[0] + l[1] * self.inv_z[1] + l[2] * self.inv_z[2]
+        self.inv_z_lanes(&l)
+    }
+
+    /// `inv_z_at` for lanes of weights.
+    #[inline(always)]
+    pub fn inv_z_lanes<L: Lane>(&self, l: &[L; 3]) -> L {
+        weighted(l, self.inv_z)
     }
 
     /// Perspective-correct barycentrics (b1, b2) in the original triangle for
     /// screen-space weights `l`, given `inv_z = inv_z_at(l)`.
     #[inline(always)]
     pub fn bary_at(&self, l: [f32; 3], inv_z: f32) -> [f32; 2] {
-        let b = (self.bz[0] * l[0] + self.bz[1] * l[1] + self.bz[2] * l[2]) / inv_z;
-        [b.y, b.z]
+        self.bary_lanes(&l, inv_z)
+    }
+
+    /// `bary_at` for lanes of weights: (bz0 l0 + bz1 l1 + bz2 l2) / inv_z,
+    /// its y and z.
+    #[inline(always)]
+    pub fn bary_lanes<L: Lane>(&self, l: &[L; 3], inv_z: L) -> [L; 2] {
+        let bz = &self.bz;
+        [weighted(l, [bz[0].y, bz[1].y, bz[2].y]) / inv_z, weighted(l, [bz[0].z, bz[1].z, bz[2].z]) / inv_z]
     }
 
     /// Affine (screen-space) barycentrics (b1, b2) in the original triangle
@@ -103,11 +132,17 @@ impl ScreenTri {
     /// each edge function evaluated directly, relative to the edge's start vertex.
     #[inline(always)]
     pub fn screen_weights(&self, q: Vec2) -> [f32; 3] {
-        let p = &self.p;
+        self.screen_weights_lanes(q.x, q.y)
+    }
+
+    /// `screen_weights` at lanes of sample positions `(qx, qy)`.
+    #[inline(always)]
+    pub fn screen_weights_lanes<L: Lane>(&self, qx: L, qy: L) -> [L; 3] {
+        let (p, inv_area) = (&self.p, qx.splat(self.inv_area));
         [
-            edge_function(p[1], p[2], q) * self.inv_area,
-            edge_function(p[2], p[0], q) * self.inv_area,
-            edge_function(p[0], p[1], q) * self.inv_area,
+            edge_function_lanes(p[1], p[2], qx, qy) * inv_area,
+            edge_function_lanes(p[2], p[0], qx, qy) * inv_area,
+            edge_function_lanes(p[0], p[1], qx, qy) * inv_area,
         ]
     }
 

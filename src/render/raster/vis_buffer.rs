@@ -19,7 +19,6 @@ use super::depth_format::{DepthEncoding, DepthFormat};
 use super::fixed::FixedTri;
 use crate::math::lanes::{mask_bits, simd_level};
 use fearless_simd::{dispatch, f32x8, Simd, SimdBase, SimdFrom};
-use glam::Vec2;
 use super::rect::{PixelRect, TestCounter};
 use super::setup::ScreenTri;
 use crate::math::{Radiance, Ray, Vec3};
@@ -35,19 +34,6 @@ use crate::scene::{PrimitiveId, PrimitiveKind, SurfaceHit};
 /// What `VisBuffer::csg` holds where no CSG object won.
 const NO_BOUNDARY: Boundary = Boundary { t: 0.0, surface: SurfaceRef::Sphere(0), leaf: 0, flipped: false };
 
-
-/// `setup::edge_function(a, b, q)` for eight samples `q`:
-/// (b.x - a.x)(q.y - a.y) - (b.y - a.y)(q.x - a.x).
-#[inline(always)]
-fn edge_lanes<S: Simd>(simd: S, a: Vec2, b: Vec2, qx: f32x8<S>, qy: f32x8<S>) -> f32x8<S> {
-    f32x8::splat(simd, b.x - a.x) * (qy - f32x8::splat(simd, a.y)) - f32x8::splat(simd, b.y - a.y) * (qx - f32x8::splat(simd, a.x))
-}
-
-/// `l0 c0 + l1 c1 + l2 c2`, summed left to right as the scalar code does.
-#[inline(always)]
-fn weighted_lanes<S: Simd>(simd: S, l: &[f32x8<S>; 3], c: [f32; 3]) -> f32x8<S> {
-    l[0] * f32x8::splat(simd, c[0]) + l[1] * f32x8::splat(simd, c[1]) + l[2] * f32x8::splat(simd, c[2])
-}
 
 /// What a depth key measures.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -108,8 +94,14 @@ pub struct VisBuffer<'j, 'a, Q: SceneQuery, R: FragmentRecorder = NoRecord> {
     pub key: DepthKey,
     /// How `NegInvZ` keys are stored (`--depth-buffer`).
     pub enc: DepthEncoding,
-    /// The painter's algorithm: no depth test, every fragment overwrites.
-    pub paint: bool,
+    /// The painter's algorithm: no depth test, every fragment overwrites
+    /// (`set_painter`).
+    paint: bool,
+    /// Whether `triangle_row` may do a row eight samples at a time: only the
+    /// depth test and the store happen per fragment (early depth, float
+    /// keys, perspective interpolation, no painter, no cost view, nothing
+    /// recorded). Worked out once per buffer, not per row.
+    rows_in_lanes: bool,
     /// Shade every fragment that passes the depth test (forward) instead of
     /// once per pixel after visibility is known (early depth).
     pub forward: bool,
@@ -164,6 +156,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             }
         };
         let cost = job.settings.view == View::Cost;
+        let rows_in_lanes = Self::rows_in_lanes_allowed(job, forward, &enc);
         VisBuffer {
             job,
             query,
@@ -172,6 +165,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             key,
             enc,
             paint: false,
+            rows_in_lanes,
             forward,
             depth,
             id: vec![PrimitiveId::NONE; n],
@@ -187,6 +181,17 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             stencil: Vec::new(),
             stencil_lights: 0,
         }
+    }
+
+    /// Draws with the painter's algorithm (no depth test) or not.
+    pub fn set_painter(&mut self, on: bool) {
+        self.paint = on;
+        self.rows_in_lanes = !on && Self::rows_in_lanes_allowed(self.job, self.forward, &self.enc);
+    }
+
+    /// `rows_in_lanes` apart from the painter.
+    fn rows_in_lanes_allowed(job: &PassJob, forward: bool, enc: &DepthEncoding) -> bool {
+        !R::ENABLED && !forward && job.settings.view != View::Cost && !job.settings.affine && enc.format == DepthFormat::F32
     }
 
     /// Index of image pixel `(x, y)` in this region's buffers.
@@ -289,14 +294,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
     #[inline]
     pub fn triangle_row(&mut self, ft: &FixedTri, x0: u32, y: u32, bits: u8) {
         let i = self.index(x0, y);
-        let plain = !R::ENABLED
-            && !self.paint
-            && !self.forward
-            && self.work.is_empty()
-            && !self.job.settings.affine
-            && self.enc.format == DepthFormat::F32
-            && i + 8 <= self.depth.len();
-        if plain && bits.count_ones() > 1 {
+        if self.rows_in_lanes && i + 8 <= self.depth.len() && bits.count_ones() > 1 {
             dispatch!(simd_level(), simd => self.triangle_row8(simd, ft, x0, y, bits, i));
             return;
         }
@@ -315,20 +313,13 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         let xs: [f32; 8] = std::array::from_fn(|k| (x0 + k as u32) as f32);
         let qx = f32x8::simd_from(simd, xs) + f32x8::splat(simd, ft.sample_off.x);
         let qy = f32x8::splat(simd, y as f32 + ft.sample_off.y);
-        let p = &st.p;
-        let inv_area = f32x8::splat(simd, st.inv_area);
-        let l = [
-            edge_lanes(simd, p[1], p[2], qx, qy) * inv_area,
-            edge_lanes(simd, p[2], p[0], qx, qy) * inv_area,
-            edge_lanes(simd, p[0], p[1], qx, qy) * inv_area,
-        ];
-        let inv_z = weighted_lanes(simd, &l, st.inv_z);
+        // The scalar fragment's arithmetic, eight samples at a time.
+        let l = st.screen_weights_lanes(qx, qy);
+        let inv_z = st.inv_z_lanes(&l);
         let key = -inv_z;
         let stored = f32x8::from_slice(simd, &self.depth[i..i + 8]);
         let passed = mask_bits(key.simd_lt(stored)) & bits;
-        // `bary_at`: (bz0 l0 + bz1 l1 + bz2 l2) / inv_z, its y and z.
-        let b1 = weighted_lanes(simd, &l, [st.bz[0].y, st.bz[1].y, st.bz[2].y]) / inv_z;
-        let b2 = weighted_lanes(simd, &l, [st.bz[0].z, st.bz[1].z, st.bz[2].z]) / inv_z;
+        let [b1, b2] = st.bary_lanes(&l, inv_z);
         let (key, b1, b2): ([f32; 8], [f32; 8], [f32; 8]) = (key.into(), b1.into(), b2.into());
         self.counts.samples_covered += bits.count_ones() as u64;
         self.counts.depth_fails += (bits & !passed).count_ones() as u64;
