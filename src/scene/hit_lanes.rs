@@ -9,11 +9,11 @@
 //! one-sample code needs it.
 
 use super::camera::CameraView;
-use super::triangles::CornerLanes;
+use super::triangles::CornerRow;
 use super::{Differentials, PrimitiveKind, Scene, SurfaceHit, Triangle};
 use crate::math::lanes::{mask_bits, mask_from_bits, simd_level, Lane, V3};
 use crate::math::{Vec2, Vec3};
-use fearless_simd::{dispatch, f32x8, Simd, SimdFrom};
+use fearless_simd::{dispatch, f32x8, Simd, SimdBase, SimdFrom};
 
 /// Most hits one call builds.
 pub const HIT_LANES: usize = 8;
@@ -223,26 +223,108 @@ fn triangle_eye_hits8<S: Simd>(simd: S, scene: &Scene, view: &CameraView, s: &Ey
     *dirs = dir.to_soa();
 }
 
-/// The corners of triangles `index` in lanes; lanes at or past `n` repeat
-/// lane 0 (their results are dropped).
+/// The corners of up to eight triangles in lanes: `attr[corner][k]` holds
+/// attribute k of a `CornerRow` (position x, y, z, normal x, y, z, u, v)
+/// of every lane's triangle.
+struct CornerLanes<S: Simd> {
+    attr: [[f32x8<S>; 8]; 3],
+    /// Bit i set when lane i's triangle is flat: its normals are the
+    /// geometric one (its rows' normals are zero).
+    flat: u8,
+    material: [u32; HIT_LANES],
+    object: [u32; HIT_LANES],
+}
+
+/// Eight rows of eight as eight columns: three rounds of interleaving row
+/// i with row i + 4 (after them, vector j holds element j of every row).
 #[inline(always)]
-fn gather_corners(scene: &Scene, index: &[u32; HIT_LANES], n: usize) -> CornerLanes {
-    let mut c = CornerLanes::default();
+fn transpose8<S: Simd>(mut m: [f32x8<S>; 8]) -> [f32x8<S>; 8] {
+    for _ in 0..3 {
+        let mut next = m;
+        for i in 0..4 {
+            let (low, high) = m[i].interleave(m[i + 4]);
+            next[2 * i] = low;
+            next[2 * i + 1] = high;
+        }
+        m = next;
+    }
+    m
+}
+
+/// Where a lane's rows point before they are read.
+static NO_ROW: CornerRow = [0.0; 8];
+
+/// The corners of triangles `index` in lanes; lanes at or past `n` repeat
+/// lane 0 (their results are dropped). Each corner of the eight triangles
+/// is read as eight rows and transposed (the store keeps a corner as one
+/// row), not copied a float at a time.
+#[inline(always)]
+fn gather_corners<S: Simd>(simd: S, scene: &Scene, index: &[u32; HIT_LANES], n: usize) -> CornerLanes<S> {
+    let (mut flat, mut material, mut object) = (0u8, [0u32; HIT_LANES], [0u32; HIT_LANES]);
+    let mut rows = [[&NO_ROW; HIT_LANES]; 3];
     for lane in 0..HIT_LANES {
         let i = if lane < n { index[lane] } else { index[0] };
-        if !scene.triangles.write_lane(i as usize, lane, &mut c) {
-            // A copy of the two-level layer, placed in world space.
-            let tri: Triangle = scene.triangle(i);
-            c.material[lane] = tri.material;
-            c.object[lane] = tri.object;
+        let Some(face) = scene.triangles.corner_rows(i as usize) else {
+            return gather_placed_corners(simd, scene, index, n);
+        };
+        for k in 0..3 {
+            rows[k][lane] = face.corners[k];
+        }
+        flat |= (face.flat as u8) << lane;
+        material[lane] = face.material;
+        object[lane] = face.object;
+    }
+    CornerLanes { attr: transpose_corners(simd, &rows), flat, material, object }
+}
+
+/// `gather_corners` where some lane's triangle is a copy of the two-level
+/// layer (placed in world space, so not in the store): every lane's rows
+/// are copied out first.
+#[inline(always)]
+fn gather_placed_corners<S: Simd>(simd: S, scene: &Scene, index: &[u32; HIT_LANES], n: usize) -> CornerLanes<S> {
+    let (mut flat, mut material, mut object) = (0u8, [0u32; HIT_LANES], [0u32; HIT_LANES]);
+    let mut placed = [[[0.0f32; 8]; 3]; HIT_LANES];
+    for lane in 0..HIT_LANES {
+        let i = if lane < n { index[lane] } else { index[0] };
+        if let Some(face) = scene.triangles.corner_rows(i as usize) {
             for k in 0..3 {
-                (c.v[k][0][lane], c.v[k][1][lane], c.v[k][2][lane]) = (tri.v[k].x, tri.v[k].y, tri.v[k].z);
-                (c.n[k][0][lane], c.n[k][1][lane], c.n[k][2][lane]) = (tri.n[k].x, tri.n[k].y, tri.n[k].z);
-                (c.uv[k][0][lane], c.uv[k][1][lane]) = (tri.uv[k].x, tri.uv[k].y);
+                placed[lane][k] = *face.corners[k];
             }
+            flat |= (face.flat as u8) << lane;
+            material[lane] = face.material;
+            object[lane] = face.object;
+        } else {
+            let tri: Triangle = scene.triangle(i);
+            for k in 0..3 {
+                let (v, nrm, uv) = (tri.v[k], tri.n[k], tri.uv[k]);
+                placed[lane][k] = [v.x, v.y, v.z, nrm.x, nrm.y, nrm.z, uv.x, uv.y];
+            }
+            material[lane] = tri.material;
+            object[lane] = tri.object;
         }
     }
-    c
+    let mut rows = [[&NO_ROW; HIT_LANES]; 3];
+    for lane in 0..HIT_LANES {
+        for k in 0..3 {
+            rows[k][lane] = &placed[lane][k];
+        }
+    }
+    CornerLanes { attr: transpose_corners(simd, &rows), flat, material, object }
+}
+
+/// Each corner's eight rows (one per lane) as eight lanes of its attributes.
+#[inline(always)]
+fn transpose_corners<S: Simd>(simd: S, rows: &[[&CornerRow; HIT_LANES]; 3]) -> [[f32x8<S>; 8]; 3] {
+    let zero = <f32x8<S> as SimdBase<S>>::splat(simd, 0.0);
+    let mut attr = [[zero; 8]; 3];
+    for (corner, corner_rows) in attr.iter_mut().zip(rows) {
+        let mut m = [zero; 8];
+        for (lane, row) in m.iter_mut().zip(corner_rows) {
+            *lane = f32x8::from_slice(simd, *row);
+        }
+        *corner = transpose8(m);
+    }
+    attr
 }
 
 /// `a b0 + b b1 + c b2`, as `hit_on` interpolates.
@@ -258,14 +340,15 @@ fn interpolate<L: Lane>(a: V3<L>, b: V3<L>, c: V3<L>, w: &[L; 3]) -> V3<L> {
 // this function, without the SIMD level `dispatch` compiles it for.
 #[inline(always)]
 fn triangle_hits8<S: Simd>(simd: S, scene: &Scene, index: &[u32; HIT_LANES], n: usize, w: [f32x8<S>; 3], dir: V3<f32x8<S>>, out: &mut HitLanes) -> V3<f32x8<S>> {
-    let c = gather_corners(scene, index, n);
-    let (v0, v1, v2) = (V3::from_soa(simd, &c.v[0]), V3::from_soa(simd, &c.v[1]), V3::from_soa(simd, &c.v[2]));
+    let c = gather_corners(simd, scene, index, n);
+    let a = &c.attr;
+    let (v0, v1, v2) = (V3 { x: a[0][0], y: a[0][1], z: a[0][2] }, V3 { x: a[1][0], y: a[1][1], z: a[1][2] }, V3 { x: a[2][0], y: a[2][1], z: a[2][2] });
     // `Triangle::geometric_normal`, then `hit_on`'s steps in order.
     let geometric = (v1 - v0).cross(v2 - v0).normalize();
     let flat = mask_from_bits(simd, c.flat);
-    let n0 = V3::select(flat, geometric, V3::from_soa(simd, &c.n[0]));
-    let n1 = V3::select(flat, geometric, V3::from_soa(simd, &c.n[1]));
-    let n2 = V3::select(flat, geometric, V3::from_soa(simd, &c.n[2]));
+    let n0 = V3::select(flat, geometric, V3 { x: a[0][3], y: a[0][4], z: a[0][5] });
+    let n1 = V3::select(flat, geometric, V3 { x: a[1][3], y: a[1][4], z: a[1][5] });
+    let n2 = V3::select(flat, geometric, V3 { x: a[2][3], y: a[2][4], z: a[2][5] });
     let shading = interpolate(n0, n1, n2, &w).normalize_or(geometric);
     let back = geometric.dot(dir).gt(w[0].splat(0.0));
     out.geometric_normal = V3::select(back, -geometric, geometric).to_soa();
@@ -273,9 +356,9 @@ fn triangle_hits8<S: Simd>(simd: S, scene: &Scene, index: &[u32; HIT_LANES], n: 
     let position = interpolate(v0, v1, v2, &w);
     out.position = position.to_soa();
     out.barycentric = [w[0].into(), w[1].into(), w[2].into()];
-    for a in 0..2 {
-        let (uv0, uv1, uv2) = (f32x8::simd_from(simd, c.uv[0][a]), f32x8::simd_from(simd, c.uv[1][a]), f32x8::simd_from(simd, c.uv[2][a]));
-        out.uv[a] = (uv0 * w[0] + uv1 * w[1] + uv2 * w[2]).into();
+    for (k, uv) in out.uv.iter_mut().enumerate() {
+        let (uv0, uv1, uv2) = (a[0][6 + k], a[1][6 + k], a[2][6 + k]);
+        *uv = (uv0 * w[0] + uv1 * w[1] + uv2 * w[2]).into();
     }
     out.kind = [PrimitiveKind::Triangle; HIT_LANES];
     out.primitive = *index;
@@ -309,6 +392,27 @@ mod tests {
     fn record_bits(h: &SurfaceHit) -> ([[u32; 3]; 4], [u32; 2], u32, u32, u32, u32, bool) {
         let v = [h.position, h.geometric_normal, h.shading_normal, h.barycentric];
         (v.map(|v| v.to_array().map(f32::to_bits)), h.uv.to_array().map(f32::to_bits), h.t.to_bits(), h.primitive, h.object, h.material, h.back_face)
+    }
+
+    /// Row r, column c holds 8r + c; after the transpose vector c holds
+    /// column c (at the machine's SIMD level).
+    #[test]
+    fn eight_rows_transpose_to_eight_columns() {
+        fn check<S: Simd>(simd: S) {
+            let zero = <f32x8<S> as SimdBase<S>>::splat(simd, 0.0);
+            let mut rows = [zero; 8];
+            for (r, row) in rows.iter_mut().enumerate() {
+                let values: [f32; 8] = std::array::from_fn(|c| (8 * r + c) as f32);
+                *row = f32x8::from_slice(simd, &values);
+            }
+            let columns = transpose8(rows);
+            for (c, column) in columns.iter().enumerate() {
+                let values: [f32; 8] = (*column).into();
+                let expected: [f32; 8] = std::array::from_fn(|r| (8 * r + c) as f32);
+                assert_eq!(values, expected, "column {c}");
+            }
+        }
+        dispatch!(crate::math::lanes::simd_level(), simd => check(simd));
     }
 
     /// Every lane's record equals `triangle_hit`'s bit for bit, on every

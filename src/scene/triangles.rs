@@ -17,12 +17,43 @@ use super::Triangle;
 use crate::math::{Vec2, Vec3};
 use rustc_hash::FxHashMap;
 
-/// One corner's attributes, shared by the triangles that meet there.
+/// One corner's attributes, shared by the triangles that meet there. Laid
+/// out as eight floats in a row (`CornerRow`): code that builds eight hits
+/// at once loads a corner of each as one vector and transposes them.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
 struct Corner {
     position: Vec3,
     normal: Vec3,
     uv: Vec2,
+}
+
+/// A corner as a row: position x, y, z, normal x, y, z, uv u, v. A flat
+/// triangle's stored normals are zero (its normal is the geometric one).
+pub type CornerRow = [f32; 8];
+
+// `Corner` is eight floats without padding (glam's `Vec3` and `Vec2` are
+// `repr(C)` structs of floats), so it can be read as a `CornerRow`.
+const _: () = assert!(std::mem::size_of::<Corner>() == std::mem::size_of::<CornerRow>());
+const _: () = assert!(std::mem::align_of::<Corner>() == std::mem::align_of::<CornerRow>());
+
+impl Corner {
+    #[inline(always)]
+    fn as_row(&self) -> &CornerRow {
+        // SAFETY: same size and alignment (checked above), and every bit
+        // pattern of the eight floats is a valid `CornerRow`.
+        unsafe { &*(self as *const Corner).cast::<CornerRow>() }
+    }
+}
+
+/// What `Triangles::corner_rows` reads of one triangle.
+#[derive(Clone, Copy, Debug)]
+pub struct FaceRows<'a> {
+    pub corners: [&'a CornerRow; 3],
+    /// Its normals are the geometric one (the rows' normals are zero).
+    pub flat: bool,
+    pub material: u32,
+    pub object: u32,
 }
 
 impl Corner {
@@ -48,20 +79,6 @@ const TWO_SIDED_BIT: u32 = 1 << 31;
 /// The corners' normals are the geometric normal (stored as zero).
 const FLAT_BIT: u32 = 1 << 30;
 const FLAG_BITS: u32 = TWO_SIDED_BIT | FLAT_BIT;
-
-/// The corners of up to eight triangles in lanes, `[corner][axis][lane]`
-/// (`Triangles::write_lane`).
-#[derive(Clone, Copy, Debug, Default)]
-pub struct CornerLanes {
-    pub v: [[[f32; 8]; 3]; 3],
-    /// Shading normals; not written for flat triangles.
-    pub n: [[[f32; 8]; 3]; 3],
-    pub uv: [[[f32; 8]; 2]; 3],
-    /// Bit i set when lane i's triangle is flat: its normals are the geometric one.
-    pub flat: u8,
-    pub material: [u32; 8],
-    pub object: [u32; 8],
-}
 
 /// A triangle's attributes as the store keeps them (`assemble` works out a
 /// flat triangle's normals from them).
@@ -153,25 +170,17 @@ impl Triangles {
         }
     }
 
-    /// Writes stored triangle `i` into lane `lane` of `out` (code that
-    /// builds several hits at once); `false` past the end. A flat
-    /// triangle's normals are left as they were, its lane marked flat.
+    /// Stored triangle `i`'s corners as rows, with its face data; `None`
+    /// past the end (copies of the two-level layer).
     #[inline(always)]
-    pub fn write_lane(&self, i: usize, lane: usize, out: &mut CornerLanes) -> bool {
-        let Some(f) = self.faces.get(i) else { return false };
-        let flat = f.object_and_flags & FLAT_BIT != 0;
-        for (k, &c) in f.corner.iter().enumerate() {
-            let c = &self.corners[c as usize];
-            (out.v[k][0][lane], out.v[k][1][lane], out.v[k][2][lane]) = (c.position.x, c.position.y, c.position.z);
-            if !flat {
-                (out.n[k][0][lane], out.n[k][1][lane], out.n[k][2][lane]) = (c.normal.x, c.normal.y, c.normal.z);
-            }
-            (out.uv[k][0][lane], out.uv[k][1][lane]) = (c.uv.x, c.uv.y);
-        }
-        out.flat = (out.flat & !(1 << lane)) | (flat as u8) << lane;
-        out.material[lane] = f.material;
-        out.object[lane] = f.object_and_flags & !FLAG_BITS;
-        true
+    pub fn corner_rows(&self, i: usize) -> Option<FaceRows<'_>> {
+        let f = self.faces.get(i)?;
+        Some(FaceRows {
+            corners: f.corner.map(|c| self.corners[c as usize].as_row()),
+            flat: f.object_and_flags & FLAT_BIT != 0,
+            material: f.material,
+            object: f.object_and_flags & !FLAG_BITS,
+        })
     }
 
     /// Where triangle `i`'s record lies in memory, for prefetching (its
