@@ -8,6 +8,8 @@
 //! no cracks and no double hits, whatever the mesh.
 
 use super::rect::{tested_rect, PixelRect, TestCounter};
+use crate::math::lanes::{mask_bits, simd_level};
+use fearless_simd::{dispatch, i32x8, Simd, SimdBase};
 use super::setup::ScreenTri;
 use super::subpixel::{snap, snap_offset, ONE};
 use crate::math::Vec2;
@@ -186,18 +188,21 @@ pub fn row_pixels(x0: u32, bits: u8) -> impl Iterator<Item = u32> {
 /// the first pixel `(x0, y)` and its covered samples as bits (bit k: pixel
 /// `x0 + k`), in the same order. For code that takes a row of samples at once.
 pub fn raster_rows<C: TestCounter, F: FnMut(u32, u32, u8)>(ft: &FixedTri, rect: PixelRect, off: [i64; 2], tested: &mut C, emit: F) {
-    if ft.wide {
-        raster_in::<i128, C, F>(ft, rect, off, tested, emit)
-    } else {
-        raster_in::<i64, C, F>(ft, rect, off, tested, emit)
-    }
-}
-
-#[inline(always)]
-fn raster_in<T: EdgeInt, C: TestCounter, F: FnMut(u32, u32, u8)>(ft: &FixedTri, rect: PixelRect, off: [i64; 2], tested: &mut C, mut emit: F) {
     let Some(r) = tested_rect(&ft.bbox, &rect, tested) else {
         return;
     };
+    if ft.wide {
+        return raster_in::<i128, F>(ft, r, off, emit);
+    }
+    match NarrowEdges::new(ft, r, off) {
+        Some(edges) => dispatch!(simd_level(), simd => raster_lanes(simd, &edges, r, emit)),
+        None => raster_in::<i64, F>(ft, r, off, emit),
+    }
+}
+
+/// The pixels of `r` (already counted as tested) one at a time, in `T`.
+#[inline(always)]
+fn raster_in<T: EdgeInt, F: FnMut(u32, u32, u8)>(ft: &FixedTri, r: PixelRect, off: [i64; 2], mut emit: F) {
     let step_x = [0, 1, 2].map(|k| T::from(ft.a[k]) * T::from(ONE));
     let step_y = [0, 1, 2].map(|k| T::from(ft.b[k]) * T::from(ONE));
     let bias = ft.bias.map(T::from);
@@ -224,6 +229,73 @@ fn raster_in<T: EdgeInt, C: TestCounter, F: FnMut(u32, u32, u8)>(ft: &FixedTri, 
         row[0] = row[0] + step_y[0];
         row[1] = row[1] + step_y[1];
         row[2] = row[2] + step_y[2];
+    }
+}
+
+/// A triangle's edge functions over a pixel rectangle when every value the
+/// eight-lane loop forms there fits in 32 bits (most triangles: those a
+/// few hundred pixels across or less). Integers, so the lanes find exactly
+/// the coverage `raster_in` finds.
+struct NarrowEdges {
+    /// At the rectangle's first pixel.
+    row: [i64; 3],
+    step_x: [i32; 3],
+    step_y: [i64; 3],
+    bias: [i32; 3],
+}
+
+impl NarrowEdges {
+    fn new(ft: &FixedTri, r: PixelRect, off: [i64; 2]) -> Option<NarrowEdges> {
+        let row: [i64; 3] = ft.edges_at_pixel(r.x0, r.y0, off);
+        // The lanes reach up to seven pixels past the rectangle's right end,
+        // and one step of eight beyond that after the last run; the values
+        // are linear in x and y, so the extremes are at the corners.
+        let last_x = ((r.x1 - r.x0).div_ceil(8) * 8 + 7) as i64;
+        let last_y = (r.y1 - r.y0 - 1) as i64;
+        let fits = |v: i64| v.abs() < i32::MAX as i64;
+        let mut step_x = [0i32; 3];
+        let mut step_y = [0i64; 3];
+        for k in 0..3 {
+            let (sx, sy) = (ft.a[k] * ONE, ft.b[k] * ONE);
+            let corners = [row[k], row[k] + sx * last_x, row[k] + sy * last_y, row[k] + sx * last_x + sy * last_y];
+            if !corners.into_iter().all(fits) || !fits(8 * sx) {
+                return None;
+            }
+            (step_x[k], step_y[k]) = (sx as i32, sy);
+        }
+        Some(NarrowEdges { row, step_x, step_y, bias: ft.bias.map(|b| b as i32) })
+    }
+}
+
+/// `raster_in` eight pixels of a row at a time: the three edge functions of
+/// eight neighbouring pixels in lanes, compared with their biases at once.
+// No closures below: they would be compiled apart from this function,
+// without the SIMD level `dispatch` compiles it for.
+#[inline(always)]
+fn raster_lanes<S: Simd, F: FnMut(u32, u32, u8)>(simd: S, edges: &NarrowEdges, r: PixelRect, mut emit: F) {
+    #[inline(always)]
+    fn splat<S: Simd>(simd: S, v: i32) -> i32x8<S> {
+        <i32x8<S> as SimdBase<S>>::splat(simd, v)
+    }
+    let lane = i32x8::from_slice(simd, &[0, 1, 2, 3, 4, 5, 6, 7]);
+    let offsets = [lane * splat(simd, edges.step_x[0]), lane * splat(simd, edges.step_x[1]), lane * splat(simd, edges.step_x[2])];
+    let run = [splat(simd, 8 * edges.step_x[0]), splat(simd, 8 * edges.step_x[1]), splat(simd, 8 * edges.step_x[2])];
+    let bias = [splat(simd, edges.bias[0]), splat(simd, edges.bias[1]), splat(simd, edges.bias[2])];
+    let mut row = edges.row;
+    for y in r.y0..r.y1 {
+        let mut e = [splat(simd, row[0] as i32) + offsets[0], splat(simd, row[1] as i32) + offsets[1], splat(simd, row[2] as i32) + offsets[2]];
+        let mut x0 = r.x0;
+        while x0 < r.x1 {
+            let n = (r.x1 - x0).min(8);
+            let inside = e[0].simd_ge(bias[0]) & e[1].simd_ge(bias[1]) & e[2].simd_ge(bias[2]);
+            let bits = mask_bits(inside) & (0xffu8 >> (8 - n));
+            if bits != 0 {
+                emit(x0, y, bits);
+            }
+            e = [e[0] + run[0], e[1] + run[1], e[2] + run[2]];
+            x0 += n;
+        }
+        row = [row[0] + edges.step_y[0], row[1] + edges.step_y[1], row[2] + edges.step_y[2]];
     }
 }
 
@@ -297,6 +369,52 @@ mod tests {
         let (a, b) = (make(half).unwrap(), FixedTri::new(&st(half), off, Vec2::splat(0.5), 16, 16).unwrap());
         assert!(!a.ray);
         assert_eq!((a.v, a.a, a.b, a.bias, a.bbox), (b.v, b.a, b.b, b.bias, b.bbox));
+    }
+
+    /// The eight-lane loop hands over exactly the runs the one-pixel loop
+    /// does, on random triangles from a few pixels to thousands across
+    /// (those fall back to 64 bits), over the whole image and over tiles.
+    #[test]
+    fn lanes_cover_exactly_what_one_pixel_at_a_time_covers() {
+        let mut state = 11u64;
+        let mut next = move || {
+            state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+            let mut z = state;
+            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+            ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let (w, h) = (300u32, 200u32);
+        let off = snap_offset(Vec2::splat(0.5));
+        let (mut narrow, mut wider, mut runs) = (0, 0, 0);
+        for i in 0..4000 {
+            let scale = [3.0, 20.0, 150.0, 6000.0][i % 4];
+            let centre = Vec2::new(next() * w as f32, next() * h as f32);
+            let mut p = [0, 1, 2].map(|_| centre + Vec2::new(next() - 0.5, next() - 0.5) * scale);
+            if i % 2 == 1 {
+                // Vertices on the half-pixel grid: edges through samples, where
+                // only the tie rule decides.
+                p = p.map(|v| (v * 2.0).round() / 2.0);
+            }
+            let Some(st) = ScreenTri::flat(0, p, Vec2::splat(0.5), w, h) else { continue };
+            let Some(ft) = FixedTri::new(&st, off, Vec2::splat(0.5), w, h) else { continue };
+            let rect = if i % 3 == 0 {
+                let (x, y) = ((next() * w as f32) as u32 / 64 * 64, (next() * h as f32) as u32 / 64 * 64);
+                PixelRect::new(x, y, (x + 64).min(w), (y + 64).min(h))
+            } else {
+                PixelRect::new(0, 0, w, h)
+            };
+            let mut lanes = Vec::new();
+            raster_rows(&ft, rect, off, &mut 0u64, |x, y, bits| lanes.push((x, y, bits)));
+            let mut one_by_one = Vec::new();
+            if let Some(r) = tested_rect(&ft.bbox, &rect, &mut 0u64) {
+                raster_in::<i64, _>(&ft, r, off, |x, y, bits| one_by_one.push((x, y, bits)));
+                if NarrowEdges::new(&ft, r, off).is_some() { narrow += 1 } else { wider += 1 }
+            }
+            assert_eq!(lanes, one_by_one, "triangle {i}: {p:?} in {rect:?}");
+            runs += lanes.len();
+        }
+        assert!(narrow > 1000 && wider > 100 && runs > 10_000, "{narrow} narrow, {wider} wider, {runs} runs");
     }
 
     #[test]

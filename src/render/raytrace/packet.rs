@@ -93,12 +93,13 @@ impl Packet {
     #[inline(always)]
     fn prepare_group<S: Simd>(&mut self, simd: S, g: usize, bvh: &crate::render::raytrace::bvh::Bvh) -> u8 {
         let lanes = 8 * g..8 * g + 8;
-        let rays = &self.rays[lanes.clone()];
-        let mut columns = [[0.0f32; 8]; 6];
-        for (k, ray) in rays.iter().enumerate() {
+        // The rays' coordinates into the packet's lanes, then read back as
+        // vectors (a copy through a temporary array was compiled into far
+        // more instructions by some builds than others).
+        for (k, ray) in self.rays[lanes.clone()].iter().enumerate() {
             for a in 0..3 {
-                columns[a][k] = ray.origin[a];
-                columns[3 + a][k] = ray.dir[a];
+                self.origin[a].0[8 * g + k] = ray.origin[a];
+                self.dir[a].0[8 * g + k] = ray.dir[a];
             }
         }
         let t_max = f32x8::from_slice(simd, &self.t_max[lanes.clone()]);
@@ -106,14 +107,12 @@ impl Packet {
         let mut origin = [one; 3];
         let mut inv = [one; 3];
         for a in 0..3 {
-            origin[a] = f32x8::simd_from(simd, columns[a]);
-            let dir = f32x8::simd_from(simd, columns[3 + a]);
+            origin[a] = f32x8::from_slice(simd, &self.origin[a].0[lanes.clone()]);
+            let dir = f32x8::from_slice(simd, &self.dir[a].0[lanes.clone()]);
             // A zero (or denormal) component gets a huge finite inverse, as
             // in `PreparedRay::new`.
             let raw = one / dir;
             inv[a] = raw.is_finite().select(raw, huge.copysign(dir));
-            self.origin[a].0[lanes.clone()].copy_from_slice(&columns[a]);
-            self.dir[a].0[lanes.clone()].copy_from_slice(&columns[3 + a]);
             inv[a].store_slice(&mut self.inv[a].0[lanes.clone()]);
         }
         self.best_t.0[lanes.clone()].copy_from_slice(&self.t_max[lanes.clone()]);
@@ -323,7 +322,9 @@ impl BvhQuery<'_> {
                 let mut child_near = [f32::INFINITY; 8];
                 // The groups of eight lanes with an active ray, and their lanes'
                 // far ends (-inf in inactive lanes, so their box tests fail).
-                let mut groups = [(0usize, f32x8::splat(simd, 0.0)); P / 8];
+                // Only the first `n_groups` are written and read: not cleared
+                // per node (512 bytes).
+                let mut groups: [MaybeUninit<(usize, f32x8<S>)>; P / 8] = [const { MaybeUninit::uninit() }; P / 8];
                 let mut n_groups = 0;
                 let mut far_max = f32::NEG_INFINITY;
                 let mut pending = mask;
@@ -335,7 +336,7 @@ impl BvhQuery<'_> {
                     let best = f32x8::from_slice(simd, &pk.best_t.0[8 * g..8 * g + 8]);
                     let far = active.select(best, f32x8::splat(simd, f32::NEG_INFINITY));
                     far_max = far_max.max(horizontal_max(far));
-                    groups[n_groups] = (g, far);
+                    groups[n_groups] = MaybeUninit::new((g, far));
                     n_groups += 1;
                 }
                 // Interval test: the children no ray of the packet can meet.
@@ -347,7 +348,9 @@ impl BvhQuery<'_> {
                     let planes: [f32x8<S>; 6] = std::array::from_fn(|k| f32x8::splat(simd, node.planes[k][c]));
                     let mut near = f32x8::splat(simd, f32::INFINITY);
                     let mut bits_all = 0u64;
-                    for &(g, t_far) in &groups[..n_groups] {
+                    for slot in &groups[..n_groups] {
+                        // SAFETY: the first `n_groups` entries were written above.
+                        let (g, t_far) = unsafe { slot.assume_init() };
                         let (hit, tn) = slab_test_rays8(simd, &planes, pk, 8 * g, t_far);
                         bits_all |= (mask_bits(hit) as u64) << (8 * g);
                         near = near.min(hit.select(tn, f32x8::splat(simd, f32::INFINITY)));
