@@ -93,13 +93,12 @@ impl Packet {
     #[inline(always)]
     fn prepare_group<S: Simd>(&mut self, simd: S, g: usize, bvh: &crate::render::raytrace::bvh::Bvh) -> u8 {
         let lanes = 8 * g..8 * g + 8;
-        // The rays' coordinates into the packet's lanes, then read back as
-        // vectors (a copy through a temporary array was compiled into far
-        // more instructions by some builds than others).
-        for (k, ray) in self.rays[lanes.clone()].iter().enumerate() {
+        let rays = &self.rays[lanes.clone()];
+        let mut columns = [[0.0f32; 8]; 6];
+        for (k, ray) in rays.iter().enumerate() {
             for a in 0..3 {
-                self.origin[a].0[8 * g + k] = ray.origin[a];
-                self.dir[a].0[8 * g + k] = ray.dir[a];
+                columns[a][k] = ray.origin[a];
+                columns[3 + a][k] = ray.dir[a];
             }
         }
         let t_max = f32x8::from_slice(simd, &self.t_max[lanes.clone()]);
@@ -107,12 +106,14 @@ impl Packet {
         let mut origin = [one; 3];
         let mut inv = [one; 3];
         for a in 0..3 {
-            origin[a] = f32x8::from_slice(simd, &self.origin[a].0[lanes.clone()]);
-            let dir = f32x8::from_slice(simd, &self.dir[a].0[lanes.clone()]);
+            origin[a] = f32x8::simd_from(simd, columns[a]);
+            let dir = f32x8::simd_from(simd, columns[3 + a]);
             // A zero (or denormal) component gets a huge finite inverse, as
             // in `PreparedRay::new`.
             let raw = one / dir;
             inv[a] = raw.is_finite().select(raw, huge.copysign(dir));
+            self.origin[a].0[lanes.clone()].copy_from_slice(&columns[a]);
+            self.dir[a].0[lanes.clone()].copy_from_slice(&columns[3 + a]);
             inv[a].store_slice(&mut self.inv[a].0[lanes.clone()]);
         }
         self.best_t.0[lanes.clone()].copy_from_slice(&self.t_max[lanes.clone()]);
