@@ -3,7 +3,8 @@
 //! vector, chosen between in proportion to their albedo. `bsdf()` itself
 //! stays the one definition of the reflectance.
 
-use super::sampling::{blinn_phong_half, blinn_phong_pdf, cosine_hemisphere, cosine_hemisphere_pdf, from_local, luminance, reflect};
+use super::sampling::{blinn_phong_half, blinn_phong_pdf, cosine_hemisphere, cosine_hemisphere_lanes, cosine_hemisphere_pdf, cosine_hemisphere_pdf_lanes, from_local, from_local_lanes, luminance, reflect};
+use crate::math::lanes::{Lane, V3};
 use super::shade::bsdf;
 use crate::math::{Vec2, Vec3};
 use crate::scene::Material;
@@ -75,13 +76,22 @@ pub fn sample_bsdf(material: &Material, albedo: Vec3, n: Vec3, w_o: Vec3, choice
 /// (`(albedo / pi) cos / (cos / pi)` exactly, without its rounding).
 #[inline]
 fn sample_lambertian(albedo: Vec3, n: Vec3, u: Vec2) -> Option<BsdfSample> {
-    let w_i = from_local(cosine_hemisphere(u), n);
-    if !(n.dot(w_i) > 0.0) {
-        return None;
-    }
+    let (w_i, pdf, usable) = cosine_lobe(V3::from(n), u.x, u.y);
+    (usable && albedo.is_finite()).then_some(BsdfSample { w_i: w_i.into(), pdf, weight: albedo })
+}
+
+/// The cosine lobe about the unit normal `n` sampled at (`ux`, `uy`), over
+/// lanes (path bounces take it eight at a time): the unit direction, its
+/// density, and whether it can be used (it leaves above the surface with a
+/// positive density).
+#[inline(always)]
+pub fn cosine_lobe<L: Lane>(n: V3<L>, ux: L, uy: L) -> (V3<L>, L, L::Mask) {
+    let w_i = from_local_lanes(cosine_hemisphere_lanes(ux, uy), n);
+    let zero = ux.splat(0.0);
+    let above = n.dot(w_i).gt(zero);
     let w_i = w_i.normalize();
-    let pdf = cosine_hemisphere_pdf(n.dot(w_i));
-    (pdf > 0.0 && albedo.is_finite()).then_some(BsdfSample { w_i, pdf, weight: albedo })
+    let pdf = cosine_hemisphere_pdf_lanes(n.dot(w_i));
+    (w_i, pdf, above & pdf.gt(zero))
 }
 
 #[cfg(test)]

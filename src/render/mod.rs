@@ -16,6 +16,7 @@ pub mod layer_support;
 pub mod lighting;
 pub mod normal_map;
 pub mod opengl;
+pub mod path_batch;
 pub mod photon_map;
 pub mod prepared;
 pub mod sampling;
@@ -279,6 +280,13 @@ pub trait SceneQuery: Sync {
     /// The first surface found along `ray` with `0 < t < t_max`; `None`
     /// when the segment is clear.
     fn occluder<R: Recorder>(&self, ray: &Ray, t_max: f32, counts: &mut RayCounts, rec: &mut R) -> Option<Occluder>;
+    /// `closest` (unrecorded) for a ray whose hit is shaded in a batch: a
+    /// triangle hit may come back as what its record is built from, so
+    /// that the batch builds eight records at once (`Scene::triangle_hits`,
+    /// the same records `closest` gives).
+    fn closest_for_batch(&self, ray: &Ray, t_max: f32, inside: bool, counts: &mut RayCounts) -> Option<BatchHit> {
+        self.closest(ray, t_max, inside, counts, &mut pixel_record::NoRecord).map(BatchHit::Record)
+    }
     /// Shadow maps to look light visibility up in (`--shadows map`);
     /// `resolve_sample` wraps the query in a `shadow_map::MapQuery` that has them.
     fn shadow_maps(&self) -> Option<&shadow_map::ShadowMaps> {
@@ -290,6 +298,15 @@ pub trait SceneQuery: Sync {
     fn volume_count(&self, _light: usize) -> Option<i32> {
         None
     }
+}
+
+/// A hit as `SceneQuery::closest_for_batch` finds it.
+#[derive(Clone, Copy, Debug)]
+pub enum BatchHit {
+    /// A triangle's hit, its record not built yet.
+    Triangle(crate::scene::hit_lanes::TriangleHitInput),
+    /// Any other hit, as its record.
+    Record(SurfaceHit),
 }
 
 /// One sample pass of a frame: every pixel sampled at the same sub-pixel offset.

@@ -4,6 +4,7 @@
 //! images never depend on the thread count and a replayed pixel draws exactly
 //! the numbers its frame drew.
 
+use crate::math::lanes::{cos_sin_turns, Lane, V3};
 use crate::math::{Vec2, Vec3};
 use std::f32::consts::PI;
 
@@ -174,31 +175,57 @@ pub fn permute(mut i: u32, len: u32, key: u32) -> u32 {
 /// Orthonormal Basis, Revisited", 2017).
 #[inline]
 pub fn tangents(n: Vec3) -> (Vec3, Vec3) {
-    let sign = 1.0f32.copysign(n.z);
-    let a = -1.0 / (sign + n.z);
+    let (t, b) = tangents_lanes(V3::from(n));
+    (t.into(), b.into())
+}
+
+/// `tangents` over lanes.
+#[inline(always)]
+pub fn tangents_lanes<L: Lane>(n: V3<L>) -> (V3<L>, V3<L>) {
+    let one = n.z.splat(1.0);
+    let sign = one.copysign(n.z);
+    let a = -one / (sign + n.z);
     let b = n.x * n.y * a;
-    (Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x), Vec3::new(b, sign + n.y * n.y * a, -n.y))
+    (V3::new(one + sign * n.x * n.x * a, sign * b, -sign * n.x), V3::new(b, sign + n.y * n.y * a, -n.y))
 }
 
 /// `local` (z along `n`) in world space.
 #[inline]
 pub fn from_local(local: Vec3, n: Vec3) -> Vec3 {
-    let (t, b) = tangents(n);
-    t * local.x + b * local.y + n * local.z
+    from_local_lanes(V3::from(local), V3::from(n)).into()
+}
+
+/// `from_local` over lanes.
+#[inline(always)]
+pub fn from_local_lanes<L: Lane>(local: V3<L>, n: V3<L>) -> V3<L> {
+    let (t, b) = tangents_lanes(n);
+    t.scale(local.x) + b.scale(local.y) + n.scale(local.z)
 }
 
 /// A direction about the local z axis with density cos(theta) / pi: points
 /// spread uniformly on the unit disk, lifted onto the hemisphere (Malley).
 #[inline]
 pub fn cosine_hemisphere(u: Vec2) -> Vec3 {
-    let r = u.x.sqrt();
-    let phi = 2.0 * PI * u.y;
-    Vec3::new(r * phi.cos(), r * phi.sin(), (1.0 - u.x).max(0.0).sqrt())
+    cosine_hemisphere_lanes(u.x, u.y).into()
+}
+
+/// `cosine_hemisphere` over lanes, for the point (`ux`, `uy`).
+#[inline(always)]
+pub fn cosine_hemisphere_lanes<L: Lane>(ux: L, uy: L) -> V3<L> {
+    let r = ux.sqrt();
+    let (cos, sin) = cos_sin_turns(uy);
+    V3::new(r * cos, r * sin, (ux.splat(1.0) - ux).max(ux.splat(0.0)).sqrt())
 }
 
 #[inline]
 pub fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
-    cos_theta.max(0.0) * (1.0 / PI)
+    cosine_hemisphere_pdf_lanes(cos_theta)
+}
+
+/// `cosine_hemisphere_pdf` over lanes.
+#[inline(always)]
+pub fn cosine_hemisphere_pdf_lanes<L: Lane>(cos_theta: L) -> L {
+    cos_theta.max(cos_theta.splat(0.0)) * cos_theta.splat(1.0 / PI)
 }
 
 /// A half vector about the local z axis with density

@@ -1,15 +1,17 @@
 //! `shade()` for eight samples at once, as frames use it: the ray caster
 //! hands over a row of its packet's tile, the rasterizers a run of visible
 //! samples. Direct light runs eight lanes wide (`lighting::direct_light` on
-//! `f32x8`, at the best SIMD level the CPU has); everything that follows
-//! rays one sample at a time (ambient occlusion, indirect light, mirrors and
-//! glass) is `shade()`'s own one-sample code, called per lane in the same
-//! order. So each lane's value is bit for bit the value `shade()` gives that
-//! sample alone, which is what pixel replays run.
+//! `f32x8`, at the best SIMD level the CPU has). Path-traced indirect light
+//! follows the samples' paths together (`path_batch`); everything else that
+//! follows rays one sample at a time (ambient occlusion, photon gathers,
+//! mirrors and glass) is `shade()`'s own one-sample code, called per lane in
+//! the same order. So each lane's value is bit for bit the value `shade()`
+//! gives that sample alone, which is what pixel replays run.
 
 use super::lighting::{self, IncidenceLanes, LightVisibility, SurfaceLanes};
 use super::pixel_record::NoRecord;
 use super::shade::{self, Incidence, Shading};
+use super::path_batch::{self, PathPool};
 use super::{debug::View, gi::PathState, Interpolation, PassJob, RayCounts, SceneQuery, ShadowMode};
 use crate::math::lanes::{mask_bits, mask_from_bits, simd_level, Lane, V3};
 use crate::math::{Radiance, Ray, Vec2, Vec3};
@@ -247,40 +249,13 @@ pub fn shade_batch<Q: SceneQuery>(job: &PassJob, query: &Q, batch: &Batch, block
     let mut paths: [PathState; LANES] = std::array::from_fn(|i| {
         PathState::new(batch.pixels[i], job.sample, settings.spp, &settings.gi, job.photons)
     });
-    // Lanes past `len` repeat lane 0's geometry (so their arithmetic stays
-    // tame) with a black material; their results are dropped.
-    let mut surface = SurfaceArrays {
-        position: hits.position,
-        normal: hits.shading_normal,
-        w_o: batch.w_o,
-        albedo: [[0.0; LANES]; 3],
-        glossy: [[0.0; LANES]; 3],
-        sharpness: [1.0; LANES],
-        ambient: [[0.0; LANES]; 3],
-    };
-    for i in n..LANES {
-        for a in 0..3 {
-            surface.position[a][i] = hits.position[a][0];
-            surface.normal[a][i] = hits.shading_normal[a][0];
-            surface.w_o[a][i] = batch.w_o[a][0];
-        }
+    let (albedo, direct) = direct_in_lanes(job, query, hits, &batch.w_o, n, &mut paths, &IN_ORDER, blocked, counts);
+    if path_batch::takes(job) {
+        let mut pool = PathPool::new();
+        pool.add(hits, &batch.w_o, n, paths, &albedo, &direct);
+        let values = pool.trace(job, query, counts);
+        return std::array::from_fn(|i| values.get(i).copied().unwrap_or(Radiance::ZERO));
     }
-    let mut albedo = [Vec3::ZERO; LANES];
-    for i in 0..n {
-        let material = &scene.materials[hits.material[i] as usize];
-        albedo[i] = shade::albedo_at(material, Vec2::new(hits.uv[0][i], hits.uv[1][i]), &hits.diff[i], settings);
-        let mut sh = Shading { scene, query, settings, path: &mut paths[i], counts: &mut *counts, rec: &mut NoRecord };
-        let ambient = shade::ambient_term(&mut sh, || hits.get(i), albedo[i]);
-        for (a, (v, g)) in [(albedo[i].x, material.glossy.x), (albedo[i].y, material.glossy.y), (albedo[i].z, material.glossy.z)].into_iter().enumerate() {
-            surface.albedo[a][i] = v;
-            surface.glossy[a][i] = g;
-        }
-        (surface.ambient[0][i], surface.ambient[1][i], surface.ambient[2][i]) = (ambient.x, ambient.y, ambient.z);
-        surface.sharpness[i] = material.sharpness;
-    }
-    let mut visibility = BatchVisibility { job, query, hits, live: ((1u32 << n) - 1) as u8, blocked, counts: &mut *counts };
-    let direct = dispatch!(simd_level(), simd => direct_light8(simd, job, &surface, &mut visibility));
-
     let mut out = [Radiance::ZERO; LANES];
     for i in 0..n {
         let material = &scene.materials[hits.material[i] as usize];
@@ -294,6 +269,77 @@ pub fn shade_batch<Q: SceneQuery>(job: &PassJob, query: &Q, batch: &Batch, block
         out[i] = shade::after_direct(&mut sh, &hit, material, albedo[i], w_o, 0, direct[i]);
     }
     out
+}
+
+/// `shade_batch` with `--gi path`, the paths not followed yet: the batch's
+/// samples go into `pool`, whose `trace` gives their radiance (in the order
+/// they were put in) with those of other batches.
+pub fn start_paths<'p, Q: SceneQuery>(job: &PassJob<'p>, query: &Q, batch: &Batch, blocked: Option<&[u8]>, counts: &mut RayCounts, pool: &mut PathPool<'p>) {
+    assert!(batch.pending.len == 0 && batch.pending_ray_count == 0, "start_paths on a batch with hits not built (`build_pending`)");
+    let settings = job.settings;
+    let mut paths: [PathState; LANES] = std::array::from_fn(|i| {
+        PathState::new(batch.pixels[i], job.sample, settings.spp, &settings.gi, job.photons)
+    });
+    let (albedo, direct) = direct_in_lanes(job, query, &batch.hits, &batch.w_o, batch.len, &mut paths, &IN_ORDER, blocked, counts);
+    pool.add(&batch.hits, &batch.w_o, batch.len, paths, &albedo, &direct);
+}
+
+/// Lane i's path is path i.
+pub const IN_ORDER: [usize; LANES] = [0, 1, 2, 3, 4, 5, 6, 7];
+
+/// What `shade()` computes before `after_direct` for the surfaces in lanes
+/// `0..n` of `hits`, seen along the unit directions `w_o`: each one's
+/// albedo, and its ambient term plus direct light (eight lanes wide).
+/// Lane i's sample follows path `paths[path_of[i]]` (the ambient term may
+/// draw from its random numbers). `blocked` as in `shade_batch`.
+#[allow(clippy::too_many_arguments)]
+pub fn direct_in_lanes<Q: SceneQuery>(
+    job: &PassJob,
+    query: &Q,
+    hits: &HitLanes,
+    w_o: &[Floats; 3],
+    n: usize,
+    paths: &mut [PathState],
+    path_of: &[usize; LANES],
+    blocked: Option<&[u8]>,
+    counts: &mut RayCounts,
+) -> ([Vec3; LANES], [Radiance; LANES]) {
+    let scene = &job.prepared.scene;
+    let settings = job.settings;
+    // Lanes past `n` repeat lane 0's geometry (so their arithmetic stays
+    // tame) with a black material; their results are dropped.
+    let mut surface = SurfaceArrays {
+        position: hits.position,
+        normal: hits.shading_normal,
+        w_o: *w_o,
+        albedo: [[0.0; LANES]; 3],
+        glossy: [[0.0; LANES]; 3],
+        sharpness: [1.0; LANES],
+        ambient: [[0.0; LANES]; 3],
+    };
+    for i in n..LANES {
+        for a in 0..3 {
+            surface.position[a][i] = hits.position[a][0];
+            surface.normal[a][i] = hits.shading_normal[a][0];
+            surface.w_o[a][i] = w_o[a][0];
+        }
+    }
+    let mut albedo = [Vec3::ZERO; LANES];
+    for i in 0..n {
+        let material = &scene.materials[hits.material[i] as usize];
+        albedo[i] = shade::albedo_at(material, Vec2::new(hits.uv[0][i], hits.uv[1][i]), &hits.diff[i], settings);
+        let mut sh = Shading { scene, query, settings, path: &mut paths[path_of[i]], counts: &mut *counts, rec: &mut NoRecord };
+        let ambient = shade::ambient_term(&mut sh, || hits.get(i), albedo[i]);
+        for (a, (v, g)) in [(albedo[i].x, material.glossy.x), (albedo[i].y, material.glossy.y), (albedo[i].z, material.glossy.z)].into_iter().enumerate() {
+            surface.albedo[a][i] = v;
+            surface.glossy[a][i] = g;
+        }
+        (surface.ambient[0][i], surface.ambient[1][i], surface.ambient[2][i]) = (ambient.x, ambient.y, ambient.z);
+        surface.sharpness[i] = material.sharpness;
+    }
+    let mut visibility = BatchVisibility { job, query, hits, live: ((1u32 << n) - 1) as u8, blocked, counts: &mut *counts };
+    let direct = dispatch!(simd_level(), simd => direct_light8(simd, job, &surface, &mut visibility));
+    (albedo, direct)
 }
 
 /// What `direct_light8` loads as lanes, one array per coordinate.

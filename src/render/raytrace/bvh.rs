@@ -27,8 +27,9 @@ use crate::math::lanes::{mask_bits, simd_level};
 use fearless_simd::{f32x8, Simd, SimdBase};
 use crate::math::Ray;
 use fearless_simd::dispatch;
-use crate::render::pixel_record::Recorder;
-use crate::render::{Occluder, PreparedScene, RayCounts, SceneQuery};
+use crate::render::pixel_record::{NoRecord, Recorder};
+use crate::render::{BatchHit, Occluder, PreparedScene, RayCounts, SceneQuery};
+use crate::scene::hit_lanes::TriangleHitInput;
 use crate::scene::{PrimitiveId, PrimitiveKind, SurfaceHit};
 use std::sync::Arc;
 use glam::{Vec3, Vec3A};
@@ -358,6 +359,18 @@ impl<'a> BvhQuery<'a> {
         self.traverse_flat::<ANY, R>(ray, t_max, inside, counts, rec)
     }
 
+    /// The hit `closest` makes of `best` along `ray`, a triangle's as what
+    /// its record is built from.
+    #[inline]
+    fn batch_hit(&self, best: &BestHit, ray: &Ray) -> BatchHit {
+        let (b1, b2) = best.bary;
+        match best.id.kind() {
+            // `primitive_hit`'s weights, for `triangle_hit`'s record.
+            PrimitiveKind::Triangle => BatchHit::Triangle(TriangleHitInput { index: best.id.index(), b: Vec3::new(1.0 - b1 - b2, b1, b2), t: best.t, dir: ray.dir }),
+            _ => BatchHit::Record(self.prepared.scene.primitive_hit(best.id, best.t, b1, b2, ray)),
+        }
+    }
+
     /// Starts loading the scene's record of triangle `id` (a hint only).
     #[inline(always)]
     fn prefetch_triangle(&self, id: PrimitiveId) {
@@ -511,6 +524,14 @@ impl SceneQuery for BvhQuery<'_> {
         }
         let best = best?;
         Some(scene.primitive_hit(best.id, best.t, best.bary.0, best.bary.1, ray))
+    }
+
+    fn closest_for_batch(&self, ray: &Ray, t_max: f32, inside: bool, counts: &mut RayCounts) -> Option<BatchHit> {
+        if !self.prepared.scene.csgs.is_empty() {
+            return self.closest(ray, t_max, inside, counts, &mut NoRecord).map(BatchHit::Record);
+        }
+        let best = self.traverse::<false, NoRecord>(ray, t_max, inside, counts, &mut NoRecord)?;
+        Some(self.batch_hit(&best, ray))
     }
 
     fn occluder<R: Recorder>(&self, ray: &Ray, t_max: f32, counts: &mut RayCounts, rec: &mut R) -> Option<Occluder> {

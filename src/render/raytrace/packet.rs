@@ -26,6 +26,7 @@ use crate::math::lanes::{mask_bits, mask_from_bits, simd_level, V3};
 use crate::math::{Radiance, Ray};
 use crate::render::debug::View;
 use crate::render::pixel_record::NoRecord;
+use crate::render::path_batch::{self, PathPool};
 use crate::render::shade_batch::{self, Batch};
 use crate::render::{miss_without_ray, resolve_sample, Occluder, PassJob, RayCounts, ShadowMode};
 use crate::scene::hit_lanes::{HitLanes, TriangleHitInput, HIT_LANES};
@@ -692,6 +693,27 @@ fn shade_tile_batched(
                 }
             }
         }
+    }
+    if path_batch::takes(job) {
+        // The tile's paths are followed together, so that their bounces
+        // fill the lanes.
+        let mut pool = PathPool::new();
+        for batch in batches.iter() {
+            for (k, bits) in lane_blocked.iter_mut().enumerate() {
+                *bits = (0..batch.len()).fold(0u8, |acc, j| acc | (((blocked[k] >> batch.slots[j]) & 1) as u8) << j);
+            }
+            shade_batch::start_paths(job, query, batch, shadows.then_some(&lane_blocked[..]), counts, &mut pool);
+        }
+        let values = pool.trace(job, query, counts);
+        let mut values = values.iter();
+        for batch in batches.iter_mut() {
+            for (j, value) in values.by_ref().take(batch.len()).enumerate() {
+                let (tx, ty) = lane_xy(batch.slots[j]);
+                band[ty * width + x0 + tx] = *value;
+            }
+            batch.clear();
+        }
+        return;
     }
     for batch in batches.iter_mut() {
         for (k, bits) in lane_blocked.iter_mut().enumerate() {

@@ -1,0 +1,319 @@
+//! Path tracing's bounces for many eye samples at once. `shade()` follows
+//! one sample's path by recursion: direct light at a surface, then one
+//! sampled direction, the radiance found along it (`shade()` again, one
+//! level deeper) times the bounce's weight. A `PathPool` follows the paths
+//! of all the samples put in it (a ray-cast tile's, a rasterizer batch's)
+//! together, one bounce at a time: the surviving paths' rays are traced,
+//! their hit records built eight at a time and their direct light computed
+//! eight lanes wide, as `shade_batch` does for the eye's surfaces. The more
+//! samples, the fuller the lanes stay as paths end.
+//!
+//! Each sample gets what the recursion computes for it, bit for bit (pixel
+//! replays run the recursion): the same random draws in the same order,
+//! the same rays, the same records and direct light, and the sums taken in
+//! the recursion's order, from the last bounce back to the first
+//! (`direct + weight * deeper`). A path that reaches a mirror or glass,
+//! whose delta lobes add a second branch, or its last permitted bounce,
+//! finishes in `shade()`'s own code from there.
+
+use super::bsdf_sampling::cosine_lobe;
+use super::gi::{self, GiMode, PathState};
+use super::pixel_record::NoRecord;
+use super::shade::{self, Shading};
+use super::shade_batch::{direct_in_lanes, LANES};
+use super::{BatchHit, PassJob, RayCounts, SceneQuery};
+use super::sampling::luminance;
+use crate::math::lanes::{mask_bits, simd_level, Lane, V3};
+use crate::math::{Radiance, Ray, Vec3};
+use fearless_simd::{dispatch, f32x8, Simd, SimdFrom};
+use crate::scene::hit_lanes::{Floats, HitLanes, TriangleHitInput};
+
+/// Whether frames hand their samples' paths to a `PathPool`.
+#[inline]
+pub fn takes(job: &PassJob) -> bool {
+    job.settings.gi.mode == GiMode::Path
+}
+
+/// One bounce a path took, kept until the radiance found beyond it is
+/// known: which sample, the surface's direct light (with its ambient
+/// term) and the bounce's weight.
+struct Bounce {
+    sample: usize,
+    direct: Radiance,
+    weight: Vec3,
+}
+
+/// Up to eight surfaces that live paths stand on: lane k holds sample
+/// `sample[k]`'s hit, the unit direction back along its ray, its albedo
+/// and its direct light.
+struct Group {
+    len: usize,
+    hits: HitLanes,
+    w_o: [Floats; 3],
+    sample: [usize; LANES],
+    albedo: [Vec3; LANES],
+    direct: [Radiance; LANES],
+    /// Triangle hits whose records are not built yet, and their lanes.
+    pending: [TriangleHitInput; LANES],
+    pending_lanes: [usize; LANES],
+    pending_len: usize,
+}
+
+/// The samples whose paths are followed together.
+pub struct PathPool<'p> {
+    /// Each sample's random numbers and throughput.
+    paths: Vec<PathState<'p>>,
+    /// What each sample's path finds beyond its last bounce in `bounces`.
+    beyond: Vec<Radiance>,
+    bounces: Vec<Bounce>,
+    /// The surfaces at the current depth, in groups of eight (the first
+    /// `live` of them), and room for the next depth's.
+    front: Vec<Group>,
+    live: usize,
+    next: Vec<Group>,
+}
+
+impl Default for PathPool<'_> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<'p> PathPool<'p> {
+    pub fn new() -> PathPool<'p> {
+        PathPool { paths: Vec::new(), beyond: Vec::new(), bounces: Vec::new(), front: Vec::new(), live: 0, next: Vec::new() }
+    }
+
+    /// Number of samples put in.
+    pub fn len(&self) -> usize {
+        self.paths.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.paths.is_empty()
+    }
+
+    /// Puts in `n` eye samples whose rays see `hits` (lanes `0..n`) from
+    /// directions `w_o`, following `paths`, with the albedo and direct light
+    /// `direct_in_lanes` found there. They are samples `len()..len() + n`.
+    pub fn add(&mut self, hits: &HitLanes, w_o: &[Floats; 3], n: usize, paths: [PathState<'p>; LANES], albedo: &[Vec3; LANES], direct: &[Radiance; LANES]) {
+        let first = self.paths.len();
+        self.paths.extend(paths.into_iter().take(n));
+        self.beyond.resize(first + n, Radiance::ZERO);
+        let group = slot(&mut self.front, self.live);
+        group.len = n;
+        group.hits = *hits;
+        group.w_o = *w_o;
+        group.sample = std::array::from_fn(|k| first + k);
+        group.albedo = *albedo;
+        group.direct = *direct;
+        self.live += 1;
+    }
+
+    /// Follows every sample's path to its end: sample i's radiance is
+    /// `result[i]`, what `shade::after_direct` at depth 0 returns for it.
+    pub fn trace<Q: SceneQuery>(mut self, job: &PassJob, query: &Q, counts: &mut RayCounts) -> Vec<Radiance> {
+        let mut depth = 0;
+        while self.live > 0 {
+            let mut pass = DepthPass { job, query, counts: &mut *counts, paths: &mut self.paths, beyond: &mut self.beyond, bounces: &mut self.bounces, next: &mut self.next, next_len: 0, depth };
+            for group in &self.front[..self.live] {
+                pass.bounce(group);
+            }
+            self.live = pass.next_len.div_ceil(LANES);
+            for group in &mut self.next[..self.live] {
+                group.complete(job, query, &mut self.paths, counts);
+            }
+            std::mem::swap(&mut self.front, &mut self.next);
+            depth += 1;
+        }
+        // The recursion's sums, innermost first: each bounce adds its weight
+        // times what lies beyond it to its surface's direct light.
+        for b in self.bounces.iter().rev() {
+            self.beyond[b.sample] = b.direct + b.weight * self.beyond[b.sample];
+        }
+        self.beyond
+    }
+}
+
+/// What one depth's bounces read and write.
+struct DepthPass<'w, 'p, 'j, Q> {
+    job: &'w PassJob<'j>,
+    query: &'w Q,
+    counts: &'w mut RayCounts,
+    paths: &'w mut [PathState<'p>],
+    beyond: &'w mut [Radiance],
+    bounces: &'w mut Vec<Bounce>,
+    /// The next depth's groups, and the surfaces put in them so far.
+    next: &'w mut Vec<Group>,
+    next_len: usize,
+    depth: u32,
+}
+
+impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
+    /// The bounce of every path of `group`: `after_direct`'s indirect term
+    /// as `indirect_path` and `follow` take it, the surfaces found put in
+    /// the next depth's groups. Lambertian surfaces sample their bounce
+    /// eight lanes at a time.
+    fn bounce(&mut self, group: &Group) {
+        let scene = &self.job.prepared.scene;
+        let settings = self.job.settings;
+        let mut lambertian = 0u8;
+        let mut u = [[0.0f32; LANES]; 2];
+        for k in 0..group.len {
+            let s = group.sample[k];
+            let material = &scene.materials[group.hits.material[k] as usize];
+            let path = &mut self.paths[s];
+            if self.depth >= settings.gi.max_path_depth() || material.has_secondary() {
+                let hit = group.hits.get(k);
+                let w_o = Vec3::new(group.w_o[0][k], group.w_o[1][k], group.w_o[2][k]);
+                let mut sh = Shading { scene, query: self.query, settings, path, counts: &mut *self.counts, rec: &mut NoRecord };
+                self.beyond[s] = shade::after_direct(&mut sh, &hit, material, group.albedo[k], w_o, self.depth, group.direct[k]);
+                continue;
+            }
+            if !material.has_glossy() {
+                // `sample_bounce`'s draws; the lobe is sampled below.
+                let _choice = path.rng.next_f32();
+                let d = path.rng.next_2d();
+                (u[0][k], u[1][k]) = (d.x, d.y);
+                lambertian |= 1 << k;
+                continue;
+            }
+            let hit = group.hits.get(k);
+            let w_o = Vec3::new(group.w_o[0][k], group.w_o[1][k], group.w_o[2][k]);
+            match gi::sample_bounce(material, group.albedo[k], &hit, w_o, self.depth, path, &mut NoRecord) {
+                Some((w_i, weight)) => self.go_on(group, k, w_i, weight),
+                None => self.beyond[s] = group.direct[k] + Vec3::ZERO,
+            }
+        }
+        if lambertian == 0 {
+            return;
+        }
+        let (w_i, usable) = dispatch!(simd_level(), simd => cosine_lobes8(simd, &group.hits, &u));
+        let mut m = lambertian;
+        while m != 0 {
+            let k = m.trailing_zeros() as usize;
+            m &= m - 1;
+            let s = group.sample[k];
+            let albedo = group.albedo[k];
+            // `sample_bsdf`'s tests for a Lambertian surface (it reflects
+            // something; its sample is usable), `sample_bounce`'s (the
+            // direction leaves the geometric surface's front), then the
+            // roulette.
+            let reflects = luminance(albedo).max(0.0) > 0.0 && albedo.is_finite();
+            let survival = if reflects && usable & 1 << k != 0 { gi::roulette(self.depth, self.paths[s].throughput * albedo, &mut self.paths[s].rng) } else { None };
+            match survival {
+                Some((scale, _)) => self.go_on(group, k, Vec3::new(w_i[0][k], w_i[1][k], w_i[2][k]), albedo * scale),
+                None => self.beyond[s] = group.direct[k] + Vec3::ZERO,
+            }
+        }
+    }
+
+    /// Lane `k`'s path goes on along `w_i` with `weight`: the bounce is
+    /// kept, and the surface its ray finds put in the next depth's groups
+    /// (the background noted where it escapes), as `follow` and
+    /// `radiance_along` do.
+    fn go_on(&mut self, group: &Group, k: usize, w_i: Vec3, weight: Vec3) {
+        let scene = &self.job.prepared.scene;
+        let s = group.sample[k];
+        self.bounces.push(Bounce { sample: s, direct: group.direct[k], weight });
+        let origin = Vec3::new(group.hits.position[0][k], group.hits.position[1][k], group.hits.position[2][k]);
+        let geometric = Vec3::new(group.hits.geometric_normal[0][k], group.hits.geometric_normal[1][k], group.hits.geometric_normal[2][k]);
+        // `SurfaceHit::spawn_ray_front`.
+        let ray = Ray::new(origin + geometric * self.job.settings.shadow_bump, w_i);
+        self.paths[s].throughput *= weight;
+        self.counts.secondary += 1;
+        match self.query.closest_for_batch(&ray, f32::INFINITY, false, self.counts) {
+            None => self.beyond[s] = scene.miss_radiance(ray.dir),
+            Some(found) => {
+                let into = slot(self.next, self.next_len / LANES);
+                if self.next_len.is_multiple_of(LANES) {
+                    into.len = 0;
+                    into.pending_len = 0;
+                }
+                into.push(s, found, -ray.dir);
+                self.next_len += 1;
+            }
+        }
+    }
+}
+
+/// `cosine_lobe` at the shading normals of `hits` for the points `u`, eight
+/// lanes wide: the directions, and the lanes whose direction is usable and
+/// leaves the geometric surface's front (`sample_bounce`'s test, written
+/// so that a NaN passes as it does there).
+#[inline(always)]
+fn cosine_lobes8<S: Simd>(simd: S, hits: &HitLanes, u: &[Floats; 2]) -> ([Floats; 3], u8) {
+    let n = V3::from_soa(simd, &hits.shading_normal);
+    let geometric = V3::from_soa(simd, &hits.geometric_normal);
+    let (w_i, _pdf, usable) = cosine_lobe(n, f32x8::simd_from(simd, u[0]), f32x8::simd_from(simd, u[1]));
+    let cos = w_i.dot(geometric);
+    let front = !Lane::le(cos, cos.splat(0.0));
+    (w_i.to_soa(), mask_bits(usable & front))
+}
+
+/// Group `i` of `groups`, made if there is none yet.
+fn slot(groups: &mut Vec<Group>, i: usize) -> &mut Group {
+    while groups.len() <= i {
+        groups.push(Group::new());
+    }
+    &mut groups[i]
+}
+
+impl Group {
+    fn new() -> Group {
+        Group {
+            len: 0,
+            hits: HitLanes::new(),
+            w_o: [[0.0; LANES]; 3],
+            sample: [0; LANES],
+            albedo: [Vec3::ZERO; LANES],
+            direct: [Radiance::ZERO; LANES],
+            pending: [TriangleHitInput::default(); LANES],
+            pending_lanes: [0; LANES],
+            pending_len: 0,
+        }
+    }
+
+    /// Adds sample `sample`'s hit, seen from unit direction `w_o`: a
+    /// record at once, a triangle's when the group is complete.
+    #[inline]
+    fn push(&mut self, sample: usize, found: BatchHit, w_o: Vec3) {
+        let k = self.len;
+        match found {
+            BatchHit::Triangle(input) => {
+                self.pending[self.pending_len] = input;
+                self.pending_lanes[self.pending_len] = k;
+                self.pending_len += 1;
+            }
+            BatchHit::Record(h) => self.hits.set(k, &h),
+        }
+        self.sample[k] = sample;
+        (self.w_o[0][k], self.w_o[1][k], self.w_o[2][k]) = (w_o.x, w_o.y, w_o.z);
+        self.len += 1;
+    }
+
+    /// Builds the pending triangles' records (eight at a time), as
+    /// `closest` gives them, completes every record as `radiance_along`
+    /// does (normal maps), and finds their direct light.
+    fn complete<Q: SceneQuery>(&mut self, job: &PassJob, query: &Q, paths: &mut [PathState], counts: &mut RayCounts) {
+        let scene = &job.prepared.scene;
+        let triangles = self.pending_len;
+        if triangles == self.len {
+            scene.triangle_hits(&self.pending[..triangles], &mut self.hits);
+        } else if triangles > 0 {
+            let mut built = HitLanes::new();
+            scene.triangle_hits(&self.pending[..triangles], &mut built);
+            for (j, &k) in self.pending_lanes[..triangles].iter().enumerate() {
+                self.hits.copy_lane(k, &built, j);
+            }
+        }
+        if scene.materials.iter().any(|m| m.normal_map.is_some()) {
+            for k in 0..self.len {
+                let mut h = self.hits.get(k);
+                super::normal_map::apply(scene, job.settings.texture_filter, &mut h);
+                self.hits.set(k, &h);
+            }
+        }
+        (self.albedo, self.direct) = direct_in_lanes(job, query, &self.hits, &self.w_o, self.len, paths, &self.sample, None, counts);
+    }
+}
