@@ -25,6 +25,7 @@ use crate::math::{Radiance, Ray, Vec3};
 use crate::render::debug::{cost_color, View};
 use crate::render::pixel_record::{CsgABufferRecord, FragmentRecord, NoRecord, PixelTrace, Recorder};
 use crate::render::{miss_without_ray, resolve_counted, resolve_sample, PassJob, RayCounts, SceneQuery};
+use crate::render::path_batch::{self, PathPool};
 use crate::render::shade_batch::{self, Batch};
 use crate::render::shadow_volume::split_depth;
 use super::stencil::{PixelRay, StencilSetup};
@@ -668,6 +669,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         let r = self.rect;
         let interpolation = self.job.settings.interpolation;
         let mut batch = Batch::new();
+        let mut paths = PathBatches::default();
         let scene = &self.job.prepared.scene;
         // A triangle seen without textures (the common case) has its hit
         // built in the batch (eight at a time), not returned and copied.
@@ -717,7 +719,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
                         let [b1, b2] = self.payload[i];
                         batch.push_eye_triangle(id.index(), (b1, b2), self.job.sample_position(x, y), self.job.pixel_index(x, y), slot);
                         if batch.is_full() {
-                            self.shade_batch_into(&mut batch, out);
+                            self.shade_batch_into(&mut batch, &mut paths, out);
                         }
                         continue;
                     }
@@ -725,7 +727,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
                         (ray, Some(hit)) => {
                             batch.push(interpolation, &hit, ray.dir, self.job.pixel_index(x, y), slot);
                             if batch.is_full() {
-                                self.shade_batch_into(&mut batch, out);
+                                self.shade_batch_into(&mut batch, &mut paths, out);
                             }
                         }
                         (_, None) => out[slot] = self.shade(i, x, y),
@@ -733,23 +735,38 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
                 }
             }
         }
-        self.shade_batch_into(&mut batch, out);
+        self.shade_batch_into(&mut batch, &mut paths, out);
         self.counts.primary += primary;
         self.counts.fragments_shaded += shaded;
         std::mem::take(&mut self.counts)
     }
 
     /// Shades the batch's samples into their slots of `out` and empties it.
-    fn shade_batch_into(&mut self, batch: &mut Batch, out: &mut [Radiance]) {
-        if batch.is_empty() {
-            return;
+    /// With `--gi path` the samples' paths wait in `paths`, to be followed
+    /// with those of the next batches (`PathBatches`); a batch that is not
+    /// full (the last of the region) follows them all.
+    fn shade_batch_into(&mut self, batch: &mut Batch, paths: &mut PathBatches<'a>, out: &mut [Radiance]) {
+        let last = !batch.is_full();
+        if !batch.is_empty() {
+            batch.build_pending(&self.job.prepared.scene, self.job.view, self.job.settings.interpolation);
+            if path_batch::takes(self.job) {
+                shade_batch::start_paths(self.job, self.query, batch, None, &mut self.counts, &mut paths.pool);
+                paths.slots.extend_from_slice(&batch.slots[..batch.len()]);
+            } else {
+                let values = shade_batch::shade_batch(self.job, self.query, batch, None, &mut self.counts);
+                for (j, value) in values.iter().enumerate().take(batch.len()) {
+                    out[batch.slots[j]] = *value;
+                }
+            }
+            batch.clear();
         }
-        batch.build_pending(&self.job.prepared.scene, self.job.view, self.job.settings.interpolation);
-        let values = shade_batch::shade_batch(self.job, self.query, batch, None, &mut self.counts);
-        for (j, value) in values.iter().enumerate().take(batch.len()) {
-            out[batch.slots[j]] = *value;
+        if !paths.pool.is_empty() && (last || paths.pool.len() >= PathBatches::SAMPLES) {
+            let values = std::mem::take(&mut paths.pool).trace(self.job, self.query, &mut self.counts);
+            for (&slot, value) in paths.slots.iter().zip(values) {
+                out[slot] = value;
+            }
+            paths.slots.clear();
         }
-        batch.clear();
     }
 
     /// Empties the buffers for another region of at most the same size (the tiles of a row).
@@ -779,4 +796,18 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             }
         }
     }
+}
+
+/// Eye samples whose paths wait to be followed together (`PathPool`), and
+/// the slots of `out` their radiance goes to.
+#[derive(Default)]
+struct PathBatches<'p> {
+    pool: PathPool<'p>,
+    slots: Vec<usize>,
+}
+
+impl PathBatches<'_> {
+    /// Samples gathered before their paths are followed: as many as a ray
+    /// caster's tile, whose paths keep the lanes about as full.
+    const SAMPLES: usize = 64;
 }
