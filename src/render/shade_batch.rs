@@ -293,6 +293,7 @@ pub const IN_ORDER: [usize; LANES] = [0, 1, 2, 3, 4, 5, 6, 7];
 /// Lane i's sample follows path `paths[path_of[i]]` (the ambient term may
 /// draw from its random numbers). `blocked` as in `shade_batch`.
 #[allow(clippy::too_many_arguments)]
+#[inline(always)]
 pub fn direct_in_lanes<Q: SceneQuery>(
     job: &PassJob,
     query: &Q,
