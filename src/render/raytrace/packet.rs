@@ -529,6 +529,8 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
                 textured: scene.has_textures(),
                 background: miss_without_ray(job),
                 batches: (0..P / shade_batch::LANES).map(|_| Batch::new()).collect(),
+                paths: PathPool::new(),
+                path_slots: Vec::new(),
             };
             for x0 in (0..width).step_by(TILE_W) {
                 let valid = eye_rays_into(job, &mut pk, (x0, y0), width, rows);
@@ -549,6 +551,7 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
                     band[ty * width + x0 + tx] = resolve_sample(job, query, &pk.rays[i], hits[i].as_ref(), job.pixel_index((x0 + tx) as u32, (y0 + ty) as u32), &mut counts, &mut NoRecord);
                 }
             }
+            context.follow_paths(job, query, band, &mut counts);
             counts
         })
         .reduce(RayCounts::default, |mut a, b| {
@@ -602,7 +605,7 @@ fn eye_rays_eight_wide<S: Simd>(simd: S, job: &PassJob, pk: &mut Packet, (x0, y0
 /// blocked, per light (lane bits of the tile, and of the batch being
 /// shaded; kept per band so no tile allocates), and what holds for the
 /// whole pass.
-struct TileContext {
+struct TileContext<'p> {
     tile: Vec<u64>,
     batch: Vec<u8>,
     /// Whether hits need ray differentials (`with_eye_differentials`).
@@ -612,6 +615,28 @@ struct TileContext {
     background: Option<Radiance>,
     /// The tile's surfaces in batches of eight, in lane order.
     batches: Vec<Batch>,
+    /// With `--gi path`, the band's samples whose paths wait to be followed
+    /// together (several tiles' worth, so that the lanes stay full as the
+    /// paths end), and the index in the band each one's radiance goes to.
+    paths: PathPool<'p>,
+    path_slots: Vec<usize>,
+}
+
+impl TileContext<'_> {
+    /// Samples a band gathers before following their paths: four tiles.
+    const PATH_SAMPLES: usize = 4 * P;
+
+    /// Follows the waiting samples' paths and writes their radiance to `band`.
+    fn follow_paths(&mut self, job: &PassJob, query: &BvhQuery, band: &mut [Radiance], counts: &mut RayCounts) {
+        if self.paths.is_empty() {
+            return;
+        }
+        let values = std::mem::take(&mut self.paths).trace(job, query, counts);
+        for (&slot, value) in self.path_slots.iter().zip(values) {
+            band[slot] = value;
+        }
+        self.path_slots.clear();
+    }
 }
 
 /// Shades one traced tile in batches of eight (`shade_batch`): the lanes
@@ -620,19 +645,19 @@ struct TileContext {
 /// towards every light go as one packet per light, then the batches are
 /// shaded, each light's visibility read from its packet.
 #[allow(clippy::too_many_arguments)]
-fn shade_tile_batched(
-    job: &PassJob,
+fn shade_tile_batched<'p>(
+    job: &PassJob<'p>,
     query: &BvhQuery,
     pk: &Packet,
     valid: u64,
     shadow_pk: &mut Packet,
-    context: &mut TileContext,
+    context: &mut TileContext<'p>,
     band: &mut [Radiance],
     (x0, y0): (usize, usize),
     width: usize,
     counts: &mut RayCounts,
 ) {
-    let TileContext { tile: blocked, batch: lane_blocked, textured, background, batches } = context;
+    let TileContext { tile: blocked, batch: lane_blocked, textured, background, batches, paths, path_slots } = context;
     let scene = &query.prepared.scene;
     let settings = job.settings;
     let mut filled = 0;
@@ -695,23 +720,21 @@ fn shade_tile_batched(
         }
     }
     if path_batch::takes(job) {
-        // The tile's paths are followed together, so that their bounces
-        // fill the lanes.
-        let mut pool = PathPool::new();
-        for batch in batches.iter() {
+        // The paths wait for those of the band's next tiles, to be
+        // followed together (`TileContext::follow_paths`).
+        for batch in batches.iter_mut() {
             for (k, bits) in lane_blocked.iter_mut().enumerate() {
                 *bits = (0..batch.len()).fold(0u8, |acc, j| acc | (((blocked[k] >> batch.slots[j]) & 1) as u8) << j);
             }
-            shade_batch::start_paths(job, query, batch, shadows.then_some(&lane_blocked[..]), counts, &mut pool);
-        }
-        let values = pool.trace(job, query, counts);
-        let mut values = values.iter();
-        for batch in batches.iter_mut() {
-            for (j, value) in values.by_ref().take(batch.len()).enumerate() {
-                let (tx, ty) = lane_xy(batch.slots[j]);
-                band[ty * width + x0 + tx] = *value;
-            }
+            shade_batch::start_paths(job, query, batch, shadows.then_some(&lane_blocked[..]), counts, paths);
+            path_slots.extend(batch.slots[..batch.len()].iter().map(|&i| {
+                let (tx, ty) = lane_xy(i);
+                ty * width + x0 + tx
+            }));
             batch.clear();
+        }
+        if paths.len() >= TileContext::PATH_SAMPLES {
+            context.follow_paths(job, query, band, counts);
         }
         return;
     }
