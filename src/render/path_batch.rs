@@ -2,11 +2,12 @@
 //! one sample's path by recursion: direct light at a surface, then one
 //! sampled direction, the radiance found along it (`shade()` again, one
 //! level deeper) times the bounce's weight. A `PathPool` follows the paths
-//! of all the samples put in it (a ray-cast tile's, a rasterizer batch's)
-//! together, one bounce at a time: the surviving paths' rays are traced,
-//! their hit records built eight at a time and their direct light computed
-//! eight lanes wide, as `shade_batch` does for the eye's surfaces. The more
-//! samples, the fuller the lanes stay as paths end.
+//! of all the samples put in it (a ray caster's band of tiles, a
+//! rasterizer's batches) together, one bounce at a time: the surviving
+//! paths' rays are traced, their hit records built eight at a time and
+//! their direct light computed eight lanes wide, as `shade_batch` does for
+//! the eye's surfaces. The more samples, the fuller the lanes stay as paths
+//! end.
 //!
 //! Each sample gets what the recursion computes for it, bit for bit (pixel
 //! replays run the recursion): the same random draws in the same order,
@@ -59,10 +60,13 @@ struct Group {
     pending_len: usize,
 }
 
-/// The samples whose paths are followed together.
+/// The samples whose paths are followed together. Kept between flushes
+/// (`follow_into` empties it), so that its buffers are allocated once.
 pub struct PathPool<'p> {
     /// Each sample's random numbers and throughput.
     paths: Vec<PathState<'p>>,
+    /// Where each sample's radiance goes in the caller's output.
+    slots: Vec<usize>,
     /// What each sample's path finds beyond its last bounce in `bounces`.
     beyond: Vec<Radiance>,
     bounces: Vec<Bounce>,
@@ -81,7 +85,7 @@ impl Default for PathPool<'_> {
 
 impl<'p> PathPool<'p> {
     pub fn new() -> PathPool<'p> {
-        PathPool { paths: Vec::new(), beyond: Vec::new(), bounces: Vec::new(), front: Vec::new(), live: 0, next: Vec::new() }
+        PathPool { paths: Vec::new(), slots: Vec::new(), beyond: Vec::new(), bounces: Vec::new(), front: Vec::new(), live: 0, next: Vec::new() }
     }
 
     /// Number of samples put in.
@@ -93,12 +97,15 @@ impl<'p> PathPool<'p> {
         self.paths.is_empty()
     }
 
-    /// Puts in `n` eye samples whose rays see `hits` (lanes `0..n`) from
-    /// directions `w_o`, following `paths`, with the albedo and direct light
-    /// `direct_in_lanes` found there. They are samples `len()..len() + n`.
-    pub fn add(&mut self, hits: &HitLanes, w_o: &[Floats; 3], n: usize, paths: [PathState<'p>; LANES], albedo: &[Vec3; LANES], direct: &[Radiance; LANES]) {
+    /// Puts in the eye samples whose rays see `hits` (lanes `0..n`, n =
+    /// `slots.len()`) from directions `w_o`, following `paths`, with the
+    /// albedo and direct light `direct_in_lanes` found there; lane k's
+    /// radiance goes to `out[slots[k]]` of `follow_into`.
+    pub fn add(&mut self, hits: &HitLanes, w_o: &[Floats; 3], slots: &[usize], paths: [PathState<'p>; LANES], albedo: &[Vec3; LANES], direct: &[Radiance; LANES]) {
+        let n = slots.len();
         let first = self.paths.len();
         self.paths.extend(paths.into_iter().take(n));
+        self.slots.extend_from_slice(slots);
         self.beyond.resize(first + n, Radiance::ZERO);
         let group = slot(&mut self.front, self.live);
         group.len = n;
@@ -110,9 +117,11 @@ impl<'p> PathPool<'p> {
         self.live += 1;
     }
 
-    /// Follows every sample's path to its end: sample i's radiance is
-    /// `result[i]`, what `shade::after_direct` at depth 0 returns for it.
-    pub fn trace<Q: SceneQuery>(mut self, job: &PassJob, query: &Q, counts: &mut RayCounts) -> Vec<Radiance> {
+    /// Follows every sample's path to its end and writes its radiance
+    /// (what `shade::after_direct` at depth 0 returns for it) to `out` at
+    /// its slot; the pool is then empty.
+    pub fn follow_into<Q: SceneQuery>(&mut self, job: &PassJob, query: &Q, counts: &mut RayCounts, out: &mut [Radiance]) {
+        let normal_maps = job.prepared.scene.materials.iter().any(|m| m.normal_map.is_some());
         let mut depth = 0;
         while self.live > 0 {
             let mut pass = DepthPass { job, query, counts: &mut *counts, paths: &mut self.paths, beyond: &mut self.beyond, bounces: &mut self.bounces, next: &mut self.next, next_len: 0, depth };
@@ -121,7 +130,7 @@ impl<'p> PathPool<'p> {
             }
             self.live = pass.next_len.div_ceil(LANES);
             for group in &mut self.next[..self.live] {
-                group.complete(job, query, &mut self.paths, counts);
+                group.complete(job, query, normal_maps, &mut self.paths, counts);
             }
             std::mem::swap(&mut self.front, &mut self.next);
             depth += 1;
@@ -131,7 +140,13 @@ impl<'p> PathPool<'p> {
         for b in self.bounces.iter().rev() {
             self.beyond[b.sample] = b.direct + b.weight * self.beyond[b.sample];
         }
-        self.beyond
+        for (&slot, value) in self.slots.iter().zip(&self.beyond) {
+            out[slot] = *value;
+        }
+        self.paths.clear();
+        self.slots.clear();
+        self.beyond.clear();
+        self.bounces.clear();
     }
 }
 
@@ -294,8 +309,9 @@ impl Group {
 
     /// Builds the pending triangles' records (eight at a time), as
     /// `closest` gives them, completes every record as `radiance_along`
-    /// does (normal maps), and finds their direct light.
-    fn complete<Q: SceneQuery>(&mut self, job: &PassJob, query: &Q, paths: &mut [PathState], counts: &mut RayCounts) {
+    /// does (`normal_maps`: whether any material has a normal map), and
+    /// finds their direct light.
+    fn complete<Q: SceneQuery>(&mut self, job: &PassJob, query: &Q, normal_maps: bool, paths: &mut [PathState], counts: &mut RayCounts) {
         let scene = &job.prepared.scene;
         let triangles = self.pending_len;
         if triangles == self.len {
@@ -307,7 +323,7 @@ impl Group {
                 self.hits.copy_lane(k, &built, j);
             }
         }
-        if scene.materials.iter().any(|m| m.normal_map.is_some()) {
+        if normal_maps {
             for k in 0..self.len {
                 let mut h = self.hits.get(k);
                 super::normal_map::apply(scene, job.settings.texture_filter, &mut h);

@@ -1,8 +1,8 @@
 //! `shade()` for eight samples at once, as frames use it: the ray caster
 //! hands over a row of its packet's tile, the rasterizers a run of visible
 //! samples. Direct light runs eight lanes wide (`lighting::direct_light` on
-//! `f32x8`, at the best SIMD level the CPU has). Path-traced indirect light
-//! follows the samples' paths together (`path_batch`); everything else that
+//! `f32x8`, at the best SIMD level the CPU has). Frames hand path-traced
+//! samples on to a `path_batch::PathPool` (`start_paths`); everything else that
 //! follows rays one sample at a time (ambient occlusion, photon gathers,
 //! mirrors and glass) is `shade()`'s own one-sample code, called per lane in
 //! the same order. So each lane's value is bit for bit the value `shade()`
@@ -11,7 +11,7 @@
 use super::lighting::{self, IncidenceLanes, LightVisibility, SurfaceLanes};
 use super::pixel_record::NoRecord;
 use super::shade::{self, Incidence, Shading};
-use super::path_batch::{self, PathPool};
+use super::path_batch::PathPool;
 use super::{debug::View, gi::PathState, Interpolation, PassJob, RayCounts, SceneQuery, ShadowMode};
 use crate::math::lanes::{mask_bits, mask_from_bits, simd_level, Lane, V3};
 use crate::math::{Radiance, Ray, Vec2, Vec3};
@@ -250,12 +250,6 @@ pub fn shade_batch<Q: SceneQuery>(job: &PassJob, query: &Q, batch: &Batch, block
         PathState::new(batch.pixels[i], job.sample, settings.spp, &settings.gi, job.photons)
     });
     let (albedo, direct) = direct_in_lanes(job, query, hits, &batch.w_o, n, &mut paths, &IN_ORDER, blocked, counts);
-    if path_batch::takes(job) {
-        let mut pool = PathPool::new();
-        pool.add(hits, &batch.w_o, n, paths, &albedo, &direct);
-        let values = pool.trace(job, query, counts);
-        return std::array::from_fn(|i| values.get(i).copied().unwrap_or(Radiance::ZERO));
-    }
     let mut out = [Radiance::ZERO; LANES];
     for i in 0..n {
         let material = &scene.materials[hits.material[i] as usize];
@@ -272,16 +266,20 @@ pub fn shade_batch<Q: SceneQuery>(job: &PassJob, query: &Q, batch: &Batch, block
 }
 
 /// `shade_batch` with `--gi path`, the paths not followed yet: the batch's
-/// samples go into `pool`, whose `trace` gives their radiance (in the order
-/// they were put in) with those of other batches.
-pub fn start_paths<'p, Q: SceneQuery>(job: &PassJob<'p>, query: &Q, batch: &Batch, blocked: Option<&[u8]>, counts: &mut RayCounts, pool: &mut PathPool<'p>) {
+/// samples go into `pool`, lane k's radiance meant for `slots[k]` of what
+/// `PathPool::follow_into` writes, with those of other batches. (Frames
+/// take this way; `shade_batch` itself follows each lane's path alone, by
+/// `shade()`'s recursion, to the same bits.)
+#[allow(clippy::too_many_arguments)]
+pub fn start_paths<'p, Q: SceneQuery>(job: &PassJob<'p>, query: &Q, batch: &Batch, blocked: Option<&[u8]>, slots: &[usize], counts: &mut RayCounts, pool: &mut PathPool<'p>) {
+    assert_eq!(slots.len(), batch.len);
     assert!(batch.pending.len == 0 && batch.pending_ray_count == 0, "start_paths on a batch with hits not built (`build_pending`)");
     let settings = job.settings;
     let mut paths: [PathState; LANES] = std::array::from_fn(|i| {
         PathState::new(batch.pixels[i], job.sample, settings.spp, &settings.gi, job.photons)
     });
     let (albedo, direct) = direct_in_lanes(job, query, &batch.hits, &batch.w_o, batch.len, &mut paths, &IN_ORDER, blocked, counts);
-    pool.add(&batch.hits, &batch.w_o, batch.len, paths, &albedo, &direct);
+    pool.add(&batch.hits, &batch.w_o, slots, paths, &albedo, &direct);
 }
 
 /// Lane i's path is path i.

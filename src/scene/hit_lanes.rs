@@ -31,6 +31,16 @@ pub struct TriangleHitInput {
     pub dir: Vec3,
 }
 
+impl TriangleHitInput {
+    /// The hit on triangle `index` with weights b1 and b2 of its second and
+    /// third corners, `t` along a ray towards `dir`: the corner weights as
+    /// `Scene::primitive_hit` makes them (`1 - b1 - b2`, b1, b2).
+    #[inline]
+    pub fn new(index: u32, (b1, b2): (f32, f32), t: f32, dir: Vec3) -> TriangleHitInput {
+        TriangleHitInput { index, b: Vec3::new(1.0 - b1 - b2, b1, b2), t, dir }
+    }
+}
+
 /// Eye samples that see a triangle, as a rasterizer's buffers hold them:
 /// the triangle, its barycentric weights b1 and b2 (b0 = 1 - b1 - b2) and
 /// the sample's image position, whose eye ray is worked out in lanes.

@@ -669,7 +669,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         let r = self.rect;
         let interpolation = self.job.settings.interpolation;
         let mut batch = Batch::new();
-        let mut paths = PathBatches::default();
+        let mut paths = PathPool::new();
         let scene = &self.job.prepared.scene;
         // A triangle seen without textures (the common case) has its hit
         // built in the batch (eight at a time), not returned and copied.
@@ -736,6 +736,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             }
         }
         self.shade_batch_into(&mut batch, &mut paths, out);
+        paths.follow_into(self.job, self.query, &mut self.counts, out);
         self.counts.primary += primary;
         self.counts.fragments_shaded += shaded;
         std::mem::take(&mut self.counts)
@@ -743,30 +744,24 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
 
     /// Shades the batch's samples into their slots of `out` and empties it.
     /// With `--gi path` the samples' paths wait in `paths`, to be followed
-    /// with those of the next batches (`PathBatches`); a batch that is not
-    /// full (the last of the region) follows them all.
-    fn shade_batch_into(&mut self, batch: &mut Batch, paths: &mut PathBatches<'a>, out: &mut [Radiance]) {
-        let last = !batch.is_full();
-        if !batch.is_empty() {
-            batch.build_pending(&self.job.prepared.scene, self.job.view, self.job.settings.interpolation);
-            if path_batch::takes(self.job) {
-                shade_batch::start_paths(self.job, self.query, batch, None, &mut self.counts, &mut paths.pool);
-                paths.slots.extend_from_slice(&batch.slots[..batch.len()]);
-            } else {
-                let values = shade_batch::shade_batch(self.job, self.query, batch, None, &mut self.counts);
-                for (j, value) in values.iter().enumerate().take(batch.len()) {
-                    out[batch.slots[j]] = *value;
-                }
-            }
-            batch.clear();
+    /// with those of the next batches once it holds `PATH_SAMPLES`.
+    fn shade_batch_into(&mut self, batch: &mut Batch, paths: &mut PathPool<'a>, out: &mut [Radiance]) {
+        if batch.is_empty() {
+            return;
         }
-        if !paths.pool.is_empty() && (last || paths.pool.len() >= PathBatches::SAMPLES) {
-            let values = std::mem::take(&mut paths.pool).trace(self.job, self.query, &mut self.counts);
-            for (&slot, value) in paths.slots.iter().zip(values) {
-                out[slot] = value;
+        batch.build_pending(&self.job.prepared.scene, self.job.view, self.job.settings.interpolation);
+        if path_batch::takes(self.job) {
+            shade_batch::start_paths(self.job, self.query, batch, None, &batch.slots[..batch.len()], &mut self.counts, paths);
+            if paths.len() >= PATH_SAMPLES {
+                paths.follow_into(self.job, self.query, &mut self.counts, out);
             }
-            paths.slots.clear();
+        } else {
+            let values = shade_batch::shade_batch(self.job, self.query, batch, None, &mut self.counts);
+            for (j, value) in values.iter().enumerate().take(batch.len()) {
+                out[batch.slots[j]] = *value;
+            }
         }
+        batch.clear();
     }
 
     /// Empties the buffers for another region of at most the same size (the tiles of a row).
@@ -798,16 +793,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
     }
 }
 
-/// Eye samples whose paths wait to be followed together (`PathPool`), and
-/// the slots of `out` their radiance goes to.
-#[derive(Default)]
-struct PathBatches<'p> {
-    pool: PathPool<'p>,
-    slots: Vec<usize>,
-}
-
-impl PathBatches<'_> {
-    /// Samples gathered before their paths are followed: as many as a ray
-    /// caster's tile, whose paths keep the lanes about as full.
-    const SAMPLES: usize = 64;
-}
+/// Samples a region gathers before following their paths together
+/// (`PathPool`): as many as a ray caster's tile, which keeps the lanes about
+/// as full.
+const PATH_SAMPLES: usize = 64;

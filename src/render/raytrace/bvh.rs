@@ -363,11 +363,9 @@ impl<'a> BvhQuery<'a> {
     /// its record is built from.
     #[inline]
     fn batch_hit(&self, best: &BestHit, ray: &Ray) -> BatchHit {
-        let (b1, b2) = best.bary;
         match best.id.kind() {
-            // `primitive_hit`'s weights, for `triangle_hit`'s record.
-            PrimitiveKind::Triangle => BatchHit::Triangle(TriangleHitInput { index: best.id.index(), b: Vec3::new(1.0 - b1 - b2, b1, b2), t: best.t, dir: ray.dir }),
-            _ => BatchHit::Record(self.prepared.scene.primitive_hit(best.id, best.t, b1, b2, ray)),
+            PrimitiveKind::Triangle => BatchHit::Triangle(TriangleHitInput::new(best.id.index(), best.bary, best.t, ray.dir)),
+            _ => BatchHit::Record(self.prepared.scene.primitive_hit(best.id, best.t, best.bary.0, best.bary.1, ray)),
         }
     }
 

@@ -192,8 +192,7 @@ impl Packet {
             if id.is_none() {
                 out[i] = None;
             } else if id.kind() == PrimitiveKind::Triangle {
-                let (b1, b2) = self.bary[i];
-                inputs[n] = TriangleHitInput { index: id.index(), b: Vec3::new(1.0 - b1 - b2, b1, b2), t: self.best_t.0[i], dir: self.rays[i].dir };
+                inputs[n] = TriangleHitInput::new(id.index(), self.bary[i], self.best_t.0[i], self.rays[i].dir);
                 lanes[n] = i;
                 n += 1;
                 if n == HIT_LANES {
@@ -530,7 +529,6 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
                 background: miss_without_ray(job),
                 batches: (0..P / shade_batch::LANES).map(|_| Batch::new()).collect(),
                 paths: PathPool::new(),
-                path_slots: Vec::new(),
             };
             for x0 in (0..width).step_by(TILE_W) {
                 let valid = eye_rays_into(job, &mut pk, (x0, y0), width, rows);
@@ -551,7 +549,7 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
                     band[ty * width + x0 + tx] = resolve_sample(job, query, &pk.rays[i], hits[i].as_ref(), job.pixel_index((x0 + tx) as u32, (y0 + ty) as u32), &mut counts, &mut NoRecord);
                 }
             }
-            context.follow_paths(job, query, band, &mut counts);
+            context.paths.follow_into(job, query, &mut counts, band);
             counts
         })
         .reduce(RayCounts::default, |mut a, b| {
@@ -617,27 +615,12 @@ struct TileContext<'p> {
     batches: Vec<Batch>,
     /// With `--gi path`, the band's samples whose paths wait to be followed
     /// together (several tiles' worth, so that the lanes stay full as the
-    /// paths end), and the index in the band each one's radiance goes to.
+    /// paths end).
     paths: PathPool<'p>,
-    path_slots: Vec<usize>,
 }
 
-impl TileContext<'_> {
-    /// Samples a band gathers before following their paths: four tiles.
-    const PATH_SAMPLES: usize = 4 * P;
-
-    /// Follows the waiting samples' paths and writes their radiance to `band`.
-    fn follow_paths(&mut self, job: &PassJob, query: &BvhQuery, band: &mut [Radiance], counts: &mut RayCounts) {
-        if self.paths.is_empty() {
-            return;
-        }
-        let values = std::mem::take(&mut self.paths).trace(job, query, counts);
-        for (&slot, value) in self.path_slots.iter().zip(values) {
-            band[slot] = value;
-        }
-        self.path_slots.clear();
-    }
-}
+/// Samples a band gathers before following their paths: four tiles.
+const PATH_SAMPLES: usize = 4 * P;
 
 /// Shades one traced tile in batches of eight (`shade_batch`): the lanes
 /// that see a surface are put into batches in lane order (a triangle's
@@ -657,7 +640,7 @@ fn shade_tile_batched<'p>(
     width: usize,
     counts: &mut RayCounts,
 ) {
-    let TileContext { tile: blocked, batch: lane_blocked, textured, background, batches, paths, path_slots } = context;
+    let TileContext { tile: blocked, batch: lane_blocked, textured, background, batches, paths } = context;
     let scene = &query.prepared.scene;
     let settings = job.settings;
     let mut filled = 0;
@@ -678,8 +661,7 @@ fn shade_tile_batched<'p>(
         }
         let batch = &mut batches[filled / shade_batch::LANES];
         if id.kind() == PrimitiveKind::Triangle && !*textured {
-            let (b1, b2) = pk.bary[i];
-            let input = TriangleHitInput { index: id.index(), b: Vec3::new(1.0 - b1 - b2, b1, b2), t: pk.best_t.0[i], dir: pk.rays[i].dir };
+            let input = TriangleHitInput::new(id.index(), pk.bary[i], pk.best_t.0[i], pk.rays[i].dir);
             batch.push_ray_triangle(input, pixel, i);
         } else {
             let mut hit = pk.hit(query, i);
@@ -726,15 +708,16 @@ fn shade_tile_batched<'p>(
             for (k, bits) in lane_blocked.iter_mut().enumerate() {
                 *bits = (0..batch.len()).fold(0u8, |acc, j| acc | (((blocked[k] >> batch.slots[j]) & 1) as u8) << j);
             }
-            shade_batch::start_paths(job, query, batch, shadows.then_some(&lane_blocked[..]), counts, paths);
-            path_slots.extend(batch.slots[..batch.len()].iter().map(|&i| {
-                let (tx, ty) = lane_xy(i);
+            // Where each lane's radiance goes in the band.
+            let slots: [usize; shade_batch::LANES] = std::array::from_fn(|j| {
+                let (tx, ty) = lane_xy(batch.slots[j]);
                 ty * width + x0 + tx
-            }));
+            });
+            shade_batch::start_paths(job, query, batch, shadows.then_some(&lane_blocked[..]), &slots[..batch.len()], counts, paths);
             batch.clear();
         }
-        if paths.len() >= TileContext::PATH_SAMPLES {
-            context.follow_paths(job, query, band, counts);
+        if paths.len() >= PATH_SAMPLES {
+            paths.follow_into(job, query, counts, band);
         }
         return;
     }
