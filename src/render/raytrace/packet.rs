@@ -703,7 +703,8 @@ fn shade_tile_batched<'p>(
     }
     if path_batch::takes(job) {
         // The paths wait for those of the band's next tiles, to be
-        // followed together (`TileContext::follow_paths`).
+        // followed together (`PathPool::follow_into`, once it holds
+        // `PATH_SAMPLES` and at the end of the band).
         for batch in batches.iter_mut() {
             for (k, bits) in lane_blocked.iter_mut().enumerate() {
                 *bits = (0..batch.len()).fold(0u8, |acc, j| acc | (((blocked[k] >> batch.slots[j]) & 1) as u8) << j);
