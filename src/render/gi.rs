@@ -59,8 +59,12 @@ impl Default for GiSettings {
 /// mirror is far below what a pixel can show.
 pub const MAX_BOUNCES: u32 = 100;
 
-/// Paths shorter than this never face Russian roulette.
-const ROULETTE_DEPTH: u32 = 5;
+/// Russian roulette decides on the bounce from this depth on (0 = the eye
+/// ray's surface): from the fifth surface a path reaches, as Mitsuba's
+/// `path` integrator with its default `rr_depth` of 5 (its depth counts
+/// surfaces from 1), so that both render the same estimator and their
+/// times at equal samples compare like with like.
+const ROULETTE_DEPTH: u32 = 4;
 
 impl GiSettings {
     /// The deepest ray a path may cast (0 = eye ray), for `Path`.
@@ -229,5 +233,9 @@ mod tests {
         }
         assert!((sum / n as f64 - 1.0).abs() < 0.02, "{}", sum / n as f64);
         assert_eq!(roulette(0, Vec3::ZERO, &mut rng), Some((1.0, 1.0)));
+        // Mitsuba's rr_depth = 5: the bounces off the first four surfaces
+        // always go on, the fifth's faces the roulette.
+        assert!((0..1000).all(|_| roulette(3, Vec3::splat(0.01), &mut rng) == Some((1.0, 1.0))));
+        assert!((0..1000).any(|_| roulette(4, Vec3::splat(0.01), &mut rng).is_none()));
     }
 }
