@@ -130,6 +130,10 @@ pub struct VisBuffer<'j, 'a, Q: SceneQuery, R: FragmentRecorder = NoRecord> {
     /// (`stencil_lights` of them), filled after the depth pass; empty otherwise.
     stencil: Vec<i32>,
     stencil_lights: usize,
+    /// With `--gi path`, the samples whose paths wait to be followed
+    /// together; kept with the buffer (empty between regions) so that its
+    /// buffers grow once, not in every region.
+    paths: PathPool<'a>,
 }
 
 impl<'j, 'a, Q: SceneQuery> VisBuffer<'j, 'a, Q, NoRecord> {
@@ -181,6 +185,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             sample: None,
             stencil: Vec::new(),
             stencil_lights: 0,
+            paths: PathPool::new(),
         }
     }
 
@@ -669,7 +674,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         let r = self.rect;
         let interpolation = self.job.settings.interpolation;
         let mut batch = Batch::new();
-        let mut paths = PathPool::new();
+        let mut paths = std::mem::take(&mut self.paths);
         let scene = &self.job.prepared.scene;
         // A triangle seen without textures (the common case) has its hit
         // built in the batch (eight at a time), not returned and copied.
@@ -737,6 +742,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         }
         self.shade_batch_into(&mut batch, &mut paths, out);
         paths.follow_into(self.job, self.query, &mut self.counts, out);
+        self.paths = paths;
         self.counts.primary += primary;
         self.counts.fragments_shaded += shaded;
         std::mem::take(&mut self.counts)

@@ -512,46 +512,52 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
     let batched = shade_batch::batchable(job);
     out.par_chunks_mut(width * TILE_H)
         .enumerate()
-        .map(|(b, band)| {
-            let mut counts = RayCounts::default();
-            if job.cancelled() {
-                return counts;
-            }
-            let y0 = job.rows.start as usize + b * TILE_H;
-            let rows = band.len() / width;
-            let mut pk = Packet::new();
-            let mut shadow_pk = Packet::new();
-            let mut hits = [None; P];
-            let mut context = TileContext {
-                tile: vec![0; scene.lights.len()],
-                batch: vec![0; scene.lights.len()],
-                textured: scene.has_textures(),
-                background: miss_without_ray(job),
-                batches: (0..P / shade_batch::LANES).map(|_| Batch::new()).collect(),
-                paths: PathPool::new(),
-            };
-            for x0 in (0..width).step_by(TILE_W) {
-                let valid = eye_rays_into(job, &mut pk, (x0, y0), width, rows);
-                counts.primary += valid.count_ones() as u64;
-                query.closest_packet(&mut pk, valid, &mut counts);
-                if batched {
-                    shade_tile_batched(job, query, &pk, valid, &mut shadow_pk, &mut context, band, (x0, y0), width, &mut counts);
-                    continue;
+        // Packets, batches and the path pool are made once per rayon job,
+        // not per band (each tile overwrites what it reads, and a band
+        // leaves its pool empty): their buffers then grow once per pass
+        // and thread rather than in every band.
+        .map_init(
+            || {
+                let context = TileContext {
+                    tile: vec![0; scene.lights.len()],
+                    batch: vec![0; scene.lights.len()],
+                    textured: scene.has_textures(),
+                    background: miss_without_ray(job),
+                    batches: (0..P / shade_batch::LANES).map(|_| Batch::new()).collect(),
+                    paths: PathPool::new(),
+                };
+                (Packet::new(), Packet::new(), [None; P], context)
+            },
+            |(pk, shadow_pk, hits, context), (b, band)| {
+                let mut counts = RayCounts::default();
+                if job.cancelled() {
+                    return counts;
                 }
-                pk.hits_into(query, valid, &mut hits);
-                let mut m = valid;
-                while m != 0 {
-                    let i = m.trailing_zeros() as usize;
-                    m &= m - 1;
-                    let (tx, ty) = lane_xy(i);
-                    let p = job.sample_position((x0 + tx) as u32, (y0 + ty) as u32);
-                    with_eye_differentials(job, p, &pk.rays[i], &mut hits[i]);
-                    band[ty * width + x0 + tx] = resolve_sample(job, query, &pk.rays[i], hits[i].as_ref(), job.pixel_index((x0 + tx) as u32, (y0 + ty) as u32), &mut counts, &mut NoRecord);
+                let y0 = job.rows.start as usize + b * TILE_H;
+                let rows = band.len() / width;
+                for x0 in (0..width).step_by(TILE_W) {
+                    let valid = eye_rays_into(job, pk, (x0, y0), width, rows);
+                    counts.primary += valid.count_ones() as u64;
+                    query.closest_packet(pk, valid, &mut counts);
+                    if batched {
+                        shade_tile_batched(job, query, pk, valid, shadow_pk, context, band, (x0, y0), width, &mut counts);
+                        continue;
+                    }
+                    pk.hits_into(query, valid, hits);
+                    let mut m = valid;
+                    while m != 0 {
+                        let i = m.trailing_zeros() as usize;
+                        m &= m - 1;
+                        let (tx, ty) = lane_xy(i);
+                        let p = job.sample_position((x0 + tx) as u32, (y0 + ty) as u32);
+                        with_eye_differentials(job, p, &pk.rays[i], &mut hits[i]);
+                        band[ty * width + x0 + tx] = resolve_sample(job, query, &pk.rays[i], hits[i].as_ref(), job.pixel_index((x0 + tx) as u32, (y0 + ty) as u32), &mut counts, &mut NoRecord);
+                    }
                 }
-            }
-            context.paths.follow_into(job, query, &mut counts, band);
-            counts
-        })
+                context.paths.follow_into(job, query, &mut counts, band);
+                counts
+            },
+        )
         .reduce(RayCounts::default, |mut a, b| {
             a += b;
             a
