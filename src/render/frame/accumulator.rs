@@ -34,6 +34,35 @@ pub fn add_sample(sum: &mut Radiance, sample: Radiance, spp: u32) {
     }
 }
 
+/// Adds a band's pass (`pass`) to its pixels' sums and sums of squared
+/// luminance; with `--adaptive`, only to the pixels still `active`, whose
+/// sample counts go up. Pixels are independent, so chunks go in parallel
+/// (at many samples per pixel this loop would otherwise be a serial part
+/// of every pass).
+fn add_pass(pass: &[Radiance], sum: &mut [Radiance], sum_sq: &mut [f32], adaptive: Option<(&[bool], &mut [u32])>, spp: u32) {
+    const CHUNK: usize = 8192;
+    let add = |p: &Radiance, s: &mut Radiance, q: &mut f32| {
+        add_sample(s, *p, spp);
+        let l = luminance(admitted(*p));
+        *q += l * l;
+    };
+    match adaptive {
+        None => pass.par_chunks(CHUNK).zip(sum.par_chunks_mut(CHUNK)).zip(sum_sq.par_chunks_mut(CHUNK)).for_each(|((pass, sum), sum_sq)| {
+            for ((p, s), q) in pass.iter().zip(sum).zip(sum_sq) {
+                add(p, s, q);
+            }
+        }),
+        Some((active, samples)) => {
+            for ((((p, s), q), &on), n) in pass.iter().zip(sum).zip(sum_sq).zip(active).zip(samples) {
+                if on {
+                    *n += 1;
+                    add(p, s, q);
+                }
+            }
+        }
+    }
+}
+
 /// The average of a pixel whose sum holds `passes` samples.
 #[inline]
 pub fn mean(sum: Radiance, passes: u32) -> Radiance {
@@ -121,6 +150,10 @@ pub struct Accumulator {
     /// the first band) are painted over the average.
     wireframe: Option<LineAlgorithm>,
     lines: Option<Vec<bool>>,
+    /// With more than one sample, what a band's pass renders before it is
+    /// added to `sum`: kept from band to band, since a fresh buffer per
+    /// band costs its allocation, zeroing and page faults every pass.
+    pass_buffer: Vec<Radiance>,
 }
 
 impl Accumulator {
@@ -144,6 +177,7 @@ impl Accumulator {
             photons: None,
             wireframe,
             lines: None,
+            pass_buffer: Vec::new(),
             adaptive: settings.adaptive.filter(|_| settings.spp > 1).map(|target| Adaptive {
                 target,
                 samples: vec![0; n],
@@ -230,7 +264,11 @@ impl Accumulator {
             // With one sample the pass is the frame: render straight into it
             // (a cancelled band is rendered again or the frame dropped, and
             // storing overwrites, so a half-written band never shows).
-            let mut mine = if self.spp == 1 { Vec::new() } else { vec![Radiance::ZERO; span.len()] };
+            let mut mine = std::mem::take(&mut self.pass_buffer);
+            if self.spp > 1 {
+                mine.clear();
+                mine.resize(span.len(), Radiance::ZERO);
+            }
             let out = if self.spp == 1 { &mut self.sum[span.clone()] } else { &mut mine[..] };
             counts = renderer.render_pass(&job, out);
             if cancelled() {
@@ -252,19 +290,12 @@ impl Accumulator {
                     }
                 });
             } else {
-                for (k, p) in mine.iter().enumerate() {
-                    let i = span.start + k;
-                    if let Some(a) = self.adaptive.as_mut() {
-                        if !a.active[i] {
-                            continue;
-                        }
-                        a.samples[i] += 1;
-                    }
-                    add_sample(&mut self.sum[i], *p, self.spp);
-                    let l = luminance(admitted(*p));
-                    self.sum_sq[i] += l * l;
-                }
+                let adaptive = self.adaptive.as_mut().map(|a| (&a.active[span.clone()], &mut a.samples[span.clone()]));
+                add_pass(&mine, &mut self.sum[span.clone()], &mut self.sum_sq[span.clone()], adaptive, self.spp);
             }
+            // (A cancelled band returns above and drops the buffer: the
+            // next band makes a new one.)
+            self.pass_buffer = mine;
             if let (Some(sum), Some(buf)) = (self.reference.as_mut(), theirs.as_ref()) {
                 for (s, p) in sum[span].iter_mut().zip(buf) {
                     add_sample(s, *p, self.spp);
