@@ -524,6 +524,10 @@ impl SceneQuery for BvhQuery<'_> {
         Some(scene.primitive_hit(best.id, best.t, best.bary.0, best.bary.1, ray))
     }
 
+    // Inlined into the pool's bounce loop, its only caller in frames: the
+    // hit (a large enum) is then built in place rather than returned and
+    // moved twice (-2.6% instructions on a cornell_gi path frame).
+    #[inline(always)]
     fn closest_for_batch(&self, ray: &Ray, t_max: f32, inside: bool, counts: &mut RayCounts) -> Option<BatchHit> {
         if !self.prepared.scene.csgs.is_empty() {
             return self.closest(ray, t_max, inside, counts, &mut NoRecord).map(BatchHit::Record);
