@@ -410,6 +410,22 @@ impl<S: Simd> V3<f32x8<S>> {
     }
 }
 
+/// Eight rows of eight as eight columns: three rounds of interleaving row
+/// i with row i + 4 (after them, vector j holds element j of every row).
+#[inline(always)]
+pub fn transpose8<S: Simd>(mut m: [f32x8<S>; 8]) -> [f32x8<S>; 8] {
+    for _ in 0..3 {
+        let mut next = m;
+        for i in 0..4 {
+            let (low, high) = m[i].interleave(m[i + 4]);
+            next[2 * i] = low;
+            next[2 * i + 1] = high;
+        }
+        m = next;
+    }
+    m
+}
+
 /// Lane `i` of a mask as a bool.
 #[inline(always)]
 pub fn mask_bits<S: Simd>(mask: mask32x8<S>) -> u8 {

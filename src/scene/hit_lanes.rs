@@ -11,7 +11,7 @@
 use super::camera::CameraView;
 use super::triangles::CornerRow;
 use super::{Differentials, PrimitiveKind, Scene, SurfaceHit, Triangle};
-use crate::math::lanes::{mask_bits, mask_from_bits, simd_level, Lane, V3};
+use crate::math::lanes::{transpose8, mask_bits, mask_from_bits, simd_level, Lane, V3};
 use crate::math::{Vec2, Vec3};
 use fearless_simd::{dispatch, f32x8, Simd, SimdBase, SimdFrom};
 
@@ -243,22 +243,6 @@ struct CornerLanes<S: Simd> {
     flat: u8,
     material: [u32; HIT_LANES],
     object: [u32; HIT_LANES],
-}
-
-/// Eight rows of eight as eight columns: three rounds of interleaving row
-/// i with row i + 4 (after them, vector j holds element j of every row).
-#[inline(always)]
-fn transpose8<S: Simd>(mut m: [f32x8<S>; 8]) -> [f32x8<S>; 8] {
-    for _ in 0..3 {
-        let mut next = m;
-        for i in 0..4 {
-            let (low, high) = m[i].interleave(m[i + 4]);
-            next[2 * i] = low;
-            next[2 * i + 1] = high;
-        }
-        m = next;
-    }
-    m
 }
 
 /// Where a lane's rows point before they are read.

@@ -22,8 +22,8 @@
 //! walk waits on.
 
 use super::intersect::TriangleEdges;
-use super::traverse::{slab_test8, test_leaf, BestHit, ChildOrder, PreparedRay};
-use crate::math::lanes::{mask_bits, simd_level};
+use super::traverse::{slab_test8, test_leaf, test_triangle_leaf, BestHit, ChildOrder, PreparedRay};
+use crate::math::lanes::{mask_bits, simd_level, V3};
 use fearless_simd::{f32x8, Simd, SimdBase};
 use crate::math::Ray;
 use fearless_simd::dispatch;
@@ -424,6 +424,10 @@ impl<'a> BvhQuery<'a> {
         // starting on a surface) start inside it.
         let origin = [f32x8::splat(simd, r.origin[0].x), f32x8::splat(simd, r.origin[1].x), f32x8::splat(simd, r.origin[2].x)];
         let inv = [f32x8::splat(simd, r.inv[0].x), f32x8::splat(simd, r.inv[1].x), f32x8::splat(simd, r.inv[2].x)];
+        // The ray in every lane, for leaves of several triangles tested at
+        // once (`test_triangle_leaf`); replays record each test, one by one.
+        let lanes_leaves = !R::ENABLED && spheres.is_empty();
+        let (ray_origin, ray_dir) = (V3::new(origin[0], origin[1], origin[2]), V3::new(f32x8::splat(simd, ray.dir.x), f32x8::splat(simd, ray.dir.y), f32x8::splat(simd, ray.dir.z)));
         let mut best = BestHit::nothing_before(t_max);
         let mut word = bvh.root;
         let (mut visits, mut tests) = (0u64, 0u64);
@@ -484,7 +488,13 @@ impl<'a> BvhQuery<'a> {
                 let (start, end) = leaf_range(word);
                 // Shadow rays (`ANY`) never start inside a sphere they may hit.
                 let before = best.id;
-                if test_leaf::<ANY, R>(&bvh.prims[start..end], spheres, ray, inside && !ANY, &mut best, &mut tests, rec) {
+                let prims = &bvh.prims[start..end];
+                let stop = if lanes_leaves && prims.len() >= 2 {
+                    test_triangle_leaf::<S, ANY>(simd, prims, ray_origin, ray_dir, &mut best, &mut tests)
+                } else {
+                    test_leaf::<ANY, R>(prims, spheres, ray, inside && !ANY, &mut best, &mut tests, rec)
+                };
+                if stop {
                     counts.nodes += visits;
                     counts.tests += tests;
                     return Some(best);

@@ -8,8 +8,10 @@ use crate::scene::{Sphere, Triangle};
 /// A triangle prepared for Möller-Trumbore: one vertex and two edges.
 /// Every BVH leaf slot holds one, so it is kept to 40 bytes: the two-sided
 /// flag rides in the sign bit of the determinant bound, which is never
-/// negative.
+/// negative. Laid out as ten floats in this order (`repr(C)`), so a leaf's
+/// triangles can be read into lanes as rows (`TriangleLanes::gather`).
 #[derive(Clone, Copy, Debug)]
+#[repr(C)]
 pub struct TriangleEdges {
     pub v0: Vec3,
     pub e1: Vec3,
@@ -17,6 +19,8 @@ pub struct TriangleEdges {
     /// `det_epsilon()`, negated for a two-sided triangle.
     epsilon_and_sides: f32,
 }
+
+const _: () = assert!(std::mem::size_of::<TriangleEdges>() == 40 && std::mem::align_of::<TriangleEdges>() == 4);
 
 impl TriangleEdges {
     /// Edges of nothing (a placeholder that no ray hits).
@@ -40,6 +44,14 @@ impl TriangleEdges {
     #[inline(always)]
     pub fn two_sided(&self) -> bool {
         self.epsilon_and_sides.is_sign_negative()
+    }
+
+    /// The ten floats: v0, e1, e2, then the signed determinant bound.
+    #[inline(always)]
+    pub fn as_floats(&self) -> &[f32; 10] {
+        // SAFETY: `repr(C)` of three `Vec3`s (three f32s each, `repr(C)`)
+        // and an f32: ten f32s, no padding, f32-aligned.
+        unsafe { &*(self as *const TriangleEdges as *const [f32; 10]) }
     }
 }
 
@@ -105,21 +117,53 @@ pub fn intersect_triangle(ray: &Ray, tri: &TriangleEdges, t_max: f32) -> Triangl
 #[inline(always)]
 pub fn intersect_triangle_lanes<L: Lane>(origin: V3<L>, dir: V3<L>, tri: &TriangleEdges, limit: L) -> (L::Mask, L, L, L) {
     let (zero, one) = (limit.splat(0.0), limit.splat(1.0));
-    let e1 = V3::splat(limit, tri.e1);
-    let e2 = V3::splat(limit, tri.e2);
-    let p = dir.cross(e2);
-    let det = e1.dot(p);
-    let epsilon = limit.splat(tri.det_epsilon());
-    let front = det.gt(epsilon);
-    let facing = if tri.two_sided() { front | (-det).gt(epsilon) } else { front };
+    // A constant mask in each branch, so the sidedness test folds away.
+    if tri.two_sided() {
+        intersect_triangles_lanes(origin, dir, &TriangleLanes::splat(limit, tri, zero.lt(one)), limit)
+    } else {
+        intersect_triangles_lanes(origin, dir, &TriangleLanes::splat(limit, tri, one.lt(zero)), limit)
+    }
+}
+
+/// Triangles in lanes (`TriangleEdges`' fields, the flag as a mask).
+pub struct TriangleLanes<L: Lane> {
+    pub v0: V3<L>,
+    pub e1: V3<L>,
+    pub e2: V3<L>,
+    pub epsilon: L,
+    pub two_sided: L::Mask,
+}
+
+impl<L: Lane> TriangleLanes<L> {
+    /// `tri` in every lane (`like` gives the SIMD context), `two_sided`
+    /// being its flag in every lane.
+    #[inline(always)]
+    fn splat(like: L, tri: &TriangleEdges, two_sided: L::Mask) -> Self {
+        TriangleLanes { v0: V3::splat(like, tri.v0), e1: V3::splat(like, tri.e1), e2: V3::splat(like, tri.e2), epsilon: like.splat(tri.det_epsilon()), two_sided }
+    }
+}
+
+/// `intersect_triangle` lane by lane, each lane a ray (`origin`, `dir`)
+/// against a triangle, with the same arithmetic in the same order: the
+/// lanes that hit (`0 < t < limit`) and their `(t, b1, b2)`, bit for bit
+/// the single test's (meaningless in the other lanes). Rays in lanes
+/// against one triangle (packets), or one ray against a leaf's triangles.
+#[inline(always)]
+pub fn intersect_triangles_lanes<L: Lane>(origin: V3<L>, dir: V3<L>, tri: &TriangleLanes<L>, limit: L) -> (L::Mask, L, L, L) {
+    let (zero, one) = (limit.splat(0.0), limit.splat(1.0));
+    let p = dir.cross(tri.e2);
+    let det = tri.e1.dot(p);
+    let front = det.gt(tri.epsilon);
+    // |det| > epsilon for two-sided triangles (false for NaN, as there).
+    let facing = front | (tri.two_sided & (-det).gt(tri.epsilon));
     let inv = one / det;
-    let s = origin - V3::splat(limit, tri.v0);
+    let s = origin - tri.v0;
     let b1 = s.dot(p) * inv;
     let inside1 = zero.le(b1) & b1.le(one);
-    let q = s.cross(e1);
+    let q = s.cross(tri.e1);
     let b2 = dir.dot(q) * inv;
     let inside2 = !(b2.lt(zero) | (b1 + b2).gt(one));
-    let t = e2.dot(q) * inv;
+    let t = tri.e2.dot(q) * inv;
     let ahead = !(t.le(zero) | t.ge(limit));
     (facing & inside1 & inside2 & ahead, t, b1, b2)
 }

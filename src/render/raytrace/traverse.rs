@@ -3,11 +3,12 @@
 //! the leaf loop with its tie rule. Written once so both traversals find the
 //! same hits; `#[inline(always)]` because they are the hot loops.
 
-use super::intersect::{intersect_sphere, intersect_triangle, TriangleEdges};
+use super::intersect::{intersect_sphere, intersect_triangle, intersect_triangles_lanes, TriangleEdges, TriangleLanes};
+use crate::math::lanes::{self, mask_bits, transpose8, V3};
 use crate::math::Ray;
 use crate::render::pixel_record::{PrimitiveTest, Recorder};
 use crate::scene::{PrimitiveId, PrimitiveKind, Sphere};
-use fearless_simd::{f32x8, mask32x8, Simd, SimdBase};
+use fearless_simd::{f32x8, mask32x8, Simd, SimdBase, SimdFrom};
 use glam::{BVec4A, Vec3, Vec3A, Vec4};
 
 /// The slab test's far distance is stretched by this factor (and the near
@@ -215,6 +216,77 @@ pub fn test_leaf<const ANY: bool, R: Recorder>(
     false
 }
 
+/// The triangles of a leaf of two to eight (`prims`, no spheres) in
+/// eight lanes; lanes past them repeat the first (their results are
+/// dropped). Each triangle's first eight floats are read as a row and the
+/// rows transposed, the last two copied one by one.
+#[inline(always)]
+fn gather_triangles<S: Simd>(simd: S, prims: &[(TriangleEdges, PrimitiveId)]) -> TriangleLanes<f32x8<S>> {
+    let n = prims.len();
+    let zero = f32x8::splat(simd, 0.0);
+    let mut rows = [zero; 8];
+    let (mut e2z, mut bound) = ([0.0f32; 8], [0.0f32; 8]);
+    for k in 0..8 {
+        let floats = prims[if k < n { k } else { 0 }].0.as_floats();
+        rows[k] = f32x8::from_slice(simd, &floats[..8]);
+        (e2z[k], bound[k]) = (floats[8], floats[9]);
+    }
+    let c = transpose8(rows);
+    let (one, bound) = (f32x8::splat(simd, 1.0), f32x8::simd_from(simd, bound));
+    TriangleLanes {
+        v0: V3::new(c[0], c[1], c[2]),
+        e1: V3::new(c[3], c[4], c[5]),
+        e2: V3::new(c[6], c[7], f32x8::simd_from(simd, e2z)),
+        // `det_epsilon()` and `two_sided()` of each: the bound's magnitude
+        // and its sign bit (set on -0.0 too).
+        epsilon: lanes::Lane::copysign(bound, one),
+        two_sided: lanes::Lane::lt(lanes::Lane::copysign(one, bound), zero),
+    }
+}
+
+/// `test_leaf` for a leaf of two to eight triangles (no spheres), nothing
+/// recorded: the ray (`origin`, `dir` in every lane) against all of them
+/// at once (`intersect_triangles_lanes`, the single test's arithmetic lane
+/// by lane), then the hits taken in primitive order with `test_leaf`'s
+/// limit and tie rule. It finds what `test_leaf` finds and counts the
+/// tests it counts.
+#[inline(always)]
+pub fn test_triangle_leaf<S: Simd, const ANY: bool>(simd: S, prims: &[(TriangleEdges, PrimitiveId)], origin: V3<f32x8<S>>, dir: V3<f32x8<S>>, best: &mut BestHit, tests: &mut u64) -> bool {
+    let n = prims.len();
+    debug_assert!((2..=8).contains(&n));
+    let triangles = gather_triangles(simd, prims);
+    let (hit, t, b1, b2) = intersect_triangles_lanes(origin, dir, &triangles, f32x8::splat(simd, best.limit));
+    let mut found = mask_bits(hit) as u32 & ((1u32 << n) - 1);
+    if found == 0 {
+        *tests += n as u64;
+        return false;
+    }
+    let (t, b1, b2): ([f32; 8], [f32; 8], [f32; 8]) = (t.into(), b1.into(), b2.into());
+    if ANY {
+        // `test_leaf` stops at the first primitive that is hit.
+        let k = found.trailing_zeros() as usize;
+        *tests += k as u64 + 1;
+        (best.t, best.id, best.bary) = (t[k], prims[k].1, (b1[k], b2[k]));
+        return true;
+    }
+    *tests += n as u64;
+    while found != 0 {
+        let k = found.trailing_zeros() as usize;
+        found &= found - 1;
+        // The single test meets the limit as the leaf's earlier hits left
+        // it (lower than or equal to the one the lanes were tested with).
+        if !(t[k] < best.limit) {
+            continue;
+        }
+        let id = prims[k].1;
+        if t[k] < best.t || id < best.id {
+            (best.t, best.id, best.bary) = (t[k], id, (b1[k], b2[k]));
+            best.limit = f32::from_bits(t[k].to_bits() + 1);
+        }
+    }
+    false
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -279,5 +351,74 @@ mod tests {
         let mut any = BestHit::nothing_before(f32::INFINITY);
         assert!(test_leaf::<true, _>(&prims, &spheres, &ray, false, &mut any, &mut tests, &mut NoRecord));
         assert_eq!((any.id, any.t, tests), (PrimitiveId::sphere(0), 3.0, 4));
+    }
+
+    fn leaf_in_lanes<S: Simd>(simd: S, any: bool, prims: &[(TriangleEdges, PrimitiveId)], ray: &Ray, best: &mut BestHit, tests: &mut u64) -> bool {
+        let lanes = |v: Vec3| V3::new(f32x8::splat(simd, v.x), f32x8::splat(simd, v.y), f32x8::splat(simd, v.z));
+        let (origin, dir) = (lanes(ray.origin), lanes(ray.dir));
+        if any {
+            test_triangle_leaf::<S, true>(simd, prims, origin, dir, best, tests)
+        } else {
+            test_triangle_leaf::<S, false>(simd, prims, origin, dir, best, tests)
+        }
+    }
+
+    /// The eight-lane leaf test finds, bit for bit, what the one-by-one
+    /// test finds, and counts the same tests: over random leaves of two to
+    /// eight triangles (one- and two-sided, some repeated so that hits tie,
+    /// some degenerate), random rays through them and random limits, both
+    /// closest hits and shadow rays' first hits.
+    #[test]
+    fn leaf_lanes_find_what_the_leaf_loop_finds() {
+        use crate::scene::Triangle;
+        use fearless_simd::dispatch;
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let mut point = |scale: f32, next: &mut dyn FnMut() -> f32| Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5) * scale;
+        let (mut hits, mut leaves) = (0, 0);
+        for _ in 0..3000 {
+            let n = 2 + (next() * 7.0) as usize;
+            let mut prims: Vec<(TriangleEdges, PrimitiveId)> = Vec::new();
+            for k in 0..n {
+                let edges = if k > 0 && next() < 0.2 {
+                    prims[(next() * k as f32) as usize].0
+                } else {
+                    let v0 = point(2.0, &mut next);
+                    let (a, b) = (point(2.0, &mut next), point(2.0, &mut next));
+                    let v = if next() < 0.05 { [v0, v0 + a, v0 + a * 2.0] } else { [v0, v0 + a, v0 + b] };
+                    let tri = Triangle { v, n: [Vec3::Z; 3], uv: [crate::math::Vec2::ZERO; 3], material: 0, object: 0, two_sided: next() < 0.5 };
+                    TriangleEdges::new(&tri)
+                };
+                prims.push((edges, PrimitiveId::triangle((next() * 1000.0) as u32)));
+            }
+            let origin = point(6.0, &mut next);
+            // Towards a point of one of the triangles (or near it).
+            let aim = &prims[(next() * n as f32) as usize].0;
+            let (u, v) = (next() * 1.2 - 0.1, next() * 0.6);
+            let dir = (aim.v0 + aim.e1 * u + aim.e2 * v - origin).normalize();
+            let ray = Ray::new(origin, dir);
+            let limit = if next() < 0.5 { f32::INFINITY } else { 1.0 + next() * 6.0 };
+            for any in [false, true] {
+                let (mut one, mut tests_one) = (BestHit::nothing_before(limit), 0u64);
+                let stop_one = if any {
+                    test_leaf::<true, _>(&prims, &[], &ray, false, &mut one, &mut tests_one, &mut NoRecord)
+                } else {
+                    test_leaf::<false, _>(&prims, &[], &ray, false, &mut one, &mut tests_one, &mut NoRecord)
+                };
+                let (mut wide, mut tests_wide) = (BestHit::nothing_before(limit), 0u64);
+                let stop_wide = dispatch!(crate::math::lanes::simd_level(), simd => leaf_in_lanes(simd, any, &prims, &ray, &mut wide, &mut tests_wide));
+                assert_eq!((stop_one, tests_one, one.id), (stop_wide, tests_wide, wide.id), "any: {any}, leaf of {n}");
+                assert_eq!([one.t, one.limit, one.bary.0, one.bary.1].map(f32::to_bits), [wide.t, wide.limit, wide.bary.0, wide.bary.1].map(f32::to_bits));
+                hits += !one.id.is_none() as u32;
+            }
+            leaves += 1;
+        }
+        // The random leaves are hit often enough for the comparison to mean something.
+        assert!(hits > leaves / 2, "{hits} hits in {leaves} leaves (two queries each)");
     }
 }
