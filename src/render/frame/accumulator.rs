@@ -36,9 +36,9 @@ pub fn add_sample(sum: &mut Radiance, sample: Radiance, spp: u32) {
 
 /// Adds a band's pass (`pass`) to its pixels' sums and sums of squared
 /// luminance; with `--adaptive`, only to the pixels still `active`, whose
-/// sample counts go up. Pixels are independent, so chunks go in parallel
-/// (at many samples per pixel this loop would otherwise be a serial part
-/// of every pass).
+/// sample counts go up. Pixels are independent, so without `--adaptive`
+/// (the frames that are timed) chunks go in parallel: at many samples per
+/// pixel this loop would otherwise be a serial part of every pass.
 fn add_pass(pass: &[Radiance], sum: &mut [Radiance], sum_sq: &mut [f32], adaptive: Option<(&[bool], &mut [u32])>, spp: u32) {
     const CHUNK: usize = 8192;
     let add = |p: &Radiance, s: &mut Radiance, q: &mut f32| {

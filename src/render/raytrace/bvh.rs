@@ -425,8 +425,9 @@ impl<'a> BvhQuery<'a> {
         let origin = [f32x8::splat(simd, r.origin[0].x), f32x8::splat(simd, r.origin[1].x), f32x8::splat(simd, r.origin[2].x)];
         let inv = [f32x8::splat(simd, r.inv[0].x), f32x8::splat(simd, r.inv[1].x), f32x8::splat(simd, r.inv[2].x)];
         // The ray in every lane, for leaves of several triangles tested at
-        // once (`test_triangle_leaf`); replays record each test, one by one.
-        let lanes_leaves = !R::ENABLED && spheres.is_empty();
+        // once by closest-hit queries (`test_triangle_leaf`); replays
+        // record each test, one by one.
+        let lanes_leaves = !ANY && !R::ENABLED && spheres.is_empty();
         let (ray_origin, ray_dir) = (V3::new(origin[0], origin[1], origin[2]), V3::new(f32x8::splat(simd, ray.dir.x), f32x8::splat(simd, ray.dir.y), f32x8::splat(simd, ray.dir.z)));
         let mut best = BestHit::nothing_before(t_max);
         let mut word = bvh.root;
@@ -490,7 +491,8 @@ impl<'a> BvhQuery<'a> {
                 let before = best.id;
                 let prims = &bvh.prims[start..end];
                 let stop = if lanes_leaves && prims.len() >= 2 {
-                    test_triangle_leaf::<S, ANY>(simd, prims, ray_origin, ray_dir, &mut best, &mut tests)
+                    test_triangle_leaf(simd, prims, ray_origin, ray_dir, &mut best, &mut tests);
+                    false
                 } else {
                     test_leaf::<ANY, R>(prims, spheres, ray, inside && !ANY, &mut best, &mut tests, rec)
                 };

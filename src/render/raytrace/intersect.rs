@@ -9,7 +9,7 @@ use crate::scene::{Sphere, Triangle};
 /// Every BVH leaf slot holds one, so it is kept to 40 bytes: the two-sided
 /// flag rides in the sign bit of the determinant bound, which is never
 /// negative. Laid out as ten floats in this order (`repr(C)`), so a leaf's
-/// triangles can be read into lanes as rows (`TriangleLanes::gather`).
+/// triangles can be read into lanes as rows (`traverse::gather_triangles`).
 #[derive(Clone, Copy, Debug)]
 #[repr(C)]
 pub struct TriangleEdges {

@@ -607,8 +607,8 @@ fn eye_rays_eight_wide<S: Simd>(simd: S, job: &PassJob, pk: &mut Packet, (x0, y0
 
 /// What shading a tile needs beside its hits: which shadow rays are
 /// blocked, per light (lane bits of the tile, and of the batch being
-/// shaded; kept per band so no tile allocates), and what holds for the
-/// whole pass.
+/// shaded; kept per rayon job so no tile or band allocates), and what holds
+/// for the whole pass.
 struct TileContext<'p> {
     tile: Vec<u64>,
     batch: Vec<u8>,

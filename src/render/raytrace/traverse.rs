@@ -244,32 +244,26 @@ fn gather_triangles<S: Simd>(simd: S, prims: &[(TriangleEdges, PrimitiveId)]) ->
     }
 }
 
-/// `test_leaf` for a leaf of two to eight triangles (no spheres), nothing
-/// recorded: the ray (`origin`, `dir` in every lane) against all of them
-/// at once (`intersect_triangles_lanes`, the single test's arithmetic lane
-/// by lane), then the hits taken in primitive order with `test_leaf`'s
-/// limit and tie rule. It finds what `test_leaf` finds and counts the
-/// tests it counts.
+/// `test_leaf` (closest hit) for a leaf of two to eight triangles (no
+/// spheres), nothing recorded: the ray (`origin`, `dir` in every lane)
+/// against all of them at once (`intersect_triangles_lanes`, the single
+/// test's arithmetic lane by lane), then the hits taken in primitive order
+/// with `test_leaf`'s limit and tie rule. It finds what `test_leaf` finds
+/// and counts the tests it counts. (Shadow rays keep the loop, which stops
+/// at the first hit: testing all of a leaf at once made the rasterized
+/// teapot's shadow rays 13% slower.)
 #[inline(always)]
-pub fn test_triangle_leaf<S: Simd, const ANY: bool>(simd: S, prims: &[(TriangleEdges, PrimitiveId)], origin: V3<f32x8<S>>, dir: V3<f32x8<S>>, best: &mut BestHit, tests: &mut u64) -> bool {
+pub fn test_triangle_leaf<S: Simd>(simd: S, prims: &[(TriangleEdges, PrimitiveId)], origin: V3<f32x8<S>>, dir: V3<f32x8<S>>, best: &mut BestHit, tests: &mut u64) {
     let n = prims.len();
     debug_assert!((2..=8).contains(&n));
+    *tests += n as u64;
     let triangles = gather_triangles(simd, prims);
     let (hit, t, b1, b2) = intersect_triangles_lanes(origin, dir, &triangles, f32x8::splat(simd, best.limit));
     let mut found = mask_bits(hit) as u32 & ((1u32 << n) - 1);
     if found == 0 {
-        *tests += n as u64;
-        return false;
+        return;
     }
     let (t, b1, b2): ([f32; 8], [f32; 8], [f32; 8]) = (t.into(), b1.into(), b2.into());
-    if ANY {
-        // `test_leaf` stops at the first primitive that is hit.
-        let k = found.trailing_zeros() as usize;
-        *tests += k as u64 + 1;
-        (best.t, best.id, best.bary) = (t[k], prims[k].1, (b1[k], b2[k]));
-        return true;
-    }
-    *tests += n as u64;
     while found != 0 {
         let k = found.trailing_zeros() as usize;
         found &= found - 1;
@@ -284,7 +278,6 @@ pub fn test_triangle_leaf<S: Simd, const ANY: bool>(simd: S, prims: &[(TriangleE
             best.limit = f32::from_bits(t[k].to_bits() + 1);
         }
     }
-    false
 }
 
 #[cfg(test)]
@@ -353,21 +346,15 @@ mod tests {
         assert_eq!((any.id, any.t, tests), (PrimitiveId::sphere(0), 3.0, 4));
     }
 
-    fn leaf_in_lanes<S: Simd>(simd: S, any: bool, prims: &[(TriangleEdges, PrimitiveId)], ray: &Ray, best: &mut BestHit, tests: &mut u64) -> bool {
+    fn leaf_in_lanes<S: Simd>(simd: S, prims: &[(TriangleEdges, PrimitiveId)], ray: &Ray, best: &mut BestHit, tests: &mut u64) {
         let lanes = |v: Vec3| V3::new(f32x8::splat(simd, v.x), f32x8::splat(simd, v.y), f32x8::splat(simd, v.z));
-        let (origin, dir) = (lanes(ray.origin), lanes(ray.dir));
-        if any {
-            test_triangle_leaf::<S, true>(simd, prims, origin, dir, best, tests)
-        } else {
-            test_triangle_leaf::<S, false>(simd, prims, origin, dir, best, tests)
-        }
+        test_triangle_leaf(simd, prims, lanes(ray.origin), lanes(ray.dir), best, tests)
     }
 
     /// The eight-lane leaf test finds, bit for bit, what the one-by-one
     /// test finds, and counts the same tests: over random leaves of two to
     /// eight triangles (one- and two-sided, some repeated so that hits tie,
-    /// some degenerate), random rays through them and random limits, both
-    /// closest hits and shadow rays' first hits.
+    /// some degenerate), random rays through them and random limits.
     #[test]
     fn leaf_lanes_find_what_the_leaf_loop_finds() {
         use crate::scene::Triangle;
@@ -403,22 +390,16 @@ mod tests {
             let dir = (aim.v0 + aim.e1 * u + aim.e2 * v - origin).normalize();
             let ray = Ray::new(origin, dir);
             let limit = if next() < 0.5 { f32::INFINITY } else { 1.0 + next() * 6.0 };
-            for any in [false, true] {
-                let (mut one, mut tests_one) = (BestHit::nothing_before(limit), 0u64);
-                let stop_one = if any {
-                    test_leaf::<true, _>(&prims, &[], &ray, false, &mut one, &mut tests_one, &mut NoRecord)
-                } else {
-                    test_leaf::<false, _>(&prims, &[], &ray, false, &mut one, &mut tests_one, &mut NoRecord)
-                };
-                let (mut wide, mut tests_wide) = (BestHit::nothing_before(limit), 0u64);
-                let stop_wide = dispatch!(crate::math::lanes::simd_level(), simd => leaf_in_lanes(simd, any, &prims, &ray, &mut wide, &mut tests_wide));
-                assert_eq!((stop_one, tests_one, one.id), (stop_wide, tests_wide, wide.id), "any: {any}, leaf of {n}");
-                assert_eq!([one.t, one.limit, one.bary.0, one.bary.1].map(f32::to_bits), [wide.t, wide.limit, wide.bary.0, wide.bary.1].map(f32::to_bits));
-                hits += !one.id.is_none() as u32;
-            }
+            let (mut one, mut tests_one) = (BestHit::nothing_before(limit), 0u64);
+            test_leaf::<false, _>(&prims, &[], &ray, false, &mut one, &mut tests_one, &mut NoRecord);
+            let (mut wide, mut tests_wide) = (BestHit::nothing_before(limit), 0u64);
+            dispatch!(crate::math::lanes::simd_level(), simd => leaf_in_lanes(simd, &prims, &ray, &mut wide, &mut tests_wide));
+            assert_eq!((tests_one, one.id), (tests_wide, wide.id), "leaf of {n}");
+            assert_eq!([one.t, one.limit, one.bary.0, one.bary.1].map(f32::to_bits), [wide.t, wide.limit, wide.bary.0, wide.bary.1].map(f32::to_bits));
+            hits += !one.id.is_none() as u32;
             leaves += 1;
         }
         // The random leaves are hit often enough for the comparison to mean something.
-        assert!(hits > leaves / 2, "{hits} hits in {leaves} leaves (two queries each)");
+        assert!(hits > leaves / 4, "{hits} hits in {leaves} leaves");
     }
 }
