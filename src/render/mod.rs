@@ -361,6 +361,15 @@ pub trait Renderer: Sync + Send {
     /// number of threads.
     fn render_pass(&self, job: &PassJob, out: &mut [Radiance]) -> RayCounts;
 
+    /// The rows of a chunk when a frame of many passes is rendered chunk by
+    /// chunk, each chunk's passes in a row (`Accumulator::render_in_chunks`);
+    /// `None` for a renderer whose `render_pass` has a cost per call that
+    /// does not shrink with its rows (a rasterizer sets up every triangle),
+    /// which renders pass by pass.
+    fn chunk_rows(&self) -> Option<u32> {
+        None
+    }
+
     /// Whether this renderer can draw `scene` with `settings`: one sentence
     /// saying why not (an option it does not support, no driver). Checked
     /// before a frame starts.

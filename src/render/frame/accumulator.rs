@@ -13,7 +13,7 @@ use crate::render::wireframe::{self, LineAlgorithm};
 use crate::render::{sample_offset, PassJob, PreparedScene, RayCounts, RenderSettings, Renderer};
 use rayon::prelude::*;
 use std::ops::Range;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 /// What a sample adds to its pixel: itself when finite, nothing otherwise.
 /// A NaN or infinite sample (a degenerate hit, a division by zero in a
@@ -325,6 +325,65 @@ impl Accumulator {
         Some(Band { rows, pass, counts, pass_done })
     }
 
+    /// Whether `render_in_chunks` can render this frame: several samples,
+    /// a fixed count of them, nothing rendered yet, and no view that needs
+    /// work per pass beside the renderer's (the diff view's reference, the
+    /// wireframe's lines).
+    pub fn renders_in_chunks(&self) -> bool {
+        self.spp > 1 && self.pass == 0 && self.row == 0 && self.adaptive.is_none() && self.reference.is_none() && self.wireframe.is_none()
+    }
+
+    /// Renders the whole frame chunk by chunk: chunks of `chunk_rows` rows
+    /// in parallel, each taking all its passes one after the other. No
+    /// thread waits for the others at the end of a pass, and a chunk's
+    /// passes meet the same part of the scene while it is still in cache.
+    /// Every pixel adds its samples in pass order, as band by band, so the
+    /// image is the same. `rows_done` counts rows times passes. Returns
+    /// `None` when `cancel` was raised (the frame is then incomplete).
+    pub fn render_in_chunks(&mut self, renderer: &dyn Renderer, prepared: &PreparedScene, chunk_rows: u32, cancel: &AtomicBool, rows_done: Option<&AtomicU64>) -> Option<()> {
+        assert!(self.renders_in_chunks(), "render_in_chunks on a frame it cannot render");
+        let (width, height, spp) = (self.settings.width, self.settings.height, self.spp);
+        super::build_shadow_maps(prepared, &self.settings);
+        self.photons = super::build_photon_map(prepared, &self.settings);
+        let view = prepared.scene.camera.view(width, height);
+        let (settings, photons) = (&self.settings, self.photons.as_deref());
+        let chunk_rows = chunk_rows.max(1);
+        let chunk = (chunk_rows * width).max(1) as usize;
+        let counts = self
+            .sum
+            .par_chunks_mut(chunk)
+            .zip(self.sum_sq.par_chunks_mut(chunk))
+            .enumerate()
+            .map(|(k, (sum, sum_sq))| {
+                let rows = k as u32 * chunk_rows..((k as u32 + 1) * chunk_rows).min(height);
+                let mut pass_buffer = vec![Radiance::ZERO; sum.len()];
+                let mut counts = RayCounts::default();
+                for pass in 0..spp {
+                    if cancel.load(Ordering::Relaxed) {
+                        break;
+                    }
+                    let job = PassJob { prepared, view: &view, settings, offset: sample_offset(pass, spp), sample: pass, photons, active: None, rows: rows.clone(), cancel };
+                    counts += renderer.render_pass(&job, &mut pass_buffer);
+                    add_pass(&pass_buffer, sum, sum_sq, None, spp);
+                    if let Some(done) = rows_done {
+                        done.fetch_add(rows.len() as u64, Ordering::Relaxed);
+                    }
+                }
+                counts
+            })
+            .reduce(RayCounts::default, |mut a, b| {
+                a += b;
+                a
+            });
+        if cancel.load(Ordering::Relaxed) {
+            return None;
+        }
+        self.counts += counts;
+        self.row_passes.fill(spp);
+        self.pass = spp;
+        Some(())
+    }
+
     /// The running average of `rows`: every pixel's sum over the passes its
     /// row holds (zero where none yet).
     pub fn mean_rows(&self, rows: Range<u32>) -> Vec<Radiance> {
@@ -512,6 +571,46 @@ mod tests {
             assert_eq!(bits(&shown), bits(&whole.pixels), "spp {spp}: running average at the end");
             assert_eq!(bits(&a.finish().pixels), bits(&whole.pixels), "spp {spp}");
         }
+    }
+
+    /// A frame rendered chunk by chunk (each chunk's passes in a row) is the
+    /// frame rendered pass by pass, bit for bit, with the same noise
+    /// estimate and counts; on path-traced frames, whose samples draw random
+    /// numbers per pixel and pass, and at a height that leaves a short chunk.
+    #[test]
+    fn chunks_equal_passes_bit_for_bit() {
+        let p = prepared("cornell-gi");
+        let cancel = AtomicBool::new(false);
+        for (spp, gi) in [(4, crate::render::gi::GiMode::Path), (3, crate::render::gi::GiMode::None)] {
+            let mut s = settings(&p, spp, View::Shaded);
+            s.height = 2 * BvhRayTracer.chunk_rows().unwrap() + 3;
+            s.gi.mode = gi;
+            let mut by_pass = Accumulator::new(&s);
+            while !by_pass.is_complete() {
+                by_pass.render_band(&BvhRayTracer, &p, s.height, &cancel).unwrap();
+            }
+            let mut chunked = Accumulator::new(&s);
+            assert!(chunked.renders_in_chunks());
+            let rows = AtomicU64::new(0);
+            chunked.render_in_chunks(&BvhRayTracer, &p, BvhRayTracer.chunk_rows().unwrap(), &cancel, Some(&rows)).unwrap();
+            assert!(chunked.is_complete() && !chunked.renders_in_chunks());
+            assert_eq!(rows.load(Ordering::Relaxed), s.height as u64 * spp as u64);
+            assert_eq!(chunked.noise_estimate().map(f32::to_bits), by_pass.noise_estimate().map(f32::to_bits), "spp {spp}");
+            assert_eq!(chunked.samples_taken(), by_pass.samples_taken());
+            let (a, b) = (chunked.finish(), by_pass.finish());
+            assert_eq!(bits(&a.pixels), bits(&b.pixels), "spp {spp}");
+            assert_eq!((a.counts.primary, a.counts.shadow, a.counts.secondary), (b.counts.primary, b.counts.shadow, b.counts.secondary));
+            // `render_frame` takes this route.
+            assert_eq!(bits(&render_frame(&BvhRayTracer, &p, &s, &cancel, None).unwrap().pixels), bits(&a.pixels));
+        }
+        let s = settings(&p, 2, View::Shaded);
+        assert!(Accumulator::new(&s).render_in_chunks(&BvhRayTracer, &p, 4, &AtomicBool::new(true), None).is_none());
+        // Frames that need work per pass beside the renderer's go pass by pass.
+        for view in [View::Diff, View::Wireframe] {
+            assert!(!Accumulator::new(&settings(&p, 2, view)).renders_in_chunks());
+        }
+        assert!(!Accumulator::new(&RenderSettings { adaptive: Some(0.1), ..s.clone() }).renders_in_chunks());
+        assert!(!Accumulator::new(&settings(&p, 1, View::Shaded)).renders_in_chunks());
     }
 
     #[test]

@@ -28,6 +28,13 @@ impl Renderer for BvhRayTracer {
         cast_pass_packets(job, &BvhQuery::new(job.prepared), out)
     }
 
+    /// Two rows of packet tiles: chunks small enough for two threads to
+    /// share the work evenly, large enough that the per-call set-up
+    /// (packets, batches, the path pool) is paid rarely.
+    fn chunk_rows(&self) -> Option<u32> {
+        Some(2 * super::packet::TILE_H as u32)
+    }
+
     /// The replay runs the frame's code from the eye ray's hit on: the same
     /// `resolve_sample` and `shade()`. It differs from the frame in exactly
     /// two places, both traversals rather than shading: the eye ray is traced
