@@ -327,7 +327,7 @@ impl BvhQuery<'_> {
                 // per node (512 bytes).
                 let mut groups: [MaybeUninit<(usize, f32x8<S>)>; P / 8] = [const { MaybeUninit::uninit() }; P / 8];
                 let mut n_groups = 0;
-                let mut far_max = f32::NEG_INFINITY;
+                let mut far_all = f32x8::splat(simd, f32::NEG_INFINITY);
                 let mut pending = mask;
                 while pending != 0 {
                     let g = pending.trailing_zeros() as usize / 8;
@@ -336,10 +336,11 @@ impl BvhQuery<'_> {
                     let active = mask_from_bits(simd, gmask);
                     let best = f32x8::from_slice(simd, &pk.best_t.0[8 * g..8 * g + 8]);
                     let far = active.select(best, f32x8::splat(simd, f32::NEG_INFINITY));
-                    far_max = far_max.max(horizontal_max(far));
+                    far_all = far_all.max(far);
                     groups[n_groups] = MaybeUninit::new((g, far));
                     n_groups += 1;
                 }
+                let far_max = horizontal_max(far_all);
                 // Interval test: the children no ray of the packet can meet.
                 let mut valid_children = bounds.children_possible(simd, node, far_max);
                 while valid_children != 0 {
@@ -410,16 +411,19 @@ fn slab_test_rays8<S: Simd>(simd: S, p: &[f32x8<S>; 6], pk: &Packet, start: usiz
     slab_test8(p, &origin, &inv, t_far)
 }
 
+/// The least lane of `v`, in two halving steps. (With a NaN lane the
+/// answer is unspecified; the traversal's lanes hold none: far ends are
+/// finite or infinite, entries of boxes hit are not NaN, and a bound taken
+/// over a NaN only culls less.)
 #[inline(always)]
 fn horizontal_min<S: Simd>(v: f32x8<S>) -> f32 {
-    let a: [f32; 8] = v.into();
-    a.into_iter().fold(f32::INFINITY, f32::min)
+    v.reduce_min()
 }
 
+/// The greatest lane of `v` (as `horizontal_min`).
 #[inline(always)]
 fn horizontal_max<S: Simd>(v: f32x8<S>) -> f32 {
-    let a: [f32; 8] = v.into();
-    a.into_iter().fold(f32::NEG_INFINITY, f32::max)
+    v.reduce_max()
 }
 
 /// The leaf loop of `traverse::test_leaf` for the rays of `mask`, each
