@@ -20,7 +20,11 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 /// shading formula) would otherwise poison the pixel for every later pass.
 #[inline]
 pub fn admitted(sample: Radiance) -> Radiance {
-    if sample.is_finite() { sample } else { Radiance::ZERO }
+    // x - x is 0 exactly when x is finite (NaN for NaN and infinities): one
+    // comparison, no branch per channel, where every pixel of every pass
+    // comes through.
+    let finite = (sample - sample).dot(Radiance::ONE) == 0.0;
+    if finite { sample } else { Radiance::ZERO }
 }
 
 /// Adds one pass's sample to a pixel's sum. With one sample per pixel the
@@ -41,9 +45,12 @@ pub fn add_sample(sum: &mut Radiance, sample: Radiance, spp: u32) {
 /// pixel this loop would otherwise be a serial part of every pass.
 fn add_pass(pass: &[Radiance], sum: &mut [Radiance], sum_sq: &mut [f32], adaptive: Option<(&[bool], &mut [u32])>, spp: u32) {
     const CHUNK: usize = 8192;
+    debug_assert!(spp > 1, "one sample is stored, not added");
     let add = |p: &Radiance, s: &mut Radiance, q: &mut f32| {
-        add_sample(s, *p, spp);
-        let l = luminance(admitted(*p));
+        // `add_sample` with several samples, the check made once for both sums.
+        let sample = admitted(*p);
+        *s += sample;
+        let l = luminance(sample);
         *q += l * l;
     };
     match adaptive {
