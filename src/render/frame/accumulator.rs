@@ -289,11 +289,17 @@ impl Accumulator {
                 }
             }
             if self.spp == 1 {
-                // A read-only scan in parallel: writes only where a sample
-                // is not finite (rarely), so the frame costs one pass of loads.
+                // A read-only scan in parallel: a chunk is rewritten only
+                // when one of its samples is not finite (rarely), so the
+                // frame costs one pass of loads. x - x is 0 for finite x and
+                // NaN otherwise, and a NaN stays in the sum: one subtraction
+                // and one addition per channel, with no branch per pixel.
                 self.sum[span.clone()].par_chunks_mut(8192).for_each(|chunk| {
-                    for s in chunk.iter_mut().filter(|s| !s.is_finite()) {
-                        *s = admitted(*s);
+                    let probe = chunk.iter().fold(Radiance::ZERO, |acc, s| acc + (*s - *s));
+                    if probe.dot(Radiance::ONE) != 0.0 {
+                        for s in chunk.iter_mut() {
+                            *s = admitted(*s);
+                        }
                     }
                 });
             } else {
