@@ -250,6 +250,12 @@ pub fn shade_batch<Q: SceneQuery>(job: &PassJob, query: &Q, batch: &Batch, block
         PathState::new(batch.pixels[i], job.sample, settings.spp, &settings.gi, job.photons)
     });
     let (albedo, direct) = direct_in_lanes(job, query, hits, &batch.w_o, n, &mut paths, &IN_ORDER, blocked, counts);
+    // A batch of one material (the common case) asks once whether anything
+    // comes after direct light.
+    // (Lanes past `n` are dropped by the callers.)
+    if n > 0 && hits.material[1..n].iter().all(|&m| m == hits.material[0]) && !shade::adds_after_direct(settings, &scene.materials[hits.material[0] as usize]) {
+        return direct;
+    }
     let mut out = [Radiance::ZERO; LANES];
     for i in 0..n {
         let material = &scene.materials[hits.material[i] as usize];
