@@ -334,18 +334,32 @@ fn render_regions(method: Method, job: &PassJob, out: &mut [Radiance]) -> RayCou
     }
     out.par_chunks_mut(width as usize * BAND_ROWS as usize)
         .enumerate()
-        .map(|(b, chunk)| {
-            if job.cancelled() {
-                return RayCounts::default();
-            }
-            let y0 = job.rows.start + b as u32 * BAND_ROWS;
-            let y1 = (y0 + BAND_ROWS).min(job.rows.end);
-            let mut vbs = layer_buffers(&layers, &query, PixelRect::new(0, y0, width, y1), key, forward);
-            for (l, vb) in layers.iter().zip(&mut vbs) {
-                l.raster(vb, b);
-            }
-            resolve_region(&mut vbs, chunk, width as usize, 0)
-        })
+        // A rayon job's bands reuse its buffers (reset per band): a fresh
+        // set per band cost its allocation and the clearing of every array.
+        // Depth keys that are ray parameters clear each pixel to its own
+        // far end, made with the buffer: those buffers are made per band.
+        .map_init(
+            || None,
+            |kept: &mut Option<Vec<VisBuffer<_>>>, (b, chunk)| {
+                if job.cancelled() {
+                    return RayCounts::default();
+                }
+                let y0 = job.rows.start + b as u32 * BAND_ROWS;
+                let y1 = (y0 + BAND_ROWS).min(job.rows.end);
+                let rect = PixelRect::new(0, y0, width, y1);
+                let vbs = match kept {
+                    Some(vbs) if key == DepthKey::NegInvZ => {
+                        vbs.iter_mut().for_each(|vb| vb.reset(rect));
+                        vbs
+                    }
+                    _ => kept.insert(layer_buffers(&layers, &query, rect, key, forward)),
+                };
+                for (l, vb) in layers.iter().zip(vbs.iter_mut()) {
+                    l.raster(vb, b);
+                }
+                resolve_region(vbs, chunk, width as usize, 0)
+            },
+        )
         .reduce(RayCounts::default, sum)
 }
 

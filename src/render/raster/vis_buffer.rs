@@ -770,17 +770,20 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         batch.clear();
     }
 
-    /// Empties the buffers for another region of at most the same size (the tiles of a row).
+    /// Empties the buffers for another region (the next tile of a row, the
+    /// next band of a rayon job). Depth keys must be -1/z (a ray-parameter
+    /// buffer is cleared per pixel when made).
     pub fn reset(&mut self, rect: PixelRect) {
         let n = rect.area() as usize;
-        assert!(self.key == DepthKey::NegInvZ && n <= self.id.capacity());
+        assert!(self.key == DepthKey::NegInvZ, "reset of a ray-parameter depth buffer");
         self.rect = rect;
         self.stride = rect.width() as usize;
         self.depth.clear();
         self.depth.resize(n, self.enc.clear_key());
         self.id.clear();
         self.id.resize(n, PrimitiveId::NONE);
-        self.payload.clear();
+        // The payload keeps what the last region left: a sample's payload
+        // is read only where its id is set, and both are written together.
         self.payload.resize(n, [0.0; 2]);
         if !self.job.prepared.scene.csgs.is_empty() {
             self.csg.clear();
