@@ -200,6 +200,24 @@ pub fn cos_sin_turns<L: Lane>(u: L) -> (L, L) {
     (L::select(negate_cos, -c, c), L::select(negate_sin, -s, s))
 }
 
+/// Whether every value is finite (no NaN, no infinity), eight lanes at a
+/// time: x - x is 0 for a finite x and NaN otherwise, and a NaN survives
+/// the sum. No branch per value: this runs over every pixel of a frame.
+pub fn all_finite(values: &[f32]) -> bool {
+    fn probe<S: Simd>(simd: S, values: &[f32]) -> bool {
+        let mut acc = <f32x8<S> as SimdBase<S>>::splat(simd, 0.0);
+        let mut rows = values.chunks_exact(8);
+        for row in &mut rows {
+            let v = f32x8::from_slice(simd, row);
+            acc = acc + (v - v);
+        }
+        let tail = rows.remainder().iter().fold(0.0f32, |a, &x| a + (x - x));
+        let lanes: [f32; 8] = acc.into();
+        lanes.iter().fold(tail, |a, &x| a + x) == 0.0
+    }
+    fearless_simd::dispatch!(simd_level(), simd => probe(simd, values))
+}
+
 /// The SIMD level of this CPU, detected once; `dispatch!` runs code
 /// generic over `Simd` at it.
 pub fn simd_level() -> fearless_simd::Level {
@@ -442,6 +460,22 @@ pub fn mask_from_bits<S: Simd>(simd: S, bits: u8) -> mask32x8<S> {
 mod tests {
     use super::*;
     use fearless_simd::{dispatch, Level};
+
+    /// A NaN or an infinity anywhere (in the eight-wide rows or the tail)
+    /// is found; finite values of any size, zeros and subnormals are not.
+    #[test]
+    fn all_finite_finds_every_non_finite_value() {
+        let finite: Vec<f32> = (0..37).map(|i| [f32::MAX, -f32::MAX, 0.0, -0.0, 1e-40, 3.5, f32::MIN_POSITIVE][i % 7]).collect();
+        assert!(all_finite(&finite));
+        assert!(all_finite(&[]));
+        for at in 0..finite.len() {
+            for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+                let mut v = finite.clone();
+                v[at] = bad;
+                assert!(!all_finite(&v), "{bad} at {at}");
+            }
+        }
+    }
 
     fn pow8(c: [f32; 8], s: [f32; 8]) -> [f32; 8] {
         let level = Level::new();

@@ -291,12 +291,9 @@ impl Accumulator {
             if self.spp == 1 {
                 // A read-only scan in parallel: a chunk is rewritten only
                 // when one of its samples is not finite (rarely), so the
-                // frame costs one pass of loads. x - x is 0 for finite x and
-                // NaN otherwise, and a NaN stays in the sum: one subtraction
-                // and one addition per channel, with no branch per pixel.
+                // frame costs one pass of loads.
                 self.sum[span.clone()].par_chunks_mut(8192).for_each(|chunk| {
-                    let probe = chunk.iter().fold(Radiance::ZERO, |acc, s| acc + (*s - *s));
-                    if probe.dot(Radiance::ONE) != 0.0 {
+                    if !crate::math::lanes::all_finite(bytemuck::cast_slice(chunk)) {
                         for s in chunk.iter_mut() {
                             *s = admitted(*s);
                         }
