@@ -691,25 +691,31 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         // Counted here, added once at the end (`resolve` counts its own).
         let (mut primary, mut shaded) = (0u64, 0u64);
         // Where that holds and no ray is needed, a row's empty pixels are
-        // filled at once; the loop below then only skips them.
+        // filled at once, and the loop below visits only the others
+        // (`visible`, columns of the row); else it visits every pixel.
         let fill = if all_ordinary { background } else { None };
+        let mut visible: Vec<u32> = Vec::with_capacity(self.stride);
         for (row, y) in (r.y0..r.y1).enumerate() {
             let line = row * out_stride + x_offset;
             let start = row * self.stride;
-            if let Some(value) = fill {
-                for (o, id) in out[line..line + self.stride].iter_mut().zip(&self.id[start..start + self.stride]) {
-                    if id.is_none() {
-                        *o = value;
-                        primary += 1;
+            visible.clear();
+            match fill {
+                Some(value) => {
+                    for (col, (o, id)) in out[line..line + self.stride].iter_mut().zip(&self.id[start..start + self.stride]).enumerate() {
+                        if id.is_none() {
+                            *o = value;
+                            primary += 1;
+                        } else {
+                            visible.push(col as u32);
+                        }
                     }
                 }
+                None => visible.extend(0..self.stride as u32),
             }
-            for (col, x) in (r.x0..r.x1).enumerate() {
+            for &col in &visible {
+                let (col, x) = (col as usize, r.x0 + col);
                 let (i, slot) = (start + col, line + col);
                 let id = self.id[i];
-                if fill.is_some() && id.is_none() {
-                    continue;
-                }
                 // Neither the recorded pixel nor one this pass leaves out.
                 let ordinary = all_ordinary || (!self.is_focus(x, y) && self.job.is_active(x, y));
                 if let (true, Some(value)) = (id.is_none() && ordinary, background) {
