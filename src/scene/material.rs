@@ -54,13 +54,17 @@ impl Material {
         self
     }
 
+    // These two are asked per shaded sample and bounce: the comparisons are
+    // made lane by lane and combined without a branch per component.
+    #[inline]
     pub fn has_glossy(&self) -> bool {
-        self.glossy != Vec3::ZERO
+        self.glossy.cmpne(Vec3::ZERO).any()
     }
 
     /// True when shading this material casts secondary rays.
+    #[inline]
     pub fn has_secondary(&self) -> bool {
-        self.mirror != Vec3::ZERO || self.transmission != Vec3::ZERO
+        (self.mirror.cmpne(Vec3::ZERO) | self.transmission.cmpne(Vec3::ZERO)).any()
     }
 
     /// Diffuse albedo at a surface point with uv `uv` and footprint `f`
