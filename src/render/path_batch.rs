@@ -88,6 +88,23 @@ impl<'p> PathPool<'p> {
         PathPool { paths: Vec::new(), slots: Vec::new(), beyond: Vec::new(), bounces: Vec::new(), front: Vec::new(), live: 0, next: Vec::new() }
     }
 
+    /// A pool with room for `samples` samples (and a batch more) and a few
+    /// bounces each, so that filling it does not reallocate and copy: the
+    /// ray caster makes one per rayon job of every pass of a chunk.
+    pub fn with_capacity(samples: usize) -> PathPool<'p> {
+        let n = samples + LANES;
+        let groups = n.div_ceil(LANES);
+        PathPool {
+            paths: Vec::with_capacity(n),
+            slots: Vec::with_capacity(n),
+            beyond: Vec::with_capacity(n),
+            bounces: Vec::with_capacity(4 * n),
+            front: Vec::with_capacity(groups),
+            live: 0,
+            next: Vec::with_capacity(groups),
+        }
+    }
+
     /// Number of samples put in.
     pub fn len(&self) -> usize {
         self.paths.len()

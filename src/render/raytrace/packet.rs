@@ -528,7 +528,7 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
                     textured: scene.has_textures(),
                     background: miss_without_ray(job),
                     batches: (0..P / shade_batch::LANES).map(|_| Batch::new()).collect(),
-                    paths: PathPool::new(),
+                    paths: if path_batch::takes(job) { PathPool::with_capacity(PATH_SAMPLES) } else { PathPool::new() },
                 };
                 (Packet::new(), Packet::new(), [None; P], context)
             },
