@@ -576,25 +576,51 @@ fn eye_rays_into(job: &PassJob, pk: &mut Packet, (x0, y0): (usize, usize), width
     dispatch!(simd_level(), simd => eye_rays_eight_wide(simd, job, pk, (x0, y0), width, rows))
 }
 
+/// Each group of eight lanes' pixel offsets in its tile, as floats (`LANE_XY`).
+const GROUP_DX: [[f32; 8]; P / 8] = group_offsets(0);
+const GROUP_DY: [[f32; 8]; P / 8] = group_offsets(1);
+
+const fn group_offsets(axis: usize) -> [[f32; 8]; P / 8] {
+    let mut table = [[0.0f32; 8]; P / 8];
+    let mut i = 0;
+    while i < P {
+        let (x, y) = LANE_XY[i];
+        table[i / 8][i % 8] = if axis == 0 { x as f32 } else { y as f32 };
+        i += 1;
+    }
+    table
+}
+
 #[inline(always)]
 fn eye_rays_eight_wide<S: Simd>(simd: S, job: &PassJob, pk: &mut Packet, (x0, y0): (usize, usize), width: usize, rows: usize) -> u64 {
     let mut valid = 0u64;
+    // A tile wholly inside the image, in a pass without inactive pixels,
+    // has every lane on a pixel: its sample positions are made as lanes.
+    // (x0 + dx) + offset, with x0 + dx an integer below 2^24: the same
+    // float as the pixel's own `sample_position`.
+    let whole = x0 + TILE_W <= width && rows >= TILE_H && job.active.is_none();
+    let (ox, oy) = (f32x8::splat(simd, x0 as f32), f32x8::splat(simd, y0 as f32));
+    let (sx, sy) = (f32x8::splat(simd, job.offset.x), f32x8::splat(simd, job.offset.y));
     for g in 0..P / 8 {
-        let (mut px, mut py) = ([0.0f32; 8], [0.0f32; 8]);
-        let mut group = 0u8;
-        for k in 0..8 {
-            let (tx, ty) = lane_xy(8 * g + k);
-            let (x, y) = ((x0 + tx) as u32, (y0 + ty) as u32);
-            let p = job.sample_position(x, y);
-            (px[k], py[k]) = (p.x, p.y);
-            if x0 + tx < width && ty < rows && job.is_active(x, y) {
-                group |= 1 << k;
+        let (px, py, group) = if whole {
+            ((ox + f32x8::from_slice(simd, &GROUP_DX[g])) + sx, (oy + f32x8::from_slice(simd, &GROUP_DY[g])) + sy, 0xffu8)
+        } else {
+            let (mut px, mut py) = ([0.0f32; 8], [0.0f32; 8]);
+            let mut group = 0u8;
+            for k in 0..8 {
+                let (tx, ty) = lane_xy(8 * g + k);
+                let (x, y) = ((x0 + tx) as u32, (y0 + ty) as u32);
+                let p = job.sample_position(x, y);
+                (px[k], py[k]) = (p.x, p.y);
+                if x0 + tx < width && ty < rows && job.is_active(x, y) {
+                    group |= 1 << k;
+                }
             }
-        }
+            (f32x8::simd_from(simd, px), f32x8::simd_from(simd, py), group)
+        };
         if group == 0 {
             continue;
         }
-        let (px, py) = (f32x8::simd_from(simd, px), f32x8::simd_from(simd, py));
         let (origin, dir) = job.view.eye_ray_lanes(px, py);
         let far: [f32; 8] = job.view.far_t_lanes(px, py).into();
         let (origin, dir) = (origin.scatter(), dir.scatter());
