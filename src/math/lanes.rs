@@ -201,17 +201,18 @@ pub fn cos_sin_turns<L: Lane>(u: L) -> (L, L) {
 }
 
 /// Whether every value is finite (no NaN, no infinity), eight lanes at a
-/// time: x - x is 0 for a finite x and NaN otherwise, and a NaN survives
-/// the sum. No branch per value: this runs over every pixel of a frame.
+/// time: x * 0 is a zero for a finite x and NaN otherwise, and a NaN
+/// survives the sum. No branch per value: this runs over every pixel of a
+/// frame.
 pub fn all_finite(values: &[f32]) -> bool {
     fn probe<S: Simd>(simd: S, values: &[f32]) -> bool {
-        let mut acc = <f32x8<S> as SimdBase<S>>::splat(simd, 0.0);
+        let zero = <f32x8<S> as SimdBase<S>>::splat(simd, 0.0);
+        let mut acc = zero;
         let mut rows = values.chunks_exact(8);
         for row in &mut rows {
-            let v = f32x8::from_slice(simd, row);
-            acc = acc + (v - v);
+            acc += f32x8::from_slice(simd, row) * zero;
         }
-        let tail = rows.remainder().iter().fold(0.0f32, |a, &x| a + (x - x));
+        let tail = rows.remainder().iter().fold(0.0f32, |a, &x| a + x * 0.0);
         let lanes: [f32; 8] = acc.into();
         lanes.iter().fold(tail, |a, &x| a + x) == 0.0
     }

@@ -54,11 +54,11 @@ pub fn render_frame_in_bands(
     let mut frame = Accumulator::new(settings);
     // Without a count of passes to report, a renderer that renders a few
     // rows as cheaply as many takes the frame chunk by chunk.
-    if let (None, Some(rows)) = (passes_done, renderer.chunk_rows()) {
-        if frame.renders_in_chunks() {
-            frame.render_in_chunks(renderer, prepared, rows, cancel, rows_done)?;
-            return Some(frame.finish());
-        }
+    if let (None, Some(rows)) = (passes_done, renderer.chunk_rows())
+        && frame.renders_in_chunks()
+    {
+        frame.render_in_chunks(renderer, prepared, rows, cancel, rows_done)?;
+        return Some(frame.finish());
     }
     let band_rows = settings.height.div_ceil(bands.clamp(1, settings.height.max(1)));
     while !frame.is_complete() {

@@ -20,10 +20,10 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 /// shading formula) would otherwise poison the pixel for every later pass.
 #[inline]
 pub fn admitted(sample: Radiance) -> Radiance {
-    // x - x is 0 exactly when x is finite (NaN for NaN and infinities): one
-    // comparison, no branch per channel, where every pixel of every pass
-    // comes through.
-    let finite = (sample - sample).dot(Radiance::ONE) == 0.0;
+    // x * 0 is a zero exactly when x is finite (NaN for NaN and the
+    // infinities): one comparison, no branch per channel, where every pixel
+    // of every pass comes through.
+    let finite = (sample * 0.0).dot(Radiance::ONE) == 0.0;
     if finite { sample } else { Radiance::ZERO }
 }
 
