@@ -251,8 +251,7 @@ pub fn shade_batch<Q: SceneQuery>(job: &PassJob, query: &Q, batch: &Batch, block
     });
     let (albedo, direct) = direct_in_lanes(job, query, hits, &batch.w_o, n, &mut paths, &IN_ORDER, blocked, counts);
     // A batch of one material (the common case) asks once whether anything
-    // comes after direct light.
-    // (Lanes past `n` are dropped by the callers.)
+    // comes after direct light (lanes past `n` are dropped by the callers).
     if n > 0 && hits.material[1..n].iter().all(|&m| m == hits.material[0]) && !shade::adds_after_direct(settings, &scene.materials[hits.material[0] as usize]) {
         return direct;
     }

@@ -243,12 +243,7 @@ impl Accumulator {
         assert!(!self.is_complete(), "render_band on a complete frame");
         let (width, height) = (self.settings.width, self.settings.height);
         if self.pass == 0 && self.row == 0 {
-            super::build_shadow_maps(prepared, &self.settings);
-            self.photons = super::build_photon_map(prepared, &self.settings);
-            if let Some(algorithm) = self.wireframe {
-                let view = prepared.scene.camera.view(width, height);
-                self.lines = Some(wireframe::line_mask(&prepared.scene, &view, algorithm));
-            }
+            self.prepare_frame(prepared);
         }
         let rows = self.row..(self.row + max_rows.max(1)).min(height);
         let mut counts = RayCounts::default();
@@ -335,6 +330,17 @@ impl Accumulator {
         Some(Band { rows, pass, counts, pass_done })
     }
 
+    /// What every pass reads, made once before the first: shadow maps or
+    /// volumes, the photon map, the wireframe's lines.
+    fn prepare_frame(&mut self, prepared: &PreparedScene) {
+        super::build_shadow_maps(prepared, &self.settings);
+        self.photons = super::build_photon_map(prepared, &self.settings);
+        if let Some(algorithm) = self.wireframe {
+            let view = prepared.scene.camera.view(self.settings.width, self.settings.height);
+            self.lines = Some(wireframe::line_mask(&prepared.scene, &view, algorithm));
+        }
+    }
+
     /// Whether `render_in_chunks` can render this frame: several samples,
     /// a fixed count of them, nothing rendered yet, and no view that needs
     /// work per pass beside the renderer's (the diff view's reference, the
@@ -353,8 +359,7 @@ impl Accumulator {
     pub fn render_in_chunks(&mut self, renderer: &dyn Renderer, prepared: &PreparedScene, chunk_rows: u32, cancel: &AtomicBool, rows_done: Option<&AtomicU64>) -> Option<()> {
         assert!(self.renders_in_chunks(), "render_in_chunks on a frame it cannot render");
         let (width, height, spp) = (self.settings.width, self.settings.height, self.spp);
-        super::build_shadow_maps(prepared, &self.settings);
-        self.photons = super::build_photon_map(prepared, &self.settings);
+        self.prepare_frame(prepared);
         let view = prepared.scene.camera.view(width, height);
         let (settings, photons) = (&self.settings, self.photons.as_deref());
         let chunk_rows = chunk_rows.max(1);
