@@ -361,6 +361,14 @@ pub trait Renderer: Sync + Send {
     /// number of threads.
     fn render_pass(&self, job: &PassJob, out: &mut [Radiance]) -> RayCounts;
 
+    /// Renders several passes of the same rows, pass k into
+    /// `out[k * n..(k + 1) * n]` (n pixels each), as `render_pass` would
+    /// one after the other (which is what this default does). A ray caster
+    /// may trace a pixel's samples of several passes together.
+    fn render_passes(&self, jobs: &[PassJob], out: &mut [Radiance]) -> RayCounts {
+        render_passes_in_turn(self, jobs, out)
+    }
+
     /// The rows of a chunk when a frame of many passes is rendered chunk by
     /// chunk, each chunk's passes in a row (`Accumulator::render_in_chunks`);
     /// `None` for a renderer whose `render_pass` has a cost per call that
@@ -411,6 +419,16 @@ pub fn renderer_by_name(name: &str) -> Result<Box<dyn Renderer>, String> {
         .into_iter()
         .find(|r| r.name() == wanted)
         .ok_or_else(|| format!("unknown renderer \"{name}\" (choose from raytrace, rasterize, {})", renderer_names().join(", ")))
+}
+
+/// `Renderer::render_passes` as `render_pass` after `render_pass`.
+pub fn render_passes_in_turn<R: Renderer + ?Sized>(renderer: &R, jobs: &[PassJob], out: &mut [Radiance]) -> RayCounts {
+    let n = (out.len() / jobs.len().max(1)).max(1);
+    let mut counts = RayCounts::default();
+    for (job, out) in jobs.iter().zip(out.chunks_mut(n)) {
+        counts += renderer.render_pass(job, out);
+    }
+    counts
 }
 
 /// What `resolve_sample` returns for a sample that sees nothing, when that

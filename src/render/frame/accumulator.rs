@@ -15,6 +15,10 @@ use rayon::prelude::*;
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
+/// Passes a chunk hands its renderer at once (`Renderer::render_passes`):
+/// the ray caster's packets hold eight passes of a few pixels.
+const PASSES_TOGETHER: u32 = 8;
+
 /// What a sample adds to its pixel: itself when finite, nothing otherwise.
 /// A NaN or infinite sample (a degenerate hit, a division by zero in a
 /// shading formula) would otherwise poison the pixel for every later pass.
@@ -371,17 +375,28 @@ impl Accumulator {
             .enumerate()
             .map(|(k, (sum, sum_sq))| {
                 let rows = k as u32 * chunk_rows..((k as u32 + 1) * chunk_rows).min(height);
-                let mut pass_buffer = vec![Radiance::ZERO; sum.len()];
+                // Up to PASSES_TOGETHER passes rendered in one call (a ray
+                // caster traces a pixel's samples of them together), then
+                // added in pass order.
+                let group = PASSES_TOGETHER.min(spp) as usize;
+                let mut pass_buffers = vec![Radiance::ZERO; group * sum.len()];
                 let mut counts = RayCounts::default();
-                for pass in 0..spp {
+                for first in (0..spp).step_by(group) {
                     if cancel.load(Ordering::Relaxed) {
                         break;
                     }
-                    let job = PassJob { prepared, view: &view, settings, offset: sample_offset(pass, spp), sample: pass, photons, active: None, rows: rows.clone(), cancel };
-                    counts += renderer.render_pass(&job, &mut pass_buffer);
-                    add_pass(&pass_buffer, sum, sum_sq, None, spp);
-                    if let Some(done) = rows_done {
-                        done.fetch_add(rows.len() as u64, Ordering::Relaxed);
+                    let passes = first..(first + group as u32).min(spp);
+                    let jobs: Vec<PassJob> = passes
+                        .clone()
+                        .map(|pass| PassJob { prepared, view: &view, settings, offset: sample_offset(pass, spp), sample: pass, photons, active: None, rows: rows.clone(), cancel })
+                        .collect();
+                    let buffers = &mut pass_buffers[..jobs.len() * sum.len()];
+                    counts += renderer.render_passes(&jobs, buffers);
+                    for pass_buffer in buffers.chunks(sum.len()) {
+                        add_pass(pass_buffer, sum, sum_sq, None, spp);
+                        if let Some(done) = rows_done {
+                            done.fetch_add(rows.len() as u64, Ordering::Relaxed);
+                        }
                     }
                 }
                 counts
@@ -596,7 +611,8 @@ mod tests {
     fn chunks_equal_passes_bit_for_bit() {
         let p = prepared("cornell-gi");
         let cancel = AtomicBool::new(false);
-        for (spp, gi) in [(4, crate::render::gi::GiMode::Path), (3, crate::render::gi::GiMode::None)] {
+        // 11 passes: a group of eight passes handed over together, then three.
+        for (spp, gi) in [(4, crate::render::gi::GiMode::Path), (3, crate::render::gi::GiMode::None), (11, crate::render::gi::GiMode::Path)] {
             let mut s = settings(&p, spp, View::Shaded);
             s.height = 2 * BvhRayTracer.chunk_rows().unwrap() + 3;
             s.gi.mode = gi;

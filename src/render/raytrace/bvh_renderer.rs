@@ -4,7 +4,7 @@
 
 use super::bvh::BvhQuery;
 use super::cast_pixel;
-use super::packet::cast_pass_packets;
+use super::packet::{cast_pass_packets, cast_passes_packets};
 use crate::math::Radiance;
 use crate::render::pixel_record::PixelTrace;
 use crate::render::{PassJob, RayCounts, Renderer};
@@ -26,6 +26,16 @@ impl Renderer for BvhRayTracer {
             return super::cast_pass(job, &BvhQuery::new(job.prepared), out);
         }
         cast_pass_packets(job, &BvhQuery::new(job.prepared), out)
+    }
+
+    /// A chunk's passes eight at a time, each pixel's samples of them in one
+    /// packet (`cast_passes_packets`), where frames are shaded in batches.
+    fn render_passes(&self, jobs: &[PassJob], out: &mut [Radiance]) -> RayCounts {
+        let passes = match jobs.first() {
+            Some(job) if job.prepared.instances.is_none() => cast_passes_packets(jobs, &BvhQuery::new(job.prepared), out),
+            _ => None,
+        };
+        passes.unwrap_or_else(|| crate::render::render_passes_in_turn(self, jobs, out))
     }
 
     /// Two rows of packet tiles: chunks small enough for two threads to

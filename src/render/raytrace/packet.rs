@@ -17,6 +17,10 @@
 //! After the eye rays, the tile's shadow rays towards each light go as one
 //! packet too, and the tile is shaded eight samples at a time from those
 //! answers (`shade_tile_batched`, `shade_batch`).
+//!
+//! A frame of many samples hands over up to eight passes at once
+//! (`cast_passes_packets`): a packet then holds a few pixels' samples of
+//! all of them, rays much closer together than one sample of 8x8 pixels.
 
 use super::bvh::{leaf_range, BvhQuery, Node8, LEAF_BIT, STACK};
 use super::{cast_pass, with_eye_differentials};
@@ -67,6 +71,60 @@ const LANE_XY: [(u8, u8); P] = {
     }
     table
 };
+
+/// Which sample each lane of a tile holds: lane i is pass `lanes[i].0` (an
+/// index into the call's jobs) at pixel `(x0 + lanes[i].1, y0 + lanes[i].2)`
+/// of the tile at `(x0, y0)`, and its radiance goes to `out` at
+/// `pass * pass_stride + y * width + x` (y counted from the band's top).
+struct TileLayout {
+    lanes: [(u8, u8, u8); P],
+    pass_stride: usize,
+}
+
+impl TileLayout {
+    /// One pass, TILE_W x TILE_H pixels (`lane_xy`).
+    const ONE_PASS: [(u8, u8, u8); P] = {
+        let mut table = [(0u8, 0u8, 0u8); P];
+        let mut i = 0;
+        while i < P {
+            table[i] = (0, LANE_XY[i].0, LANE_XY[i].1);
+            i += 1;
+        }
+        table
+    };
+
+    /// `passes` (2, 4 or 8) passes of a tile of `P / passes` pixels
+    /// (`pass_tile`): lanes `g * P / passes..` are pass g's, each group of
+    /// eight of them a 4x2 block of its pixels.
+    const fn passes(passes: usize) -> [(u8, u8, u8); P] {
+        let per_pass = P / passes;
+        let blocks_across = pass_tile(passes).0 / 4;
+        let mut table = [(0u8, 0u8, 0u8); P];
+        let mut i = 0;
+        while i < P {
+            let (g, j) = (i / per_pass, i % per_pass);
+            let (b, q) = (j / 8, j % 8);
+            table[i] = (g as u8, (4 * (b % blocks_across) + q % 4) as u8, (2 * (b / blocks_across) + q / 4) as u8);
+            i += 1;
+        }
+        table
+    }
+}
+
+/// The pixels (across, down) of a tile that holds `passes` passes (2, 4 or
+/// 8) of each: a pixel's samples of those passes go down the tree
+/// together, so a packet's rays stay close together and meet fewer boxes
+/// and leaves than 8x8 pixels of one pass do.
+const fn pass_tile(passes: usize) -> (usize, usize) {
+    match passes {
+        8 => (4, 2),
+        4 => (4, 4),
+        _ => (8, 4),
+    }
+}
+
+/// The lanes of tiles of 2, 4 and 8 passes.
+const PASS_LAYOUTS: [[(u8, u8, u8); P]; 3] = [TileLayout::passes(2), TileLayout::passes(4), TileLayout::passes(8)];
 
 /// The rays of one packet and their traversal state, structure of arrays.
 pub struct Packet {
@@ -544,7 +602,8 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
                     counts.primary += valid.count_ones() as u64;
                     query.closest_packet(pk, valid, &mut counts);
                     if batched {
-                        shade_tile_batched(job, query, pk, valid, shadow_pk, context, band, (x0, y0), width, &mut counts);
+                        let layout = TileLayout { lanes: TileLayout::ONE_PASS, pass_stride: 0 };
+                        shade_tile_batched(std::slice::from_ref(job), &layout, query, pk, valid, shadow_pk, context, band, (x0, y0), 0, width, &mut counts);
                         continue;
                     }
                     pk.hits_into(query, valid, hits);
@@ -566,6 +625,94 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
             a += b;
             a
         })
+}
+
+/// `Renderer::render_passes` for the BVH: two to eight passes of the same
+/// rows, pass k into `out[k * n..]` (n = the rows' pixels), traced as tiles
+/// of a few pixels (`pass_tile`) with each pixel's samples of every pass in
+/// one packet (`TileLayout::passes`), then shaded as `cast_pass_packets`
+/// shades, each batch in its own pass. Every sample is the one
+/// `cast_pass_packets` makes for its pass: the same eye ray, hit, shadow
+/// answers and shading. Runs on the calling thread (the frame's chunks are
+/// what run in parallel). `None` where `cast_pass_packets` would not shade
+/// in batches, or for one pass or more than eight: the caller then renders
+/// pass by pass.
+pub fn cast_passes_packets(jobs: &[PassJob], query: &BvhQuery, out: &mut [Radiance]) -> Option<RayCounts> {
+    let first = jobs.first()?;
+    let scene = &query.prepared.scene;
+    if !(2..=P / 8).contains(&jobs.len()) || query.prepared.bvh.deep || first.settings.view == View::Cost || !scene.csgs.is_empty() || !shade_batch::batchable(first) || first.active.is_some() {
+        return None;
+    }
+    let width = first.view.width as usize;
+    let rows = first.rows.len();
+    let n = rows * width;
+    debug_assert_eq!(out.len(), jobs.len() * n);
+    let mut context = TileContext {
+        tile: vec![0; scene.lights.len()],
+        batch: vec![0; scene.lights.len()],
+        textured: scene.has_textures(),
+        background: miss_without_ray(first),
+        batches: (0..P / shade_batch::LANES).map(|_| Batch::new()).collect(),
+        paths: if path_batch::takes(first) { PathPool::with_capacity(PATH_SAMPLES) } else { PathPool::new() },
+    };
+    let (mut pk, mut shadow_pk) = (Packet::new(), Packet::new());
+    // The tile for the next power of two passes (lanes of missing passes
+    // stay empty).
+    let passes = jobs.len().next_power_of_two();
+    let (tile_w, tile_h) = pass_tile(passes);
+    let layout = TileLayout { lanes: PASS_LAYOUTS[passes.trailing_zeros() as usize - 1], pass_stride: n };
+    let mut counts = RayCounts::default();
+    for ty0 in (0..rows).step_by(tile_h) {
+        if first.cancelled() {
+            break;
+        }
+        let y0 = first.rows.start as usize + ty0;
+        for x0 in (0..width).step_by(tile_w) {
+            let valid = dispatch!(simd_level(), simd => eye_rays_of_passes(simd, jobs, &layout, &mut pk, (x0, y0), width, rows - ty0));
+            counts.primary += valid.count_ones() as u64;
+            query.closest_packet(&mut pk, valid, &mut counts);
+            shade_tile_batched(jobs, &layout, query, &pk, valid, &mut shadow_pk, &mut context, out, (x0, y0), ty0, width, &mut counts);
+        }
+    }
+    context.paths.follow_into(first, query, &mut counts, out);
+    Some(counts)
+}
+
+/// The eye rays of the passes `jobs` for the tile at `(x0, y0)` laid out as
+/// `layout` says (each group of eight lanes one pass's 4x2 block; `rows`
+/// rows of the band are left), as `eye_rays_eight_wide` makes them; the
+/// lanes on a pixel.
+#[inline(always)]
+fn eye_rays_of_passes<S: Simd>(simd: S, jobs: &[PassJob], layout: &TileLayout, pk: &mut Packet, (x0, y0): (usize, usize), width: usize, rows: usize) -> u64 {
+    let mut valid = 0u64;
+    for group in 0..P / 8 {
+        let lanes = &layout.lanes[8 * group..8 * group + 8];
+        let Some(job) = jobs.get(lanes[0].0 as usize) else { continue };
+        let (mut dx, mut dy) = ([0.0f32; 8], [0.0f32; 8]);
+        let mut inside = 0u8;
+        for (k, &(_, tx, ty)) in lanes.iter().enumerate() {
+            (dx[k], dy[k]) = (tx as f32, ty as f32);
+            inside |= ((x0 + (tx as usize) < width && (ty as usize) < rows) as u8) << k;
+        }
+        if inside == 0 {
+            continue;
+        }
+        // (x0 + dx) + offset, with x0 + dx an integer below 2^24: the
+        // pixel's own `sample_position`.
+        let px = (f32x8::splat(simd, x0 as f32) + f32x8::simd_from(simd, dx)) + f32x8::splat(simd, job.offset.x);
+        let py = (f32x8::splat(simd, y0 as f32) + f32x8::simd_from(simd, dy)) + f32x8::splat(simd, job.offset.y);
+        let (origin, dir) = job.view.eye_ray_lanes(px, py);
+        let far: [f32; 8] = job.view.far_t_lanes(px, py).into();
+        let (origin, dir) = (origin.scatter(), dir.scatter());
+        for k in 0..8 {
+            if inside & (1 << k) != 0 {
+                pk.rays[8 * group + k] = Ray::new(origin[k], dir[k]);
+                pk.t_max[8 * group + k] = far[k];
+            }
+        }
+        valid |= (inside as u64) << (8 * group);
+    }
+    valid
 }
 
 /// The eye rays of the tile at `(x0, y0)` (`rows` rows of the band, the
@@ -660,12 +807,16 @@ const PATH_SAMPLES: usize = 4 * P;
 
 /// Shades one traced tile in batches of eight (`shade_batch`): the lanes
 /// that see a surface are put into batches in lane order (a triangle's
-/// record built in its batch, eight at a time), then the tile's shadow rays
-/// towards every light go as one packet per light, then the batches are
-/// shaded, each light's visibility read from its packet.
+/// record built in its batch, eight at a time; a batch holds one pass's
+/// samples), then the tile's shadow rays towards every light go as one
+/// packet per light, then the batches are shaded, each light's visibility
+/// read from its packet. Lane i holds the sample `layout` names, of pass
+/// `jobs[layout.lanes[i].0]`; `band` holds the tile's rows from `row`, each
+/// `width` pixels.
 #[allow(clippy::too_many_arguments)]
 fn shade_tile_batched<'p>(
-    job: &PassJob<'p>,
+    jobs: &[PassJob<'p>],
+    layout: &TileLayout,
     query: &BvhQuery,
     pk: &Packet,
     valid: u64,
@@ -673,28 +824,45 @@ fn shade_tile_batched<'p>(
     context: &mut TileContext<'p>,
     band: &mut [Radiance],
     (x0, y0): (usize, usize),
+    row: usize,
     width: usize,
     counts: &mut RayCounts,
 ) {
     let TileContext { tile: blocked, batch: lane_blocked, textured, background, batches, paths } = context;
     let scene = &query.prepared.scene;
-    let settings = job.settings;
-    let mut filled = 0;
+    let first = &jobs[0];
+    let settings = first.settings;
+    let out_index = |i: usize| {
+        let (g, tx, ty) = layout.lanes[i];
+        g as usize * layout.pass_stride + (row + ty as usize) * width + x0 + tx as usize
+    };
+    // Each batch's pass, and the pass of the lane pushed last.
+    let mut batch_pass = [0usize; P / shade_batch::LANES];
+    let mut last_pass = 0usize;
+    let mut filled = 0usize;
     let mut m = valid;
     while m != 0 {
         let i = m.trailing_zeros() as usize;
         m &= m - 1;
-        let (tx, ty) = lane_xy(i);
+        let (g, tx, ty) = layout.lanes[i];
+        let (g, tx, ty) = (g as usize, tx as usize, ty as usize);
+        let job = &jobs[g];
         let (x, y) = ((x0 + tx) as u32, (y0 + ty) as u32);
         let pixel = job.pixel_index(x, y);
         let id = pk.best_id[i];
         if id.is_none() {
-            band[ty * width + x0 + tx] = match background {
+            band[out_index(i)] = match background {
                 Some(value) => *value,
                 None => resolve_sample(job, query, &pk.rays[i], None, pixel, counts, &mut NoRecord),
             };
             continue;
         }
+        if g != last_pass {
+            // A new pass starts a new batch.
+            filled = filled.next_multiple_of(shade_batch::LANES);
+            last_pass = g;
+        }
+        batch_pass[filled / shade_batch::LANES] = g;
         let batch = &mut batches[filled / shade_batch::LANES];
         if id.kind() == PrimitiveKind::Triangle && !*textured {
             let input = TriangleHitInput::new(id.index(), pk.bary[i], pk.best_t.0[i], pk.rays[i].dir);
@@ -711,7 +879,7 @@ fn shade_tile_batched<'p>(
     }
     let batches = &mut batches[..filled.div_ceil(shade_batch::LANES)];
     for batch in batches.iter_mut() {
-        batch.build_pending(scene, job.view, settings.interpolation);
+        batch.build_pending(scene, first.view, settings.interpolation);
     }
     let shadows = settings.shadows == ShadowMode::Ray;
     if shadows {
@@ -737,35 +905,31 @@ fn shade_tile_batched<'p>(
             }
         }
     }
-    if path_batch::takes(job) {
+    if path_batch::takes(first) {
         // The paths wait for those of the band's next tiles, to be
         // followed together (`PathPool::follow_into`, once it holds
         // `PATH_SAMPLES` and at the end of the band).
-        for batch in batches.iter_mut() {
+        for (b, batch) in batches.iter_mut().enumerate() {
             for (k, bits) in lane_blocked.iter_mut().enumerate() {
                 *bits = (0..batch.len()).fold(0u8, |acc, j| acc | (((blocked[k] >> batch.slots[j]) & 1) as u8) << j);
             }
             // Where each lane's radiance goes in the band.
-            let slots: [usize; shade_batch::LANES] = std::array::from_fn(|j| {
-                let (tx, ty) = lane_xy(batch.slots[j]);
-                ty * width + x0 + tx
-            });
-            shade_batch::start_paths(job, query, batch, shadows.then_some(&lane_blocked[..]), &slots[..batch.len()], counts, paths);
+            let slots: [usize; shade_batch::LANES] = std::array::from_fn(|j| out_index(batch.slots[j]));
+            shade_batch::start_paths(&jobs[batch_pass[b]], query, batch, shadows.then_some(&lane_blocked[..]), &slots[..batch.len()], counts, paths);
             batch.clear();
         }
         if paths.len() >= PATH_SAMPLES {
-            paths.follow_into(job, query, counts, band);
+            paths.follow_into(first, query, counts, band);
         }
         return;
     }
-    for batch in batches.iter_mut() {
+    for (b, batch) in batches.iter_mut().enumerate() {
         for (k, bits) in lane_blocked.iter_mut().enumerate() {
             *bits = (0..batch.len()).fold(0u8, |acc, j| acc | (((blocked[k] >> batch.slots[j]) & 1) as u8) << j);
         }
-        let values = shade_batch::shade_batch(job, query, batch, shadows.then_some(&lane_blocked[..]), counts);
+        let values = shade_batch::shade_batch(&jobs[batch_pass[b]], query, batch, shadows.then_some(&lane_blocked[..]), counts);
         for j in 0..batch.len() {
-            let (tx, ty) = lane_xy(batch.slots[j]);
-            band[ty * width + x0 + tx] = values[j];
+            band[out_index(batch.slots[j])] = values[j];
         }
         batch.clear();
     }
@@ -816,6 +980,56 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Several passes traced together (`cast_passes_packets`) give each
+    /// pass, bit for bit, what `cast_pass_packets` gives it alone: on every
+    /// built-in scene without CSG, direct and path traced, two to eight
+    /// passes (every tile layout, and lanes of a missing pass), an image
+    /// whose width and rows cut the tiles, rows not starting at the top.
+    #[test]
+    fn passes_together_equal_passes_alone() {
+        use crate::render::gi::GiMode;
+        use crate::render::{sample_offset, RenderSettings};
+        use std::sync::atomic::AtomicBool;
+        let cancel = AtomicBool::new(false);
+        let mut compared = 0;
+        for name in builtin::names() {
+            let prepared = PreparedScene::new(builtin::load_builtin(name).unwrap().unwrap());
+            if !prepared.scene.csgs.is_empty() || prepared.bvh.deep {
+                continue;
+            }
+            let query = BvhQuery::new(&prepared);
+            let (w, h) = (23u32, 13u32);
+            let view = prepared.scene.camera.view(w, h);
+            for (gi, passes) in [(GiMode::None, 8u32), (GiMode::Path, 3), (GiMode::Path, 2), (GiMode::None, 4)] {
+                let mut settings = RenderSettings { width: w, height: h, spp: 2 * passes, ..RenderSettings::for_scene(&prepared.scene) };
+                settings.gi.mode = gi;
+                let rows = 2..h;
+                let jobs: Vec<PassJob> = (passes..2 * passes)
+                    .map(|pass| PassJob { prepared: &prepared, view: &view, settings: &settings, offset: sample_offset(pass, settings.spp), sample: pass, photons: None, active: None, rows: rows.clone(), cancel: &cancel })
+                    .collect();
+                let n = (rows.len() * w as usize).max(1);
+                let mut together = vec![Radiance::splat(-1.0); jobs.len() * n];
+                let counts = cast_passes_packets(&jobs, &query, &mut together).expect("batched passes go together");
+                let mut alone_counts = RayCounts::default();
+                for (k, job) in jobs.iter().enumerate() {
+                    let mut alone = vec![Radiance::splat(-2.0); n];
+                    alone_counts += cast_pass_packets(job, &query, &mut alone);
+                    let key = |v: &[Radiance]| v.iter().map(|r| r.to_array().map(f32::to_bits)).collect::<Vec<_>>();
+                    assert_eq!(key(&together[k * n..(k + 1) * n]), key(&alone), "{name} {gi:?} pass {k} of {passes}");
+                    compared += n;
+                }
+                assert_eq!((counts.primary, counts.shadow, counts.secondary), (alone_counts.primary, alone_counts.shadow, alone_counts.secondary), "{name} {gi:?}");
+            }
+            // One pass, or more than a packet holds, go pass by pass.
+            let settings = RenderSettings { width: w, height: h, spp: 9, ..RenderSettings::for_scene(&prepared.scene) };
+            let jobs: Vec<PassJob> = (0..9).map(|pass| PassJob { prepared: &prepared, view: &view, settings: &settings, offset: sample_offset(pass, 9), sample: pass, photons: None, active: None, rows: 0..h, cancel: &cancel }).collect();
+            let mut out = vec![Radiance::ZERO; 9 * (w * h) as usize];
+            assert!(cast_passes_packets(&jobs, &query, &mut out).is_none());
+            assert!(cast_passes_packets(&jobs[..1], &query, &mut out[..(w * h) as usize]).is_none());
+        }
+        assert!(compared > 20_000, "only {compared} samples compared");
     }
 
     /// The shadow ray the pre-pass traces (`Batch::shadow_rays`, eight
