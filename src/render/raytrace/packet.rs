@@ -603,7 +603,7 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
                     query.closest_packet(pk, valid, &mut counts);
                     if batched {
                         let layout = TileLayout { lanes: TileLayout::ONE_PASS, pass_stride: 0 };
-                        shade_tile_batched(std::slice::from_ref(job), &layout, query, pk, valid, shadow_pk, context, band, (x0, y0), 0, width, &mut counts);
+                        shade_tile_batched::<false>(std::slice::from_ref(job), &layout, query, pk, valid, shadow_pk, context, band, (x0, y0), 0, width, &mut counts);
                         continue;
                     }
                     pk.hits_into(query, valid, hits);
@@ -671,7 +671,7 @@ pub fn cast_passes_packets(jobs: &[PassJob], query: &BvhQuery, out: &mut [Radian
             let valid = dispatch!(simd_level(), simd => eye_rays_of_passes(simd, jobs, &layout, &mut pk, (x0, y0), width, rows - ty0));
             counts.primary += valid.count_ones() as u64;
             query.closest_packet(&mut pk, valid, &mut counts);
-            shade_tile_batched(jobs, &layout, query, &pk, valid, &mut shadow_pk, &mut context, out, (x0, y0), ty0, width, &mut counts);
+            shade_tile_batched::<true>(jobs, &layout, query, &pk, valid, &mut shadow_pk, &mut context, out, (x0, y0), ty0, width, &mut counts);
         }
     }
     context.paths.follow_into(first, query, &mut counts, out);
@@ -805,6 +805,19 @@ struct TileContext<'p> {
 /// Samples a band gathers before following their paths: four tiles.
 const PATH_SAMPLES: usize = 4 * P;
 
+/// Lane `i`'s (pass, x, y) in its tile: `layout`'s, or with one pass
+/// `lane_xy`'s (the table the compiler then reads directly).
+#[inline(always)]
+fn lane_of<const PASSES: bool>(layout: &TileLayout, i: usize) -> (usize, usize, usize) {
+    if PASSES {
+        let (g, x, y) = layout.lanes[i];
+        (g as usize, x as usize, y as usize)
+    } else {
+        let (x, y) = lane_xy(i);
+        (0, x, y)
+    }
+}
+
 /// Shades one traced tile in batches of eight (`shade_batch`): the lanes
 /// that see a surface are put into batches in lane order (a triangle's
 /// record built in its batch, eight at a time; a batch holds one pass's
@@ -812,9 +825,12 @@ const PATH_SAMPLES: usize = 4 * P;
 /// packet per light, then the batches are shaded, each light's visibility
 /// read from its packet. Lane i holds the sample `layout` names, of pass
 /// `jobs[layout.lanes[i].0]`; `band` holds the tile's rows from `row`, each
-/// `width` pixels.
+/// `width` pixels. Compiled apart for one pass (`PASSES` false: lanes as
+/// `lane_xy`, every batch the one job's), which frames of one sample take
+/// tile by tile, and for several.
 #[allow(clippy::too_many_arguments)]
-fn shade_tile_batched<'p>(
+#[inline(always)]
+fn shade_tile_batched<'p, const PASSES: bool>(
     jobs: &[PassJob<'p>],
     layout: &TileLayout,
     query: &BvhQuery,
@@ -833,8 +849,8 @@ fn shade_tile_batched<'p>(
     let first = &jobs[0];
     let settings = first.settings;
     let out_index = |i: usize| {
-        let (g, tx, ty) = layout.lanes[i];
-        g as usize * layout.pass_stride + (row + ty as usize) * width + x0 + tx as usize
+        let (g, tx, ty) = lane_of::<PASSES>(layout, i);
+        g * layout.pass_stride + (row + ty) * width + x0 + tx
     };
     // Each batch's pass, and the pass of the lane pushed last.
     let mut batch_pass = [0usize; P / shade_batch::LANES];
@@ -844,9 +860,8 @@ fn shade_tile_batched<'p>(
     while m != 0 {
         let i = m.trailing_zeros() as usize;
         m &= m - 1;
-        let (g, tx, ty) = layout.lanes[i];
-        let (g, tx, ty) = (g as usize, tx as usize, ty as usize);
-        let job = &jobs[g];
+        let (g, tx, ty) = lane_of::<PASSES>(layout, i);
+        let job = if PASSES { &jobs[g] } else { first };
         let (x, y) = ((x0 + tx) as u32, (y0 + ty) as u32);
         let pixel = job.pixel_index(x, y);
         let id = pk.best_id[i];
@@ -857,7 +872,7 @@ fn shade_tile_batched<'p>(
             };
             continue;
         }
-        if g != last_pass {
+        if PASSES && g != last_pass {
             // A new pass starts a new batch.
             filled = filled.next_multiple_of(shade_batch::LANES);
             last_pass = g;
@@ -915,7 +930,7 @@ fn shade_tile_batched<'p>(
             }
             // Where each lane's radiance goes in the band.
             let slots: [usize; shade_batch::LANES] = std::array::from_fn(|j| out_index(batch.slots[j]));
-            shade_batch::start_paths(&jobs[batch_pass[b]], query, batch, shadows.then_some(&lane_blocked[..]), &slots[..batch.len()], counts, paths);
+            shade_batch::start_paths(if PASSES { &jobs[batch_pass[b]] } else { first }, query, batch, shadows.then_some(&lane_blocked[..]), &slots[..batch.len()], counts, paths);
             batch.clear();
         }
         if paths.len() >= PATH_SAMPLES {
@@ -927,7 +942,7 @@ fn shade_tile_batched<'p>(
         for (k, bits) in lane_blocked.iter_mut().enumerate() {
             *bits = (0..batch.len()).fold(0u8, |acc, j| acc | (((blocked[k] >> batch.slots[j]) & 1) as u8) << j);
         }
-        let values = shade_batch::shade_batch(&jobs[batch_pass[b]], query, batch, shadows.then_some(&lane_blocked[..]), counts);
+        let values = shade_batch::shade_batch(if PASSES { &jobs[batch_pass[b]] } else { first }, query, batch, shadows.then_some(&lane_blocked[..]), counts);
         for j in 0..batch.len() {
             band[out_index(batch.slots[j])] = values[j];
         }
