@@ -40,6 +40,9 @@ pub struct Batch {
     /// Unit directions towards the eye, in lanes.
     w_o: [Floats; 3],
     pixels: [u32; LANES],
+    /// Each lane's sample index among its pixel's (its pass): with the
+    /// pixel, the key of its random numbers.
+    samples: [u32; LANES],
     /// The caller's index for each lane's result.
     pub slots: [usize; LANES],
     /// Eye samples pushed but not built yet, and their lanes.
@@ -64,6 +67,7 @@ impl Batch {
             hits: HitLanes::new(),
             w_o: [[0.0; LANES], [0.0; LANES], [1.0; LANES]],
             pixels: [0; LANES],
+            samples: [0; LANES],
             slots: [0; LANES],
             pending: EyeSamples::default(),
             pending_lanes: [0; LANES],
@@ -103,13 +107,14 @@ impl Batch {
     /// later, with the batch's other pending hits, eight at a time
     /// (`build_pending`, before shading).
     #[inline]
-    pub fn push_ray_triangle(&mut self, input: TriangleHitInput, pixel: u32, slot: usize) {
+    pub fn push_ray_triangle(&mut self, input: TriangleHitInput, pixel: u32, sample: u32, slot: usize) {
         let i = self.len;
         self.pending_rays[self.pending_ray_count] = input;
         self.pending_ray_lanes[self.pending_ray_count] = i;
         self.pending_ray_count += 1;
         (self.w_o[0][i], self.w_o[1][i], self.w_o[2][i]) = (-input.dir.x, -input.dir.y, -input.dir.z);
         self.pixels[i] = pixel;
+        self.samples[i] = sample;
         self.slots[i] = slot;
         self.len += 1;
     }
@@ -121,11 +126,12 @@ impl Batch {
     /// batch's other pending samples, eight at a time (`build_pending`,
     /// before shading).
     #[inline]
-    pub fn push_eye_triangle(&mut self, index: u32, (b1, b2): (f32, f32), p: Vec2, pixel: u32, slot: usize) {
+    pub fn push_eye_triangle(&mut self, index: u32, (b1, b2): (f32, f32), p: Vec2, pixel: u32, sample: u32, slot: usize) {
         let i = self.len;
         self.pending_lanes[self.pending.len] = i;
         self.pending.push(index, b1, b2, p);
         self.pixels[i] = pixel;
+        self.samples[i] = sample;
         self.slots[i] = slot;
         self.len += 1;
     }
@@ -192,7 +198,7 @@ impl Batch {
     /// whose eye ray along `dir` sees `hit`, its result meant for `slot`.
     /// The batch must not be full.
     #[inline]
-    pub fn push(&mut self, interpolation: Interpolation, hit: &SurfaceHit, dir: Vec3, pixel: u32, slot: usize) {
+    pub fn push(&mut self, interpolation: Interpolation, hit: &SurfaceHit, dir: Vec3, pixel: u32, sample: u32, slot: usize) {
         let i = self.len;
         match interpolation {
             Interpolation::Flat => self.hits.set(i, &SurfaceHit { shading_normal: hit.geometric_normal, ..*hit }),
@@ -200,6 +206,7 @@ impl Batch {
         }
         (self.w_o[0][i], self.w_o[1][i], self.w_o[2][i]) = (-dir.x, -dir.y, -dir.z);
         self.pixels[i] = pixel;
+        self.samples[i] = sample;
         self.slots[i] = slot;
         self.len += 1;
     }
@@ -247,7 +254,7 @@ pub fn shade_batch<Q: SceneQuery>(job: &PassJob, query: &Q, batch: &Batch, block
     let n = batch.len;
     let hits = &batch.hits;
     let mut paths: [PathState; LANES] = std::array::from_fn(|i| {
-        PathState::new(batch.pixels[i], job.sample, settings.spp, &settings.gi, job.photons)
+        PathState::new(batch.pixels[i], batch.samples[i], settings.spp, &settings.gi, job.photons)
     });
     let (albedo, direct) = direct_in_lanes(job, query, hits, &batch.w_o, n, &mut paths, &IN_ORDER, blocked, counts);
     // A batch of one material (the common case) asks once whether anything
@@ -281,7 +288,7 @@ pub fn start_paths<'p, Q: SceneQuery>(job: &PassJob<'p>, query: &Q, batch: &Batc
     assert!(batch.pending.len == 0 && batch.pending_ray_count == 0, "start_paths on a batch with hits not built (`build_pending`)");
     let settings = job.settings;
     let mut paths: [PathState; LANES] = std::array::from_fn(|i| {
-        PathState::new(batch.pixels[i], job.sample, settings.spp, &settings.gi, job.photons)
+        PathState::new(batch.pixels[i], batch.samples[i], settings.spp, &settings.gi, job.photons)
     });
     let (albedo, direct) = direct_in_lanes(job, query, &batch.hits, &batch.w_o, batch.len, &mut paths, &IN_ORDER, blocked, counts);
     pool.add(&batch.hits, &batch.w_o, slots, paths, &albedo, &direct);
@@ -526,7 +533,7 @@ mod tests {
                     let Some(hit) = query.closest(&ray, view.far_t(p.x, p.y), false, &mut RayCounts::default(), &mut NoRecord) else { continue };
                     let pixel = job.pixel_index(x, y);
                     let one = crate::render::resolve_sample(&job, &query, &ray, Some(&hit), pixel, &mut RayCounts::default(), &mut NoRecord);
-                    batch.push(interpolation, &hit, ray.dir, pixel, 0);
+                    batch.push(interpolation, &hit, ray.dir, pixel, job.sample, 0);
                     expected.push(one);
                     // Odd-sized batches too: flush after five when the pixel index says so.
                     if batch.is_full() || (pixel % 7 == 0 && batch.len() == 5) {

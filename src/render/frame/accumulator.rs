@@ -16,8 +16,8 @@ use std::ops::Range;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 /// Passes a chunk hands its renderer at once (`Renderer::render_passes`):
-/// the ray caster's packets hold eight passes of a few pixels.
-const PASSES_TOGETHER: u32 = 8;
+/// the ray caster's packets hold up to sixteen passes of a few pixels.
+const PASSES_TOGETHER: u32 = crate::render::raytrace::packet::MAX_PASSES as u32;
 
 /// What a sample adds to its pixel: itself when finite, nothing otherwise.
 /// A NaN or infinite sample (a degenerate hit, a division by zero in a
@@ -611,8 +611,8 @@ mod tests {
     fn chunks_equal_passes_bit_for_bit() {
         let p = prepared("cornell-gi");
         let cancel = AtomicBool::new(false);
-        // 11 passes: a group of eight passes handed over together, then three.
-        for (spp, gi) in [(4, crate::render::gi::GiMode::Path), (3, crate::render::gi::GiMode::None), (11, crate::render::gi::GiMode::Path)] {
+        // 19 passes: sixteen handed over together, then three.
+        for (spp, gi) in [(4, crate::render::gi::GiMode::Path), (3, crate::render::gi::GiMode::None), (19, crate::render::gi::GiMode::Path)] {
             let mut s = settings(&p, spp, View::Shaded);
             s.height = 2 * BvhRayTracer.chunk_rows().unwrap() + 3;
             s.gi.mode = gi;

@@ -728,7 +728,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
                     shaded += 1;
                     if plain && id.kind() == crate::scene::PrimitiveKind::Triangle {
                         let [b1, b2] = self.payload[i];
-                        batch.push_eye_triangle(id.index(), (b1, b2), self.job.sample_position(x, y), self.job.pixel_index(x, y), slot);
+                        batch.push_eye_triangle(id.index(), (b1, b2), self.job.sample_position(x, y), self.job.pixel_index(x, y), self.job.sample, slot);
                         if batch.is_full() {
                             self.shade_batch_into(&mut batch, &mut paths, out);
                         }
@@ -736,7 +736,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
                     }
                     match self.eye_hit(i, x, y) {
                         (ray, Some(hit)) => {
-                            batch.push(interpolation, &hit, ray.dir, self.job.pixel_index(x, y), slot);
+                            batch.push(interpolation, &hit, ray.dir, self.job.pixel_index(x, y), self.job.sample, slot);
                             if batch.is_full() {
                                 self.shade_batch_into(&mut batch, &mut paths, out);
                             }

@@ -18,7 +18,7 @@
 //! packet too, and the tile is shaded eight samples at a time from those
 //! answers (`shade_tile_batched`, `shade_batch`).
 //!
-//! A frame of many samples hands over up to eight passes at once
+//! A frame of many samples hands over up to sixteen passes at once
 //! (`cast_passes_packets`): a packet then holds a few pixels' samples of
 //! all of them, rays much closer together than one sample of 8x8 pixels.
 
@@ -93,38 +93,49 @@ impl TileLayout {
         table
     };
 
-    /// `passes` (2, 4 or 8) passes of a tile of `P / passes` pixels
-    /// (`pass_tile`): lanes `g * P / passes..` are pass g's, each group of
-    /// eight of them a 4x2 block of its pixels.
+    /// `passes` (2, 4, 8 or 16) passes of a tile of `P / passes` pixels
+    /// (`pass_tile`): lanes `g * P / passes..` are pass g's pixels, in 4x2
+    /// blocks (2x2 for sixteen passes), so that each group of eight lanes
+    /// is as compact as it can be.
     const fn passes(passes: usize) -> [(u8, u8, u8); P] {
         let per_pass = P / passes;
-        let blocks_across = pass_tile(passes).0 / 4;
+        let (tile_w, _) = pass_tile(passes);
         let mut table = [(0u8, 0u8, 0u8); P];
         let mut i = 0;
         while i < P {
             let (g, j) = (i / per_pass, i % per_pass);
-            let (b, q) = (j / 8, j % 8);
-            table[i] = (g as u8, (4 * (b % blocks_across) + q % 4) as u8, (2 * (b / blocks_across) + q / 4) as u8);
+            let (x, y) = if per_pass < 8 {
+                (j % 2, j / 2)
+            } else {
+                let (b, q) = (j / 8, j % 8);
+                let blocks_across = tile_w / 4;
+                (4 * (b % blocks_across) + q % 4, 2 * (b / blocks_across) + q / 4)
+            };
+            table[i] = (g as u8, x as u8, y as u8);
             i += 1;
         }
         table
     }
 }
 
-/// The pixels (across, down) of a tile that holds `passes` passes (2, 4 or
-/// 8) of each: a pixel's samples of those passes go down the tree
+/// The pixels (across, down) of a tile that holds `passes` passes (2, 4, 8
+/// or 16) of each: a pixel's samples of those passes go down the tree
 /// together, so a packet's rays stay close together and meet fewer boxes
 /// and leaves than 8x8 pixels of one pass do.
 const fn pass_tile(passes: usize) -> (usize, usize) {
     match passes {
+        16 => (2, 2),
         8 => (4, 2),
         4 => (4, 4),
         _ => (8, 4),
     }
 }
 
-/// The lanes of tiles of 2, 4 and 8 passes.
-const PASS_LAYOUTS: [[(u8, u8, u8); P]; 3] = [TileLayout::passes(2), TileLayout::passes(4), TileLayout::passes(8)];
+/// Most passes a tile holds.
+pub const MAX_PASSES: usize = 16;
+
+/// The lanes of tiles of 2, 4, 8 and 16 passes.
+const PASS_LAYOUTS: [[(u8, u8, u8); P]; 4] = [TileLayout::passes(2), TileLayout::passes(4), TileLayout::passes(8), TileLayout::passes(16)];
 
 /// The rays of one packet and their traversal state, structure of arrays.
 pub struct Packet {
@@ -627,7 +638,7 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
         })
 }
 
-/// `Renderer::render_passes` for the BVH: two to eight passes of the same
+/// `Renderer::render_passes` for the BVH: two to MAX_PASSES passes of the same
 /// rows, pass k into `out[k * n..]` (n = the rows' pixels), traced as tiles
 /// of a few pixels (`pass_tile`) with each pixel's samples of every pass in
 /// one packet (`TileLayout::passes`), then shaded as `cast_pass_packets`
@@ -635,12 +646,12 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
 /// `cast_pass_packets` makes for its pass: the same eye ray, hit, shadow
 /// answers and shading. Runs on the calling thread (the frame's chunks are
 /// what run in parallel). `None` where `cast_pass_packets` would not shade
-/// in batches, or for one pass or more than eight: the caller then renders
+/// in batches, or for one pass or more than MAX_PASSES: the caller then renders
 /// pass by pass.
 pub fn cast_passes_packets(jobs: &[PassJob], query: &BvhQuery, out: &mut [Radiance]) -> Option<RayCounts> {
     let first = jobs.first()?;
     let scene = &query.prepared.scene;
-    if !(2..=P / 8).contains(&jobs.len()) || query.prepared.bvh.deep || first.settings.view == View::Cost || !scene.csgs.is_empty() || !shade_batch::batchable(first) || first.active.is_some() {
+    if !(2..=MAX_PASSES).contains(&jobs.len()) || query.prepared.bvh.deep || first.settings.view == View::Cost || !scene.csgs.is_empty() || !shade_batch::batchable(first) || first.active.is_some() {
         return None;
     }
     let width = first.view.width as usize;
@@ -679,30 +690,30 @@ pub fn cast_passes_packets(jobs: &[PassJob], query: &BvhQuery, out: &mut [Radian
 }
 
 /// The eye rays of the passes `jobs` for the tile at `(x0, y0)` laid out as
-/// `layout` says (each group of eight lanes one pass's 4x2 block; `rows`
-/// rows of the band are left), as `eye_rays_eight_wide` makes them; the
-/// lanes on a pixel.
+/// `layout` says (`rows` rows of the band are left), as
+/// `eye_rays_eight_wide` makes them; the lanes on a pixel.
 #[inline(always)]
 fn eye_rays_of_passes<S: Simd>(simd: S, jobs: &[PassJob], layout: &TileLayout, pk: &mut Packet, (x0, y0): (usize, usize), width: usize, rows: usize) -> u64 {
     let mut valid = 0u64;
+    let view = jobs[0].view;
     for group in 0..P / 8 {
         let lanes = &layout.lanes[8 * group..8 * group + 8];
-        let Some(job) = jobs.get(lanes[0].0 as usize) else { continue };
-        let (mut dx, mut dy) = ([0.0f32; 8], [0.0f32; 8]);
+        let (mut dx, mut dy, mut ox, mut oy) = ([0.0f32; 8], [0.0f32; 8], [0.0f32; 8], [0.0f32; 8]);
         let mut inside = 0u8;
-        for (k, &(_, tx, ty)) in lanes.iter().enumerate() {
-            (dx[k], dy[k]) = (tx as f32, ty as f32);
+        for (k, &(g, tx, ty)) in lanes.iter().enumerate() {
+            let Some(job) = jobs.get(g as usize) else { continue };
+            (dx[k], dy[k], ox[k], oy[k]) = (tx as f32, ty as f32, job.offset.x, job.offset.y);
             inside |= ((x0 + (tx as usize) < width && (ty as usize) < rows) as u8) << k;
         }
         if inside == 0 {
             continue;
         }
         // (x0 + dx) + offset, with x0 + dx an integer below 2^24: the
-        // pixel's own `sample_position`.
-        let px = (f32x8::splat(simd, x0 as f32) + f32x8::simd_from(simd, dx)) + f32x8::splat(simd, job.offset.x);
-        let py = (f32x8::splat(simd, y0 as f32) + f32x8::simd_from(simd, dy)) + f32x8::splat(simd, job.offset.y);
-        let (origin, dir) = job.view.eye_ray_lanes(px, py);
-        let far: [f32; 8] = job.view.far_t_lanes(px, py).into();
+        // pixel's own `sample_position` in its lane's pass.
+        let px = (f32x8::splat(simd, x0 as f32) + f32x8::simd_from(simd, dx)) + f32x8::simd_from(simd, ox);
+        let py = (f32x8::splat(simd, y0 as f32) + f32x8::simd_from(simd, dy)) + f32x8::simd_from(simd, oy);
+        let (origin, dir) = view.eye_ray_lanes(px, py);
+        let far: [f32; 8] = view.far_t_lanes(px, py).into();
         let (origin, dir) = (origin.scatter(), dir.scatter());
         for k in 0..8 {
             if inside & (1 << k) != 0 {
@@ -820,8 +831,8 @@ fn lane_of<const PASSES: bool>(layout: &TileLayout, i: usize) -> (usize, usize, 
 
 /// Shades one traced tile in batches of eight (`shade_batch`): the lanes
 /// that see a surface are put into batches in lane order (a triangle's
-/// record built in its batch, eight at a time; a batch holds one pass's
-/// samples), then the tile's shadow rays towards every light go as one
+/// record built in its batch, eight at a time; each lane keeps its own
+/// pass's sample index), then the tile's shadow rays towards every light go as one
 /// packet per light, then the batches are shaded, each light's visibility
 /// read from its packet. Lane i holds the sample `layout` names, of pass
 /// `jobs[layout.lanes[i].0]`; `band` holds the tile's rows from `row`, each
@@ -852,9 +863,6 @@ fn shade_tile_batched<'p, const PASSES: bool>(
         let (g, tx, ty) = lane_of::<PASSES>(layout, i);
         g * layout.pass_stride + (row + ty) * width + x0 + tx
     };
-    // Each batch's pass, and the pass of the lane pushed last.
-    let mut batch_pass = [0usize; P / shade_batch::LANES];
-    let mut last_pass = 0usize;
     let mut filled = 0usize;
     let mut m = valid;
     while m != 0 {
@@ -872,23 +880,17 @@ fn shade_tile_batched<'p, const PASSES: bool>(
             };
             continue;
         }
-        if PASSES && g != last_pass {
-            // A new pass starts a new batch.
-            filled = filled.next_multiple_of(shade_batch::LANES);
-            last_pass = g;
-        }
-        batch_pass[filled / shade_batch::LANES] = g;
         let batch = &mut batches[filled / shade_batch::LANES];
         if id.kind() == PrimitiveKind::Triangle && !*textured {
             let input = TriangleHitInput::new(id.index(), pk.bary[i], pk.best_t.0[i], pk.rays[i].dir);
-            batch.push_ray_triangle(input, pixel, i);
+            batch.push_ray_triangle(input, pixel, job.sample, i);
         } else {
             let mut hit = pk.hit(query, i);
             if *textured {
                 with_eye_differentials(job, job.sample_position(x, y), &pk.rays[i], &mut hit);
             }
             let hit = hit.expect("a lane with an id has a hit");
-            batch.push(settings.interpolation, &hit, pk.rays[i].dir, pixel, i);
+            batch.push(settings.interpolation, &hit, pk.rays[i].dir, pixel, job.sample, i);
         }
         filled += 1;
     }
@@ -924,13 +926,13 @@ fn shade_tile_batched<'p, const PASSES: bool>(
         // The paths wait for those of the band's next tiles, to be
         // followed together (`PathPool::follow_into`, once it holds
         // `PATH_SAMPLES` and at the end of the band).
-        for (b, batch) in batches.iter_mut().enumerate() {
+        for batch in batches.iter_mut() {
             for (k, bits) in lane_blocked.iter_mut().enumerate() {
                 *bits = (0..batch.len()).fold(0u8, |acc, j| acc | (((blocked[k] >> batch.slots[j]) & 1) as u8) << j);
             }
             // Where each lane's radiance goes in the band.
             let slots: [usize; shade_batch::LANES] = std::array::from_fn(|j| out_index(batch.slots[j]));
-            shade_batch::start_paths(if PASSES { &jobs[batch_pass[b]] } else { first }, query, batch, shadows.then_some(&lane_blocked[..]), &slots[..batch.len()], counts, paths);
+            shade_batch::start_paths(first, query, batch, shadows.then_some(&lane_blocked[..]), &slots[..batch.len()], counts, paths);
             batch.clear();
         }
         if paths.len() >= PATH_SAMPLES {
@@ -938,11 +940,11 @@ fn shade_tile_batched<'p, const PASSES: bool>(
         }
         return;
     }
-    for (b, batch) in batches.iter_mut().enumerate() {
+    for batch in batches.iter_mut() {
         for (k, bits) in lane_blocked.iter_mut().enumerate() {
             *bits = (0..batch.len()).fold(0u8, |acc, j| acc | (((blocked[k] >> batch.slots[j]) & 1) as u8) << j);
         }
-        let values = shade_batch::shade_batch(if PASSES { &jobs[batch_pass[b]] } else { first }, query, batch, shadows.then_some(&lane_blocked[..]), counts);
+        let values = shade_batch::shade_batch(first, query, batch, shadows.then_some(&lane_blocked[..]), counts);
         for j in 0..batch.len() {
             band[out_index(batch.slots[j])] = values[j];
         }
@@ -999,7 +1001,7 @@ mod tests {
 
     /// Several passes traced together (`cast_passes_packets`) give each
     /// pass, bit for bit, what `cast_pass_packets` gives it alone: on every
-    /// built-in scene without CSG, direct and path traced, two to eight
+    /// built-in scene without CSG, direct and path traced, two to sixteen
     /// passes (every tile layout, and lanes of a missing pass), an image
     /// whose width and rows cut the tiles, rows not starting at the top.
     #[test]
@@ -1017,7 +1019,7 @@ mod tests {
             let query = BvhQuery::new(&prepared);
             let (w, h) = (23u32, 13u32);
             let view = prepared.scene.camera.view(w, h);
-            for (gi, passes) in [(GiMode::None, 8u32), (GiMode::Path, 3), (GiMode::Path, 2), (GiMode::None, 4)] {
+            for (gi, passes) in [(GiMode::None, 8u32), (GiMode::Path, 3), (GiMode::Path, 2), (GiMode::None, 4), (GiMode::Path, 16), (GiMode::None, 13)] {
                 let mut settings = RenderSettings { width: w, height: h, spp: 2 * passes, ..RenderSettings::for_scene(&prepared.scene) };
                 settings.gi.mode = gi;
                 let rows = 2..h;
@@ -1038,9 +1040,9 @@ mod tests {
                 assert_eq!((counts.primary, counts.shadow, counts.secondary), (alone_counts.primary, alone_counts.shadow, alone_counts.secondary), "{name} {gi:?}");
             }
             // One pass, or more than a packet holds, go pass by pass.
-            let settings = RenderSettings { width: w, height: h, spp: 9, ..RenderSettings::for_scene(&prepared.scene) };
-            let jobs: Vec<PassJob> = (0..9).map(|pass| PassJob { prepared: &prepared, view: &view, settings: &settings, offset: sample_offset(pass, 9), sample: pass, photons: None, active: None, rows: 0..h, cancel: &cancel }).collect();
-            let mut out = vec![Radiance::ZERO; 9 * (w * h) as usize];
+            let settings = RenderSettings { width: w, height: h, spp: 17, ..RenderSettings::for_scene(&prepared.scene) };
+            let jobs: Vec<PassJob> = (0..17).map(|pass| PassJob { prepared: &prepared, view: &view, settings: &settings, offset: sample_offset(pass, 17), sample: pass, photons: None, active: None, rows: 0..h, cancel: &cancel }).collect();
+            let mut out = vec![Radiance::ZERO; 17 * (w * h) as usize];
             assert!(cast_passes_packets(&jobs, &query, &mut out).is_none());
             assert!(cast_passes_packets(&jobs[..1], &query, &mut out[..(w * h) as usize]).is_none());
         }
@@ -1094,7 +1096,7 @@ mod tests {
                         shade(&mut sh, h, -ray.dir, 0)
                     });
                     expected.push(trace.lights.iter().find(|l| l.light == 0).and_then(|l| l.shadow_ray));
-                    batch.push(interpolation, &hit, ray.dir, 0, 0);
+                    batch.push(interpolation, &hit, ray.dir, 0, 0, 0);
                     if batch.is_full() {
                         check(&mut batch, &mut expected);
                     }
