@@ -94,24 +94,17 @@ impl TileLayout {
     };
 
     /// `passes` (2, 4, 8 or 16) passes of a tile of `P / passes` pixels
-    /// (`pass_tile`): lanes `g * P / passes..` are pass g's pixels, in 4x2
-    /// blocks (2x2 for sixteen passes), so that each group of eight lanes
-    /// is as compact as it can be.
+    /// (`pass_tile`), pixel by pixel: lane i is pass `i % passes` of the
+    /// tile's pixel `i / passes` (row by row). A group of eight lanes is
+    /// then one pixel's samples (or a few neighbours'), whose rays go down
+    /// the tree almost as one, and a batch shades surfaces of one triangle.
     const fn passes(passes: usize) -> [(u8, u8, u8); P] {
-        let per_pass = P / passes;
         let (tile_w, _) = pass_tile(passes);
         let mut table = [(0u8, 0u8, 0u8); P];
         let mut i = 0;
         while i < P {
-            let (g, j) = (i / per_pass, i % per_pass);
-            let (x, y) = if per_pass < 8 {
-                (j % 2, j / 2)
-            } else {
-                let (b, q) = (j / 8, j % 8);
-                let blocks_across = tile_w / 4;
-                (4 * (b % blocks_across) + q % 4, 2 * (b / blocks_across) + q / 4)
-            };
-            table[i] = (g as u8, x as u8, y as u8);
+            let (pass, pixel) = (i % passes, i / passes);
+            table[i] = (pass as u8, (pixel % tile_w) as u8, (pixel / tile_w) as u8);
             i += 1;
         }
         table
