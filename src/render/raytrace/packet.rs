@@ -34,7 +34,7 @@ use crate::render::path_batch::{self, PathPool};
 use crate::render::shade_batch::{self, Batch};
 use crate::render::{miss_without_ray, resolve_sample, Occluder, PassJob, RayCounts, ShadowMode};
 use crate::scene::hit_lanes::{HitLanes, TriangleHitInput, HIT_LANES};
-use crate::scene::{PrimitiveId, PrimitiveKind, Sphere, SurfaceHit};
+use crate::scene::{CameraView, PrimitiveId, PrimitiveKind, Sphere, SurfaceHit};
 use fearless_simd::{dispatch, f32x8, mask32x8, Select, Simd, SimdBase, SimdFloat, SimdFrom};
 use glam::Vec3;
 use rayon::prelude::*;
@@ -665,6 +665,7 @@ pub fn cast_passes_packets(jobs: &[PassJob], query: &BvhQuery, out: &mut [Radian
     let passes = jobs.len().next_power_of_two();
     let (tile_w, tile_h) = pass_tile(passes);
     let layout = TileLayout { lanes: PASS_LAYOUTS[passes.trailing_zeros() as usize - 1], pass_stride: n };
+    let lanes = PassLanes::new(jobs, &layout);
     let mut counts = RayCounts::default();
     for ty0 in (0..rows).step_by(tile_h) {
         if first.cancelled() {
@@ -672,7 +673,7 @@ pub fn cast_passes_packets(jobs: &[PassJob], query: &BvhQuery, out: &mut [Radian
         }
         let y0 = first.rows.start as usize + ty0;
         for x0 in (0..width).step_by(tile_w) {
-            let valid = dispatch!(simd_level(), simd => eye_rays_of_passes(simd, jobs, &layout, &mut pk, (x0, y0), width, rows - ty0));
+            let valid = dispatch!(simd_level(), simd => eye_rays_of_passes(simd, first.view, &lanes, &layout, &mut pk, (x0, y0), (tile_w, tile_h), width, rows - ty0));
             counts.primary += valid.count_ones() as u64;
             query.closest_packet(&mut pk, valid, &mut counts);
             shade_tile_batched::<true>(jobs, &layout, query, &pk, valid, &mut shadow_pk, &mut context, out, (x0, y0), ty0, width, &mut counts);
@@ -682,29 +683,57 @@ pub fn cast_passes_packets(jobs: &[PassJob], query: &BvhQuery, out: &mut [Radian
     Some(counts)
 }
 
-/// The eye rays of the passes `jobs` for the tile at `(x0, y0)` laid out as
-/// `layout` says (`rows` rows of the band are left), as
+/// What the eye rays of a call's pass tiles need per group of eight lanes,
+/// worked out once per call: each lane's pixel within the tile and its
+/// pass's sub-pixel offset, as floats, and which lanes hold a pass.
+struct PassLanes {
+    dx: [[f32; 8]; P / 8],
+    dy: [[f32; 8]; P / 8],
+    offset_x: [[f32; 8]; P / 8],
+    offset_y: [[f32; 8]; P / 8],
+    with_pass: [u8; P / 8],
+}
+
+impl PassLanes {
+    fn new(jobs: &[PassJob], layout: &TileLayout) -> PassLanes {
+        let mut lanes = PassLanes { dx: [[0.0; 8]; P / 8], dy: [[0.0; 8]; P / 8], offset_x: [[0.0; 8]; P / 8], offset_y: [[0.0; 8]; P / 8], with_pass: [0; P / 8] };
+        for (i, &(g, tx, ty)) in layout.lanes.iter().enumerate() {
+            let (group, k) = (i / 8, i % 8);
+            (lanes.dx[group][k], lanes.dy[group][k]) = (tx as f32, ty as f32);
+            if let Some(job) = jobs.get(g as usize) {
+                (lanes.offset_x[group][k], lanes.offset_y[group][k]) = (job.offset.x, job.offset.y);
+                lanes.with_pass[group] |= 1 << k;
+            }
+        }
+        lanes
+    }
+}
+
+/// The eye rays of the pass tile at `(x0, y0)` laid out as `layout` says
+/// (`rows` rows of the band are left, the tile `tile_w` pixels wide), as
 /// `eye_rays_eight_wide` makes them; the lanes on a pixel.
+#[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn eye_rays_of_passes<S: Simd>(simd: S, jobs: &[PassJob], layout: &TileLayout, pk: &mut Packet, (x0, y0): (usize, usize), width: usize, rows: usize) -> u64 {
+fn eye_rays_of_passes<S: Simd>(simd: S, view: &CameraView, lanes: &PassLanes, layout: &TileLayout, pk: &mut Packet, (x0, y0): (usize, usize), (tile_w, tile_h): (usize, usize), width: usize, rows: usize) -> u64 {
+    let whole = x0 + tile_w <= width && rows >= tile_h;
+    let (ox, oy) = (f32x8::splat(simd, x0 as f32), f32x8::splat(simd, y0 as f32));
     let mut valid = 0u64;
-    let view = jobs[0].view;
     for group in 0..P / 8 {
-        let lanes = &layout.lanes[8 * group..8 * group + 8];
-        let (mut dx, mut dy, mut ox, mut oy) = ([0.0f32; 8], [0.0f32; 8], [0.0f32; 8], [0.0f32; 8]);
-        let mut inside = 0u8;
-        for (k, &(g, tx, ty)) in lanes.iter().enumerate() {
-            let Some(job) = jobs.get(g as usize) else { continue };
-            (dx[k], dy[k], ox[k], oy[k]) = (tx as f32, ty as f32, job.offset.x, job.offset.y);
-            inside |= ((x0 + (tx as usize) < width && (ty as usize) < rows) as u8) << k;
+        let mut inside = lanes.with_pass[group];
+        if !whole {
+            for (k, &(_, tx, ty)) in layout.lanes[8 * group..8 * group + 8].iter().enumerate() {
+                if x0 + tx as usize >= width || ty as usize >= rows {
+                    inside &= !(1 << k);
+                }
+            }
         }
         if inside == 0 {
             continue;
         }
         // (x0 + dx) + offset, with x0 + dx an integer below 2^24: the
         // pixel's own `sample_position` in its lane's pass.
-        let px = (f32x8::splat(simd, x0 as f32) + f32x8::simd_from(simd, dx)) + f32x8::simd_from(simd, ox);
-        let py = (f32x8::splat(simd, y0 as f32) + f32x8::simd_from(simd, dy)) + f32x8::simd_from(simd, oy);
+        let px = (ox + f32x8::simd_from(simd, lanes.dx[group])) + f32x8::simd_from(simd, lanes.offset_x[group]);
+        let py = (oy + f32x8::simd_from(simd, lanes.dy[group])) + f32x8::simd_from(simd, lanes.offset_y[group]);
         let (origin, dir) = view.eye_ray_lanes(px, py);
         let far: [f32; 8] = view.far_t_lanes(px, py).into();
         let (origin, dir) = (origin.scatter(), dir.scatter());
