@@ -254,6 +254,20 @@ static NO_ROW: CornerRow = [0.0; 8];
 /// row), not copied a float at a time.
 #[inline(always)]
 fn gather_corners<S: Simd>(simd: S, scene: &Scene, index: &[u32; HIT_LANES], n: usize) -> CornerLanes<S> {
+    // Every lane on one triangle (a pixel's samples, as the ray caster
+    // batches them): its rows are read once and put in every lane.
+    if index[1..n.max(1)].iter().all(|&i| i == index[0]) {
+        if let Some(face) = scene.triangles.corner_rows(index[0] as usize) {
+            let mut attr = [[f32x8::simd_from(simd, [0.0; HIT_LANES]); 8]; 3];
+            for (corner, row) in attr.iter_mut().zip(face.corners) {
+                for (lanes, &v) in corner.iter_mut().zip(row) {
+                    *lanes = f32x8::simd_from(simd, [v; HIT_LANES]);
+                }
+            }
+            let flat = if face.flat { u8::MAX } else { 0 };
+            return CornerLanes { attr, flat, material: [face.material; HIT_LANES], object: [face.object; HIT_LANES] };
+        }
+    }
     let (mut flat, mut material, mut object) = (0u8, [0u32; HIT_LANES], [0u32; HIT_LANES]);
     let mut rows = [[&NO_ROW; HIT_LANES]; 3];
     for lane in 0..HIT_LANES {
@@ -417,6 +431,7 @@ mod tests {
     fn eight_lanes_build_the_records_triangle_hit_builds() {
         let mut compared = 0;
         let mut layer_compared = 0;
+        let mut one_triangle = 0;
         let mut state = 7u64;
         // `forest-100` holds its trees as copies of the two-level layer.
         for name in builtin::names().into_iter().chain(["forest-100"]) {
@@ -428,6 +443,9 @@ mod tests {
                 let inputs: Vec<TriangleHitInput> = chunk
                     .iter()
                     .map(|&index| {
+                        // Every third chunk puts all its lanes on one
+                        // triangle (read once, not gathered lane by lane).
+                        let index = if c % 3 == 2 { chunk[0] } else { index };
                         let (b1, b2) = (next(&mut state), next(&mut state));
                         let (b1, b2) = if b1 + b2 > 1.0 { (1.0 - b1, 1.0 - b2) } else { (b1, b2) };
                         let dir = Vec3::new(next(&mut state) - 0.5, next(&mut state) - 0.5, next(&mut state) - 0.5).normalize_or(Vec3::Z);
@@ -441,11 +459,12 @@ mod tests {
                     let expected = scene.triangle_hit(input.index, input.b, input.t, &ray);
                     assert_eq!(record_bits(&got.get(lane)), record_bits(&expected), "{name}: triangle {}", input.index);
                     compared += 1;
+                    one_triangle += (c % 3 == 2 && inputs.len() > 1) as usize;
                     layer_compared += (input.index as usize >= scene.triangles.len()) as usize;
                 }
             }
         }
-        assert!(compared > 10_000 && layer_compared > 100, "{compared} records compared, {layer_compared} of layer copies");
+        assert!(compared > 10_000 && layer_compared > 100 && one_triangle > 1000, "{compared} records compared, {layer_compared} of layer copies, {one_triangle} in batches of one triangle");
     }
 
     /// A rasterizer's eye samples built in lanes give, bit for bit, the
