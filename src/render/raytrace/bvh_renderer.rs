@@ -28,8 +28,9 @@ impl Renderer for BvhRayTracer {
         cast_pass_packets(job, &BvhQuery::new(job.prepared), out)
     }
 
-    /// A chunk's passes eight at a time, each pixel's samples of them in one
-    /// packet (`cast_passes_packets`), where frames are shaded in batches.
+    /// A chunk's passes up to `packet::MAX_PASSES` at a time, each pixel's
+    /// samples of them in one packet (`cast_passes_packets`), where frames
+    /// are shaded in batches; otherwise one after the other.
     fn render_passes(&self, jobs: &[PassJob], out: &mut [Radiance]) -> RayCounts {
         let passes = match jobs.first() {
             Some(job) if job.prepared.instances.is_none() => cast_passes_packets(jobs, &BvhQuery::new(job.prepared), out),

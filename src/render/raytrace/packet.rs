@@ -635,12 +635,13 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
 /// rows, pass k into `out[k * n..]` (n = the rows' pixels), traced as tiles
 /// of a few pixels (`pass_tile`) with each pixel's samples of every pass in
 /// one packet (`TileLayout::passes`), then shaded as `cast_pass_packets`
-/// shades, each batch in its own pass. Every sample is the one
+/// shades (a batch may hold samples of several passes: each lane keeps its
+/// own sample index). Every sample is the one
 /// `cast_pass_packets` makes for its pass: the same eye ray, hit, shadow
 /// answers and shading. Runs on the calling thread (the frame's chunks are
 /// what run in parallel). `None` where `cast_pass_packets` would not shade
-/// in batches, or for one pass or more than MAX_PASSES: the caller then renders
-/// pass by pass.
+/// in batches, or for one pass or more than MAX_PASSES: the caller then
+/// renders pass by pass.
 pub fn cast_passes_packets(jobs: &[PassJob], query: &BvhQuery, out: &mut [Radiance]) -> Option<RayCounts> {
     let first = jobs.first()?;
     let scene = &query.prepared.scene;
@@ -734,18 +735,25 @@ fn eye_rays_of_passes<S: Simd>(simd: S, view: &CameraView, lanes: &PassLanes, la
         // pixel's own `sample_position` in its lane's pass.
         let px = (ox + f32x8::simd_from(simd, lanes.dx[group])) + f32x8::simd_from(simd, lanes.offset_x[group]);
         let py = (oy + f32x8::simd_from(simd, lanes.dy[group])) + f32x8::simd_from(simd, lanes.offset_y[group]);
-        let (origin, dir) = view.eye_ray_lanes(px, py);
-        let far: [f32; 8] = view.far_t_lanes(px, py).into();
-        let (origin, dir) = (origin.scatter(), dir.scatter());
-        for k in 0..8 {
-            if inside & (1 << k) != 0 {
-                pk.rays[8 * group + k] = Ray::new(origin[k], dir[k]);
-                pk.t_max[8 * group + k] = far[k];
-            }
-        }
+        store_eye_rays(view, pk, group, (px, py), inside);
         valid |= (inside as u64) << (8 * group);
     }
     valid
+}
+
+/// The eye rays through image positions `(px, py)` into lanes `8 * group..`
+/// of `pk`, with their far ends, for the lanes set in `lanes`.
+#[inline(always)]
+fn store_eye_rays<S: Simd>(view: &CameraView, pk: &mut Packet, group: usize, (px, py): (f32x8<S>, f32x8<S>), lanes: u8) {
+    let (origin, dir) = view.eye_ray_lanes(px, py);
+    let far: [f32; 8] = view.far_t_lanes(px, py).into();
+    let (origin, dir) = (origin.scatter(), dir.scatter());
+    for k in 0..8 {
+        if lanes & (1 << k) != 0 {
+            pk.rays[8 * group + k] = Ray::new(origin[k], dir[k]);
+            pk.t_max[8 * group + k] = far[k];
+        }
+    }
 }
 
 /// The eye rays of the tile at `(x0, y0)` (`rows` rows of the band, the
@@ -801,15 +809,7 @@ fn eye_rays_eight_wide<S: Simd>(simd: S, job: &PassJob, pk: &mut Packet, (x0, y0
         if group == 0 {
             continue;
         }
-        let (origin, dir) = job.view.eye_ray_lanes(px, py);
-        let far: [f32; 8] = job.view.far_t_lanes(px, py).into();
-        let (origin, dir) = (origin.scatter(), dir.scatter());
-        for k in 0..8 {
-            if group & (1 << k) != 0 {
-                pk.rays[8 * g + k] = Ray::new(origin[k], dir[k]);
-                pk.t_max[8 * g + k] = far[k];
-            }
-        }
+        store_eye_rays(job.view, pk, g, (px, py), group);
         valid |= (group as u64) << (8 * g);
     }
     valid
