@@ -573,7 +573,6 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
     if query.prepared.bvh.deep || job.settings.view == View::Cost || !query.prepared.scene.csgs.is_empty() {
         return cast_pass(job, query, out);
     }
-    let scene = &query.prepared.scene;
     let width = job.view.width as usize;
     let batched = shade_batch::batchable(job);
     out.par_chunks_mut(width * TILE_H)
@@ -584,15 +583,7 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
         // and thread rather than in every band.
         .map_init(
             || {
-                let context = TileContext {
-                    tile: vec![0; scene.lights.len()],
-                    batch: vec![0; scene.lights.len()],
-                    textured: scene.has_textures(),
-                    background: miss_without_ray(job),
-                    batches: (0..P / shade_batch::LANES).map(|_| Batch::new()).collect(),
-                    paths: if path_batch::takes(job) { PathPool::with_capacity(PATH_SAMPLES) } else { PathPool::new() },
-                };
-                (Packet::new(), Packet::new(), [None; P], context)
+                (Packet::new(), Packet::new(), [None; P], TileContext::new(job))
             },
             |(pk, shadow_pk, hits, context), (b, band)| {
                 let mut counts = RayCounts::default();
@@ -652,14 +643,7 @@ pub fn cast_passes_packets(jobs: &[PassJob], query: &BvhQuery, out: &mut [Radian
     let rows = first.rows.len();
     let n = rows * width;
     debug_assert_eq!(out.len(), jobs.len() * n);
-    let mut context = TileContext {
-        tile: vec![0; scene.lights.len()],
-        batch: vec![0; scene.lights.len()],
-        textured: scene.has_textures(),
-        background: miss_without_ray(first),
-        batches: (0..P / shade_batch::LANES).map(|_| Batch::new()).collect(),
-        paths: if path_batch::takes(first) { PathPool::with_capacity(PATH_SAMPLES) } else { PathPool::new() },
-    };
+    let mut context = TileContext::new(first);
     let (mut pk, mut shadow_pk) = (Packet::new(), Packet::new());
     // The tile for the next power of two passes (lanes of missing passes
     // stay empty).
@@ -833,6 +817,21 @@ struct TileContext<'p> {
     /// together (several tiles' worth, so that the lanes stay full as the
     /// paths end).
     paths: PathPool<'p>,
+}
+
+impl<'p> TileContext<'p> {
+    /// Empty buffers for the tiles of `job`'s pass (or passes).
+    fn new(job: &PassJob<'p>) -> TileContext<'p> {
+        let scene = &job.prepared.scene;
+        TileContext {
+            tile: vec![0; scene.lights.len()],
+            batch: vec![0; scene.lights.len()],
+            textured: scene.has_textures(),
+            background: miss_without_ray(job),
+            batches: (0..P / shade_batch::LANES).map(|_| Batch::new()).collect(),
+            paths: if path_batch::takes(job) { PathPool::with_capacity(PATH_SAMPLES) } else { PathPool::new() },
+        }
+    }
 }
 
 /// Samples a band gathers before following their paths: four tiles.
