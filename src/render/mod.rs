@@ -378,6 +378,12 @@ pub trait Renderer: Sync + Send {
         None
     }
 
+    /// How many passes a chunk hands `render_passes` at once: more than one
+    /// only for a renderer that does something with them together.
+    fn passes_at_once(&self) -> u32 {
+        1
+    }
+
     /// Whether this renderer can draw `scene` with `settings`: one sentence
     /// saying why not (an option it does not support, no driver). Checked
     /// before a frame starts.

@@ -90,7 +90,8 @@ impl<'p> PathPool<'p> {
 
     /// A pool with room for `samples` samples (and a batch more) and a few
     /// bounces each, so that filling it does not reallocate and copy: the
-    /// ray caster makes one per rayon job of every pass of a chunk.
+    /// ray caster makes one per rayon job of a pass, and per call of a
+    /// chunk's passes.
     pub fn with_capacity(samples: usize) -> PathPool<'p> {
         let n = samples + LANES;
         let groups = n.div_ceil(LANES);

@@ -15,10 +15,6 @@ use rayon::prelude::*;
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
-/// Passes a chunk hands its renderer at once (`Renderer::render_passes`):
-/// the ray caster's packets hold up to sixteen passes of a few pixels.
-const PASSES_TOGETHER: u32 = crate::render::raytrace::packet::MAX_PASSES as u32;
-
 /// What a sample adds to its pixel: itself when finite, nothing otherwise.
 /// A NaN or infinite sample (a degenerate hit, a division by zero in a
 /// shading formula) would otherwise poison the pixel for every later pass.
@@ -375,10 +371,10 @@ impl Accumulator {
             .enumerate()
             .map(|(k, (sum, sum_sq))| {
                 let rows = k as u32 * chunk_rows..((k as u32 + 1) * chunk_rows).min(height);
-                // Up to PASSES_TOGETHER passes rendered in one call (a ray
+                // Up to `passes_at_once` passes rendered in one call (a ray
                 // caster traces a pixel's samples of them together), then
                 // added in pass order.
-                let group = PASSES_TOGETHER.min(spp) as usize;
+                let group = renderer.passes_at_once().clamp(1, spp) as usize;
                 let mut pass_buffers = vec![Radiance::ZERO; group * sum.len()];
                 let mut counts = RayCounts::default();
                 for first in (0..spp).step_by(group) {

@@ -39,6 +39,10 @@ impl Renderer for BvhRayTracer {
         passes.unwrap_or_else(|| crate::render::render_passes_in_turn(self, jobs, out))
     }
 
+    fn passes_at_once(&self) -> u32 {
+        super::packet::MAX_PASSES as u32
+    }
+
     /// Two rows of packet tiles: chunks small enough for two threads to
     /// share the work evenly, large enough that the per-call set-up
     /// (packets, batches, the path pool) is paid rarely.

@@ -82,15 +82,16 @@ struct TileLayout {
 }
 
 impl TileLayout {
-    /// One pass, TILE_W x TILE_H pixels (`lane_xy`).
-    const ONE_PASS: [(u8, u8, u8); P] = {
-        let mut table = [(0u8, 0u8, 0u8); P];
+    /// One pass, TILE_W x TILE_H pixels: `lane_xy`'s lanes (which
+    /// `shade_tile_batched::<false>` reads directly).
+    const ONE_PASS: TileLayout = {
+        let mut lanes = [(0u8, 0u8, 0u8); P];
         let mut i = 0;
         while i < P {
-            table[i] = (0, LANE_XY[i].0, LANE_XY[i].1);
+            lanes[i] = (0, LANE_XY[i].0, LANE_XY[i].1);
             i += 1;
         }
-        table
+        TileLayout { lanes, pass_stride: 0 }
     };
 
     /// `passes` (2, 4, 8 or 16) passes of a tile of `P / passes` pixels
@@ -597,8 +598,7 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
                     counts.primary += valid.count_ones() as u64;
                     query.closest_packet(pk, valid, &mut counts);
                     if batched {
-                        let layout = TileLayout { lanes: TileLayout::ONE_PASS, pass_stride: 0 };
-                        shade_tile_batched::<false>(std::slice::from_ref(job), &layout, query, pk, valid, shadow_pk, context, band, (x0, y0), 0, width, &mut counts);
+                        shade_tile_batched::<false>(std::slice::from_ref(job), &TileLayout::ONE_PASS, query, pk, valid, shadow_pk, context, band, (x0, y0), 0, width, &mut counts);
                         continue;
                     }
                     pk.hits_into(query, valid, hits);
@@ -944,9 +944,9 @@ fn shade_tile_batched<'p, const PASSES: bool>(
         }
     }
     if path_batch::takes(first) {
-        // The paths wait for those of the band's next tiles, to be
-        // followed together (`PathPool::follow_into`, once it holds
-        // `PATH_SAMPLES` and at the end of the band).
+        // The paths wait for those of the next tiles, to be followed
+        // together (`PathPool::follow_into`, once it holds `PATH_SAMPLES`
+        // and at the end of the band, or of the call with several passes).
         for batch in batches.iter_mut() {
             for (k, bits) in lane_blocked.iter_mut().enumerate() {
                 *bits = (0..batch.len()).fold(0u8, |acc, j| acc | (((blocked[k] >> batch.slots[j]) & 1) as u8) << j);
