@@ -550,6 +550,7 @@ fn cmd_bench(scene_arg: &str, opts: &RenderOpts, frames: u32) -> Result<(), Stri
     let l = load(scene_arg, opts)?;
     let cancel = AtomicBool::new(false);
     let mut times = Vec::new();
+    let mut first_ms = 0.0;
     let mut counts = RayCounts::default();
     for i in 0..=frames {
         let start = Instant::now();
@@ -561,12 +562,16 @@ fn cmd_bench(scene_arg: &str, opts: &RenderOpts, frames: u32) -> Result<(), Stri
         if i > 0 {
             times.push(ms);
             counts = frame.counts;
+        } else {
+            first_ms = ms;
         }
     }
     times.sort_by(f64::total_cmp);
     let median = times[times.len() / 2];
     let mut j = stats_json(&l, median, &counts, l.settings.spp);
     j["render_ms_min"] = json!(times[0]);
+    // The untimed first frame: what one `render` in a fresh process pays.
+    j["first_ms"] = json!(first_ms);
     j["frames"] = json!(frames);
     j["primary_rays_per_s"] = json!(counts.primary as f64 / (median / 1e3));
     j["rays_per_s"] = json!((counts.primary + counts.shadow + counts.secondary) as f64 / (median / 1e3));

@@ -287,6 +287,20 @@ pub trait SceneQuery: Sync {
     fn closest_for_batch(&self, ray: &Ray, t_max: f32, inside: bool, counts: &mut RayCounts) -> Option<BatchHit> {
         self.closest(ray, t_max, inside, counts, &mut pixel_record::NoRecord).map(BatchHit::Record)
     }
+    /// `closest_for_batch` from code already running at SIMD level `simd`
+    /// (inside a `dispatch!` around a loop over many rays): a traversal
+    /// written over `Simd` can then be inlined there, instead of choosing
+    /// the level and entering its compiled copy once per ray.
+    #[inline(always)]
+    fn closest_for_batch_at<S: fearless_simd::Simd>(&self, _simd: S, ray: &Ray, t_max: f32, inside: bool, counts: &mut RayCounts) -> Option<BatchHit> {
+        self.closest_for_batch(ray, t_max, inside, counts)
+    }
+    /// `occluder` (unrecorded) from code already running at SIMD level
+    /// `simd`, as `closest_for_batch_at` is to `closest_for_batch`.
+    #[inline(always)]
+    fn occluder_at<S: fearless_simd::Simd>(&self, _simd: S, ray: &Ray, t_max: f32, counts: &mut RayCounts) -> Option<Occluder> {
+        self.occluder(ray, t_max, counts, &mut pixel_record::NoRecord)
+    }
     /// Shadow maps to look light visibility up in (`--shadows map`);
     /// `resolve_sample` wraps the query in a `shadow_map::MapQuery` that has them.
     fn shadow_maps(&self) -> Option<&shadow_map::ShadowMaps> {

@@ -188,6 +188,14 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
     /// the next depth's groups. Lambertian surfaces sample their bounce
     /// eight lanes at a time.
     fn bounce(&mut self, group: &Group) {
+        // One choice of SIMD level for the group: its rays' walks (written
+        // over `Simd`) are then compiled into this loop, not entered ray by ray.
+        dispatch!(simd_level(), simd => self.bounce_at(simd, group))
+    }
+
+    /// `bounce` at SIMD level `simd`.
+    #[inline(always)]
+    fn bounce_at<S: Simd>(&mut self, simd: S, group: &Group) {
         let scene = &self.job.prepared.scene;
         let settings = self.job.settings;
         let mut lambertian = 0u8;
@@ -214,14 +222,14 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
             let hit = group.hits.get(k);
             let w_o = Vec3::new(group.w_o[0][k], group.w_o[1][k], group.w_o[2][k]);
             match gi::sample_bounce(material, group.albedo[k], &hit, w_o, self.depth, path, &mut NoRecord) {
-                Some((w_i, weight)) => self.go_on(group, k, w_i, weight),
+                Some((w_i, weight)) => self.go_on(simd, group, k, w_i, weight),
                 None => self.beyond[s] = group.direct[k] + Vec3::ZERO,
             }
         }
         if lambertian == 0 {
             return;
         }
-        let (w_i, usable) = dispatch!(simd_level(), simd => cosine_lobes8(simd, &group.hits, &u));
+        let (w_i, usable) = cosine_lobes8(simd, &group.hits, &u);
         let mut m = lambertian;
         while m != 0 {
             let k = m.trailing_zeros() as usize;
@@ -235,7 +243,7 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
             let reflects = luminance(albedo).max(0.0) > 0.0 && albedo.is_finite();
             let survival = if reflects && usable & 1 << k != 0 { gi::roulette(self.depth, self.paths[s].throughput * albedo, &mut self.paths[s].rng) } else { None };
             match survival {
-                Some((scale, _)) => self.go_on(group, k, Vec3::new(w_i[0][k], w_i[1][k], w_i[2][k]), albedo * scale),
+                Some((scale, _)) => self.go_on(simd, group, k, Vec3::new(w_i[0][k], w_i[1][k], w_i[2][k]), albedo * scale),
                 None => self.beyond[s] = group.direct[k] + Vec3::ZERO,
             }
         }
@@ -245,7 +253,8 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
     /// kept, and the surface its ray finds put in the next depth's groups
     /// (the background noted where it escapes), as `follow` and
     /// `radiance_along` do.
-    fn go_on(&mut self, group: &Group, k: usize, w_i: Vec3, weight: Vec3) {
+    #[inline(always)]
+    fn go_on<S: Simd>(&mut self, simd: S, group: &Group, k: usize, w_i: Vec3, weight: Vec3) {
         let scene = &self.job.prepared.scene;
         let s = group.sample[k];
         self.bounces.push(Bounce { sample: s, direct: group.direct[k], weight });
@@ -255,7 +264,7 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
         let ray = Ray::new(origin + geometric * self.job.settings.shadow_bump, w_i);
         self.paths[s].throughput *= weight;
         self.counts.secondary += 1;
-        match self.query.closest_for_batch(&ray, f32::INFINITY, false, self.counts) {
+        match self.query.closest_for_batch_at(simd, &ray, f32::INFINITY, false, self.counts) {
             None => self.beyond[s] = scene.miss_radiance(ray.dir),
             Some(found) => {
                 let into = slot(self.next, self.next_len / LANES);

@@ -414,6 +414,13 @@ impl<Q: SceneQuery> BatchVisibility<'_, '_, Q> {
     /// arrives unblocked.
     #[inline(never)]
     fn cast_shadow_rays(&mut self, rays: &ShadowRays, lit: u8) -> u8 {
+        // One choice of SIMD level for the lanes' rays, whose walks are
+        // then compiled into the loop (`occluder_at`).
+        dispatch!(simd_level(), simd => self.cast_shadow_rays_at(simd, rays, lit))
+    }
+
+    #[inline(always)]
+    fn cast_shadow_rays_at<S: Simd>(&mut self, simd: S, rays: &ShadowRays, lit: u8) -> u8 {
         let scene = &self.job.prepared.scene;
         let mut visible = 0u8;
         let mut m = lit;
@@ -422,7 +429,7 @@ impl<Q: SceneQuery> BatchVisibility<'_, '_, Q> {
             m &= m - 1;
             let (ray, t_max) = rays.get(scene, self.hits, i);
             self.counts.shadow += 1;
-            if self.query.occluder(&ray, t_max, self.counts, &mut NoRecord).is_none() {
+            if self.query.occluder_at(simd, &ray, t_max, self.counts).is_none() {
                 visible |= 1 << i;
             }
         }

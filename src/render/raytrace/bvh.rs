@@ -388,17 +388,28 @@ impl<'a> BvhQuery<'a> {
         counts: &mut RayCounts,
         rec: &mut R,
     ) -> Option<BestHit> {
-        let bvh = &self.prepared.bvh;
         // Compiled once per SIMD level: the eight-lane box test is one AVX
         // instruction per step where the CPU has it.
-        dispatch!(simd_level(), simd => {
-            if bvh.deep {
-                self.traverse_with::<_, ANY, R, _>(simd, ray, t_max, inside, counts, rec, &mut Vec::new())
-            } else {
-                let mut stack = ArrayStack { items: [const { std::mem::MaybeUninit::uninit() }; STACK], len: 0 };
-                self.traverse_with::<_, ANY, R, _>(simd, ray, t_max, inside, counts, rec, &mut stack)
-            }
-        })
+        dispatch!(simd_level(), simd => self.traverse_flat_at::<_, ANY, R>(simd, ray, t_max, inside, counts, rec))
+    }
+
+    /// `traverse_flat` at SIMD level `simd`, chosen by the caller.
+    #[inline(always)]
+    fn traverse_flat_at<S: Simd, const ANY: bool, R: Recorder>(
+        &self,
+        simd: S,
+        ray: &Ray,
+        t_max: f32,
+        inside: bool,
+        counts: &mut RayCounts,
+        rec: &mut R,
+    ) -> Option<BestHit> {
+        if self.prepared.bvh.deep {
+            self.traverse_with::<_, ANY, R, _>(simd, ray, t_max, inside, counts, rec, &mut Vec::new())
+        } else {
+            let mut stack = ArrayStack { items: [const { std::mem::MaybeUninit::uninit() }; STACK], len: 0 };
+            self.traverse_with::<_, ANY, R, _>(simd, ray, t_max, inside, counts, rec, &mut stack)
+        }
     }
 
     /// The traversal shared by both queries. `ANY` stops at the first hit.
@@ -549,12 +560,32 @@ impl SceneQuery for BvhQuery<'_> {
         Some(self.batch_hit(&best, ray))
     }
 
+    #[inline(always)]
+    fn closest_for_batch_at<S: Simd>(&self, simd: S, ray: &Ray, t_max: f32, inside: bool, counts: &mut RayCounts) -> Option<BatchHit> {
+        // Scenes with instances or CSG objects take the general way.
+        if !self.prepared.scene.csgs.is_empty() || self.prepared.instances.is_some() || self.prepared.bvh.prims.is_empty() {
+            return self.closest_for_batch(ray, t_max, inside, counts);
+        }
+        let best = self.traverse_flat_at::<S, false, NoRecord>(simd, ray, t_max, inside, counts, &mut NoRecord)?;
+        Some(self.batch_hit(&best, ray))
+    }
+
     fn occluder<R: Recorder>(&self, ray: &Ray, t_max: f32, counts: &mut RayCounts, rec: &mut R) -> Option<Occluder> {
         match self.traverse::<true, R>(ray, t_max, false, counts, rec) {
             Some(best) => Some(Occluder::new(best.id, best.t)),
             None if self.prepared.scene.csgs.is_empty() => None,
             None => crate::render::csg::occluder_in_scene(&self.prepared.scene, ray, t_max, counts),
         }
+    }
+
+    #[inline(always)]
+    fn occluder_at<S: Simd>(&self, simd: S, ray: &Ray, t_max: f32, counts: &mut RayCounts) -> Option<Occluder> {
+        // Scenes with instances or CSG objects take the general way.
+        if !self.prepared.scene.csgs.is_empty() || self.prepared.instances.is_some() || self.prepared.bvh.prims.is_empty() {
+            return self.occluder(ray, t_max, counts, &mut NoRecord);
+        }
+        let best = self.traverse_flat_at::<S, true, NoRecord>(simd, ray, t_max, false, counts, &mut NoRecord)?;
+        Some(Occluder::new(best.id, best.t))
     }
 }
 
