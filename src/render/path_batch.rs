@@ -75,6 +75,21 @@ pub struct PathPool<'p> {
     front: Vec<Group>,
     live: usize,
     next: Vec<Group>,
+    /// Per material of the scene, what its bounce needs (`SurfaceKind`),
+    /// worked out once per `follow_into` instead of per lane and bounce.
+    kinds: Vec<SurfaceKind>,
+}
+
+/// How a path leaves a surface of some material.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum SurfaceKind {
+    /// Mirror or glass (`Material::has_secondary`): `shade()`'s own code
+    /// finishes the path.
+    Secondary,
+    /// A glossy lobe beside the diffuse one: `gi::sample_bounce`.
+    Glossy,
+    /// Diffuse only: the cosine lobe, sampled eight lanes at a time.
+    Lambertian,
 }
 
 impl Default for PathPool<'_> {
@@ -85,7 +100,7 @@ impl Default for PathPool<'_> {
 
 impl<'p> PathPool<'p> {
     pub fn new() -> PathPool<'p> {
-        PathPool { paths: Vec::new(), slots: Vec::new(), beyond: Vec::new(), bounces: Vec::new(), front: Vec::new(), live: 0, next: Vec::new() }
+        PathPool { paths: Vec::new(), slots: Vec::new(), beyond: Vec::new(), bounces: Vec::new(), front: Vec::new(), live: 0, next: Vec::new(), kinds: Vec::new() }
     }
 
     /// A pool with room for `samples` samples (and a batch more) and a few
@@ -103,6 +118,7 @@ impl<'p> PathPool<'p> {
             front: Vec::with_capacity(groups),
             live: 0,
             next: Vec::with_capacity(groups),
+            kinds: Vec::new(),
         }
     }
 
@@ -139,10 +155,17 @@ impl<'p> PathPool<'p> {
     /// (what `shade::after_direct` at depth 0 returns for it) to `out` at
     /// its slot; the pool is then empty.
     pub fn follow_into<Q: SceneQuery>(&mut self, job: &PassJob, query: &Q, counts: &mut RayCounts, out: &mut [Radiance]) {
-        let normal_maps = job.prepared.scene.materials.iter().any(|m| m.normal_map.is_some());
+        let materials = &job.prepared.scene.materials;
+        let normal_maps = materials.iter().any(|m| m.normal_map.is_some());
+        self.kinds.clear();
+        self.kinds.extend(materials.iter().map(|m| match (m.has_secondary(), m.has_glossy()) {
+            (true, _) => SurfaceKind::Secondary,
+            (false, true) => SurfaceKind::Glossy,
+            (false, false) => SurfaceKind::Lambertian,
+        }));
         let mut depth = 0;
         while self.live > 0 {
-            let mut pass = DepthPass { job, query, counts: &mut *counts, paths: &mut self.paths, beyond: &mut self.beyond, bounces: &mut self.bounces, next: &mut self.next, next_len: 0, depth };
+            let mut pass = DepthPass { job, query, counts: &mut *counts, paths: &mut self.paths, beyond: &mut self.beyond, bounces: &mut self.bounces, next: &mut self.next, next_len: 0, depth, kinds: &self.kinds };
             for group in &self.front[..self.live] {
                 pass.bounce(group);
             }
@@ -180,6 +203,7 @@ struct DepthPass<'w, 'p, 'j, Q> {
     next: &'w mut Vec<Group>,
     next_len: usize,
     depth: u32,
+    kinds: &'w [SurfaceKind],
 }
 
 impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
@@ -198,20 +222,23 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
     fn bounce_at<S: Simd>(&mut self, simd: S, group: &Group) {
         let scene = &self.job.prepared.scene;
         let settings = self.job.settings;
+        // Paths at their last permitted bounce finish in `shade()`'s code.
+        let last = self.depth >= settings.gi.max_path_depth();
         let mut lambertian = 0u8;
         let mut u = [[0.0f32; LANES]; 2];
         for k in 0..group.len {
             let s = group.sample[k];
+            let kind = self.kinds[group.hits.material[k] as usize];
             let material = &scene.materials[group.hits.material[k] as usize];
             let path = &mut self.paths[s];
-            if self.depth >= settings.gi.max_path_depth() || material.has_secondary() {
+            if last || kind == SurfaceKind::Secondary {
                 let hit = group.hits.get(k);
                 let w_o = Vec3::new(group.w_o[0][k], group.w_o[1][k], group.w_o[2][k]);
                 let mut sh = Shading { scene, query: self.query, settings, path, counts: &mut *self.counts, rec: &mut NoRecord };
                 self.beyond[s] = shade::after_direct(&mut sh, &hit, material, group.albedo[k], w_o, self.depth, group.direct[k]);
                 continue;
             }
-            if !material.has_glossy() {
+            if kind == SurfaceKind::Lambertian {
                 // `sample_bounce`'s draws; the lobe is sampled below.
                 let _choice = path.rng.next_f32();
                 let d = path.rng.next_2d();
