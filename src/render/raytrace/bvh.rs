@@ -323,12 +323,17 @@ impl Stack for Vec<(u32, f32)> {
 /// Closest-hit and shadow queries through the scene's BVH.
 pub struct BvhQuery<'a> {
     pub(super) prepared: &'a PreparedScene,
+    /// Whether every query is one walk of the flat BVH: no instances, no
+    /// CSG objects, some primitives (`closest_for_batch_at`, `occluder_at`
+    /// ask this per ray).
+    flat_only: bool,
 }
 
 impl<'a> BvhQuery<'a> {
     #[inline]
     pub fn new(prepared: &'a PreparedScene) -> BvhQuery<'a> {
-        BvhQuery { prepared }
+        let flat_only = prepared.scene.csgs.is_empty() && prepared.instances.is_none() && !prepared.bvh.prims.is_empty();
+        BvhQuery { prepared, flat_only }
     }
 
     #[inline(always)]
@@ -563,7 +568,7 @@ impl SceneQuery for BvhQuery<'_> {
     #[inline(always)]
     fn closest_for_batch_at<S: Simd>(&self, simd: S, ray: &Ray, t_max: f32, inside: bool, counts: &mut RayCounts) -> Option<BatchHit> {
         // Scenes with instances or CSG objects take the general way.
-        if !self.prepared.scene.csgs.is_empty() || self.prepared.instances.is_some() || self.prepared.bvh.prims.is_empty() {
+        if !self.flat_only {
             return self.closest_for_batch(ray, t_max, inside, counts);
         }
         let best = self.traverse_flat_at::<S, false, NoRecord>(simd, ray, t_max, inside, counts, &mut NoRecord)?;
@@ -581,7 +586,7 @@ impl SceneQuery for BvhQuery<'_> {
     #[inline(always)]
     fn occluder_at<S: Simd>(&self, simd: S, ray: &Ray, t_max: f32, counts: &mut RayCounts) -> Option<Occluder> {
         // Scenes with instances or CSG objects take the general way.
-        if !self.prepared.scene.csgs.is_empty() || self.prepared.instances.is_some() || self.prepared.bvh.prims.is_empty() {
+        if !self.flat_only {
             return self.occluder(ray, t_max, counts, &mut NoRecord);
         }
         let best = self.traverse_flat_at::<S, true, NoRecord>(simd, ray, t_max, false, counts, &mut NoRecord)?;
