@@ -23,9 +23,9 @@ use super::pixel_record::NoRecord;
 use super::shade::{self, Shading};
 use super::shade_batch::{direct_in_lanes, LANES};
 use super::{BatchHit, PassJob, RayCounts, SceneQuery};
-use super::sampling::luminance;
+use super::sampling::{luminance, permute, permute_pow2_lanes};
 use crate::math::lanes::{mask_bits, simd_level, Lane, V3};
-use crate::math::{Radiance, Ray, Vec3};
+use crate::math::{Radiance, Ray, Vec2, Vec3};
 use fearless_simd::{dispatch, f32x8, Simd, SimdFrom};
 use crate::scene::hit_lanes::{Floats, HitLanes, TriangleHitInput};
 
@@ -226,6 +226,11 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
         let last = self.depth >= settings.gi.max_path_depth();
         let mut lambertian = 0u8;
         let mut u = [[0.0f32; LANES]; 2];
+        // Lanes whose stratified point waits for its cell (`next_2d_begin`):
+        // their jitter and shuffle key.
+        let mut unplaced = 0u8;
+        let mut jitter = [Vec2::ZERO; LANES];
+        let mut shuffle = [0u64; LANES];
         for k in 0..group.len {
             let s = group.sample[k];
             let kind = self.kinds[group.hits.material[k] as usize];
@@ -241,8 +246,13 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
             if kind == SurfaceKind::Lambertian {
                 // `sample_bounce`'s draws; the lobe is sampled below.
                 let _choice = path.rng.next_f32();
-                let d = path.rng.next_2d();
-                (u[0][k], u[1][k]) = (d.x, d.y);
+                match path.rng.next_2d_begin() {
+                    Ok(d) => (u[0][k], u[1][k]) = (d.x, d.y),
+                    Err((j, key)) => {
+                        (jitter[k], shuffle[k]) = (j, key);
+                        unplaced |= 1 << k;
+                    }
+                }
                 lambertian |= 1 << k;
                 continue;
             }
@@ -255,6 +265,9 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
         }
         if lambertian == 0 {
             return;
+        }
+        if unplaced != 0 {
+            self.place_points(simd, group, unplaced, &jitter, &shuffle, &mut u);
         }
         let (w_i, usable) = cosine_lobes8(simd, &group.hits, &u);
         let mut m = lambertian;
@@ -273,6 +286,46 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
                 Some((scale, _)) => self.go_on(simd, group, k, Vec3::new(w_i[0][k], w_i[1][k], w_i[2][k]), albedo * scale),
                 None => self.beyond[s] = group.direct[k] + Vec3::ZERO,
             }
+        }
+    }
+
+    /// `next_2d`'s points of the lanes in `lanes`, from `next_2d_begin`'s
+    /// jitter and shuffle keys, into `u`: the sample indices permuted eight
+    /// at a time where the sample count is a power of two (the common
+    /// counts), one by one otherwise.
+    #[inline(always)]
+    fn place_points<S: Simd>(&self, simd: S, group: &Group, lanes: u8, jitter: &[Vec2; LANES], shuffle: &[u64; LANES], u: &mut [Floats; 2]) {
+        let rng = |k: usize| &self.paths[group.sample[k]].rng;
+        let first = lanes.trailing_zeros() as usize;
+        let (spp, second) = (rng(first).spp(), rng(first).uses_second());
+        let (mut low, mut high) = ([0u32; LANES], [0u32; LANES]);
+        // A pool's paths share their frame's sample count (`PathState::new`
+        // takes the frame's): the lanes are permuted with one count.
+        debug_assert!((0..LANES).all(|k| lanes & 1 << k == 0 || rng(k).spp() == spp));
+        if spp.is_power_of_two() {
+            let index: [u32; LANES] = std::array::from_fn(|k| if lanes & 1 << k != 0 { rng(k).sample() } else { 0 });
+            low = permute_pow2_lanes(simd, index, spp, shuffle.map(|key| key as u32));
+            if second {
+                high = permute_pow2_lanes(simd, index, spp, shuffle.map(|key| (key >> 32) as u32));
+            }
+        } else {
+            let mut m = lanes;
+            while m != 0 {
+                let k = m.trailing_zeros() as usize;
+                m &= m - 1;
+                let (n, i) = (rng(k).spp(), rng(k).sample());
+                low[k] = permute(i, n, shuffle[k] as u32);
+                if rng(k).uses_second() {
+                    high[k] = permute(i, n, (shuffle[k] >> 32) as u32);
+                }
+            }
+        }
+        let mut m = lanes;
+        while m != 0 {
+            let k = m.trailing_zeros() as usize;
+            m &= m - 1;
+            let d = rng(k).place_2d(jitter[k], low[k], high[k]);
+            (u[0][k], u[1][k]) = (d.x, d.y);
         }
     }
 

@@ -5,6 +5,7 @@
 //! the numbers its frame drew.
 
 use crate::math::lanes::{cos_sin_turns, Lane, V3};
+use fearless_simd::{u32x8, Simd, SimdBase, SimdFrom};
 use crate::math::{Vec2, Vec3};
 use std::f32::consts::PI;
 
@@ -99,26 +100,68 @@ impl SampleRng {
     /// pixel's stratification for the first draws, uniform after.
     #[inline]
     pub fn next_2d(&mut self) -> Vec2 {
+        match self.next_2d_begin() {
+            Ok(point) => point,
+            Err((jitter, shuffle)) => {
+                let second = if self.grid == 0 { permute(self.sample, self.spp, (shuffle >> 32) as u32) } else { 0 };
+                self.place_2d(jitter, permute(self.sample, self.spp, shuffle as u32), second)
+            }
+        }
+    }
+
+    /// `next_2d` up to the choice of the sample's cell: `Ok` with the point
+    /// where it is not stratified, else `Err` with its jitter and the
+    /// shuffle key, whose permutations of `sample()` among `spp()`
+    /// (`permute` with the key's low half, and for a Latin hypercube also
+    /// its high half) `place_2d` takes. Split so that a caller with many
+    /// streams can permute them together (`permute_pow2_lanes`).
+    #[inline]
+    pub fn next_2d_begin(&mut self) -> Result<Vec2, (Vec2, u64)> {
         let jitter = Vec2::new(self.next_f32(), self.next_f32());
         if self.spp == 1 || self.pairs >= STRATIFIED_PAIRS {
-            return jitter;
+            return Ok(jitter);
         }
         // One shuffle of the cells per pixel and dimension, the same for
         // all the pixel's samples (derived from the key, not the counter).
         let shuffle = mix64(self.key ^ (self.pairs as u64 + 1).wrapping_mul(GOLDEN));
         self.pairs += 1;
+        Err((jitter, shuffle))
+    }
+
+    /// `next_2d`'s point from `next_2d_begin`'s jitter and the permuted
+    /// sample index under the shuffle key's low half (`first`) and high
+    /// half (`second`, read only for a Latin hypercube).
+    #[inline]
+    pub fn place_2d(&self, jitter: Vec2, first: u32, second: u32) -> Vec2 {
         let n = self.grid;
         if n != 0 {
-            let cell = permute(self.sample, self.spp, shuffle as u32);
+            let cell = first;
             let (column, row) = if n.is_power_of_two() { (cell & (n - 1), cell >> n.trailing_zeros()) } else { (cell % n, cell / n) };
             Vec2::new(over(column as f32 + jitter.x, n), over(row as f32 + jitter.y, n))
         } else {
             // Latin hypercube: a shuffled stratum per axis.
-            let cx = permute(self.sample, self.spp, shuffle as u32);
-            let cy = permute(self.sample, self.spp, (shuffle >> 32) as u32);
-            Vec2::new(over(cx as f32 + jitter.x, self.spp), over(cy as f32 + jitter.y, self.spp))
+            Vec2::new(over(first as f32 + jitter.x, self.spp), over(second as f32 + jitter.y, self.spp))
         }
         .min(Vec2::splat(1.0 - f32::EPSILON / 2.0))
+    }
+
+    /// This sample's index among its pixel's.
+    #[inline]
+    pub fn sample(&self) -> u32 {
+        self.sample
+    }
+
+    /// The pixel's sample count (at least 1).
+    #[inline]
+    pub fn spp(&self) -> u32 {
+        self.spp
+    }
+
+    /// Whether `place_2d` reads its `second` permutation (a Latin
+    /// hypercube, for a count that is not a square).
+    #[inline]
+    pub fn uses_second(&self) -> bool {
+        self.grid == 0
     }
 }
 
@@ -168,6 +211,40 @@ pub fn permute(mut i: u32, len: u32, key: u32) -> u32 {
             return if len.is_power_of_two() { i & w } else { i % len };
         }
     }
+}
+
+/// `permute` of eight indices at once, each under its own key, all with
+/// the same power-of-two `len`: the same arithmetic in 32-bit lanes (for a
+/// power of two the walk ends after one round).
+#[inline(always)]
+pub fn permute_pow2_lanes<S: Simd>(simd: S, i: [u32; 8], len: u32, key: [u32; 8]) -> [u32; 8] {
+    debug_assert!(len.is_power_of_two());
+    if len <= 1 {
+        return [0; 8];
+    }
+    let w = u32x8::splat(simd, len - 1);
+    let p = u32x8::simd_from(simd, key);
+    let c = |v: u32| u32x8::splat(simd, v);
+    let mut i = u32x8::simd_from(simd, i);
+    i ^= p;
+    i *= c(0xe170893d);
+    i ^= p >> 16;
+    i ^= (i & w) >> 4;
+    i ^= p >> 8;
+    i *= c(0x0929eb3f);
+    i ^= p >> 23;
+    i ^= (i & w) >> 1;
+    i *= c(1) | p >> 27;
+    i *= c(0x6935fa69);
+    i ^= (i & w) >> 11;
+    i *= c(0x74dcb303);
+    i ^= (i & w) >> 2;
+    i *= c(0x9e501cc3);
+    i ^= (i & w) >> 2;
+    i *= c(0xc860a3df);
+    i &= w;
+    i ^= i >> 5;
+    ((i + p) & w).into()
 }
 
 /// Two unit tangents completing `n` (unit) to a right-handed orthonormal
@@ -323,6 +400,41 @@ mod tests {
                 let mut seen: Vec<u32> = (0..len).map(|i| permute(i, len, key)).collect();
                 seen.sort();
                 assert_eq!(seen, (0..len).collect::<Vec<_>>(), "len {len} key {key}");
+            }
+        }
+    }
+
+    #[test]
+    fn permuting_eight_at_once_matches_one_at_a_time() {
+        let mut r = SampleRng::for_index(11, 0, 0);
+        for len in [1u32, 2, 4, 8, 16, 64, 256, 1 << 20] {
+            for _ in 0..200 {
+                let i: [u32; 8] = std::array::from_fn(|_| (r.next_f32() * len as f32) as u32);
+                let key: [u32; 8] = std::array::from_fn(|_| r.next_bits() as u32);
+                let wide = fearless_simd::dispatch!(crate::math::lanes::simd_level(), simd => permute_pow2_lanes(simd, i, len, key));
+                for k in 0..8 {
+                    assert_eq!(wide[k], permute(i[k], len, key[k]), "len {len}, index {}, key {:#x}", i[k], key[k]);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_2d_draw_in_two_steps_is_the_draw_in_one() {
+        for spp in [1u32, 2, 4, 5, 8, 9, 16] {
+            for sample in 0..spp {
+                let (mut one, mut two) = (SampleRng::stratified(77, sample, spp, 5), SampleRng::stratified(77, sample, spp, 5));
+                for _ in 0..12 {
+                    let want = one.next_2d();
+                    let got = match two.next_2d_begin() {
+                        Ok(p) => p,
+                        Err((jitter, key)) => {
+                            let (n, i) = (two.spp(), two.sample());
+                            two.place_2d(jitter, permute(i, n, key as u32), if two.uses_second() { permute(i, n, (key >> 32) as u32) } else { u32::MAX })
+                        }
+                    };
+                    assert_eq!(got.to_array().map(f32::to_bits), want.to_array().map(f32::to_bits), "spp {spp}, sample {sample}");
+                }
             }
         }
     }
