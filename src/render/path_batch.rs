@@ -23,7 +23,7 @@ use super::pixel_record::NoRecord;
 use super::shade::{self, Shading};
 use super::shade_batch::{direct_in_lanes, LANES};
 use super::{BatchHit, PassJob, RayCounts, SceneQuery};
-use super::sampling::{luminance, permute, permute_pow2_lanes};
+use super::sampling::{luminance, permute, permute_pow2_lanes, Draw2d};
 use crate::math::lanes::{mask_bits, simd_level, Lane, V3};
 use crate::math::{Radiance, Ray, Vec2, Vec3};
 use fearless_simd::{dispatch, f32x8, Simd, SimdFrom};
@@ -247,8 +247,8 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
                 // `sample_bounce`'s draws; the lobe is sampled below.
                 let _choice = path.rng.next_f32();
                 match path.rng.next_2d_begin() {
-                    Ok(d) => (u[0][k], u[1][k]) = (d.x, d.y),
-                    Err((j, key)) => {
+                    Draw2d::Point(d) => (u[0][k], u[1][k]) = (d.x, d.y),
+                    Draw2d::Unplaced { jitter: j, shuffle: key } => {
                         (jitter[k], shuffle[k]) = (j, key);
                         unplaced |= 1 << k;
                     }

@@ -101,31 +101,28 @@ impl SampleRng {
     #[inline]
     pub fn next_2d(&mut self) -> Vec2 {
         match self.next_2d_begin() {
-            Ok(point) => point,
-            Err((jitter, shuffle)) => {
+            Draw2d::Point(point) => point,
+            Draw2d::Unplaced { jitter, shuffle } => {
                 let second = if self.grid == 0 { permute(self.sample, self.spp, (shuffle >> 32) as u32) } else { 0 };
                 self.place_2d(jitter, permute(self.sample, self.spp, shuffle as u32), second)
             }
         }
     }
 
-    /// `next_2d` up to the choice of the sample's cell: `Ok` with the point
-    /// where it is not stratified, else `Err` with its jitter and the
-    /// shuffle key, whose permutations of `sample()` among `spp()`
-    /// (`permute` with the key's low half, and for a Latin hypercube also
-    /// its high half) `place_2d` takes. Split so that a caller with many
-    /// streams can permute them together (`permute_pow2_lanes`).
-    #[inline]
-    pub fn next_2d_begin(&mut self) -> Result<Vec2, (Vec2, u64)> {
+    /// `next_2d` up to the choice of the sample's cell (see `Draw2d`).
+    /// Split so that a caller with many streams can permute them together
+    /// (`permute_pow2_lanes`).
+    #[inline(always)]
+    pub fn next_2d_begin(&mut self) -> Draw2d {
         let jitter = Vec2::new(self.next_f32(), self.next_f32());
         if self.spp == 1 || self.pairs >= STRATIFIED_PAIRS {
-            return Ok(jitter);
+            return Draw2d::Point(jitter);
         }
         // One shuffle of the cells per pixel and dimension, the same for
         // all the pixel's samples (derived from the key, not the counter).
         let shuffle = mix64(self.key ^ (self.pairs as u64 + 1).wrapping_mul(GOLDEN));
         self.pairs += 1;
-        Err((jitter, shuffle))
+        Draw2d::Unplaced { jitter, shuffle }
     }
 
     /// `next_2d`'s point from `next_2d_begin`'s jitter and the permuted
@@ -163,6 +160,18 @@ impl SampleRng {
     pub fn uses_second(&self) -> bool {
         self.grid == 0
     }
+}
+
+/// A 2D draw begun by `SampleRng::next_2d_begin`.
+pub enum Draw2d {
+    /// The point itself (this draw is not stratified).
+    Point(Vec2),
+    /// The jitter within the sample's cell, and the shuffle key whose
+    /// permutations of the sample's index among the pixel's
+    /// (`permute(sample(), spp(), key)` with the key's low half, and for a
+    /// Latin hypercube also with its high half) pick the cell:
+    /// `SampleRng::place_2d` takes them.
+    Unplaced { jitter: Vec2, shuffle: u64 },
 }
 
 /// `x / n`. For a power of two it multiplies by the exact reciprocal, which
@@ -427,8 +436,8 @@ mod tests {
                 for _ in 0..12 {
                     let want = one.next_2d();
                     let got = match two.next_2d_begin() {
-                        Ok(p) => p,
-                        Err((jitter, key)) => {
+                        Draw2d::Point(p) => p,
+                        Draw2d::Unplaced { jitter, shuffle: key } => {
                             let (n, i) = (two.spp(), two.sample());
                             two.place_2d(jitter, permute(i, n, key as u32), if two.uses_second() { permute(i, n, (key >> 32) as u32) } else { u32::MAX })
                         }

@@ -366,7 +366,7 @@ mod tests {
             state ^= state << 17;
             (state >> 40) as f32 / (1u64 << 24) as f32
         };
-        let mut point = |scale: f32, next: &mut dyn FnMut() -> f32| Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5) * scale;
+        let point = |scale: f32, next: &mut dyn FnMut() -> f32| Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5) * scale;
         let (mut hits, mut leaves) = (0, 0);
         for _ in 0..3000 {
             let n = 2 + (next() * 7.0) as usize;
