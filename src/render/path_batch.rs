@@ -76,7 +76,7 @@ pub struct PathPool<'p> {
     live: usize,
     next: Vec<Group>,
     /// Per material of the scene, what its bounce needs (`SurfaceKind`),
-    /// worked out once per `follow_into` instead of per lane and bounce.
+    /// worked out once instead of per lane and bounce.
     kinds: Vec<SurfaceKind>,
 }
 
@@ -157,12 +157,16 @@ impl<'p> PathPool<'p> {
     pub fn follow_into<Q: SceneQuery>(&mut self, job: &PassJob, query: &Q, counts: &mut RayCounts, out: &mut [Radiance]) {
         let materials = &job.prepared.scene.materials;
         let normal_maps = materials.iter().any(|m| m.normal_map.is_some());
-        self.kinds.clear();
-        self.kinds.extend(materials.iter().map(|m| match (m.has_secondary(), m.has_glossy()) {
-            (true, _) => SurfaceKind::Secondary,
-            (false, true) => SurfaceKind::Glossy,
-            (false, false) => SurfaceKind::Lambertian,
-        }));
+        // A pool serves one call of its renderer, so one scene: the table
+        // is made at its first flush.
+        if self.kinds.len() != materials.len() {
+            self.kinds.clear();
+            self.kinds.extend(materials.iter().map(|m| match (m.has_secondary(), m.has_glossy()) {
+                (true, _) => SurfaceKind::Secondary,
+                (false, true) => SurfaceKind::Glossy,
+                (false, false) => SurfaceKind::Lambertian,
+            }));
+        }
         let mut depth = 0;
         while self.live > 0 {
             let mut pass = DepthPass { job, query, counts: &mut *counts, paths: &mut self.paths, beyond: &mut self.beyond, bounces: &mut self.bounces, next: &mut self.next, next_len: 0, depth, kinds: &self.kinds };
