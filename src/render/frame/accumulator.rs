@@ -163,6 +163,15 @@ pub struct Accumulator {
     pass_buffer: Vec<Radiance>,
 }
 
+/// `n` zero radiances, written by every thread of the pool: a frame's sum
+/// is megabytes (11 MB at 1280x720), and filling it on one thread kept the
+/// others waiting before every frame.
+fn zeros(n: usize) -> Vec<Radiance> {
+    let mut v = Vec::with_capacity(n);
+    v.par_extend(rayon::iter::repeat_n(Radiance::ZERO, n));
+    v
+}
+
 impl Accumulator {
     /// An empty frame of `settings.width` x `settings.height` pixels and
     /// `settings.spp` samples (at least one).
@@ -174,7 +183,7 @@ impl Accumulator {
         let n = settings.width as usize * settings.height as usize;
         Accumulator {
             spp: settings.spp.max(1),
-            sum: vec![Radiance::ZERO; n],
+            sum: zeros(n),
             sum_sq: if settings.spp > 1 { vec![0.0; n] } else { Vec::new() },
             row_passes: vec![0; settings.height as usize],
             reference: diff.then(|| vec![Radiance::ZERO; n]),
