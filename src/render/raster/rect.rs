@@ -1,6 +1,8 @@
 //! Pixel rectangles: the regions, bounding boxes and spans every coverage
 //! loop works on, and the count of the samples those loops test.
 
+use crate::math::rounding;
+
 /// A half-open rectangle of pixels `[x0, x1) x [y0, y1)`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub struct PixelRect {
@@ -72,8 +74,8 @@ pub fn sample_span(lo: f32, hi: f32, off: f32, n: u32) -> (u32, u32) {
     if !(lo <= hi) {
         return (0, 0);
     }
-    let a = (lo - off).ceil().clamp(0.0, n as f32);
-    let b = ((hi - off).floor() + 1.0).clamp(0.0, n as f32);
+    let a = rounding::ceil(lo - off).clamp(0.0, n as f32);
+    let b = (rounding::floor(hi - off) + 1.0).clamp(0.0, n as f32);
     (a as u32, b as u32)
 }
 

@@ -14,7 +14,7 @@ const CLAMP: f64 = (1u64 << 60) as f64;
 /// A coordinate in pixels snapped to the sub-pixel grid.
 #[inline]
 pub fn snap(v: f32) -> i64 {
-    ((v as f64) * ONE as f64).round().clamp(-CLAMP, CLAMP) as i64
+    crate::math::rounding::round((v as f64) * ONE as f64).clamp(-CLAMP, CLAMP) as i64
 }
 
 /// The pass's sample offset snapped to the sub-pixel grid.
