@@ -131,6 +131,15 @@ fn main() {
             bounce_counts = RayCounts::default();
             bounce_hits = bounce_rays.iter().map(|r| query.closest(r, f32::INFINITY, false, &mut bounce_counts, &mut NoRecord).is_some() as u64).sum();
         });
+        // The same rays as a path frame's pool traces them: the walk and the
+        // winning triangle's id and weights, its record built later eight at
+        // a time (`closest_for_batch`). What a peer's bare walk compares with.
+        let mut walk_hits = 0u64;
+        let walk = best_of(reps, || {
+            let mut counts = RayCounts::default();
+            walk_hits = bounce_rays.iter().map(|r| query.closest_for_batch(r, f32::INFINITY, false, &mut counts).is_some() as u64).sum();
+        });
+        assert_eq!(walk_hits, bounce_hits, "the batch query finds what the closest-hit query finds");
 
         let cancel = AtomicBool::new(false);
         let mut out = vec![Radiance::ZERO; (w * h) as usize];
@@ -148,7 +157,7 @@ fn main() {
         println!(
             "pinhole {} tris={} {}x{} threads={} nodes={} depth={} build_ms={:.1} bare_ms={:.1} bare_mrays_per_s={:.2} hits={} packet_ms={:.1} packet_mrays_per_s={:.2} packet_hits={} \
              depth_view_ms={:.1} depth_view_mrays_per_s={:.2} nodes_per_ray={:.1} tests_per_ray={:.1} \
-             bounce_rays={} bounce_ns_per_ray_1_thread={:.1} bounce_hits={} bounce_nodes_per_ray={:.2} bounce_tests_per_ray={:.2} shaded_ms={:.1} shaded_mrays_per_s={:.2} (primary+shadow)",
+             bounce_rays={} bounce_ns_per_ray_1_thread={:.1} bounce_walk_ns_per_ray_1_thread={:.1} bounce_hits={} bounce_nodes_per_ray={:.2} bounce_tests_per_ray={:.2} shaded_ms={:.1} shaded_mrays_per_s={:.2} (primary+shadow)",
             Path::new(&path).file_stem().unwrap().to_string_lossy(),
             prepared.edges.len(),
             w,
@@ -169,6 +178,7 @@ fn main() {
             dc.tests as f64 / rays,
             bounce_rays.len(),
             bounce * 1e9 / bounce_rays.len() as f64,
+            walk * 1e9 / bounce_rays.len() as f64,
             bounce_hits,
             bounce_counts.nodes as f64 / bounce_rays.len() as f64,
             bounce_counts.tests as f64 / bounce_rays.len() as f64,

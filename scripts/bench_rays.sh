@@ -2,7 +2,12 @@
 # Incoherent rays, one thread: the first bounce of a path tracer (one
 # cosine-sampled direction from each primary hit), traced one at a time by
 # pinhole's BVH and by Embree 3 over the same triangles and rays. Scenes
-# without spheres only (Embree is given the triangles).
+# without spheres only (Embree is given the triangles). Pinhole's figures:
+# `bounce_ns_per_ray` with each hit's full record built one at a time
+# (`closest`), `bounce_walk_ns_per_ray` the walk alone as path frames call
+# it (`closest_for_batch`: the hit's triangle and weights); Embree's:
+# single rays (`rtcIntersect1`) and packets of 16 consecutive rays
+# (`rtcIntersect16`, as Mitsuba 3's LLVM variants call it on AVX-512).
 #
 #   bash scripts/bench_rays.sh [SCENE.toml ...]     (default: bunny_ground)
 #
