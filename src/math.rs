@@ -1,6 +1,7 @@
 //! Small math vocabulary shared by the whole core: rays, radiance, glam re-exports.
 
 pub mod lanes;
+pub mod prefetch;
 pub mod rounding;
 
 pub use glam::{Mat3, Vec2, Vec3};

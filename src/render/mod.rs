@@ -301,6 +301,12 @@ pub trait SceneQuery: Sync {
     fn occluder_at<S: fearless_simd::Simd>(&self, _simd: S, ray: &Ray, t_max: f32, counts: &mut RayCounts) -> Option<Occluder> {
         self.occluder(ray, t_max, counts, &mut pixel_record::NoRecord)
     }
+    /// The BVH query behind this one where its packets can trace the
+    /// rays this query would trace one by one (`packet::shadow_packets`):
+    /// the flat tree, no instances or CSG objects. `None` for any other.
+    fn bvh_packets(&self) -> Option<&raytrace::bvh::BvhQuery<'_>> {
+        None
+    }
     /// Shadow maps to look light visibility up in (`--shadows map`);
     /// `resolve_sample` wraps the query in a `shadow_map::MapQuery` that has them.
     fn shadow_maps(&self) -> Option<&shadow_map::ShadowMaps> {

@@ -137,6 +137,18 @@ impl Triangles {
         self.faces[i].corner.map(|c| self.corners[c as usize].position)
     }
 
+    /// Asks the cache for triangle `i`'s three corners (nothing past the
+    /// end): loops over the triangles in order read the faces in order but
+    /// their shared corners scattered about the array. A hint only.
+    #[inline(always)]
+    pub fn prefetch_corners(&self, i: usize) {
+        if let Some(f) = self.faces.get(i) {
+            for c in f.corner {
+                crate::math::prefetch::prefetch_value(&self.corners[c as usize]);
+            }
+        }
+    }
+
     /// The positions of triangle `i` and whether it is two-sided: what
     /// visibility reads.
     #[inline]

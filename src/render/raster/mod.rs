@@ -40,6 +40,7 @@ pub mod pass;
 pub mod rect;
 pub mod scanline;
 pub mod setup;
+pub mod shade_queue;
 pub mod small;
 pub mod sphere;
 pub mod stencil;

@@ -30,12 +30,17 @@ use super::tiled::{self, RectCoverage, TileGrid};
 use super::vis_buffer::{DepthKey, FragmentRecorder, VisBuffer};
 use super::method::Method;
 use super::{barycentric, bbox, incremental, scanline, small};
+use crate::math::prefetch::prefetch_value;
 use crate::math::{Radiance, Vec2};
 use crate::render::raytrace::bvh::BvhQuery;
 use crate::render::pixel_record::PixelTrace;
 use crate::render::{debug, PassJob, PreparedScene, RayCounts, SceneQuery, ShadowMode};
 use rayon::prelude::*;
 use std::ops::Range;
+
+/// How many triangles ahead of the one being drawn a band asks the cache
+/// for the next record (`Layer::raster`).
+const RECORDS_AHEAD: usize = 4;
 
 /// The scene query for shadow and secondary rays of rasterized frames.
 pub type Query<'a> = BvhQuery<'a>;
@@ -171,7 +176,14 @@ impl<'a> Layer<'a> {
             }
             Geometry::FixedTriangles { fts, off, bins } => {
                 let mut tested = vb.begin_tests();
-                for &i in &bins[region] {
+                let bin = &bins[region];
+                for (k, &i) in bin.iter().enumerate() {
+                    // A band reads its triangles' records in bin order, which
+                    // jumps about the array: ask for one a few triangles
+                    // ahead while this one is drawn.
+                    if let Some(&ahead) = bin.get(k + RECORDS_AHEAD) {
+                        prefetch_value(&fts[ahead as usize]);
+                    }
                     let ft = &fts[i as usize];
                     if ft.ray {
                         small::ray_test(vb, ft, rect, &mut tested);

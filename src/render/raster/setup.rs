@@ -228,6 +228,8 @@ pub fn setup_pass(job: &PassJob) -> Vec<ScreenTri> {
 /// `setup_pass`, each piece passed through `keep` as it is made, so that a
 /// variant that converts the pieces (fixed point) never holds both lists.
 pub fn setup_pass_map<T: Send>(job: &PassJob, keep: impl Fn(ScreenTri) -> Option<T> + Sync) -> Vec<T> {
+    /// How many triangles ahead the set-up asks for the corners it will read.
+    const CORNERS_AHEAD: usize = 8;
     const CHUNK: usize = 4096;
     let view = job.view;
     let rows = PixelRect::new(0, job.rows.start, view.width, job.rows.end);
@@ -243,6 +245,8 @@ pub fn setup_pass_map<T: Send>(job: &PassJob, keep: impl Fn(ScreenTri) -> Option
             match chunk.copy {
                 None => {
                     for i in chunk.range {
+                        // The corners a few triangles on, while this one is set up.
+                        scene.triangles.prefetch_corners(i + CORNERS_AHEAD);
                         // Setup reads the vertices and the sidedness alone.
                         let (v, two_sided) = scene.triangles.geometry(i);
                         let t = Triangle { v, n: [Vec3::ZERO; 3], uv: [Vec2::ZERO; 3], material: 0, object: 0, two_sided };

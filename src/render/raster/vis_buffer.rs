@@ -25,8 +25,9 @@ use crate::math::{Radiance, Ray, Vec3};
 use crate::render::debug::{cost_color, View};
 use crate::render::pixel_record::{CsgABufferRecord, FragmentRecord, NoRecord, PixelTrace, Recorder};
 use crate::render::{miss_without_ray, resolve_counted, resolve_sample, PassJob, RayCounts, SceneQuery};
-use crate::render::path_batch::{self, PathPool};
-use crate::render::shade_batch::{self, Batch};
+use crate::render::path_batch::PathPool;
+use super::shade_queue::ShadeQueue;
+use crate::render::shade_batch;
 use crate::render::shadow_volume::split_depth;
 use super::stencil::{PixelRay, StencilSetup};
 use crate::render::csg::{Boundary, SurfaceRef};
@@ -673,7 +674,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
     fn resolve_batched(&mut self, out: &mut [Radiance], out_stride: usize, x_offset: usize) -> RayCounts {
         let r = self.rect;
         let interpolation = self.job.settings.interpolation;
-        let mut batch = Batch::new();
+        let mut queue = ShadeQueue::new(self.job.prepared.scene.lights.len());
         let mut paths = std::mem::take(&mut self.paths);
         let scene = &self.job.prepared.scene;
         // A triangle seen without textures (the common case) has its hit
@@ -728,17 +729,17 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
                     shaded += 1;
                     if plain && id.kind() == crate::scene::PrimitiveKind::Triangle {
                         let [b1, b2] = self.payload[i];
-                        batch.push_eye_triangle(id.index(), (b1, b2), self.job.sample_position(x, y), self.job.pixel_index(x, y), self.job.sample, slot);
-                        if batch.is_full() {
-                            self.shade_batch_into(&mut batch, &mut paths, out);
+                        queue.batch().push_eye_triangle(id.index(), (b1, b2), self.job.sample_position(x, y), self.job.pixel_index(x, y), self.job.sample, slot);
+                        if queue.advance() {
+                            queue.flush(self.job, self.query, &mut paths, &mut self.counts, out);
                         }
                         continue;
                     }
                     match self.eye_hit(i, x, y) {
                         (ray, Some(hit)) => {
-                            batch.push(interpolation, &hit, ray.dir, self.job.pixel_index(x, y), self.job.sample, slot);
-                            if batch.is_full() {
-                                self.shade_batch_into(&mut batch, &mut paths, out);
+                            queue.batch().push(interpolation, &hit, ray.dir, self.job.pixel_index(x, y), self.job.sample, slot);
+                            if queue.advance() {
+                                queue.flush(self.job, self.query, &mut paths, &mut self.counts, out);
                             }
                         }
                         (_, None) => out[slot] = self.shade(i, x, y),
@@ -746,7 +747,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
                 }
             }
         }
-        self.shade_batch_into(&mut batch, &mut paths, out);
+        queue.flush(self.job, self.query, &mut paths, &mut self.counts, out);
         paths.follow_into(self.job, self.query, &mut self.counts, out);
         self.paths = paths;
         self.counts.primary += primary;
@@ -754,27 +755,6 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         std::mem::take(&mut self.counts)
     }
 
-    /// Shades the batch's samples into their slots of `out` and empties it.
-    /// With `--gi path` the samples' paths wait in `paths`, to be followed
-    /// with those of the next batches once it holds `PATH_SAMPLES`.
-    fn shade_batch_into(&mut self, batch: &mut Batch, paths: &mut PathPool<'a>, out: &mut [Radiance]) {
-        if batch.is_empty() {
-            return;
-        }
-        batch.build_pending(&self.job.prepared.scene, self.job.view, self.job.settings.interpolation);
-        if path_batch::takes(self.job) {
-            shade_batch::start_paths(self.job, self.query, batch, None, &batch.slots[..batch.len()], &mut self.counts, paths);
-            if paths.len() >= PATH_SAMPLES {
-                paths.follow_into(self.job, self.query, &mut self.counts, out);
-            }
-        } else {
-            let values = shade_batch::shade_batch(self.job, self.query, batch, None, &mut self.counts);
-            for (j, value) in values.iter().enumerate().take(batch.len()) {
-                out[batch.slots[j]] = *value;
-            }
-        }
-        batch.clear();
-    }
 
     /// Empties the buffers for another region (the next tile of a row, the
     /// next band of a rayon job). Depth keys must be -1/z (a ray-parameter
@@ -808,7 +788,3 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
     }
 }
 
-/// Samples a region gathers before following their paths together
-/// (`PathPool`): as many as a ray caster's tile, which keeps the lanes about
-/// as full.
-const PATH_SAMPLES: usize = 64;

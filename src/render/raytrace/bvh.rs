@@ -24,6 +24,7 @@
 use super::intersect::TriangleEdges;
 use super::traverse::{slab_test8, test_leaf, test_triangle_leaf, BestHit, ChildOrder, PreparedRay};
 use crate::math::lanes::{mask_bits, simd_level, V3};
+use crate::math::prefetch::{prefetch, prefetch_lines};
 use fearless_simd::{f32x8, Simd, SimdBase};
 use crate::math::Ray;
 use fearless_simd::dispatch;
@@ -115,29 +116,6 @@ fn leaf_word(first: u32, count: u32) -> u32 {
 pub(super) fn leaf_range(word: u32) -> (usize, usize) {
     let first = ((word & !LEAF_BIT) >> 3) as usize;
     (first, first + (word & 7) as usize + 1)
-}
-
-/// Asks the cache for the `lines` lines of 64 bytes from `p`: a hint that
-/// never faults, whatever the address, and changes no result.
-#[inline(always)]
-fn prefetch_lines(p: *const u8, lines: usize) {
-    #[cfg(target_arch = "x86_64")]
-    for line in 0..lines {
-        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-        // SAFETY: a prefetch never faults, whatever the address.
-        unsafe { _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(64 * line).cast()) };
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = (p, lines);
-}
-
-/// Asks the cache for the lines holding `bytes` bytes from `p`, which need
-/// not start a line (as `prefetch_lines`).
-#[inline(always)]
-fn prefetch(p: *const u8, bytes: usize) {
-    prefetch_lines(p, bytes.div_ceil(64));
-    // The last byte's line, when `p` does not start a line.
-    prefetch_lines(p.wrapping_add(bytes - 1), 1);
 }
 
 impl Bvh {
@@ -573,6 +551,10 @@ impl SceneQuery for BvhQuery<'_> {
         }
         let best = self.traverse_flat_at::<S, false, NoRecord>(simd, ray, t_max, inside, counts, &mut NoRecord)?;
         Some(self.batch_hit(&best, ray))
+    }
+
+    fn bvh_packets(&self) -> Option<&BvhQuery<'_>> {
+        (self.flat_only && !self.prepared.bvh.deep).then_some(self)
     }
 
     fn occluder<R: Recorder>(&self, ray: &Ray, t_max: f32, counts: &mut RayCounts, rec: &mut R) -> Option<Occluder> {

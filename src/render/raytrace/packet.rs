@@ -32,7 +32,7 @@ use crate::render::debug::View;
 use crate::render::pixel_record::NoRecord;
 use crate::render::path_batch::{self, PathPool};
 use crate::render::shade_batch::{self, Batch};
-use crate::render::{miss_without_ray, resolve_sample, Occluder, PassJob, RayCounts, ShadowMode};
+use crate::render::{miss_without_ray, resolve_sample, Occluder, PassJob, RayCounts, RenderSettings, ShadowMode};
 use crate::scene::hit_lanes::{HitLanes, TriangleHitInput, HIT_LANES};
 use crate::scene::{CameraView, PrimitiveId, PrimitiveKind, Sphere, SurfaceHit};
 use fearless_simd::{dispatch, f32x8, mask32x8, Select, Simd, SimdBase, SimdFloat, SimdFrom};
@@ -564,6 +564,37 @@ fn test_leaf_packet<S: Simd, const ANY: bool>(
     }
 }
 
+/// The shadow rays `shade()` casts from the surfaces of `batches` (hits
+/// built) towards each light, traced as one packet per light: lane j of
+/// batch b goes into packet lane `lane(b, j)`, and that bit of
+/// `blocked[light]` is set when its ray meets something before the light,
+/// exactly when the single ray's `occluder` would (see `occluded_packet`).
+/// What `shade_batch` and `start_paths` then take as their `blocked`.
+pub fn shadow_packets(query: &BvhQuery, settings: &RenderSettings, batches: &[Batch], lane: impl Fn(usize, usize) -> usize, pk: &mut Packet, blocked: &mut [u64], counts: &mut RayCounts) {
+    let scene = &query.prepared.scene;
+    for (k, light) in scene.lights.iter().enumerate() {
+        let mut cast = 0u64;
+        for (b, batch) in batches.iter().enumerate() {
+            batch.shadow_rays(scene, light, settings.shadow_bump, settings.terminator_lift, |j, ray, t_max| {
+                let i = lane(b, j);
+                pk.rays[i] = ray;
+                pk.t_max[i] = t_max;
+                cast |= 1 << i;
+            });
+        }
+        blocked[k] = 0;
+        if cast != 0 {
+            query.occluded_packet(pk, cast, counts);
+            let mut m = cast;
+            while m != 0 {
+                let i = m.trailing_zeros() as usize;
+                m &= m - 1;
+                blocked[k] |= (pk.occluder(i).is_some() as u64) << i;
+            }
+        }
+    }
+}
+
 /// `cast_pass` for the BVH: the same pixels, eye rays traced a tile at a
 /// time; where frames are shaded in batches, the tile's shadow rays go as
 /// one packet per light and its surfaces are shaded eight at a time
@@ -921,27 +952,7 @@ fn shade_tile_batched<'p, const PASSES: bool>(
     }
     let shadows = settings.shadows == ShadowMode::Ray;
     if shadows {
-        for (k, light) in scene.lights.iter().enumerate() {
-            let mut cast = 0u64;
-            for batch in batches.iter() {
-                batch.shadow_rays(scene, light, settings.shadow_bump, settings.terminator_lift, |j, ray, t_max| {
-                    let i = batch.slots[j];
-                    shadow_pk.rays[i] = ray;
-                    shadow_pk.t_max[i] = t_max;
-                    cast |= 1 << i;
-                });
-            }
-            blocked[k] = 0;
-            if cast != 0 {
-                query.occluded_packet(shadow_pk, cast, counts);
-                let mut m = cast;
-                while m != 0 {
-                    let i = m.trailing_zeros() as usize;
-                    m &= m - 1;
-                    blocked[k] |= (shadow_pk.occluder(i).is_some() as u64) << i;
-                }
-            }
-        }
+        shadow_packets(query, settings, batches, |b, j| batches[b].slots[j], shadow_pk, blocked, counts);
     }
     if path_batch::takes(first) {
         // The paths wait for those of the next tiles, to be followed

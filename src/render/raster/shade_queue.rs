@@ -1,0 +1,214 @@
+//! A band's visible samples waiting to be shaded: up to eight batches of
+//! eight (`shade_batch::Batch`). With `--shadows ray` the queued surfaces'
+//! shadow rays are traced as one packet per light before the batches are
+//! shaded, as the ray caster does for its tiles: neighbouring samples'
+//! rays towards a light walk the BVH together instead of one by one. The
+//! packet answers whether each ray is blocked exactly as the single ray
+//! would, so the image is the same.
+
+use crate::math::Radiance;
+use crate::render::path_batch::{self, PathPool};
+use crate::render::raytrace::packet::{shadow_packets, Packet};
+use crate::render::shade_batch::{self, Batch, LANES};
+use crate::render::{PassJob, RayCounts, SceneQuery, ShadowMode};
+
+/// Batches queued before their shadow packets are traced: eight batches of
+/// eight lanes fill a packet's 64 rays.
+const BATCHES: usize = 8;
+
+/// Samples gathered before their paths are followed together (`PathPool`):
+/// as many as a ray caster's tile, which keeps the lanes about as full.
+pub const PATH_SAMPLES: usize = 64;
+
+pub struct ShadeQueue {
+    batches: Vec<Batch>,
+    /// The batch new samples go into; those before it are full.
+    current: usize,
+    shadow_pk: Box<Packet>,
+    /// Per light, the queue's blocked lanes (bit 8 b + j: lane j of batch b).
+    queue_blocked: Vec<u64>,
+    /// Per light, one batch's blocked lanes, as `shade_batch` takes them.
+    batch_blocked: Vec<u8>,
+}
+
+impl ShadeQueue {
+    pub fn new(lights: usize) -> ShadeQueue {
+        ShadeQueue {
+            batches: (0..BATCHES).map(|_| Batch::new()).collect(),
+            current: 0,
+            shadow_pk: Packet::new(),
+            queue_blocked: vec![0; lights],
+            batch_blocked: vec![0; lights],
+        }
+    }
+
+    /// The batch the next sample goes into (never full).
+    pub fn batch(&mut self) -> &mut Batch {
+        &mut self.batches[self.current]
+    }
+
+    /// Call after each sample put in `batch()`: moves on when that batch is
+    /// full, and returns whether the whole queue is (then `flush` it).
+    pub fn advance(&mut self) -> bool {
+        if self.batches[self.current].is_full() {
+            self.current += 1;
+        }
+        self.current == BATCHES
+    }
+
+    /// Shades every queued sample into `out` at its slot (with `--gi
+    /// path`, puts it into `paths`, followed once they are `PATH_SAMPLES`)
+    /// and empties the queue.
+    pub fn flush<'p, Q: SceneQuery>(&mut self, job: &PassJob<'p>, query: &Q, paths: &mut PathPool<'p>, counts: &mut RayCounts, out: &mut [Radiance]) {
+        let queued = if self.current < BATCHES && !self.batches[self.current].is_empty() { self.current + 1 } else { self.current };
+        self.current = 0;
+        if queued == 0 {
+            return;
+        }
+        let batches = &mut self.batches[..queued];
+        for batch in batches.iter_mut() {
+            batch.build_pending(&job.prepared.scene, job.view, job.settings.interpolation);
+        }
+        let packets = if job.settings.shadows == ShadowMode::Ray { query.bvh_packets() } else { None };
+        if let Some(bvh) = packets {
+            shadow_packets(bvh, job.settings, batches, |b, j| LANES * b + j, &mut self.shadow_pk, &mut self.queue_blocked, counts);
+        }
+        for (b, batch) in batches.iter_mut().enumerate() {
+            for (bits, queue_bits) in self.batch_blocked.iter_mut().zip(&self.queue_blocked) {
+                *bits = (queue_bits >> (LANES * b)) as u8;
+            }
+            // Without packets the lanes' rays are cast one by one in shading.
+            let blocked = packets.is_some().then_some(&self.batch_blocked[..]);
+            if path_batch::takes(job) {
+                shade_batch::start_paths(job, query, batch, blocked, &batch.slots[..batch.len()], counts, paths);
+                if paths.len() >= PATH_SAMPLES {
+                    paths.follow_into(job, query, counts, out);
+                }
+            } else {
+                let values = shade_batch::shade_batch(job, query, batch, blocked, counts);
+                for (j, value) in values.iter().enumerate().take(batch.len()) {
+                    out[batch.slots[j]] = *value;
+                }
+            }
+            batch.clear();
+        }
+    }
+}
+
+const _: () = assert!(BATCHES * LANES <= 64 && LANES == 8, "a queue's lanes fill one shadow packet, eight bits per batch");
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::gi::GiMode;
+    use crate::render::pixel_record::NoRecord;
+    use crate::render::raytrace::bvh::BvhQuery;
+    use crate::render::{resolve_sample, Interpolation, PreparedScene, RenderSettings};
+    use crate::scene::builtin;
+    use std::sync::atomic::AtomicBool;
+
+    /// Every visible sample of every built-in scene put through the queue
+    /// (its shadow rays traced as packets, its paths followed by the pool)
+    /// comes out as `resolve_sample` shades it alone, bit for bit.
+    #[test]
+    fn queued_samples_equal_one_sample_shading() {
+        let mut compared = 0;
+        for name in builtin::names() {
+            let prepared = PreparedScene::new(builtin::load_builtin(name).unwrap().unwrap());
+            let query = BvhQuery::new(&prepared);
+            let (w, h) = (37u32, 23u32);
+            let view = prepared.scene.camera.view(w, h);
+            let cancel = AtomicBool::new(false);
+            for (shadows, gi) in [(ShadowMode::Ray, GiMode::None), (ShadowMode::Ray, GiMode::Path), (ShadowMode::None, GiMode::None)] {
+                let mut settings = RenderSettings { interpolation: Interpolation::Phong, shadows, spp: 2, ..RenderSettings::for_scene(&prepared.scene) };
+                settings.gi.mode = gi;
+                let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: glam::Vec2::splat(0.5), sample: 1, photons: None, active: None, rows: 0..h, cancel: &cancel };
+                let mut queue = ShadeQueue::new(prepared.scene.lights.len());
+                let mut paths = PathPool::new();
+                let mut out = vec![Radiance::splat(-1.0); (w * h) as usize];
+                let mut expected = vec![None; (w * h) as usize];
+                for (x, y) in (0..h).flat_map(|y| (0..w).map(move |x| (x, y))) {
+                    let p = job.sample_position(x, y);
+                    let ray = view.eye_ray(p.x, p.y);
+                    let Some(hit) = query.closest(&ray, view.far_t(p.x, p.y), false, &mut RayCounts::default(), &mut NoRecord) else { continue };
+                    let pixel = job.pixel_index(x, y);
+                    expected[pixel as usize] = Some(resolve_sample(&job, &query, &ray, Some(&hit), pixel, &mut RayCounts::default(), &mut NoRecord));
+                    queue.batch().push(settings.interpolation, &hit, ray.dir, pixel, job.sample, pixel as usize);
+                    if queue.advance() {
+                        queue.flush(&job, &query, &mut paths, &mut RayCounts::default(), &mut out);
+                    }
+                }
+                queue.flush(&job, &query, &mut paths, &mut RayCounts::default(), &mut out);
+                paths.follow_into(&job, &query, &mut RayCounts::default(), &mut out);
+                for (i, e) in expected.iter().enumerate() {
+                    if let Some(e) = e {
+                        assert_eq!(out[i].to_array().map(f32::to_bits), e.to_array().map(f32::to_bits), "{name} {shadows:?} {gi:?} pixel {i}");
+                        compared += 1;
+                    }
+                }
+            }
+        }
+        assert!(compared > 5000, "only {compared} samples compared");
+    }
+
+    /// `shadow_packets` sets lane j of batch b's bit exactly where the
+    /// single shadow ray of that lane finds an occluder, for batches of
+    /// every length, on scenes with shadows falling on their floors.
+    #[test]
+    fn packet_shadow_bits_are_the_single_rays_answers() {
+        let mut blocked_seen = 0;
+        for name in ["bunny", "spheres", "cornell-gi", "teapot"] {
+            let prepared = PreparedScene::new(builtin::load_builtin(name).unwrap().unwrap());
+            let query = BvhQuery::new(&prepared);
+            let bvh = query.bvh_packets().expect("a flat scene traces packets");
+            let settings = RenderSettings { shadows: ShadowMode::Ray, ..RenderSettings::for_scene(&prepared.scene) };
+            let (w, h) = (64u32, 48u32);
+            let view = prepared.scene.camera.view(w, h);
+            let scene = &prepared.scene;
+            let mut batches: Vec<Batch> = (0..BATCHES).map(|_| Batch::new()).collect();
+            let mut pk = Packet::new();
+            let mut blocked = vec![0u64; scene.lights.len()];
+            let mut b = 0;
+            let mut check = |batches: &mut Vec<Batch>, used: usize| {
+                for batch in batches[..used].iter_mut() {
+                    batch.build_pending(scene, &view, settings.interpolation);
+                }
+                shadow_packets(bvh, &settings, &batches[..used], |b, j| LANES * b + j, &mut pk, &mut blocked, &mut RayCounts::default());
+                for (k, light) in scene.lights.iter().enumerate() {
+                    let mut expected = 0u64;
+                    for (b, batch) in batches[..used].iter().enumerate() {
+                        batch.shadow_rays(scene, light, settings.shadow_bump, settings.terminator_lift, |j, ray, t_max| {
+                            let hit = query.occluder(&ray, t_max, &mut RayCounts::default(), &mut NoRecord).is_some();
+                            expected |= (hit as u64) << (LANES * b + j);
+                        });
+                    }
+                    assert_eq!(blocked[k], expected, "{name} light {k}");
+                    blocked_seen += expected.count_ones();
+                }
+                for batch in batches.iter_mut() {
+                    batch.clear();
+                }
+            };
+            let mut n = 0usize;
+            for (x, y) in (0..h).flat_map(|y| (0..w).map(move |x| (x, y))) {
+                let p = glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+                let ray = view.eye_ray(p.x, p.y);
+                let Some(hit) = query.closest(&ray, view.far_t(p.x, p.y), false, &mut RayCounts::default(), &mut NoRecord) else { continue };
+                batches[b].push(settings.interpolation, &hit, ray.dir, 0, 0, 0);
+                n += 1;
+                // Batches of one to eight lanes: move on after a length
+                // that cycles through them.
+                if batches[b].len() == 1 + n % LANES || batches[b].is_full() {
+                    b += 1;
+                    if b == BATCHES {
+                        check(&mut batches, b);
+                        b = 0;
+                    }
+                }
+            }
+            let used = b + usize::from(!batches[b].is_empty());
+            check(&mut batches, used);
+        }
+        assert!(blocked_seen > 500, "only {blocked_seen} blocked shadow rays");
+    }
+}
