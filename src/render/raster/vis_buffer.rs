@@ -755,7 +755,6 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         std::mem::take(&mut self.counts)
     }
 
-
     /// Empties the buffers for another region (the next tile of a row, the
     /// next band of a rayon job). Depth keys must be -1/z (a ray-parameter
     /// buffer is cleared per pixel when made).
@@ -787,4 +786,3 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         }
     }
 }
-
