@@ -237,6 +237,9 @@ pub fn setup_pass_map<T: Send>(job: &PassJob, keep: impl Fn(ScreenTri) -> Option
     let spans = super::cull::visible_spans(job).spans;
     let chunks = chunks_of(scene, &spans, CHUNK);
     let frustum = (job.settings.clip == ClipMode::Frustum).then(|| side_planes(view));
+    // A band of the image (the viewer renders a pass band by band) skips
+    // the set-up of triangles that lie wholly above or below it.
+    let banded = job.rows.start > 0 || job.rows.end < view.height;
     let pieces: Vec<Vec<T>> = chunks
         .into_par_iter()
         .map(|chunk| {
@@ -249,6 +252,9 @@ pub fn setup_pass_map<T: Send>(job: &PassJob, keep: impl Fn(ScreenTri) -> Option
                         scene.triangles.prefetch_corners(i + CORNERS_AHEAD);
                         // Setup reads the vertices and the sidedness alone.
                         let (v, two_sided) = scene.triangles.geometry(i);
+                        if banded && misses_rows(view, &v, &job.rows) {
+                            continue;
+                        }
                         let t = Triangle { v, n: [Vec3::ZERO; 3], uv: [Vec2::ZERO; 3], material: 0, object: 0, two_sided };
                         setup_triangle_clipped(view, &t, i as u32, job.offset, near_clip, frustum.as_ref(), &mut out);
                     }
@@ -260,6 +266,9 @@ pub fn setup_pass_map<T: Send>(job: &PassJob, keep: impl Fn(ScreenTri) -> Option
                     for local in chunk.range {
                         // Setup reads the vertices and the sidedness alone.
                         let (v, two_sided) = layer.world_vertices(inst, local);
+                        if banded && misses_rows(view, &v, &job.rows) {
+                            continue;
+                        }
                         let t = Triangle { v, n: [Vec3::ZERO; 3], uv: [Vec2::ZERO; 3], material: 0, object: 0, two_sided };
                         setup_triangle_clipped(view, &t, inst.base + local as u32, job.offset, near_clip, frustum.as_ref(), &mut out);
                     }
@@ -279,6 +288,26 @@ pub fn setup_pass_map<T: Send>(job: &PassJob, keep: impl Fn(ScreenTri) -> Option
         all.extend(p);
     }
     all
+}
+
+/// Whether the triangle with corners `v` certainly covers no sample of
+/// pixel rows `rows`: every corner in front of the near plane (no clipping
+/// to come) and all of them projected more than two pixels above the first
+/// row or below the last. Only a triangle whose pixel box misses the rows,
+/// which the set-up would drop, is dropped here; one it keeps may still
+/// miss them.
+#[inline]
+fn misses_rows(view: &CameraView, v: &[Vec3; 3], rows: &std::ops::Range<u32>) -> bool {
+    let c = v.map(|v| view.to_camera(v));
+    if c.iter().any(|c| !(-c.z >= view.near)) {
+        return false;
+    }
+    let y = c.map(|c| view.project_camera(c).y);
+    if !y.iter().all(|y| y.is_finite()) {
+        return false;
+    }
+    let (lo, hi) = (y[0].min(y[1]).min(y[2]), y[0].max(y[1]).max(y[2]));
+    hi < rows.start as f32 - 2.0 || lo > rows.end as f32 + 2.0
 }
 
 /// A run of triangles set up together: indices into `Scene::triangles`, or
