@@ -18,7 +18,7 @@ const BATCHES: usize = 8;
 
 /// Samples gathered before their paths are followed together (`PathPool`):
 /// as many as a ray caster's tile, which keeps the lanes about as full.
-pub const PATH_SAMPLES: usize = 64;
+const PATH_SAMPLES: usize = 64;
 
 pub struct ShadeQueue {
     batches: Vec<Batch>,

@@ -135,6 +135,10 @@ pub struct VisBuffer<'j, 'a, Q: SceneQuery, R: FragmentRecorder = NoRecord> {
     /// together; kept with the buffer (empty between regions) so that its
     /// buffers grow once, not in every region.
     paths: PathPool<'a>,
+    /// The visible samples waiting to be shaded (`resolve_batched`): kept
+    /// with the buffer (empty between regions), made at the first region
+    /// that shades in batches rather than in every region or tile.
+    queue: Option<ShadeQueue>,
 }
 
 impl<'j, 'a, Q: SceneQuery> VisBuffer<'j, 'a, Q, NoRecord> {
@@ -187,6 +191,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             stencil: Vec::new(),
             stencil_lights: 0,
             paths: PathPool::new(),
+            queue: None,
         }
     }
 
@@ -674,7 +679,8 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
     fn resolve_batched(&mut self, out: &mut [Radiance], out_stride: usize, x_offset: usize) -> RayCounts {
         let r = self.rect;
         let interpolation = self.job.settings.interpolation;
-        let mut queue = ShadeQueue::new(self.job.prepared.scene.lights.len());
+        let lights = self.job.prepared.scene.lights.len();
+        let mut queue = self.queue.take().unwrap_or_else(|| ShadeQueue::new(lights));
         let mut paths = std::mem::take(&mut self.paths);
         let scene = &self.job.prepared.scene;
         // A triangle seen without textures (the common case) has its hit
@@ -750,6 +756,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         queue.flush(self.job, self.query, &mut paths, &mut self.counts, out);
         paths.follow_into(self.job, self.query, &mut self.counts, out);
         self.paths = paths;
+        self.queue = Some(queue);
         self.counts.primary += primary;
         self.counts.fragments_shaded += shaded;
         std::mem::take(&mut self.counts)
