@@ -378,13 +378,16 @@ impl Accumulator {
             .par_chunks_mut(chunk)
             .zip(self.sum_sq.par_chunks_mut(chunk))
             .enumerate()
-            .map(|(k, (sum, sum_sq))| {
+            // One pass buffer per rayon job, not per chunk: a fresh one of
+            // this size is mapped memory whose every page faults in.
+            .map_init(Vec::new, |pass_buffers, (k, (sum, sum_sq))| {
                 let rows = k as u32 * chunk_rows..((k as u32 + 1) * chunk_rows).min(height);
                 // Up to `passes_at_once` passes rendered in one call (a ray
                 // caster traces a pixel's samples of them together), then
                 // added in pass order.
                 let group = renderer.passes_at_once().clamp(1, spp) as usize;
-                let mut pass_buffers = vec![Radiance::ZERO; group * sum.len()];
+                pass_buffers.clear();
+                pass_buffers.resize(group * sum.len(), Radiance::ZERO);
                 let mut counts = RayCounts::default();
                 for first in (0..spp).step_by(group) {
                     if cancel.load(Ordering::Relaxed) {

@@ -474,19 +474,30 @@ fn slab_test_rays8<S: Simd>(simd: S, p: &[f32x8<S>; 6], pk: &Packet, start: usiz
     slab_test8(p, &origin, &inv, t_far)
 }
 
-/// The least lane of `v`, in two halving steps. (With a NaN lane the
-/// answer is unspecified; the traversal's lanes hold none: far ends are
-/// finite or infinite, entries of boxes hit are not NaN, and a bound taken
-/// over a NaN only culls less.)
+/// The least lane of `v`: the lanes' halves compared pairwise, then the
+/// quarters, then the last two, each step taking `a < b ? a : b` as the
+/// SIMD minimum does (so the answer is `reduce_min`'s, bit for bit). Written
+/// out on the lanes because `reduce_min` is not inlined into the
+/// traversal: three calls per child box. (With a NaN lane the answer is
+/// unspecified; the traversal's lanes hold none: far ends are finite or
+/// infinite, entries of boxes hit are not NaN, and a bound taken over a
+/// NaN only culls less.)
 #[inline(always)]
 fn horizontal_min<S: Simd>(v: f32x8<S>) -> f32 {
-    v.reduce_min()
+    reduce_lanes(v.into(), |a, b| if a < b { a } else { b })
 }
 
-/// The greatest lane of `v` (as `horizontal_min`).
+/// The greatest lane of `v` (as `horizontal_min`, with `a > b ? a : b`).
 #[inline(always)]
 fn horizontal_max<S: Simd>(v: f32x8<S>) -> f32 {
-    v.reduce_max()
+    reduce_lanes(v.into(), |a, b| if a > b { a } else { b })
+}
+
+/// `pick` over eight lanes in `reduce_min`'s order: halves, quarters, pair.
+#[inline(always)]
+fn reduce_lanes(l: [f32; 8], pick: impl Fn(f32, f32) -> f32) -> f32 {
+    let h = [pick(l[0], l[4]), pick(l[1], l[5]), pick(l[2], l[6]), pick(l[3], l[7])];
+    pick(pick(h[0], h[2]), pick(h[1], h[3]))
 }
 
 /// The leaf loop of `traverse::test_leaf` for the rays of `mask`, each
