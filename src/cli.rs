@@ -552,11 +552,14 @@ fn cmd_bench(scene_arg: &str, opts: &RenderOpts, frames: u32) -> Result<(), Stri
     let mut times = Vec::new();
     let mut first_ms = 0.0;
     let mut counts = RayCounts::default();
+    // Each frame renders over the one before's pixels, as a viewer redraws
+    // its image (`render_frame_reusing`).
+    let mut spare = Vec::new();
     for i in 0..=frames {
         let start = Instant::now();
         let frame = l
             .pool
-            .install(|| render::render_frame(l.renderer.as_ref(), &l.prepared, &l.settings, &cancel, None))
+            .install(|| render::render_frame_reusing(l.renderer.as_ref(), &l.prepared, &l.settings, &cancel, std::mem::take(&mut spare)))
             .ok_or("the render was cancelled")?;
         let ms = start.elapsed().as_secs_f64() * 1e3;
         if i > 0 {
@@ -565,6 +568,7 @@ fn cmd_bench(scene_arg: &str, opts: &RenderOpts, frames: u32) -> Result<(), Stri
         } else {
             first_ms = ms;
         }
+        spare = frame.pixels;
     }
     times.sort_by(f64::total_cmp);
     let median = times[times.len() / 2];

@@ -47,11 +47,32 @@ pub fn render_frame_in_bands(
     bands: u32,
     rows_done: Option<&AtomicU64>,
 ) -> Option<FrameResult> {
+    render_frame_over(renderer, prepared, settings, cancel, passes_done, bands, rows_done, Vec::new())
+}
+
+/// `render_frame` into `spare`'s storage where it fits
+/// (`Accumulator::reusing`): what a caller that renders frame after frame
+/// (`pinhole bench`) hands back from the frame before.
+pub fn render_frame_reusing(renderer: &dyn Renderer, prepared: &PreparedScene, settings: &RenderSettings, cancel: &AtomicBool, spare: Vec<Radiance>) -> Option<FrameResult> {
+    render_frame_over(renderer, prepared, settings, cancel, None, 1, None, spare)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn render_frame_over(
+    renderer: &dyn Renderer,
+    prepared: &PreparedScene,
+    settings: &RenderSettings,
+    cancel: &AtomicBool,
+    passes_done: Option<&AtomicU32>,
+    bands: u32,
+    rows_done: Option<&AtomicU64>,
+    spare: Vec<Radiance>,
+) -> Option<FrameResult> {
     // Sub-sampling interpolates shaded images; debug views show every pixel.
     if settings.subsample.is_on() && settings.view == super::debug::View::Shaded {
         return subsample::render_subsampled(renderer, prepared, settings, cancel, passes_done);
     }
-    let mut frame = Accumulator::new(settings);
+    let mut frame = Accumulator::reusing(settings, spare);
     // Without a count of passes to report, a renderer that renders a few
     // rows as cheaply as many takes the frame chunk by chunk.
     if let (None, Some(rows)) = (passes_done, renderer.chunk_rows())

@@ -30,7 +30,7 @@ pub mod pixel_record;
 pub mod pixel_report;
 pub mod wireframe;
 
-pub use frame::{render_frame, render_frame_in_bands, replay_pixel, FrameResult, PixelReplay};
+pub use frame::{render_frame, render_frame_in_bands, render_frame_reusing, replay_pixel, FrameResult, PixelReplay};
 pub use prepared::PreparedScene;
 
 use crate::math::{Radiance, Ray, Vec2};
