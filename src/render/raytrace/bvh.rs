@@ -272,13 +272,6 @@ struct ArrayStack {
     len: usize,
 }
 
-impl ArrayStack {
-    #[inline(always)]
-    fn new() -> ArrayStack {
-        ArrayStack { items: [const { std::mem::MaybeUninit::uninit() }; STACK], len: 0 }
-    }
-}
-
 impl Stack for ArrayStack {
     #[inline(always)]
     fn push(&mut self, word: u32, t: f32) {
@@ -397,7 +390,8 @@ impl<'a> BvhQuery<'a> {
         if self.prepared.bvh.deep {
             self.traverse_with::<_, ANY, R, _>(simd, ray, t_max, inside, counts, rec, &mut Vec::new())
         } else {
-            self.traverse_with::<_, ANY, R, _>(simd, ray, t_max, inside, counts, rec, &mut ArrayStack::new())
+            let mut stack = ArrayStack { items: [const { std::mem::MaybeUninit::uninit() }; STACK], len: 0 };
+            self.traverse_with::<_, ANY, R, _>(simd, ray, t_max, inside, counts, rec, &mut stack)
         }
     }
 
@@ -415,138 +409,8 @@ impl<'a> BvhQuery<'a> {
         rec: &mut R,
         stack: &mut St,
     ) -> Option<BestHit> {
-        let mut walk = Walk::new(simd, self.prepared.bvh.root, ray, t_max, inside);
-        // The ray in every lane, for leaves of several triangles tested at
-        // once by closest-hit queries (`test_triangle_leaf`); replays
-        // record each test, one by one.
-        let lanes_leaves = !ANY && !R::ENABLED && self.prepared.scene.spheres.is_empty();
-        let (mut visits, mut tests) = (0u64, 0u64);
-        while self.walk_step::<S, ANY, R, St>(simd, &mut walk, stack, lanes_leaves, &mut visits, &mut tests, rec) {}
-        counts.nodes += visits;
-        counts.tests += tests;
-        (!walk.best.id.is_none()).then_some(walk.best)
-    }
-
-    /// One node of a walk: the node `walk.word` names is tested (its
-    /// children's boxes, or its leaf's primitives) and `walk.word` moved to
-    /// the next node to visit, the nearest child entered or the next entry
-    /// of `stack` that may still hold something nearer. Returns false when
-    /// the walk is over (nothing left, or `ANY` found a hit).
-    #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
-    fn walk_step<S: Simd, const ANY: bool, R: Recorder, St: Stack>(
-        &self,
-        simd: S,
-        walk: &mut Walk<S>,
-        stack: &mut St,
-        lanes_leaves: bool,
-        visits: &mut u64,
-        tests: &mut u64,
-        rec: &mut R,
-    ) -> bool {
         let bvh = &self.prepared.bvh;
-        let word = walk.word;
-        *visits += 1;
-        if R::ENABLED {
-            rec.node_visit(word);
-        }
-        if word & LEAF_BIT == 0 {
-            let node = &bvh.nodes[word as usize];
-            let (mask, tn) = slab8_lanes(simd, node, &walk.origin, &walk.inv, walk.best.t);
-            if mask != 0 {
-                if mask & (mask - 1) == 0 {
-                    // One child (the most common case): it is read at
-                    // once, so asking the cache for it first gains nothing.
-                    walk.word = node.child[mask.trailing_zeros() as usize];
-                    return true;
-                }
-                // Ask for every child the ray enters now: the walk is a
-                // chain of dependent loads that miss the cache, and the
-                // bookkeeping below can hide part of the next one.
-                let mut m = mask;
-                while m != 0 {
-                    bvh.prefetch_child(node.child[m.trailing_zeros() as usize]);
-                    m &= m - 1;
-                }
-                let tn: [f32; 8] = tn.into();
-                if mask.count_ones() == 2 {
-                    // The common case without the sort. On equal entry
-                    // distances it takes the lower slot first, where
-                    // `ChildOrder` would take the later one: either order
-                    // finds the same hit (the leaf tie rule; only a ray
-                    // almost in a triangle's plane, whose hit wanders out
-                    // of the triangle's box, can tell them apart), and this
-                    // one is kept because pixel replays record the visit order.
-                    let (i, j) = (mask.trailing_zeros() as usize, 31 - mask.leading_zeros() as usize);
-                    let (near, far) = if tn[i] <= tn[j] { (i, j) } else { (j, i) };
-                    stack.push(node.child[far], tn[far]);
-                    walk.word = node.child[near];
-                    return true;
-                }
-                let mut order = ChildOrder::new();
-                let mut m = mask;
-                while m != 0 {
-                    let i = m.trailing_zeros() as usize;
-                    m &= m - 1;
-                    order.insert(node.child[i], tn[i]);
-                }
-                if let Some((nearest, farther)) = order.nearest_and_farther() {
-                    for &(w, t) in farther {
-                        stack.push(w, t);
-                    }
-                    walk.word = nearest;
-                    return true;
-                }
-            }
-        } else {
-            let (start, end) = leaf_range(word);
-            let best = &mut walk.best;
-            // Shadow rays (`ANY`) never start inside a sphere they may hit.
-            let before = best.id;
-            let prims = &bvh.prims[start..end];
-            let stop = if lanes_leaves && prims.len() >= 2 {
-                test_triangle_leaf(simd, prims, walk.ray_origin, walk.ray_dir, best, tests);
-                false
-            } else {
-                test_leaf::<ANY, R>(prims, &self.prepared.scene.spheres, &walk.ray, walk.inside && !ANY, best, tests, rec)
-            };
-            if stop {
-                return false;
-            }
-            if !ANY && best.id != before {
-                // The hit record will read this triangle: start its load
-                // while the walk goes on.
-                self.prefetch_triangle(best.id);
-            }
-        }
-        // Pop the next node that may still hold something nearer.
-        while let Some((next, t_enter)) = stack.pop() {
-            if t_enter <= walk.best.t {
-                walk.word = next;
-                return true;
-            }
-        }
-        false
-    }
-}
-
-/// A walk under way: the ray, prepared for the box tests (each component
-/// in every lane) and the leaf tests, the best hit so far and the node to
-/// visit next. Its stack is kept beside it.
-struct Walk<S: Simd> {
-    origin: [f32x8<S>; 3],
-    inv: [f32x8<S>; 3],
-    ray_origin: V3<f32x8<S>>,
-    ray_dir: V3<f32x8<S>>,
-    ray: Ray,
-    inside: bool,
-    best: BestHit,
-    word: u32,
-}
-
-impl<S: Simd> Walk<S> {
-    #[inline(always)]
-    fn new(simd: S, root: u32, ray: &Ray, t_max: f32, inside: bool) -> Walk<S> {
+        let spheres = &self.prepared.scene.spheres;
         let r = PreparedRay::new(ray);
         // No separate test of the root's box: the root node's test of its
         // children's boxes (inside it) rejects a ray that misses the scene
@@ -554,8 +418,101 @@ impl<S: Simd> Walk<S> {
         // starting on a surface) start inside it.
         let origin = [f32x8::splat(simd, r.origin[0].x), f32x8::splat(simd, r.origin[1].x), f32x8::splat(simd, r.origin[2].x)];
         let inv = [f32x8::splat(simd, r.inv[0].x), f32x8::splat(simd, r.inv[1].x), f32x8::splat(simd, r.inv[2].x)];
-        let ray_dir = V3::new(f32x8::splat(simd, ray.dir.x), f32x8::splat(simd, ray.dir.y), f32x8::splat(simd, ray.dir.z));
-        Walk { origin, inv, ray_origin: V3::new(origin[0], origin[1], origin[2]), ray_dir, ray: *ray, inside, best: BestHit::nothing_before(t_max), word: root }
+        // The ray in every lane, for leaves of several triangles tested at
+        // once by closest-hit queries (`test_triangle_leaf`); replays
+        // record each test, one by one.
+        let lanes_leaves = !ANY && !R::ENABLED && spheres.is_empty();
+        let (ray_origin, ray_dir) = (V3::new(origin[0], origin[1], origin[2]), V3::new(f32x8::splat(simd, ray.dir.x), f32x8::splat(simd, ray.dir.y), f32x8::splat(simd, ray.dir.z)));
+        let mut best = BestHit::nothing_before(t_max);
+        let mut word = bvh.root;
+        let (mut visits, mut tests) = (0u64, 0u64);
+        'walk: loop {
+            visits += 1;
+            if R::ENABLED {
+                rec.node_visit(word);
+            }
+            if word & LEAF_BIT == 0 {
+                let node = &bvh.nodes[word as usize];
+                let (mask, tn) = slab8_lanes(simd, node, &origin, &inv, best.t);
+                if mask != 0 {
+                    if mask & (mask - 1) == 0 {
+                        // One child (the most common case): it is read at
+                        // once, so asking the cache for it first gains nothing.
+                        word = node.child[mask.trailing_zeros() as usize];
+                        continue 'walk;
+                    }
+                    // Ask for every child the ray enters now: the walk is a
+                    // chain of dependent loads that miss the cache, and the
+                    // bookkeeping below can hide part of the next one.
+                    let mut m = mask;
+                    while m != 0 {
+                        bvh.prefetch_child(node.child[m.trailing_zeros() as usize]);
+                        m &= m - 1;
+                    }
+                    let tn: [f32; 8] = tn.into();
+                    if mask.count_ones() == 2 {
+                        // The common case without the sort. On equal entry
+                        // distances it takes the lower slot first, where
+                        // `ChildOrder` would take the later one: either order
+                        // finds the same hit (the leaf tie rule; only a ray
+                        // almost in a triangle's plane, whose hit wanders out
+                        // of the triangle's box, can tell them apart), and this
+                        // one is kept because pixel replays record the visit order.
+                        let (i, j) = (mask.trailing_zeros() as usize, 31 - mask.leading_zeros() as usize);
+                        let (near, far) = if tn[i] <= tn[j] { (i, j) } else { (j, i) };
+                        stack.push(node.child[far], tn[far]);
+                        word = node.child[near];
+                        continue 'walk;
+                    }
+                    let mut order = ChildOrder::new();
+                    let mut m = mask;
+                    while m != 0 {
+                        let i = m.trailing_zeros() as usize;
+                        m &= m - 1;
+                        order.insert(node.child[i], tn[i]);
+                    }
+                    if let Some((nearest, farther)) = order.nearest_and_farther() {
+                        for &(w, t) in farther {
+                            stack.push(w, t);
+                        }
+                        word = nearest;
+                        continue 'walk;
+                    }
+                }
+            } else {
+                let (start, end) = leaf_range(word);
+                // Shadow rays (`ANY`) never start inside a sphere they may hit.
+                let before = best.id;
+                let prims = &bvh.prims[start..end];
+                let stop = if lanes_leaves && prims.len() >= 2 {
+                    test_triangle_leaf(simd, prims, ray_origin, ray_dir, &mut best, &mut tests);
+                    false
+                } else {
+                    test_leaf::<ANY, R>(prims, spheres, ray, inside && !ANY, &mut best, &mut tests, rec)
+                };
+                if stop {
+                    counts.nodes += visits;
+                    counts.tests += tests;
+                    return Some(best);
+                }
+                if !ANY && best.id != before {
+                    // The hit record will read this triangle: start its load
+                    // while the walk goes on.
+                    self.prefetch_triangle(best.id);
+                }
+            }
+            // Pop the next node that may still hold something nearer.
+            while let Some((next, t_enter)) = stack.pop() {
+                if t_enter <= best.t {
+                    word = next;
+                    continue 'walk;
+                }
+            }
+            break;
+        }
+        counts.nodes += visits;
+        counts.tests += tests;
+        (!best.id.is_none()).then_some(best)
     }
 }
 
