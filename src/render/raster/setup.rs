@@ -202,7 +202,17 @@ pub fn setup_triangle_clipped(view: &CameraView, t: &Triangle, index: u32, off: 
         },
         None => None,
     };
-    for piece in clip_near(triangle_vertices(c), view.near).as_slice() {
+    // Wholly in front of the near plane (nearly every triangle): the clip
+    // would hand back the triangle itself, so it is not run.
+    let whole = [triangle_vertices(c)];
+    let clipped;
+    let pieces = if c.iter().all(|c| -c.z >= view.near) {
+        &whole[..]
+    } else {
+        clipped = clip_near(whole[0], view.near);
+        clipped.as_slice()
+    };
+    for piece in pieces {
         let p = piece.map(|v| view.project_camera(v.pos));
         let inv_z = piece.map(|v| 1.0 / -v.pos.z);
         let bz = [piece[0].bary * inv_z[0], piece[1].bary * inv_z[1], piece[2].bary * inv_z[2]];
@@ -227,7 +237,7 @@ pub fn setup_pass(job: &PassJob) -> Vec<ScreenTri> {
 
 /// `setup_pass`, each piece passed through `keep` as it is made, so that a
 /// variant that converts the pieces (fixed point) never holds both lists.
-pub fn setup_pass_map<T: Send>(job: &PassJob, keep: impl Fn(ScreenTri) -> Option<T> + Sync) -> Vec<T> {
+pub fn setup_pass_map<T: Copy + Send + Sync>(job: &PassJob, keep: impl Fn(ScreenTri) -> Option<T> + Sync) -> Vec<T> {
     /// How many triangles ahead the set-up asks for the corners it will read.
     const CORNERS_AHEAD: usize = 8;
     const CHUNK: usize = 4096;
@@ -275,18 +285,35 @@ pub fn setup_pass_map<T: Send>(job: &PassJob, keep: impl Fn(ScreenTri) -> Option
                 }
             }
             // Drop pieces outside the rows of this job.
-            // Held until the runs are joined: exactly as long as needed.
             let mut kept = Vec::with_capacity(out.len());
             kept.extend(out.into_iter().filter(|st| !st.bbox.intersect(&rows).is_empty()).filter_map(&keep));
-            kept.shrink_to_fit();
             kept
         })
         .collect();
-    // Each run's pieces are freed as they are moved: one copy at a time.
-    let mut all = Vec::with_capacity(pieces.iter().map(Vec::len).sum());
-    for p in pieces {
-        all.extend(p);
+    join_runs(pieces)
+}
+
+/// The runs' pieces in one array, in run order. Each run is copied by the
+/// thread that takes it: a frame's fixed-point pieces are about 250 bytes
+/// each, and one thread copying them all held up the other.
+fn join_runs<T: Copy + Send + Sync>(runs: Vec<Vec<T>>) -> Vec<T> {
+    let total = runs.iter().map(Vec::len).sum();
+    let mut all: Vec<T> = Vec::with_capacity(total);
+    let mut rest = &mut all.spare_capacity_mut()[..total];
+    let mut places = Vec::with_capacity(runs.len());
+    for run in &runs {
+        let (place, after) = rest.split_at_mut(run.len());
+        places.push(place);
+        rest = after;
     }
+    runs.par_iter().zip(places).for_each(|(run, place)| {
+        // SAFETY: `place` is `run.len()` uninitialised slots of `all`,
+        // disjoint from every other run's; `T: Copy`, so `run` still owns
+        // (and frees) its values.
+        unsafe { std::ptr::copy_nonoverlapping(run.as_ptr(), place.as_mut_ptr().cast::<T>(), run.len()) }
+    });
+    // SAFETY: the places cover the first `total` slots, all written above.
+    unsafe { all.set_len(total) };
     all
 }
 
