@@ -148,6 +148,11 @@ impl FixedTri {
 /// dropped when degenerate after snapping (`FixedTri::new_or_small`). The
 /// list `fixed`, `tiled` and the painter draw.
 pub fn setup_snapped_or_small(job: &crate::render::PassJob, sample_off: Vec2, width: u32, height: u32) -> Vec<FixedTri> {
+    setup_snapped_or_small_runs(job, sample_off, width, height).joined()
+}
+
+/// `setup_snapped_or_small`, run by run as the threads made them.
+pub fn setup_snapped_or_small_runs(job: &crate::render::PassJob, sample_off: Vec2, width: u32, height: u32) -> super::runs::Runs<FixedTri> {
     let off = snap_offset(sample_off);
     super::setup::setup_pass_map(job, |st| FixedTri::new_or_small(&st, off, sample_off, width, height))
 }

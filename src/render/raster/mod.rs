@@ -38,6 +38,7 @@ pub mod naive;
 pub mod painter;
 pub mod pass;
 pub mod rect;
+pub mod runs;
 pub mod scanline;
 pub mod setup;
 pub mod shade_queue;

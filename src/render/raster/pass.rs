@@ -21,7 +21,8 @@ use super::fixed::{self, FixedTri};
 use super::msaa;
 use super::naive::{ray_test_rect, region_rays};
 use super::rect::PixelRect;
-use super::setup::{bin_rows, setup_pass, ScreenTri};
+use super::runs::Runs;
+use super::setup::{bin_rows, bin_rows_by_id, setup_pass, ScreenTri};
 use super::painter::{self, Paint};
 use super::sphere::{all_sphere_bounds, raster_sphere, raster_spheres};
 use super::stencil::StencilSetup;
@@ -61,8 +62,8 @@ enum Geometry {
     TriangleBoxes { boxes: Vec<(u32, PixelRect)>, bins: Vec<Vec<u32>> },
     /// barycentric, incremental, scanline: screen triangles binned by band.
     FloatTriangles { tris: Vec<ScreenTri>, bins: Vec<Vec<u32>> },
-    /// fixed: fixed-point (snapped) triangles binned by band.
-    FixedTriangles { fts: Vec<FixedTri>, off: [i64; 2], bins: Vec<Vec<u32>> },
+    /// fixed: fixed-point (snapped) triangles binned by band, by id.
+    FixedTriangles { fts: Runs<FixedTri>, off: [i64; 2], bins: Vec<Vec<u32>> },
     /// tiled: fixed-point (snapped) triangles binned by tile, with their whole-tile coverage.
     FixedTriangleTiles { fts: Vec<FixedTri>, off: [i64; 2], bins: Vec<Vec<(u32, RectCoverage)>> },
     /// painter: fixed-point triangles and spheres in draw order, the order binned by band.
@@ -108,8 +109,8 @@ impl<'a> Layer<'a> {
                 Geometry::FloatTriangles { tris, bins }
             }
             Method::Fixed => {
-                let fts = fixed::setup_snapped_or_small(&job, offset, w, h);
-                let bins = bin_rows(fts.iter().map(|f| f.bbox), r0, r1, BAND_ROWS);
+                let fts = fixed::setup_snapped_or_small_runs(&job, offset, w, h);
+                let bins = bin_rows_by_id(fts.with_ids().map(|(id, f)| (id, f.bbox)), r0, r1, BAND_ROWS);
                 Geometry::FixedTriangles { fts, off: snap_offset(offset), bins }
             }
             Method::Tiled => {
@@ -182,9 +183,9 @@ impl<'a> Layer<'a> {
                     // jumps about the array: ask for one a few triangles
                     // ahead while this one is drawn.
                     if let Some(&ahead) = bin.get(k + RECORDS_AHEAD) {
-                        prefetch_value(&fts[ahead as usize]);
+                        prefetch_value(fts.get(ahead));
                     }
-                    let ft = &fts[i as usize];
+                    let ft = fts.get(i);
                     if ft.ray {
                         small::ray_test(vb, ft, rect, &mut tested);
                     } else {

@@ -5,6 +5,7 @@
 
 use super::clip::{clip_frustum, clip_near, side_planes, triangle_vertices, ClipMode, FrustumClip};
 use super::rect::{sample_span, PixelRect};
+use super::runs::Runs;
 use super::subpixel;
 use crate::math::lanes::Lane;
 use crate::math::{Vec2, Vec3};
@@ -232,12 +233,13 @@ pub fn setup_triangle_clipped(view: &CameraView, t: &Triangle, index: u32, off: 
 /// in parallel). Copies made by `instances` whose bounding sphere lies
 /// outside the view volume are skipped whole (`cull::visible_spans`).
 pub fn setup_pass(job: &PassJob) -> Vec<ScreenTri> {
-    setup_pass_map(job, Some)
+    setup_pass_map(job, Some).joined()
 }
 
 /// `setup_pass`, each piece passed through `keep` as it is made, so that a
-/// variant that converts the pieces (fixed point) never holds both lists.
-pub fn setup_pass_map<T: Copy + Send + Sync>(job: &PassJob, keep: impl Fn(ScreenTri) -> Option<T> + Sync) -> Vec<T> {
+/// variant that converts the pieces (fixed point) never holds both lists;
+/// the pieces run by run, as the threads made them.
+pub fn setup_pass_map<T: Copy + Send + Sync>(job: &PassJob, keep: impl Fn(ScreenTri) -> Option<T> + Sync) -> Runs<T> {
     /// How many triangles ahead the set-up asks for the corners it will read.
     const CORNERS_AHEAD: usize = 8;
     const CHUNK: usize = 4096;
@@ -290,31 +292,7 @@ pub fn setup_pass_map<T: Copy + Send + Sync>(job: &PassJob, keep: impl Fn(Screen
             kept
         })
         .collect();
-    join_runs(pieces)
-}
-
-/// The runs' pieces in one array, in run order. Each run is copied by the
-/// thread that takes it: a frame's fixed-point pieces are about 250 bytes
-/// each, and one thread copying them all held up the other.
-fn join_runs<T: Copy + Send + Sync>(runs: Vec<Vec<T>>) -> Vec<T> {
-    let total = runs.iter().map(Vec::len).sum();
-    let mut all: Vec<T> = Vec::with_capacity(total);
-    let mut rest = &mut all.spare_capacity_mut()[..total];
-    let mut places = Vec::with_capacity(runs.len());
-    for run in &runs {
-        let (place, after) = rest.split_at_mut(run.len());
-        places.push(place);
-        rest = after;
-    }
-    runs.par_iter().zip(places).for_each(|(run, place)| {
-        // SAFETY: `place` is `run.len()` uninitialised slots of `all`,
-        // disjoint from every other run's; `T: Copy`, so `run` still owns
-        // (and frees) its values.
-        unsafe { std::ptr::copy_nonoverlapping(run.as_ptr(), place.as_mut_ptr().cast::<T>(), run.len()) }
-    });
-    // SAFETY: the places cover the first `total` slots, all written above.
-    unsafe { all.set_len(total) };
-    all
+    Runs::new(pieces)
 }
 
 /// Whether the triangle with corners `v` certainly covers no sample of
@@ -384,16 +362,21 @@ fn chunks_of(scene: &crate::scene::Scene, spans: &[std::ops::Range<usize>], size
 /// For consecutive bands of `band` rows starting at `rows_start`, the indices
 /// of the rectangles that overlap each band, in order.
 pub fn bin_rows(rects: impl Iterator<Item = PixelRect>, rows_start: u32, rows_end: u32, band: u32) -> Vec<Vec<u32>> {
+    bin_rows_by_id(rects.enumerate().map(|(i, r)| (i as u32, r)), rows_start, rows_end, band)
+}
+
+/// `bin_rows` of pieces named by ids (`Runs`) rather than by place.
+pub fn bin_rows_by_id(rects: impl Iterator<Item = (u32, PixelRect)>, rows_start: u32, rows_end: u32, band: u32) -> Vec<Vec<u32>> {
     let n = (rows_end.saturating_sub(rows_start)).div_ceil(band) as usize;
     let mut bins = vec![Vec::new(); n];
-    for (i, r) in rects.enumerate() {
+    for (i, r) in rects {
         let y0 = r.y0.max(rows_start);
         let y1 = r.y1.min(rows_end);
         if y0 >= y1 || r.x0 >= r.x1 {
             continue;
         }
         for b in (y0 - rows_start) / band..=(y1 - 1 - rows_start) / band {
-            bins[b as usize].push(i as u32);
+            bins[b as usize].push(i);
         }
     }
     bins
