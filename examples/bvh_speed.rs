@@ -140,6 +140,37 @@ fn main() {
             walk_hits = bounce_rays.iter().map(|r| query.closest_for_batch(r, f32::INFINITY, false, &mut counts).is_some() as u64).sum();
         });
         assert_eq!(walk_hits, bounce_hits, "the batch query finds what the closest-hit query finds");
+        // The same rays in packets of 64 consecutive ones, walked together
+        // until 12 or fewer of a packet are in an entry, then alone
+        // (`closest_hybrid`, as path frames trace them). PINHOLE_HYBRID_SWEEP=1
+        // prints other packet sizes and switch points too.
+        let hybrid_time = |size: usize, switch: u32| {
+            let mut pk = Packet::new();
+            let mut hits = 0u64;
+            let t = best_of(reps, || {
+                let mut counts = RayCounts::default();
+                hits = 0;
+                for chunk in bounce_rays.chunks(size) {
+                    for (k, r) in chunk.iter().enumerate() {
+                        pk.rays[k] = *r;
+                        pk.t_max[k] = f32::INFINITY;
+                    }
+                    let valid = u64::MAX >> (64 - chunk.len());
+                    query.closest_hybrid(&mut pk, valid, switch, &mut counts);
+                    hits += pk.hit_count(valid) as u64;
+                }
+            });
+            assert_eq!(hits, bounce_hits, "the hybrid packets find what single rays find");
+            t
+        };
+        let hybrid = hybrid_time(64, 12);
+        if std::env::var("PINHOLE_HYBRID_SWEEP").is_ok() {
+            for size in [8usize, 16, 32, 64] {
+                for switch in [0u32, 1, 2, 4, 8, 12, 16] {
+                    eprintln!("hybrid size={size} switch={switch} ns_per_ray={:.1}", hybrid_time(size, switch) * 1e9 / bounce_rays.len() as f64);
+                }
+            }
+        }
 
         let cancel = AtomicBool::new(false);
         let mut out = vec![Radiance::ZERO; (w * h) as usize];
@@ -157,7 +188,7 @@ fn main() {
         println!(
             "pinhole {} tris={} {}x{} threads={} nodes={} depth={} build_ms={:.1} bare_ms={:.1} bare_mrays_per_s={:.2} hits={} packet_ms={:.1} packet_mrays_per_s={:.2} packet_hits={} \
              depth_view_ms={:.1} depth_view_mrays_per_s={:.2} nodes_per_ray={:.1} tests_per_ray={:.1} \
-             bounce_rays={} bounce_ns_per_ray_1_thread={:.1} bounce_walk_ns_per_ray_1_thread={:.1} bounce_hits={} bounce_nodes_per_ray={:.2} bounce_tests_per_ray={:.2} shaded_ms={:.1} shaded_mrays_per_s={:.2} (primary+shadow)",
+             bounce_rays={} bounce_ns_per_ray_1_thread={:.1} bounce_walk_ns_per_ray_1_thread={:.1} bounce_hybrid_ns_per_ray_1_thread={:.1} bounce_hits={} bounce_nodes_per_ray={:.2} bounce_tests_per_ray={:.2} shaded_ms={:.1} shaded_mrays_per_s={:.2} (primary+shadow)",
             Path::new(&path).file_stem().unwrap().to_string_lossy(),
             prepared.edges.len(),
             w,
@@ -179,6 +210,7 @@ fn main() {
             bounce_rays.len(),
             bounce * 1e9 / bounce_rays.len() as f64,
             walk * 1e9 / bounce_rays.len() as f64,
+            hybrid * 1e9 / bounce_rays.len() as f64,
             bounce_hits,
             bounce_counts.nodes as f64 / bounce_rays.len() as f64,
             bounce_counts.tests as f64 / bounce_rays.len() as f64,

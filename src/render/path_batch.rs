@@ -22,6 +22,7 @@ use super::gi::{self, GiMode, PathState};
 use super::pixel_record::NoRecord;
 use super::shade::{self, Shading};
 use super::shade_batch::{direct_in_lanes, LANES};
+use super::raytrace::packet::{Packet, TILE_H, TILE_W};
 use super::{BatchHit, PassJob, RayCounts, SceneQuery};
 use super::sampling::{luminance, permute, permute_pow2_lanes, Draw2d};
 use crate::math::lanes::{mask_bits, simd_level, Lane, V3};
@@ -78,6 +79,10 @@ pub struct PathPool<'p> {
     /// Per material of the scene, what its bounce needs (`SurfaceKind`),
     /// worked out once instead of per lane and bounce.
     kinds: Vec<SurfaceKind>,
+    /// The current depth's bounce rays, by sample, in the order sampled.
+    rays: Vec<(usize, Ray)>,
+    /// Room for a packet of them (made at the first use of packets).
+    packet: Option<Box<Packet>>,
 }
 
 /// How a path leaves a surface of some material.
@@ -100,7 +105,7 @@ impl Default for PathPool<'_> {
 
 impl<'p> PathPool<'p> {
     pub fn new() -> PathPool<'p> {
-        PathPool { paths: Vec::new(), slots: Vec::new(), beyond: Vec::new(), bounces: Vec::new(), front: Vec::new(), live: 0, next: Vec::new(), kinds: Vec::new() }
+        PathPool { paths: Vec::new(), slots: Vec::new(), beyond: Vec::new(), bounces: Vec::new(), front: Vec::new(), live: 0, next: Vec::new(), kinds: Vec::new(), rays: Vec::new(), packet: None }
     }
 
     /// A pool with room for `samples` samples (and a batch more) and a few
@@ -119,6 +124,8 @@ impl<'p> PathPool<'p> {
             live: 0,
             next: Vec::with_capacity(groups),
             kinds: Vec::new(),
+            rays: Vec::with_capacity(n),
+            packet: None,
         }
     }
 
@@ -169,10 +176,11 @@ impl<'p> PathPool<'p> {
         }
         let mut depth = 0;
         while self.live > 0 {
-            let mut pass = DepthPass { job, query, counts: &mut *counts, paths: &mut self.paths, beyond: &mut self.beyond, bounces: &mut self.bounces, next: &mut self.next, next_len: 0, depth, kinds: &self.kinds };
+            let mut pass = DepthPass { job, query, counts: &mut *counts, paths: &mut self.paths, beyond: &mut self.beyond, bounces: &mut self.bounces, next: &mut self.next, next_len: 0, depth, kinds: &self.kinds, rays: &mut self.rays };
             for group in &self.front[..self.live] {
                 pass.bounce(group);
             }
+            pass.trace(&mut self.packet);
             self.live = pass.next_len.div_ceil(LANES);
             for group in &mut self.next[..self.live] {
                 group.complete(job, query, normal_maps, &mut self.paths, counts);
@@ -208,31 +216,23 @@ struct DepthPass<'w, 'p, 'j, Q> {
     next_len: usize,
     depth: u32,
     kinds: &'w [SurfaceKind],
+    /// The depth's bounce rays so far, by sample (`go_on`), for `trace`.
+    rays: &'w mut Vec<(usize, Ray)>,
 }
 
 impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
     /// The bounce of every path of `group`: `after_direct`'s indirect term
-    /// as `indirect_path` and `follow` take it, the surfaces found put in
-    /// the next depth's groups. Lambertian surfaces sample their bounce
-    /// eight lanes at a time.
+    /// as `indirect_path` and `follow` take it, up to the bounce's ray
+    /// (queued for `trace`). Lambertian surfaces sample their bounce eight
+    /// lanes at a time.
     fn bounce(&mut self, group: &Group) {
-        // One choice of SIMD level for the group: its rays' walks (written
-        // over `Simd`) are then compiled into this loop, not entered ray by ray.
-        dispatch!(simd_level(), simd => self.bounce_at(simd, group))
-    }
-
-    /// `bounce` at SIMD level `simd`.
-    #[inline(always)]
-    fn bounce_at<S: Simd>(&mut self, simd: S, group: &Group) {
-        let mut rays = BounceRays { sample: [0; LANES], ray: [Ray::new(Vec3::ZERO, Vec3::Z); LANES], len: 0 };
-        self.sample_bounces(simd, group, &mut rays);
-        self.trace(simd, &rays);
+        dispatch!(simd_level(), simd => self.sample_bounces(simd, group))
     }
 
     /// The bounce of every path of `group` up to its ray: the paths that
-    /// go on have their ray put in `rays`, for `trace`.
+    /// go on have their ray queued, for `trace`.
     #[inline(always)]
-    fn sample_bounces<S: Simd>(&mut self, simd: S, group: &Group, rays: &mut BounceRays) {
+    fn sample_bounces<S: Simd>(&mut self, simd: S, group: &Group) {
         let scene = &self.job.prepared.scene;
         let settings = self.job.settings;
         // Paths at their last permitted bounce finish in `shade()`'s code.
@@ -272,7 +272,7 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
             let hit = group.hits.get(k);
             let w_o = Vec3::new(group.w_o[0][k], group.w_o[1][k], group.w_o[2][k]);
             match gi::sample_bounce(material, group.albedo[k], &hit, w_o, self.depth, path, &mut NoRecord) {
-                Some((w_i, weight)) => self.go_on(group, k, w_i, weight, rays),
+                Some((w_i, weight)) => self.go_on(group, k, w_i, weight),
                 None => self.beyond[s] = group.direct[k] + Vec3::ZERO,
             }
         }
@@ -296,7 +296,7 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
             let reflects = luminance(albedo).max(0.0) > 0.0 && albedo.is_finite();
             let survival = if reflects && usable & 1 << k != 0 { gi::roulette(self.depth, self.paths[s].throughput * albedo, &mut self.paths[s].rng) } else { None };
             match survival {
-                Some((scale, _)) => self.go_on(group, k, Vec3::new(w_i[0][k], w_i[1][k], w_i[2][k]), albedo * scale, rays),
+                Some((scale, _)) => self.go_on(group, k, Vec3::new(w_i[0][k], w_i[1][k], w_i[2][k]), albedo * scale),
                 None => self.beyond[s] = group.direct[k] + Vec3::ZERO,
             }
         }
@@ -343,9 +343,9 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
     }
 
     /// Lane `k`'s path goes on along `w_i` with `weight`: the bounce is
-    /// kept and its ray put in `rays`, as `follow` and `radiance_along` go on.
+    /// kept and its ray queued, as `follow` and `radiance_along` go on.
     #[inline(always)]
-    fn go_on(&mut self, group: &Group, k: usize, w_i: Vec3, weight: Vec3, rays: &mut BounceRays) {
+    fn go_on(&mut self, group: &Group, k: usize, w_i: Vec3, weight: Vec3) {
         let s = group.sample[k];
         self.bounces.push(Bounce { sample: s, direct: group.direct[k], weight });
         let origin = Vec3::new(group.hits.position[0][k], group.hits.position[1][k], group.hits.position[2][k]);
@@ -354,39 +354,65 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
         let ray = Ray::new(origin + geometric * self.job.settings.shadow_bump, w_i);
         self.paths[s].throughput *= weight;
         self.counts.secondary += 1;
-        (rays.sample[rays.len], rays.ray[rays.len]) = (s, ray);
-        rays.len += 1;
+        self.rays.push((s, ray));
     }
 
-    /// Traces a group's `rays` in order, back to back (a walk between other
-    /// work ran about a tenth slower: the branch history and the cache
-    /// lines it had warmed are gone): the surface each finds is put in the
-    /// next depth's groups, the background noted where it escapes.
-    #[inline(always)]
-    fn trace<S: Simd>(&mut self, simd: S, rays: &BounceRays) {
-        let scene = &self.job.prepared.scene;
-        for (&s, ray) in rays.sample[..rays.len].iter().zip(&rays.ray[..rays.len]) {
-            match self.query.closest_for_batch_at(simd, ray, f32::INFINITY, false, self.counts) {
-                None => self.beyond[s] = scene.miss_radiance(ray.dir),
-                Some(found) => {
-                    let into = slot(self.next, self.next_len / LANES);
-                    if self.next_len.is_multiple_of(LANES) {
-                        into.len = 0;
-                        into.pending_len = 0;
+    /// Traces the depth's queued rays: the surface each finds is put in
+    /// the next depth's groups (in the order the rays were queued), the
+    /// background noted where it escapes. Through the flat tree they go in
+    /// packets (`closest_hybrid`: walked together near the root, where
+    /// many rays of a packet enter the same nodes, then ray by ray; alone,
+    /// these incoherent rays took about a quarter longer); else one by one.
+    fn trace(&mut self, packet: &mut Option<Box<Packet>>) {
+        /// Rays per packet, and how few of them in an entry go on alone:
+        /// the best of 8-64 and 1-16 on the first bounces of `bunny_ground`
+        /// and `cornell_gi` (`examples/bvh_speed.rs`).
+        const PACKET_RAYS: usize = TILE_W * TILE_H;
+        const ALONE: u32 = 12;
+        let rays = std::mem::take(self.rays);
+        match self.query.bvh_packets() {
+            Some(bvh) => {
+                let pk = packet.get_or_insert_with(Packet::new);
+                for chunk in rays.chunks(PACKET_RAYS) {
+                    for (k, (_, ray)) in chunk.iter().enumerate() {
+                        pk.rays[k] = *ray;
+                        pk.t_max[k] = f32::INFINITY;
                     }
-                    into.push(s, found, -ray.dir);
-                    self.next_len += 1;
+                    let valid = u64::MAX >> (64 - chunk.len());
+                    bvh.closest_hybrid(pk, valid, ALONE, self.counts);
+                    for (k, &(s, ray)) in chunk.iter().enumerate() {
+                        self.found(s, &ray, pk.batch_hit(bvh, k));
+                    }
                 }
+            }
+            None => dispatch!(simd_level(), simd => {
+                for &(s, ray) in &rays {
+                    let hit = self.query.closest_for_batch_at(simd, &ray, f32::INFINITY, false, self.counts);
+                    self.found(s, &ray, hit);
+                }
+            }),
+        }
+        *self.rays = rays;
+        self.rays.clear();
+    }
+
+    /// Sample `s`'s bounce ray `ray` found `hit`: it goes in the next
+    /// depth's groups, or the path ends in the background.
+    #[inline(always)]
+    fn found(&mut self, s: usize, ray: &Ray, hit: Option<BatchHit>) {
+        match hit {
+            None => self.beyond[s] = self.job.prepared.scene.miss_radiance(ray.dir),
+            Some(found) => {
+                let into = slot(self.next, self.next_len / LANES);
+                if self.next_len.is_multiple_of(LANES) {
+                    into.len = 0;
+                    into.pending_len = 0;
+                }
+                into.push(s, found, -ray.dir);
+                self.next_len += 1;
             }
         }
     }
-}
-
-/// The rays of a group's paths that go on (`DepthPass::go_on`), by sample.
-struct BounceRays {
-    sample: [usize; LANES],
-    ray: [Ray; LANES],
-    len: usize,
 }
 
 /// `cosine_lobe` at the shading normals of `hits` for the points `u`, eight

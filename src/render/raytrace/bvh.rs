@@ -345,7 +345,7 @@ impl<'a> BvhQuery<'a> {
     /// The hit `closest` makes of `best` along `ray`, a triangle's as what
     /// its record is built from.
     #[inline]
-    fn batch_hit(&self, best: &BestHit, ray: &Ray) -> BatchHit {
+    pub(super) fn batch_hit(&self, best: &BestHit, ray: &Ray) -> BatchHit {
         match best.id.kind() {
             PrimitiveKind::Triangle => BatchHit::Triangle(TriangleHitInput::new(best.id.index(), best.bary, best.t, ray.dir)),
             _ => BatchHit::Record(self.prepared.scene.primitive_hit(best.id, best.t, best.bary.0, best.bary.1, ray)),
@@ -388,11 +388,19 @@ impl<'a> BvhQuery<'a> {
         rec: &mut R,
     ) -> Option<BestHit> {
         if self.prepared.bvh.deep {
-            self.traverse_with::<_, ANY, R, _>(simd, ray, t_max, inside, counts, rec, &mut Vec::new())
+            self.traverse_with::<_, ANY, R, _>(simd, ray, t_max, inside, counts, rec, &mut Vec::new(), None)
         } else {
             let mut stack = ArrayStack { items: [const { std::mem::MaybeUninit::uninit() }; STACK], len: 0 };
-            self.traverse_with::<_, ANY, R, _>(simd, ray, t_max, inside, counts, rec, &mut stack)
+            self.traverse_with::<_, ANY, R, _>(simd, ray, t_max, inside, counts, rec, &mut stack, None)
         }
+    }
+
+    /// A closest-hit walk of `ray` from node `word` on, with `best` found so
+    /// far (the packets' hybrid walk hands its last rays over here).
+    #[inline(always)]
+    pub(super) fn closest_from_at<S: Simd>(&self, simd: S, ray: &Ray, word: u32, best: BestHit, counts: &mut RayCounts) -> BestHit {
+        let mut stack = ArrayStack { items: [const { std::mem::MaybeUninit::uninit() }; STACK], len: 0 };
+        self.traverse_with::<_, false, NoRecord, _>(simd, ray, best.t, false, counts, &mut NoRecord, &mut stack, Some((word, best))).unwrap_or(best)
     }
 
     /// The traversal shared by both queries. `ANY` stops at the first hit.
@@ -408,6 +416,7 @@ impl<'a> BvhQuery<'a> {
         counts: &mut RayCounts,
         rec: &mut R,
         stack: &mut St,
+        from: Option<(u32, BestHit)>,
     ) -> Option<BestHit> {
         let bvh = &self.prepared.bvh;
         let spheres = &self.prepared.scene.spheres;
@@ -423,8 +432,7 @@ impl<'a> BvhQuery<'a> {
         // record each test, one by one.
         let lanes_leaves = !ANY && !R::ENABLED && spheres.is_empty();
         let (ray_origin, ray_dir) = (V3::new(origin[0], origin[1], origin[2]), V3::new(f32x8::splat(simd, ray.dir.x), f32x8::splat(simd, ray.dir.y), f32x8::splat(simd, ray.dir.z)));
-        let mut best = BestHit::nothing_before(t_max);
-        let mut word = bvh.root;
+        let (mut word, mut best) = from.unwrap_or((bvh.root, BestHit::nothing_before(t_max)));
         let (mut visits, mut tests) = (0u64, 0u64);
         'walk: loop {
             visits += 1;

@@ -30,6 +30,7 @@ use crate::math::lanes::{mask_bits, mask_from_bits, simd_level, V3};
 use crate::math::{Radiance, Ray};
 use crate::render::debug::View;
 use crate::render::pixel_record::NoRecord;
+use crate::render::BatchHit;
 use crate::render::path_batch::{self, PathPool};
 use crate::render::shade_batch::{self, Batch};
 use crate::render::{miss_without_ray, resolve_sample, Occluder, PassJob, RayCounts, RenderSettings, ShadowMode};
@@ -232,6 +233,14 @@ impl Packet {
         Some(query.prepared.scene.primitive_hit(id, self.best_t.0[i], b1, b2, &self.rays[i]))
     }
 
+    /// The hit of lane `i` after `closest_packet` or `closest_hybrid`, as
+    /// `closest_for_batch` returns it.
+    #[inline]
+    pub fn batch_hit(&self, query: &BvhQuery, i: usize) -> Option<BatchHit> {
+        let best = BestHit { t: self.best_t.0[i], limit: self.limit[i], id: self.best_id[i], bary: self.bary[i] };
+        (!best.id.is_none()).then(|| query.batch_hit(&best, &self.rays[i]))
+    }
+
     /// `hit` of every lane in `valid`, written into `out`: triangle hits
     /// are built eight at a time (`Scene::triangle_hits`), the others one
     /// by one.
@@ -337,7 +346,14 @@ impl BvhQuery<'_> {
     /// Closest hits of the packet's rays whose bit is set in `valid`. The
     /// tree must not be `deep` (the stack is fixed).
     pub fn closest_packet(&self, pk: &mut Packet, valid: u64, counts: &mut RayCounts) {
-        dispatch!(simd_level(), simd => self.trace_packet::<_, false>(simd, pk, valid, counts));
+        dispatch!(simd_level(), simd => self.trace_packet::<_, false, false>(simd, pk, valid, 0, counts));
+    }
+
+    /// `closest_packet` for incoherent rays: the packet walks together
+    /// while more than `switch` of its rays are in an entry, then each of
+    /// those rays walks the entry's subtree alone.
+    pub fn closest_hybrid(&self, pk: &mut Packet, valid: u64, switch: u32, counts: &mut RayCounts) {
+        dispatch!(simd_level(), simd => self.trace_packet::<_, false, true>(simd, pk, valid, switch, counts));
     }
 
     /// Shadow rays: for each ray in `valid`, whether `occluder` finds
@@ -346,12 +362,12 @@ impl BvhQuery<'_> {
     /// first found); whether there is one cannot: with the far end fixed at
     /// t_max, a ray meets exactly the leaves it meets alone.
     pub fn occluded_packet(&self, pk: &mut Packet, valid: u64, counts: &mut RayCounts) {
-        dispatch!(simd_level(), simd => self.trace_packet::<_, true>(simd, pk, valid, counts));
+        dispatch!(simd_level(), simd => self.trace_packet::<_, true, false>(simd, pk, valid, 0, counts));
     }
 
     /// The packet traversal, compiled for the SIMD level `simd` proves.
     #[inline(always)]
-    fn trace_packet<S: Simd, const ANY: bool>(&self, simd: S, pk: &mut Packet, valid: u64, counts: &mut RayCounts) {
+    fn trace_packet<S: Simd, const ANY: bool, const HYBRID: bool>(&self, simd: S, pk: &mut Packet, valid: u64, switch: u32, counts: &mut RayCounts) {
         let bvh = &self.prepared.bvh;
         debug_assert!(!bvh.deep);
         let spheres = &self.prepared.scene.spheres;
@@ -376,6 +392,17 @@ impl BvhQuery<'_> {
         loop {
             if ANY {
                 mask &= !done;
+            }
+            if HYBRID && !ANY && mask != 0 && mask.count_ones() <= switch {
+                let mut m = mask;
+                while m != 0 {
+                    let i = m.trailing_zeros() as usize;
+                    m &= m - 1;
+                    let best = BestHit { t: pk.best_t.0[i], limit: pk.limit[i], id: pk.best_id[i], bary: pk.bary[i] };
+                    let b = self.closest_from_at(simd, &pk.rays[i], word, best, counts);
+                    (pk.best_t.0[i], pk.limit[i], pk.best_id[i], pk.bary[i]) = (b.t, b.limit, b.id, b.bary);
+                }
+                mask = 0;
             }
             visits += mask.count_ones() as u64;
             if mask == 0 {
@@ -1036,6 +1063,55 @@ mod tests {
                             let single = query.closest(&pk.rays[i], pk.t_max[i], false, &mut RayCounts::default(), &mut NoRecord);
                             assert_eq!(key(&pk.hit(&query, i)), key(&single), "{name}: tile ({x0}, {y0}) lane {i}");
                         }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Incoherent rays (bounces: from each eye hit of a small image, one
+    /// random direction off the surface) in packets, walked together and
+    /// then alone from every switch point (`closest_hybrid`, from never to
+    /// always alone), find what each ray finds alone, bit for bit.
+    #[test]
+    fn hybrid_packets_find_the_single_ray_hits() {
+        use crate::render::sampling::{cosine_hemisphere, from_local, SampleRng};
+        for name in builtin::names() {
+            let prepared = PreparedScene::new(builtin::load_builtin(name).unwrap().unwrap());
+            if prepared.bvh.deep || !prepared.scene.csgs.is_empty() || prepared.instances.is_some() {
+                continue;
+            }
+            let (w, h) = (29u32, 23u32);
+            let view = prepared.scene.camera.view(w, h);
+            let query = BvhQuery::new(&prepared);
+            let mut rays = Vec::new();
+            for y in 0..h {
+                for x in 0..w {
+                    let (px, py) = (x as f32 + 0.5, y as f32 + 0.5);
+                    if let Some(hit) = query.closest(&view.eye_ray(px, py), view.far_t(px, py), false, &mut RayCounts::default(), &mut NoRecord) {
+                        let mut rng = SampleRng::for_index(7, (x + y * w) as u64, 0);
+                        rays.push(hit.spawn_ray_front(from_local(cosine_hemisphere(rng.next_2d()), hit.geometric_normal), 1e-4));
+                    }
+                }
+            }
+            let key = |h: Option<BatchHit>| {
+                h.map(|h| match h {
+                    BatchHit::Triangle(t) => (0, t.index, t.t.to_bits(), t.b.to_array().map(f32::to_bits)),
+                    BatchHit::Record(r) => (1, r.primitive, r.t.to_bits(), r.barycentric.to_array().map(f32::to_bits)),
+                })
+            };
+            let mut pk = Packet::new();
+            for switch in [0, 1, 4, 12, 64] {
+                for chunk in rays.chunks(P) {
+                    for (k, ray) in chunk.iter().enumerate() {
+                        pk.rays[k] = *ray;
+                        pk.t_max[k] = f32::INFINITY;
+                    }
+                    let valid = u64::MAX >> (64 - chunk.len());
+                    query.closest_hybrid(&mut pk, valid, switch, &mut RayCounts::default());
+                    for (k, ray) in chunk.iter().enumerate() {
+                        let single = query.closest_for_batch(ray, f32::INFINITY, false, &mut RayCounts::default());
+                        assert_eq!(key(pk.batch_hit(&query, k)), key(single), "{name}: switch {switch}, ray {k}");
                     }
                 }
             }
