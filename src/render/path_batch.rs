@@ -21,9 +21,9 @@ use super::bsdf_sampling::cosine_lobe;
 use super::gi::{self, GiMode, PathState};
 use super::pixel_record::NoRecord;
 use super::shade::{self, Shading};
-use super::shade_batch::{direct_in_lanes, LANES};
+use super::shade_batch::{direct_in_lanes, shadow_rays_of, LANES};
 use super::raytrace::packet::{Packet, TILE_H, TILE_W};
-use super::{BatchHit, PassJob, RayCounts, SceneQuery};
+use super::{BatchHit, PassJob, RayCounts, SceneQuery, ShadowMode};
 use super::sampling::{luminance, permute, permute_pow2_lanes, Draw2d};
 use crate::math::lanes::{mask_bits, simd_level, Lane, V3};
 use crate::math::{Radiance, Ray, Vec2, Vec3};
@@ -83,6 +83,8 @@ pub struct PathPool<'p> {
     rays: Vec<(usize, Ray)>,
     /// Room for a packet of them (made at the first use of packets).
     packet: Option<Box<Packet>>,
+    /// Per group and light, the lanes whose shadow ray is blocked.
+    blocked: Vec<u8>,
 }
 
 /// How a path leaves a surface of some material.
@@ -105,7 +107,7 @@ impl Default for PathPool<'_> {
 
 impl<'p> PathPool<'p> {
     pub fn new() -> PathPool<'p> {
-        PathPool { paths: Vec::new(), slots: Vec::new(), beyond: Vec::new(), bounces: Vec::new(), front: Vec::new(), live: 0, next: Vec::new(), kinds: Vec::new(), rays: Vec::new(), packet: None }
+        PathPool { paths: Vec::new(), slots: Vec::new(), beyond: Vec::new(), bounces: Vec::new(), front: Vec::new(), live: 0, next: Vec::new(), kinds: Vec::new(), rays: Vec::new(), packet: None, blocked: Vec::new() }
     }
 
     /// A pool with room for `samples` samples (and a batch more) and a few
@@ -126,6 +128,7 @@ impl<'p> PathPool<'p> {
             kinds: Vec::new(),
             rays: Vec::with_capacity(n),
             packet: None,
+            blocked: Vec::new(),
         }
     }
 
@@ -182,8 +185,15 @@ impl<'p> PathPool<'p> {
             }
             pass.trace(&mut self.packet);
             self.live = pass.next_len.div_ceil(LANES);
-            for group in &mut self.next[..self.live] {
-                group.complete(job, query, normal_maps, &mut self.paths, counts);
+            let groups = &mut self.next[..self.live];
+            for group in groups.iter_mut() {
+                group.build(job, normal_maps);
+            }
+            let lights = job.prepared.scene.lights.len();
+            let blocked = shadow_bits(job, query, groups, &mut self.packet, &mut self.blocked, counts);
+            for (g, group) in groups.iter_mut().enumerate() {
+                let bits = blocked.then(|| &self.blocked[g * lights..(g + 1) * lights]);
+                (group.albedo, group.direct) = direct_in_lanes(job, query, &group.hits, &group.w_o, group.len, &mut self.paths, &group.sample, bits, counts);
             }
             std::mem::swap(&mut self.front, &mut self.next);
             depth += 1;
@@ -415,6 +425,52 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
     }
 }
 
+/// The shadow rays of `groups`' surfaces towards every light, traced ahead
+/// in packets through the flat tree (`occluded_hybrid`; these rays leave
+/// scattered surfaces, so the packets go on ray by ray once few share an
+/// entry): `blocked[g * lights + k]` gets the lanes of group g whose ray
+/// towards light k is blocked. False, leaving `direct_in_lanes` to cast
+/// them one by one, where rays are not how the frame finds shadows or
+/// the query has no packets.
+fn shadow_bits<Q: SceneQuery>(job: &PassJob, query: &Q, groups: &[Group], packet: &mut Option<Box<Packet>>, blocked: &mut Vec<u8>, counts: &mut RayCounts) -> bool {
+    const ALONE: u32 = 12;
+    let settings = job.settings;
+    let Some(bvh) = query.bvh_packets().filter(|_| settings.shadows == ShadowMode::Ray) else { return false };
+    let scene = &job.prepared.scene;
+    let lights = scene.lights.len();
+    blocked.clear();
+    blocked.resize(groups.len() * lights, 0);
+    let pk = packet.get_or_insert_with(Packet::new);
+    // Which group, lane and light each packet lane's ray belongs to.
+    let mut owner = [(0usize, 0usize); TILE_W * TILE_H];
+    let mut n = 0;
+    let flush = |pk: &mut Packet, owner: &[(usize, usize)], n: usize, blocked: &mut [u8], counts: &mut RayCounts| {
+        let valid = u64::MAX >> (64 - n);
+        bvh.occluded_hybrid(pk, valid, ALONE, counts);
+        for (i, &(slot, lane)) in owner[..n].iter().enumerate() {
+            blocked[slot] |= (pk.occluder(i).is_some() as u8) << lane;
+        }
+    };
+    for (k, light) in scene.lights.iter().enumerate() {
+        for (g, group) in groups.iter().enumerate() {
+            shadow_rays_of(scene, &group.hits, group.len, light, settings.shadow_bump, settings.terminator_lift, |lane, ray, t_max| {
+                pk.rays[n] = ray;
+                pk.t_max[n] = t_max;
+                owner[n] = (g * lights + k, lane);
+                n += 1;
+                if n == owner.len() {
+                    flush(pk, &owner, n, blocked, counts);
+                    n = 0;
+                }
+            });
+        }
+    }
+    if n > 0 {
+        flush(pk, &owner, n, blocked, counts);
+    }
+    true
+}
+
 /// `cosine_lobe` at the shading normals of `hits` for the points `u`, eight
 /// lanes wide: the directions, and the lanes whose direction is usable and
 /// leaves the geometric surface's front (`sample_bounce`'s test, written
@@ -471,10 +527,10 @@ impl Group {
     }
 
     /// Builds the pending triangles' records (eight at a time), as
-    /// `closest` gives them, completes every record as `radiance_along`
-    /// does (`normal_maps`: whether any material has a normal map), and
-    /// finds their direct light.
-    fn complete<Q: SceneQuery>(&mut self, job: &PassJob, query: &Q, normal_maps: bool, paths: &mut [PathState], counts: &mut RayCounts) {
+    /// `closest` gives them, and completes every record as `radiance_along`
+    /// does (`normal_maps`: whether any material has a normal map); their
+    /// direct light comes next (`follow_into`).
+    fn build(&mut self, job: &PassJob, normal_maps: bool) {
         let scene = &job.prepared.scene;
         let triangles = self.pending_len;
         if triangles == self.len {
@@ -493,6 +549,5 @@ impl Group {
                 self.hits.set(k, &h);
             }
         }
-        (self.albedo, self.direct) = direct_in_lanes(job, query, &self.hits, &self.w_o, self.len, paths, &self.sample, None, counts);
     }
 }

@@ -166,21 +166,8 @@ impl Batch {
     /// `shadow_ray`, eight lanes at a time), each handed to `put` with its
     /// lane and far end: what the packets trace ahead of shading.
     #[inline]
-    pub fn shadow_rays(&self, scene: &Scene, light: &Light, bump: f32, lift: bool, mut put: impl FnMut(usize, Ray, f32)) {
-        if self.len == 0 {
-            return;
-        }
-        let (rays, lit) = dispatch!(simd_level(), simd => {
-            let inc = lighting::incidence(light, V3::from_soa(simd, &self.hits.position), V3::from_soa(simd, &self.hits.shading_normal));
-            (ShadowRays::new(&self.hits, &inc, bump, lift), mask_bits(inc.illuminates()))
-        });
-        let mut m = lit & ((1u32 << self.len) - 1) as u8;
-        while m != 0 {
-            let i = m.trailing_zeros() as usize;
-            m &= m - 1;
-            let (ray, t_max) = rays.get(scene, &self.hits, i);
-            put(i, ray, t_max);
-        }
+    pub fn shadow_rays(&self, scene: &Scene, light: &Light, bump: f32, lift: bool, put: impl FnMut(usize, Ray, f32)) {
+        shadow_rays_of(scene, &self.hits, self.len, light, bump, lift, put);
     }
 
     /// The part of `build_pending` for `push_ray_triangle`'s hits.
@@ -376,6 +363,25 @@ fn direct_light8<S: Simd, Q: SceneQuery>(simd: S, job: &PassJob, inputs: &Surfac
     };
     let start = V3::from_soa(simd, &inputs.ambient);
     lighting::direct_light(&job.prepared.scene.lights, &surface, start, visibility).scatter()
+}
+
+/// `Batch::shadow_rays` for the surfaces in lanes `0..len` of `hits`.
+#[inline]
+pub fn shadow_rays_of(scene: &Scene, hits: &HitLanes, len: usize, light: &Light, bump: f32, lift: bool, mut put: impl FnMut(usize, Ray, f32)) {
+    if len == 0 {
+        return;
+    }
+    let (rays, lit) = dispatch!(simd_level(), simd => {
+        let inc = lighting::incidence(light, V3::from_soa(simd, &hits.position), V3::from_soa(simd, &hits.shading_normal));
+        (ShadowRays::new(hits, &inc, bump, lift), mask_bits(inc.illuminates()))
+    });
+    let mut m = lit & ((1u32 << len) - 1) as u8;
+    while m != 0 {
+        let i = m.trailing_zeros() as usize;
+        m &= m - 1;
+        let (ray, t_max) = rays.get(scene, hits, i);
+        put(i, ray, t_max);
+    }
 }
 
 /// Visibility for a batch: the packet's answers when it traced them, else

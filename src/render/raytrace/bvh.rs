@@ -403,6 +403,14 @@ impl<'a> BvhQuery<'a> {
         self.traverse_with::<_, false, NoRecord, _>(simd, ray, best.t, false, counts, &mut NoRecord, &mut stack, Some((word, best))).unwrap_or(best)
     }
 
+    /// A shadow walk of `ray` up to `t_max` from node `word` on: the first
+    /// occluder found below it, if any.
+    #[inline(always)]
+    pub(super) fn occluder_from_at<S: Simd>(&self, simd: S, ray: &Ray, word: u32, t_max: f32, counts: &mut RayCounts) -> Option<BestHit> {
+        let mut stack = ArrayStack { items: [const { std::mem::MaybeUninit::uninit() }; STACK], len: 0 };
+        self.traverse_with::<_, true, NoRecord, _>(simd, ray, t_max, false, counts, &mut NoRecord, &mut stack, Some((word, BestHit::nothing_before(t_max))))
+    }
+
     /// The traversal shared by both queries. `ANY` stops at the first hit.
     /// Returns the winning primitive's hit.
     #[inline(always)]

@@ -356,6 +356,12 @@ impl BvhQuery<'_> {
         dispatch!(simd_level(), simd => self.trace_packet::<_, false, true>(simd, pk, valid, switch, counts));
     }
 
+    /// `occluded_packet` for incoherent rays, walked together and then
+    /// alone as in `closest_hybrid`.
+    pub fn occluded_hybrid(&self, pk: &mut Packet, valid: u64, switch: u32, counts: &mut RayCounts) {
+        dispatch!(simd_level(), simd => self.trace_packet::<_, true, true>(simd, pk, valid, switch, counts));
+    }
+
     /// Shadow rays: for each ray in `valid`, whether `occluder` finds
     /// something (then `Packet::occluder` is some). Which occluder is
     /// reported may differ from the single-ray query's (both stop at the
@@ -393,14 +399,21 @@ impl BvhQuery<'_> {
             if ANY {
                 mask &= !done;
             }
-            if HYBRID && !ANY && mask != 0 && mask.count_ones() <= switch {
+            if HYBRID && mask != 0 && mask.count_ones() <= switch {
                 let mut m = mask;
                 while m != 0 {
                     let i = m.trailing_zeros() as usize;
                     m &= m - 1;
-                    let best = BestHit { t: pk.best_t.0[i], limit: pk.limit[i], id: pk.best_id[i], bary: pk.bary[i] };
-                    let b = self.closest_from_at(simd, &pk.rays[i], word, best, counts);
-                    (pk.best_t.0[i], pk.limit[i], pk.best_id[i], pk.bary[i]) = (b.t, b.limit, b.id, b.bary);
+                    if ANY {
+                        if let Some(b) = self.occluder_from_at(simd, &pk.rays[i], word, pk.best_t.0[i], counts) {
+                            (pk.best_t.0[i], pk.best_id[i]) = (b.t, b.id);
+                            done |= 1 << i;
+                        }
+                    } else {
+                        let best = BestHit { t: pk.best_t.0[i], limit: pk.limit[i], id: pk.best_id[i], bary: pk.bary[i] };
+                        let b = self.closest_from_at(simd, &pk.rays[i], word, best, counts);
+                        (pk.best_t.0[i], pk.limit[i], pk.best_id[i], pk.bary[i]) = (b.t, b.limit, b.id, b.bary);
+                    }
                 }
                 mask = 0;
             }
@@ -1075,7 +1088,8 @@ mod tests {
     /// Incoherent rays (bounces: from each eye hit of a small image, one
     /// random direction off the surface) in packets, walked together and
     /// then alone from every switch point (`closest_hybrid`, from never to
-    /// always alone), find what each ray finds alone, bit for bit.
+    /// always alone), find what each ray finds alone, bit for bit; as
+    /// shadow rays (`occluded_hybrid`), whether something blocks them.
     #[test]
     fn hybrid_packets_find_the_single_ray_hits() {
         use crate::render::sampling::{cosine_hemisphere, from_local, SampleRng};
@@ -1115,6 +1129,17 @@ mod tests {
                     for (k, ray) in chunk.iter().enumerate() {
                         let single = query.closest_for_batch(ray, f32::INFINITY, false, &mut RayCounts::default());
                         assert_eq!(key(pk.batch_hit(&query, k)), key(single), "{name}: switch {switch}, ray {k}");
+                    }
+                    // As shadow rays, with far ends that cut some of them
+                    // short of what they hit.
+                    for (k, ray) in chunk.iter().enumerate() {
+                        pk.rays[k] = *ray;
+                        pk.t_max[k] = [0.05, 0.5, 5.0][k % 3];
+                    }
+                    query.occluded_hybrid(&mut pk, valid, switch, &mut RayCounts::default());
+                    for (k, ray) in chunk.iter().enumerate() {
+                        let single = query.occluder(ray, pk.t_max[k], &mut RayCounts::default(), &mut NoRecord);
+                        assert_eq!(pk.occluder(k).is_some(), single.is_some(), "{name}: shadow, switch {switch}, ray {k}");
                     }
                 }
             }
