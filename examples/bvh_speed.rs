@@ -144,13 +144,13 @@ fn main() {
         // until 12 or fewer of a packet are in an entry, then alone
         // (`closest_hybrid`, as path frames trace them). PINHOLE_HYBRID_SWEEP=1
         // prints other packet sizes and switch points too.
-        let hybrid_time = |size: usize, switch: u32| {
+        let hybrid_time = |rays: &[pinhole::math::Ray], size: usize, switch: u32| {
             let mut pk = Packet::new();
             let mut hits = 0u64;
             let t = best_of(reps, || {
                 let mut counts = RayCounts::default();
                 hits = 0;
-                for chunk in bounce_rays.chunks(size) {
+                for chunk in rays.chunks(size) {
                     for (k, r) in chunk.iter().enumerate() {
                         pk.rays[k] = *r;
                         pk.t_max[k] = f32::INFINITY;
@@ -163,11 +163,11 @@ fn main() {
             assert_eq!(hits, bounce_hits, "the hybrid packets find what single rays find");
             t
         };
-        let hybrid = hybrid_time(64, 12);
+        let hybrid = hybrid_time(&bounce_rays, 64, 12);
         if std::env::var("PINHOLE_HYBRID_SWEEP").is_ok() {
             for size in [8usize, 16, 32, 64] {
                 for switch in [0u32, 1, 2, 4, 8, 12, 16] {
-                    eprintln!("hybrid size={size} switch={switch} ns_per_ray={:.1}", hybrid_time(size, switch) * 1e9 / bounce_rays.len() as f64);
+                    eprintln!("hybrid size={size} switch={switch} ns_per_ray={:.1}", hybrid_time(&bounce_rays, size, switch) * 1e9 / bounce_rays.len() as f64);
                 }
             }
         }
