@@ -4,10 +4,13 @@
 //! level deeper) times the bounce's weight. A `PathPool` follows the paths
 //! of all the samples put in it (a ray caster's band of tiles, a
 //! rasterizer's batches) together, one bounce at a time: the surviving
-//! paths' rays are traced, their hit records built eight at a time and
-//! their direct light computed eight lanes wide, as `shade_batch` does for
-//! the eye's surfaces. The more samples, the fuller the lanes stay as paths
-//! end.
+//! paths' rays are traced (through the flat tree in packets of 64, which
+//! walk together near the root and split into single walks below), their
+//! hit records built eight at a time, their shadow rays traced ahead in
+//! packets too, and their direct light computed eight lanes wide, as
+//! `shade_batch` does for the eye's surfaces. The more samples, the fuller
+//! the lanes and packets stay as paths end. The answers are each single
+//! ray's, bit for bit.
 //!
 //! Each sample gets what the recursion computes for it, bit for bit (pixel
 //! replays run the recursion): the same random draws in the same order,
