@@ -140,9 +140,9 @@ fn main() {
             walk_hits = bounce_rays.iter().map(|r| query.closest_for_batch(r, f32::INFINITY, false, &mut counts).is_some() as u64).sum();
         });
         assert_eq!(walk_hits, bounce_hits, "the batch query finds what the closest-hit query finds");
-        // The same rays in packets of 64 consecutive ones, walked together
-        // until 12 or fewer of a packet are in an entry, then alone
-        // (`closest_hybrid`, as path frames trace them). PINHOLE_HYBRID_SWEEP=1
+        // The same rays in packets of consecutive ones, walked together
+        // until few of a packet are in an entry, then alone (`closest_hybrid`
+        // with the sizes path frames use). PINHOLE_HYBRID_SWEEP=1
         // prints other packet sizes and switch points too.
         let hybrid_time = |rays: &[pinhole::math::Ray], size: usize, switch: u32| {
             let mut pk = Packet::new();
@@ -163,7 +163,7 @@ fn main() {
             assert_eq!(hits, bounce_hits, "the hybrid packets find what single rays find");
             t
         };
-        let hybrid = hybrid_time(&bounce_rays, 64, 12);
+        let hybrid = hybrid_time(&bounce_rays, packet::PACKET_RAYS, packet::HYBRID_ALONE);
         if std::env::var("PINHOLE_HYBRID_SWEEP").is_ok() {
             for size in [8usize, 16, 32, 64] {
                 for switch in [0u32, 1, 2, 4, 8, 12, 16] {

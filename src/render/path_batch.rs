@@ -25,7 +25,7 @@ use super::gi::{self, GiMode, PathState};
 use super::pixel_record::NoRecord;
 use super::shade::{self, Shading};
 use super::shade_batch::{direct_in_lanes, shadow_rays_of, LANES};
-use super::raytrace::packet::{Packet, TILE_H, TILE_W};
+use super::raytrace::packet::{Packet, HYBRID_ALONE, PACKET_RAYS};
 use super::{BatchHit, PassJob, RayCounts, SceneQuery, ShadowMode};
 use super::sampling::{luminance, permute, permute_pow2_lanes, Draw2d};
 use crate::math::lanes::{mask_bits, simd_level, Lane, V3};
@@ -377,12 +377,8 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
     /// many rays of a packet enter the same nodes, then ray by ray; alone,
     /// these incoherent rays took about a quarter longer); else one by one.
     fn trace(&mut self, packet: &mut Option<Box<Packet>>) {
-        /// Rays per packet, and how few of them in an entry go on alone:
-        /// the best of 8-64 and 1-16 on the first bounces of `bunny_ground`
-        /// and `cornell_gi` (`examples/bvh_speed.rs`).
-        const PACKET_RAYS: usize = TILE_W * TILE_H;
-        const ALONE: u32 = 12;
-        let rays = std::mem::take(self.rays);
+        // Taken for the loop (`found` needs `self`), given back emptied.
+        let mut rays = std::mem::take(self.rays);
         match self.query.bvh_packets() {
             Some(bvh) => {
                 let pk = packet.get_or_insert_with(Packet::new);
@@ -392,7 +388,7 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
                         pk.t_max[k] = f32::INFINITY;
                     }
                     let valid = u64::MAX >> (64 - chunk.len());
-                    bvh.closest_hybrid(pk, valid, ALONE, self.counts);
+                    bvh.closest_hybrid(pk, valid, HYBRID_ALONE, self.counts);
                     for (k, &(s, ray)) in chunk.iter().enumerate() {
                         self.found(s, &ray, pk.batch_hit(bvh, k));
                     }
@@ -405,8 +401,8 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
                 }
             }),
         }
+        rays.clear();
         *self.rays = rays;
-        self.rays.clear();
     }
 
     /// Sample `s`'s bounce ray `ray` found `hit`: it goes in the next
@@ -436,7 +432,6 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
 /// them one by one, where rays are not how the frame finds shadows or
 /// the query has no packets.
 fn shadow_bits<Q: SceneQuery>(job: &PassJob, query: &Q, groups: &[Group], packet: &mut Option<Box<Packet>>, blocked: &mut Vec<u8>, counts: &mut RayCounts) -> bool {
-    const ALONE: u32 = 12;
     let settings = job.settings;
     let Some(bvh) = query.bvh_packets().filter(|_| settings.shadows == ShadowMode::Ray) else { return false };
     let scene = &job.prepared.scene;
@@ -445,11 +440,11 @@ fn shadow_bits<Q: SceneQuery>(job: &PassJob, query: &Q, groups: &[Group], packet
     blocked.resize(groups.len() * lights, 0);
     let pk = packet.get_or_insert_with(Packet::new);
     // Which group, lane and light each packet lane's ray belongs to.
-    let mut owner = [(0usize, 0usize); TILE_W * TILE_H];
+    let mut owner = [(0usize, 0usize); PACKET_RAYS];
     let mut n = 0;
     let flush = |pk: &mut Packet, owner: &[(usize, usize)], n: usize, blocked: &mut [u8], counts: &mut RayCounts| {
         let valid = u64::MAX >> (64 - n);
-        bvh.occluded_hybrid(pk, valid, ALONE, counts);
+        bvh.occluded_hybrid(pk, valid, HYBRID_ALONE, counts);
         for (i, &(slot, lane)) in owner[..n].iter().enumerate() {
             blocked[slot] |= (pk.occluder(i).is_some() as u8) << lane;
         }

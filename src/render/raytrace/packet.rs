@@ -237,8 +237,20 @@ impl Packet {
     /// `closest_for_batch` returns it.
     #[inline]
     pub fn batch_hit(&self, query: &BvhQuery, i: usize) -> Option<BatchHit> {
-        let best = BestHit { t: self.best_t.0[i], limit: self.limit[i], id: self.best_id[i], bary: self.bary[i] };
+        let best = self.best(i);
         (!best.id.is_none()).then(|| query.batch_hit(&best, &self.rays[i]))
+    }
+
+    /// Lane `i`'s closest hit so far, as a single ray's walk keeps it.
+    #[inline(always)]
+    fn best(&self, i: usize) -> BestHit {
+        BestHit { t: self.best_t.0[i], limit: self.limit[i], id: self.best_id[i], bary: self.bary[i] }
+    }
+
+    /// Lane `i` takes `best` as its closest hit so far.
+    #[inline(always)]
+    fn set_best(&mut self, i: usize, best: &BestHit) {
+        (self.best_t.0[i], self.limit[i], self.best_id[i], self.bary[i]) = (best.t, best.limit, best.id, best.bary);
     }
 
     /// `hit` of every lane in `valid`, written into `out`: triangle hits
@@ -406,13 +418,12 @@ impl BvhQuery<'_> {
                     m &= m - 1;
                     if ANY {
                         if let Some(b) = self.occluder_from_at(simd, &pk.rays[i], word, pk.best_t.0[i], counts) {
-                            (pk.best_t.0[i], pk.best_id[i]) = (b.t, b.id);
+                            pk.set_best(i, &b);
                             done |= 1 << i;
                         }
                     } else {
-                        let best = BestHit { t: pk.best_t.0[i], limit: pk.limit[i], id: pk.best_id[i], bary: pk.bary[i] };
-                        let b = self.closest_from_at(simd, &pk.rays[i], word, best, counts);
-                        (pk.best_t.0[i], pk.limit[i], pk.best_id[i], pk.bary[i]) = (b.t, b.limit, b.id, b.bary);
+                        let b = self.closest_from_at(simd, &pk.rays[i], word, pk.best(i), counts);
+                        pk.set_best(i, &b);
                     }
                 }
                 mask = 0;
@@ -565,16 +576,13 @@ fn test_leaf_packet<S: Simd, const ANY: bool>(
             while m != 0 {
                 let i = m.trailing_zeros() as usize;
                 m &= m - 1;
-                let mut best = BestHit { t: pk.best_t.0[i], limit: pk.limit[i], id: pk.best_id[i], bary: pk.bary[i] };
+                let mut best = pk.best(i);
                 let mut sphere_tests = 0;
                 if test_leaf::<ANY, _>(std::slice::from_ref(prim), spheres, &pk.rays[i], false, &mut best, &mut sphere_tests, &mut NoRecord) {
                     *done |= 1 << i;
                     active &= !(1 << i);
                 }
-                pk.best_t.0[i] = best.t;
-                pk.limit[i] = best.limit;
-                pk.best_id[i] = best.id;
-                pk.bary[i] = best.bary;
+                pk.set_best(i, &best);
             }
             continue;
         }
@@ -915,6 +923,15 @@ impl<'p> TileContext<'p> {
         }
     }
 }
+
+/// Rays in a packet.
+pub const PACKET_RAYS: usize = P;
+
+/// Where incoherent rays' packets (`closest_hybrid`, `occluded_hybrid`) go
+/// on ray by ray: once this few of a packet's rays share an entry. The best
+/// of 1-16 (with 8-64 rays a packet) on the first bounces of `bunny_ground`
+/// and `cornell_gi` (`examples/bvh_speed.rs`); 8 to 24 are alike in frames.
+pub const HYBRID_ALONE: u32 = 12;
 
 /// Samples a band gathers before following their paths: sixteen tiles.
 /// The more a depth holds, the fuller the bounce rays' packets past the
