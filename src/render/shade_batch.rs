@@ -12,7 +12,7 @@ use super::lighting::{self, IncidenceLanes, LightVisibility, SurfaceLanes};
 use super::pixel_record::NoRecord;
 use super::shade::{self, Incidence, Shading};
 use super::path_batch::PathPool;
-use super::{debug::View, gi::PathState, Interpolation, PassJob, RayCounts, SceneQuery, ShadowMode};
+use super::{debug::View, gi::{GiMode, PathState}, Interpolation, PassJob, RayCounts, SceneQuery, ShadowMode};
 use crate::math::lanes::{mask_bits, mask_from_bits, simd_level, Lane, V3};
 use crate::math::{Radiance, Ray, Vec2, Vec3};
 use crate::scene::hit_lanes::{EyeSamples, Floats, HitLanes, TriangleHitInput};
@@ -117,6 +117,21 @@ impl Batch {
         self.samples[i] = sample;
         self.slots[i] = slot;
         self.len += 1;
+    }
+
+    /// Eight `push_ray_triangle`s at once into an empty batch, their
+    /// records built at once (`Scene::triangle_hits_of_rays`): lane k is
+    /// the hit on triangle `index[k]` with weights `b1[k]`, `b2[k]`, `t[k]`
+    /// along a ray towards `dir`, for sample `samples[k]` of pixel
+    /// `pixels[k]`, meant for `slots[k]`.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    pub fn fill_ray_triangles(&mut self, scene: &Scene, interpolation: Interpolation, index: &[u32; LANES], bary: (&Floats, &Floats), t: &Floats, dir: &[Floats; 3], pixels: [u32; LANES], samples: [u32; LANES], slots: [usize; LANES]) {
+        assert!(self.len == 0, "fill_ray_triangles into a batch that holds samples");
+        place_built(&mut self.hits, LANES, &IN_ORDER, interpolation, |out| scene.triangle_hits_of_rays(index, bary, t, dir, out));
+        self.w_o = dir.map(|a| a.map(|d| -d));
+        (self.pixels, self.samples, self.slots) = (pixels, samples, slots);
+        self.len = LANES;
     }
 
     /// `push` of the hit a rasterizer's eye sample at image position `p`
@@ -314,6 +329,7 @@ pub fn direct_in_lanes<Q: SceneQuery>(
         glossy: [[0.0; LANES]; 3],
         sharpness: [1.0; LANES],
         ambient: [[0.0; LANES]; 3],
+        uniform: None,
     };
     for i in n..LANES {
         for a in 0..3 {
@@ -323,17 +339,29 @@ pub fn direct_in_lanes<Q: SceneQuery>(
         }
     }
     let mut albedo = [Vec3::ZERO; LANES];
-    for i in 0..n {
-        let material = &scene.materials[hits.material[i] as usize];
-        albedo[i] = shade::albedo_at(material, Vec2::new(hits.uv[0][i], hits.uv[1][i]), &hits.diff[i], settings);
-        let mut sh = Shading { scene, query, settings, path: &mut paths[path_of[i]], counts: &mut *counts, rec: &mut NoRecord };
-        let ambient = shade::ambient_term(&mut sh, || hits.get(i), albedo[i]);
-        for (a, (v, g)) in [(albedo[i].x, material.glossy.x), (albedo[i].y, material.glossy.y), (albedo[i].z, material.glossy.z)].into_iter().enumerate() {
-            surface.albedo[a][i] = v;
-            surface.glossy[a][i] = g;
+    let first = &scene.materials[hits.material[0] as usize];
+    if n > 0 && first.texture.is_none() && settings.gi.mode != GiMode::Ao && hits.material[1..n].iter().all(|&m| m == hits.material[0]) {
+        // One untextured material (the common batch): its albedo, lobes and
+        // ambient term are the same in every lane, worked out once and
+        // splatted, rather than written lane by lane and loaded back.
+        let a = shade::albedo_at(first, Vec2::ZERO, &hits.diff[0], settings);
+        let mut sh = Shading { scene, query, settings, path: &mut paths[path_of[0]], counts: &mut *counts, rec: &mut NoRecord };
+        let ambient = shade::ambient_term(&mut sh, || hits.get(0), a);
+        albedo = [a; LANES];
+        surface.uniform = Some(UniformSurface { albedo: a, glossy: first.glossy, sharpness: first.sharpness, ambient });
+    } else {
+        for i in 0..n {
+            let material = &scene.materials[hits.material[i] as usize];
+            albedo[i] = shade::albedo_at(material, Vec2::new(hits.uv[0][i], hits.uv[1][i]), &hits.diff[i], settings);
+            let mut sh = Shading { scene, query, settings, path: &mut paths[path_of[i]], counts: &mut *counts, rec: &mut NoRecord };
+            let ambient = shade::ambient_term(&mut sh, || hits.get(i), albedo[i]);
+            for (a, (v, g)) in [(albedo[i].x, material.glossy.x), (albedo[i].y, material.glossy.y), (albedo[i].z, material.glossy.z)].into_iter().enumerate() {
+                surface.albedo[a][i] = v;
+                surface.glossy[a][i] = g;
+            }
+            (surface.ambient[0][i], surface.ambient[1][i], surface.ambient[2][i]) = (ambient.x, ambient.y, ambient.z);
+            surface.sharpness[i] = material.sharpness;
         }
-        (surface.ambient[0][i], surface.ambient[1][i], surface.ambient[2][i]) = (ambient.x, ambient.y, ambient.z);
-        surface.sharpness[i] = material.sharpness;
     }
     let mut visibility = BatchVisibility { job, query, hits, live: ((1u32 << n) - 1) as u8, blocked, counts: &mut *counts };
     let direct = dispatch!(simd_level(), simd => direct_light8(simd, job, &surface, &mut visibility));
@@ -349,19 +377,33 @@ struct SurfaceArrays {
     glossy: [Floats; 3],
     sharpness: Floats,
     ambient: [Floats; 3],
+    /// When every lane has the same values of the four above: those.
+    uniform: Option<UniformSurface>,
+}
+
+/// A material's values that are the same in every lane of a batch.
+struct UniformSurface {
+    albedo: Vec3,
+    glossy: Vec3,
+    sharpness: f32,
+    ambient: Radiance,
 }
 
 #[inline(always)]
 fn direct_light8<S: Simd, Q: SceneQuery>(simd: S, job: &PassJob, inputs: &SurfaceArrays, visibility: &mut BatchVisibility<Q>) -> [Radiance; LANES] {
+    let like = <f32x8<S> as fearless_simd::SimdBase<S>>::splat(simd, 0.0);
+    let (albedo, glossy, sharpness, start) = match &inputs.uniform {
+        Some(u) => (V3::splat(like, u.albedo), V3::splat(like, u.glossy), like.splat(u.sharpness), V3::splat(like, u.ambient)),
+        None => (V3::from_soa(simd, &inputs.albedo), V3::from_soa(simd, &inputs.glossy), f32x8::simd_from(simd, inputs.sharpness), V3::from_soa(simd, &inputs.ambient)),
+    };
     let surface = SurfaceLanes {
         position: V3::from_soa(simd, &inputs.position),
         normal: V3::from_soa(simd, &inputs.normal),
         w_o: V3::from_soa(simd, &inputs.w_o),
-        albedo: V3::from_soa(simd, &inputs.albedo),
-        glossy: V3::from_soa(simd, &inputs.glossy),
-        sharpness: f32x8::simd_from(simd, inputs.sharpness),
+        albedo,
+        glossy,
+        sharpness,
     };
-    let start = V3::from_soa(simd, &inputs.ambient);
     lighting::direct_light(&job.prepared.scene.lights, &surface, start, visibility).scatter()
 }
 
@@ -502,7 +544,6 @@ mod tests {
     use super::*;
     use crate::render::pixel_record::NoRecord;
     use crate::render::raytrace::bvh::BvhQuery;
-    use crate::render::gi::GiMode;
     use crate::render::{PreparedScene, RenderSettings};
     use crate::scene::builtin;
     use std::sync::atomic::AtomicBool;
@@ -559,5 +600,58 @@ mod tests {
             }
         }
         assert!(compared > 3000, "only {compared} samples compared");
+    }
+
+    /// Eight ray hits filled into a batch at once (`fill_ray_triangles`,
+    /// what the ray caster does for a packet's group of eight triangle
+    /// hits) make the records and the shading that eight
+    /// `push_ray_triangle`s make: on every built-in scene, flat and Phong.
+    #[test]
+    fn filled_batches_equal_pushed_ones() {
+        let mut compared = 0;
+        for name in builtin::names() {
+            let prepared = PreparedScene::new(builtin::load_builtin(name).unwrap().unwrap());
+            let query = BvhQuery::new(&prepared);
+            let scene = &prepared.scene;
+            let (w, h) = (29u32, 19u32);
+            let view = scene.camera.view(w, h);
+            let cancel = AtomicBool::new(false);
+            for interpolation in [Interpolation::Phong, Interpolation::Flat] {
+                let settings = RenderSettings { interpolation, ..RenderSettings::for_scene(scene) };
+                let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: glam::Vec2::new(0.25, 0.75), sample: 3, photons: None, active: None, rows: 0..h, cancel: &cancel };
+                let mut hits = Vec::new();
+                for (x, y) in (0..h).flat_map(|y| (0..w).map(move |x| (x, y))) {
+                    let p = job.sample_position(x, y);
+                    let ray = view.eye_ray(p.x, p.y);
+                    match query.closest(&ray, view.far_t(p.x, p.y), false, &mut RayCounts::default(), &mut NoRecord) {
+                        Some(hit) if hit.kind == PrimitiveKind::Triangle => hits.push((hit, ray, job.pixel_index(x, y))),
+                        _ => continue,
+                    }
+                }
+                for eight in hits.chunks_exact(LANES) {
+                    let mut pushed = Batch::new();
+                    for (slot, (hit, ray, pixel)) in eight.iter().enumerate() {
+                        pushed.push_ray_triangle(TriangleHitInput::new(hit.primitive, (hit.barycentric.y, hit.barycentric.z), hit.t, ray.dir), *pixel, job.sample, slot);
+                    }
+                    pushed.build_pending(scene, &view, interpolation);
+                    let index = std::array::from_fn(|k| eight[k].0.primitive);
+                    let (b1, b2): (Floats, Floats) = (std::array::from_fn(|k| eight[k].0.barycentric.y), std::array::from_fn(|k| eight[k].0.barycentric.z));
+                    let t = std::array::from_fn(|k| eight[k].0.t);
+                    let dir = std::array::from_fn(|a| std::array::from_fn(|k| eight[k].1.dir[a]));
+                    let mut filled = Batch::new();
+                    filled.fill_ray_triangles(scene, interpolation, &index, (&b1, &b2), &t, &dir, std::array::from_fn(|k| eight[k].2), [job.sample; LANES], IN_ORDER);
+                    assert_eq!((filled.len(), filled.slots, filled.pixels), (pushed.len(), pushed.slots, pushed.pixels));
+                    for k in 0..LANES {
+                        let (a, b) = (filled.hit(k), pushed.hit(k));
+                        assert_eq!(format!("{a:?}"), format!("{b:?}"), "{name} {interpolation:?} lane {k}");
+                        assert_eq!(filled.w_o.map(|c| c[k].to_bits()), pushed.w_o.map(|c| c[k].to_bits()));
+                    }
+                    let (a, b) = (shade_batch(&job, &query, &filled, None, &mut RayCounts::default()), shade_batch(&job, &query, &pushed, None, &mut RayCounts::default()));
+                    assert_eq!(a.map(|v| v.to_array().map(f32::to_bits)), b.map(|v| v.to_array().map(f32::to_bits)), "{name} {interpolation:?}");
+                    compared += LANES;
+                }
+            }
+        }
+        assert!(compared > 2000, "only {compared} samples compared");
     }
 }

@@ -202,6 +202,21 @@ impl Scene {
         });
     }
 
+    /// `triangle_hits` for eight ray hits already in lanes (a packet's
+    /// group of eight rays that all found a triangle): triangles `index`,
+    /// weights `b1` and `b2` of their second and third corners, `t` along
+    /// rays towards `dir`. The same records, without packing inputs lane by
+    /// lane.
+    pub fn triangle_hits_of_rays(&self, index: &[u32; HIT_LANES], (b1, b2): (&Floats, &Floats), t: &Floats, dir: &[Floats; 3], out: &mut HitLanes) {
+        out.t = *t;
+        dispatch!(simd_level(), simd => {
+            let (b1, b2) = (f32x8::simd_from(simd, *b1), f32x8::simd_from(simd, *b2));
+            // `TriangleHitInput::new`'s corner weights.
+            let w = [b1.splat(1.0) - b1 - b2, b1, b2];
+            triangle_hits8(simd, self, index, HIT_LANES, w, V3::from_soa(simd, dir), out);
+        });
+    }
+
     /// For each eye sample of `samples`, the record of where its eye ray
     /// (`view.eye_ray`) meets its triangle, as `triangle_hit` builds it with
     /// `t` the hit position's distance along the ray; written to the lane of
