@@ -320,27 +320,18 @@ pub fn direct_in_lanes<Q: SceneQuery>(
     let scene = &job.prepared.scene;
     let settings = job.settings;
     // Lanes past `n` repeat lane 0's geometry (so their arithmetic stays
-    // tame) with a black material; their results are dropped.
-    let mut surface = SurfaceArrays {
-        position: hits.position,
-        normal: hits.shading_normal,
-        w_o: *w_o,
-        albedo: [[0.0; LANES]; 3],
-        glossy: [[0.0; LANES]; 3],
-        sharpness: [1.0; LANES],
-        ambient: [[0.0; LANES]; 3],
-        uniform: None,
+    // tame); their results are dropped. A full batch is read in place.
+    let padded;
+    let geometry = if n == LANES {
+        Geometry { position: &hits.position, normal: &hits.shading_normal, w_o }
+    } else {
+        let pad = |v: &[Floats; 3]| v.map(|c| std::array::from_fn(|i| if i < n { c[i] } else { c[0] }));
+        padded = [pad(&hits.position), pad(&hits.shading_normal), pad(w_o)];
+        Geometry { position: &padded[0], normal: &padded[1], w_o: &padded[2] }
     };
-    for i in n..LANES {
-        for a in 0..3 {
-            surface.position[a][i] = hits.position[a][0];
-            surface.normal[a][i] = hits.shading_normal[a][0];
-            surface.w_o[a][i] = w_o[a][0];
-        }
-    }
     let mut albedo = [Vec3::ZERO; LANES];
     let first = &scene.materials[hits.material[0] as usize];
-    if n > 0 && first.texture.is_none() && settings.gi.mode != GiMode::Ao && hits.material[1..n].iter().all(|&m| m == hits.material[0]) {
+    let materials = if n > 0 && first.texture.is_none() && settings.gi.mode != GiMode::Ao && hits.material[1..n].iter().all(|&m| m == hits.material[0]) {
         // One untextured material (the common batch): its albedo, lobes and
         // ambient term are the same in every lane, worked out once and
         // splatted, rather than written lane by lane and loaded back.
@@ -348,58 +339,56 @@ pub fn direct_in_lanes<Q: SceneQuery>(
         let mut sh = Shading { scene, query, settings, path: &mut paths[path_of[0]], counts: &mut *counts, rec: &mut NoRecord };
         let ambient = shade::ambient_term(&mut sh, || hits.get(0), a);
         albedo = [a; LANES];
-        surface.uniform = Some(UniformSurface { albedo: a, glossy: first.glossy, sharpness: first.sharpness, ambient });
+        MaterialLanes::Uniform { albedo: a, glossy: first.glossy, sharpness: first.sharpness, ambient }
     } else {
+        // Lanes past `n` get a black material.
+        let (mut albedo_lanes, mut glossy, mut sharpness, mut ambient_lanes) = ([[0.0; LANES]; 3], [[0.0; LANES]; 3], [1.0; LANES], [[0.0; LANES]; 3]);
         for i in 0..n {
             let material = &scene.materials[hits.material[i] as usize];
             albedo[i] = shade::albedo_at(material, Vec2::new(hits.uv[0][i], hits.uv[1][i]), &hits.diff[i], settings);
             let mut sh = Shading { scene, query, settings, path: &mut paths[path_of[i]], counts: &mut *counts, rec: &mut NoRecord };
             let ambient = shade::ambient_term(&mut sh, || hits.get(i), albedo[i]);
             for (a, (v, g)) in [(albedo[i].x, material.glossy.x), (albedo[i].y, material.glossy.y), (albedo[i].z, material.glossy.z)].into_iter().enumerate() {
-                surface.albedo[a][i] = v;
-                surface.glossy[a][i] = g;
+                albedo_lanes[a][i] = v;
+                glossy[a][i] = g;
             }
-            (surface.ambient[0][i], surface.ambient[1][i], surface.ambient[2][i]) = (ambient.x, ambient.y, ambient.z);
-            surface.sharpness[i] = material.sharpness;
+            (ambient_lanes[0][i], ambient_lanes[1][i], ambient_lanes[2][i]) = (ambient.x, ambient.y, ambient.z);
+            sharpness[i] = material.sharpness;
         }
-    }
+        MaterialLanes::PerLane { albedo: albedo_lanes, glossy, sharpness, ambient: ambient_lanes }
+    };
     let mut visibility = BatchVisibility { job, query, hits, live: ((1u32 << n) - 1) as u8, blocked, counts: &mut *counts };
-    let direct = dispatch!(simd_level(), simd => direct_light8(simd, job, &surface, &mut visibility));
+    let direct = dispatch!(simd_level(), simd => direct_light8(simd, job, &geometry, &materials, &mut visibility));
     (albedo, direct)
 }
 
-/// What `direct_light8` loads as lanes, one array per coordinate.
-struct SurfaceArrays {
-    position: [Floats; 3],
-    normal: [Floats; 3],
-    w_o: [Floats; 3],
-    albedo: [Floats; 3],
-    glossy: [Floats; 3],
-    sharpness: Floats,
-    ambient: [Floats; 3],
-    /// When every lane has the same values of the four above: those.
-    uniform: Option<UniformSurface>,
+/// Where the surfaces of a batch are and which way they face and are seen,
+/// one array per coordinate.
+struct Geometry<'a> {
+    position: &'a [Floats; 3],
+    normal: &'a [Floats; 3],
+    w_o: &'a [Floats; 3],
 }
 
-/// A material's values that are the same in every lane of a batch.
-struct UniformSurface {
-    albedo: Vec3,
-    glossy: Vec3,
-    sharpness: f32,
-    ambient: Radiance,
+/// A batch's material values as `direct_light8` loads them.
+enum MaterialLanes {
+    /// The same in every lane (one material without a texture).
+    Uniform { albedo: Vec3, glossy: Vec3, sharpness: f32, ambient: Radiance },
+    /// One array per coordinate.
+    PerLane { albedo: [Floats; 3], glossy: [Floats; 3], sharpness: Floats, ambient: [Floats; 3] },
 }
 
 #[inline(always)]
-fn direct_light8<S: Simd, Q: SceneQuery>(simd: S, job: &PassJob, inputs: &SurfaceArrays, visibility: &mut BatchVisibility<Q>) -> [Radiance; LANES] {
+fn direct_light8<S: Simd, Q: SceneQuery>(simd: S, job: &PassJob, geometry: &Geometry, materials: &MaterialLanes, visibility: &mut BatchVisibility<Q>) -> [Radiance; LANES] {
     let like = <f32x8<S> as fearless_simd::SimdBase<S>>::splat(simd, 0.0);
-    let (albedo, glossy, sharpness, start) = match &inputs.uniform {
-        Some(u) => (V3::splat(like, u.albedo), V3::splat(like, u.glossy), like.splat(u.sharpness), V3::splat(like, u.ambient)),
-        None => (V3::from_soa(simd, &inputs.albedo), V3::from_soa(simd, &inputs.glossy), f32x8::simd_from(simd, inputs.sharpness), V3::from_soa(simd, &inputs.ambient)),
+    let (albedo, glossy, sharpness, start) = match materials {
+        MaterialLanes::Uniform { albedo, glossy, sharpness, ambient } => (V3::splat(like, *albedo), V3::splat(like, *glossy), like.splat(*sharpness), V3::splat(like, *ambient)),
+        MaterialLanes::PerLane { albedo, glossy, sharpness, ambient } => (V3::from_soa(simd, albedo), V3::from_soa(simd, glossy), f32x8::simd_from(simd, *sharpness), V3::from_soa(simd, ambient)),
     };
     let surface = SurfaceLanes {
-        position: V3::from_soa(simd, &inputs.position),
-        normal: V3::from_soa(simd, &inputs.normal),
-        w_o: V3::from_soa(simd, &inputs.w_o),
+        position: V3::from_soa(simd, geometry.position),
+        normal: V3::from_soa(simd, geometry.normal),
+        w_o: V3::from_soa(simd, geometry.w_o),
         albedo,
         glossy,
         sharpness,
