@@ -187,6 +187,32 @@ impl Bvh {
         }
     }
 
+    /// Boxes that together hold every primitive: the children of the
+    /// nodes `levels` below the root (or the leaves above them), as the
+    /// nodes store them (so padded as the traversal sees them). For a
+    /// tighter outline of the scene than the root's box.
+    pub fn cut_boxes(&self, levels: u32) -> Vec<Aabb> {
+        if self.prims.is_empty() {
+            return Vec::new();
+        }
+        if self.root & LEAF_BIT != 0 {
+            return vec![self.root_bounds];
+        }
+        let mut boxes = Vec::new();
+        let mut nodes = vec![(self.root, 1)];
+        while let Some((id, level)) = nodes.pop() {
+            let n = &self.nodes[id as usize];
+            for i in (0..8).filter(|i| n.valid & 1 << i != 0) {
+                if level < levels && n.child[i] & LEAF_BIT == 0 {
+                    nodes.push((n.child[i], level + 1));
+                } else {
+                    boxes.push(Aabb { min: Vec3::new(n.planes[0][i], n.planes[2][i], n.planes[4][i]), max: Vec3::new(n.planes[1][i], n.planes[3][i], n.planes[5][i]) });
+                }
+            }
+        }
+        boxes
+    }
+
     pub fn node_content(&self, id: u32) -> NodeContent {
         if id & LEAF_BIT == 0 {
             let n = &self.nodes[id as usize];
