@@ -255,15 +255,23 @@ pub fn shade_batch<Q: SceneQuery>(job: &PassJob, query: &Q, batch: &Batch, block
     let settings = job.settings;
     let n = batch.len;
     let hits = &batch.hits;
-    let mut paths: [PathState; LANES] = std::array::from_fn(|i| {
-        PathState::new(batch.pixels[i], batch.samples[i], settings.spp, &settings.gi, job.photons)
-    });
-    let (albedo, direct) = direct_in_lanes(job, query, hits, &batch.w_o, n, &mut paths, &IN_ORDER, blocked, counts);
+    let path = |i: usize| PathState::new(batch.pixels[i], batch.samples[i], settings.spp, &settings.gi, job.photons);
+    // Without ambient occlusion or traced light, direct light draws no
+    // random numbers: one lane's state serves them all there, and the
+    // lanes that go on (mirror, glass) start theirs below, as fresh as
+    // they would be.
+    let draws = settings.gi.mode != GiMode::None;
+    let mut paths: Option<[PathState; LANES]> = draws.then(|| std::array::from_fn(path));
+    let (albedo, direct) = match paths.as_mut() {
+        Some(paths) => direct_in_lanes(job, query, hits, &batch.w_o, n, paths, &IN_ORDER, blocked, counts),
+        None => direct_in_lanes(job, query, hits, &batch.w_o, n, &mut [path(0)], &[0; LANES], blocked, counts),
+    };
     // A batch of one material (the common case) asks once whether anything
     // comes after direct light (lanes past `n` are dropped by the callers).
     if n > 0 && hits.material[1..n].iter().all(|&m| m == hits.material[0]) && !shade::adds_after_direct(settings, &scene.materials[hits.material[0] as usize]) {
         return direct;
     }
+    let mut paths = paths.unwrap_or_else(|| std::array::from_fn(path));
     let mut out = [Radiance::ZERO; LANES];
     for i in 0..n {
         let material = &scene.materials[hits.material[i] as usize];
