@@ -60,6 +60,13 @@ impl Aabb {
     pub fn contains(&self, o: &Aabb) -> bool {
         self.min.cmple(o.min).all() && self.max.cmpge(o.max).all()
     }
+
+    /// The eight corners; bit 0 of the index picks max x, bit 1 max y,
+    /// bit 2 max z.
+    pub fn corners(&self) -> [Vec3; 8] {
+        let (lo, hi) = (self.min, self.max);
+        std::array::from_fn(|k| Vec3::new(if k & 1 == 0 { lo.x } else { hi.x }, if k & 2 == 0 { lo.y } else { hi.y }, if k & 4 == 0 { lo.z } else { hi.z }))
+    }
 }
 
 /// What a node holds, for the viewer and the debugger.

@@ -79,8 +79,7 @@ impl InstanceAccel {
             inverse.push(m.inverse());
             let b = meshes[inst.mesh as usize].bounds();
             let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-            for k in 0..8 {
-                let c = Vec3::new(if k & 1 == 0 { b.min.x } else { b.max.x }, if k & 2 == 0 { b.min.y } else { b.max.y }, if k & 4 == 0 { b.min.z } else { b.max.z });
+            for c in b.corners() {
                 let w = m.transform_point3(c);
                 lo = lo.min(w);
                 hi = hi.max(w);

@@ -985,8 +985,7 @@ impl SeenTiles {
         let mut seen = vec![false; columns * tile_rows];
         let top = job.rows.start as f32;
         for b in query.prepared.bvh.cut_boxes(levels) {
-            let rect = (0..8).try_fold((f32::INFINITY, f32::NEG_INFINITY, f32::INFINITY, f32::NEG_INFINITY), |r, k| {
-                let corner = Vec3::new(if k & 1 == 0 { b.min.x } else { b.max.x }, if k & 2 == 0 { b.min.y } else { b.max.y }, if k & 4 == 0 { b.min.z } else { b.max.z });
+            let rect = b.corners().into_iter().try_fold((f32::INFINITY, f32::NEG_INFINITY, f32::INFINITY, f32::NEG_INFINITY), |r, corner| {
                 let (p, _) = job.view.project(corner)?;
                 Some((r.0.min(p.x), r.1.max(p.x), r.2.min(p.y), r.3.max(p.y)))
             });
