@@ -329,11 +329,21 @@ impl PacketBounds {
 
     /// The children of `node` (bit mask) that some ray of the packet, with
     /// far end at most `far_max`, may meet: a superset of every ray's own
-    /// slab test's mask. NaNs never cull.
+    /// slab test's mask. NaNs never cull. Also, when `CERTAIN`, the
+    /// children that every ray of the packet meets, each ray's far end
+    /// being at least `far_min` (a subset of the rays' own masks' common
+    /// part: NaNs never certify), and below each child's lane a bound
+    /// under every ray's entry into it.
     #[inline(always)]
-    fn children_possible<S: Simd>(&self, simd: S, node: &Node8, far_max: f32) -> u32 {
+    fn children_bounds<S: Simd, const CERTAIN: bool>(&self, simd: S, node: &Node8, far_max: f32, far_min: f32) -> (u32, u32, f32x8<S>) {
         let mut entry = f32x8::splat(simd, 0.0);
         let mut exit = f32x8::splat(simd, f32::INFINITY);
+        // Bounds above every ray's entry and below every ray's exit: a
+        // ray's entry along an axis is the lesser of its two plane
+        // distances, so at most the lesser of their upper bounds; its exit
+        // the greater, so at least the greater of their lower bounds.
+        let mut entry_hi = f32x8::splat(simd, 0.0);
+        let mut exit_lo = f32x8::splat(simd, f32::INFINITY);
         for a in 0..3 {
             let (p0, p1) = (f32x8::from_slice(simd, &node.planes[2 * a]), f32x8::from_slice(simd, &node.planes[2 * a + 1]));
             let (il, ih) = (f32x8::splat(simd, self.inv_lo[a]), f32x8::splat(simd, self.inv_hi[a]));
@@ -342,15 +352,33 @@ impl PacketBounds {
             let (a1l, a1h) = (p1 - oh, p1 - ol);
             let (q0, q1, q2, q3) = (a0l * il, a0l * ih, a0h * il, a0h * ih);
             let (r0, r1, r2, r3) = (a1l * il, a1l * ih, a1h * il, a1h * ih);
-            let near = q0.min(q1).min(q2.min(q3)).min(r0.min(r1).min(r2.min(r3)));
-            let far = q0.max(q1).max(q2.max(q3)).max(r0.max(r1).max(r2.max(r3)));
-            entry = entry.max(near);
-            exit = exit.min(far);
+            let (q_lo, q_hi) = (q0.min(q1).min(q2.min(q3)), q0.max(q1).max(q2.max(q3)));
+            let (r_lo, r_hi) = (r0.min(r1).min(r2.min(r3)), r0.max(r1).max(r2.max(r3)));
+            entry = entry.max(q_lo.min(r_lo));
+            exit = exit.min(q_hi.max(r_hi));
+            if CERTAIN {
+                entry_hi = entry_hi.max(q_hi.min(r_hi));
+                exit_lo = exit_lo.min(q_lo.max(r_lo));
+            }
         }
         let entry = entry * (1.0 - SLAB_WIDEN);
         let exit = (exit * (1.0 + SLAB_WIDEN)).min(far_max);
         // Culled only where entry > exit is certain (false for NaN).
-        !(mask_bits(entry.simd_gt(exit)) as u32) & node.valid
+        let possible = !(mask_bits(entry.simd_gt(exit)) as u32) & node.valid;
+        if !CERTAIN {
+            return (possible, 0, entry);
+        }
+        let entry_hi = entry_hi * (1.0 - SLAB_WIDEN);
+        let exit_lo = (exit_lo * (1.0 + SLAB_WIDEN)).min(far_min);
+        // Certain only where entry_hi <= exit_lo holds (false for NaN).
+        let certain = mask_bits(entry_hi.simd_le(exit_lo)) as u32 & possible;
+        (possible, certain, entry)
+    }
+
+    /// Whether every bound is finite, so that no product in
+    /// `children_bounds` is a NaN that a min or max would drop.
+    fn finite(&self) -> bool {
+        [self.o_lo, self.o_hi, self.inv_lo, self.inv_hi].iter().all(|v| v.iter().all(|x| x.is_finite()))
     }
 }
 
@@ -401,6 +429,9 @@ impl BvhQuery<'_> {
             return;
         }
         let bounds = PacketBounds::new(simd, pk, mask);
+        // Coherent packets (not the hybrid's scattered rays) often lie
+        // wholly inside a node's child near the root.
+        let certify = !HYBRID && bounds.finite();
         let mut stack: [MaybeUninit<(u32, u64)>; STACK] = [const { MaybeUninit::uninit() }; STACK];
         let mut len = 0usize;
         let mut word = bvh.root;
@@ -442,6 +473,7 @@ impl BvhQuery<'_> {
                 let mut groups: [MaybeUninit<(usize, f32x8<S>)>; P / 8] = [const { MaybeUninit::uninit() }; P / 8];
                 let mut n_groups = 0;
                 let mut far_all = f32x8::splat(simd, f32::NEG_INFINITY);
+                let mut far_least = f32x8::splat(simd, f32::INFINITY);
                 let mut pending = mask;
                 while pending != 0 {
                     let g = pending.trailing_zeros() as usize / 8;
@@ -451,12 +483,32 @@ impl BvhQuery<'_> {
                     let best = f32x8::from_slice(simd, &pk.best_t.0[8 * g..8 * g + 8]);
                     let far = active.select(best, f32x8::splat(simd, f32::NEG_INFINITY));
                     far_all = far_all.max(far);
+                    if certify {
+                        far_least = far_least.min(active.select(best, f32x8::splat(simd, f32::INFINITY)));
+                    }
                     groups[n_groups] = MaybeUninit::new((g, far));
                     n_groups += 1;
                 }
                 let far_max = horizontal_max(far_all);
-                // Interval test: the children no ray of the packet can meet.
-                let mut valid_children = bounds.children_possible(simd, node, far_max);
+                // Interval test: the children no ray of the packet can meet,
+                // and (coherent packets) those every active ray meets, which
+                // take the whole mask without each ray's own box test.
+                let (mut valid_children, certain, entry) = if certify {
+                    bounds.children_bounds::<S, true>(simd, node, far_max, horizontal_min(far_least))
+                } else {
+                    bounds.children_bounds::<S, false>(simd, node, far_max, 0.0)
+                };
+                if certain != 0 {
+                    let entry: [f32; 8] = entry.into();
+                    let mut m = certain;
+                    while m != 0 {
+                        let c = m.trailing_zeros() as usize;
+                        m &= m - 1;
+                        child_mask[c] = mask;
+                        child_near[c] = entry[c];
+                    }
+                    valid_children &= !certain;
+                }
                 while valid_children != 0 {
                     let c = valid_children.trailing_zeros() as usize;
                     valid_children &= valid_children - 1;
