@@ -102,6 +102,12 @@ pub enum PrimitiveKind {
 #[repr(transparent)]
 pub struct PrimitiveId(u32);
 
+// SAFETY: a transparent wrapper of a u32 that any 32 bits make (the kind
+// and index are read from the bits): packets compare ids eight lanes at a
+// time as u32 lanes.
+unsafe impl bytemuck::Zeroable for PrimitiveId {}
+unsafe impl bytemuck::Pod for PrimitiveId {}
+
 impl PrimitiveId {
     const SPHERE_BIT: u32 = 1 << 31;
     const CSG_BITS: u32 = 3 << 30;

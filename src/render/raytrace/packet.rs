@@ -36,7 +36,7 @@ use crate::render::shade_batch::{self, Batch};
 use crate::render::{miss_without_ray, resolve_sample, Occluder, PassJob, RayCounts, RenderSettings, SceneQuery, ShadowMode};
 use crate::scene::hit_lanes::{HitLanes, TriangleHitInput, HIT_LANES};
 use crate::scene::{CameraView, PrimitiveId, PrimitiveKind, Sphere, SurfaceHit};
-use fearless_simd::{dispatch, f32x8, mask32x8, Select, Simd, SimdBase, SimdFloat, SimdFrom};
+use fearless_simd::{dispatch, f32x8, mask32x8, u32x8, Bytes, Select, Simd, SimdBase, SimdFloat, SimdFrom};
 use glam::Vec3;
 use rayon::prelude::*;
 use std::mem::MaybeUninit;
@@ -145,7 +145,8 @@ pub struct Packet {
     /// hit, so an equal-t hit on an earlier primitive can still win the tie.
     limit: [f32; P],
     best_id: [PrimitiveId; P],
-    bary: [(f32, f32); P],
+    /// The closest hit's weights of its triangle's second and third corners.
+    bary: [Lanes; 2],
 }
 
 impl Packet {
@@ -206,7 +207,7 @@ impl Packet {
             best_t: zero,
             limit: [0.0; P],
             best_id: [PrimitiveId::NONE; P],
-            bary: [(0.0, 0.0); P],
+            bary: [zero; 2],
         })
     }
 
@@ -229,8 +230,7 @@ impl Packet {
         if id.is_none() {
             return None;
         }
-        let (b1, b2) = self.bary[i];
-        Some(query.prepared.scene.primitive_hit(id, self.best_t.0[i], b1, b2, &self.rays[i]))
+        Some(query.prepared.scene.primitive_hit(id, self.best_t.0[i], self.bary[0].0[i], self.bary[1].0[i], &self.rays[i]))
     }
 
     /// The hit of lane `i` after `closest_packet` or `closest_hybrid`, as
@@ -244,13 +244,20 @@ impl Packet {
     /// Lane `i`'s closest hit so far, as a single ray's walk keeps it.
     #[inline(always)]
     fn best(&self, i: usize) -> BestHit {
-        BestHit { t: self.best_t.0[i], limit: self.limit[i], id: self.best_id[i], bary: self.bary[i] }
+        BestHit { t: self.best_t.0[i], limit: self.limit[i], id: self.best_id[i], bary: self.weights(i) }
     }
 
     /// Lane `i` takes `best` as its closest hit so far.
     #[inline(always)]
     fn set_best(&mut self, i: usize, best: &BestHit) {
-        (self.best_t.0[i], self.limit[i], self.best_id[i], self.bary[i]) = (best.t, best.limit, best.id, best.bary);
+        (self.best_t.0[i], self.limit[i], self.best_id[i]) = (best.t, best.limit, best.id);
+        (self.bary[0].0[i], self.bary[1].0[i]) = best.bary;
+    }
+
+    /// Lane `i`'s hit weights (second and third corners).
+    #[inline(always)]
+    fn weights(&self, i: usize) -> (f32, f32) {
+        (self.bary[0].0[i], self.bary[1].0[i])
     }
 
     /// `hit` of every lane in `valid`, written into `out`: triangle hits
@@ -276,7 +283,7 @@ impl Packet {
             if id.is_none() {
                 out[i] = None;
             } else if id.kind() == PrimitiveKind::Triangle {
-                inputs[n] = TriangleHitInput::new(id.index(), self.bary[i], self.best_t.0[i], self.rays[i].dir);
+                inputs[n] = TriangleHitInput::new(id.index(), self.weights(i), self.best_t.0[i], self.rays[i].dir);
                 lanes[n] = i;
                 n += 1;
                 if n == HIT_LANES {
@@ -648,28 +655,38 @@ fn test_leaf_packet<S: Simd, const ANY: bool>(
             let dir = V3::load(simd, [&pk.dir[0].0, &pk.dir[1].0, &pk.dir[2].0], base);
             let limit = f32x8::from_slice(simd, &pk.limit[base..base + 8]);
             let (hit, t, b1, b2) = intersect_triangle_lanes(origin, dir, tri, limit);
-            let mut found = mask_bits(hit) & lanes;
+            let found = mask_bits(hit) & lanes;
             if found == 0 {
                 continue;
             }
-            let (t, b1, b2): ([f32; 8], [f32; 8], [f32; 8]) = (t.into(), b1.into(), b2.into());
-            while found != 0 {
-                let j = found.trailing_zeros() as usize;
-                found &= found - 1;
-                let i = base + j;
-                if ANY {
-                    pk.best_t.0[i] = t[j];
-                    pk.best_id[i] = id;
-                    pk.bary[i] = (b1[j], b2[j]);
-                    *done |= 1 << i;
-                    active &= !(1 << i);
-                } else if t[j] < pk.best_t.0[i] || id < pk.best_id[i] {
-                    // As `test_leaf`: t <= best here; on a tie the lower id wins.
-                    pk.best_t.0[i] = t[j];
-                    pk.best_id[i] = id;
-                    pk.bary[i] = (b1[j], b2[j]);
-                    pk.limit[i] = f32::from_bits(t[j].to_bits() + 1);
-                }
+            // Every lane's update at once (each lane is its own ray): as
+            // `test_leaf`, t <= best here, and the hit is taken when nearer
+            // or, on a tie, when its id is lower; a shadow ray takes its
+            // first and is done.
+            let ids: &mut [u32] = bytemuck::cast_slice_mut(&mut pk.best_id[base..base + 8]);
+            let old_id = u32x8::from_slice(simd, ids);
+            let new_id = u32x8::splat(simd, bytemuck::cast(id));
+            let best = f32x8::from_slice(simd, &pk.best_t.0[base..base + 8]);
+            let take = if ANY {
+                mask_from_bits(simd, found)
+            } else {
+                let nearer = t.simd_lt(best) | new_id.simd_lt(old_id);
+                nearer & mask_from_bits(simd, found)
+            };
+            take.select(t, best).store_slice(&mut pk.best_t.0[base..base + 8]);
+            take.select(new_id, old_id).store_slice(ids);
+            for (w, lanes) in [b1, b2].into_iter().zip(&mut pk.bary) {
+                let slot = &mut lanes.0[base..base + 8];
+                take.select(w, f32x8::from_slice(simd, slot)).store_slice(slot);
+            }
+            if ANY {
+                *done |= (found as u64) << base;
+                active &= !((found as u64) << base);
+            } else {
+                // Just above the new best, so that a tie can still be won.
+                let above: f32x8<S> = (t.bitcast::<u32x8<S>>() + 1).bitcast();
+                let limit = &mut pk.limit[base..base + 8];
+                take.select(above, f32x8::from_slice(simd, limit)).store_slice(limit);
             }
         }
     }
@@ -1151,7 +1168,7 @@ fn shade_tile_batched<'p, const PASSES: bool>(
             let (mut pixels, mut samples, mut slots) = ([0u32; 8], [0u32; 8], [0usize; 8]);
             for (k, lane) in group.clone().enumerate() {
                 index[k] = pk.best_id[lane].index();
-                (b1[k], b2[k]) = pk.bary[lane];
+                (b1[k], b2[k]) = pk.weights(lane);
                 let (g, tx, ty) = lane_of::<PASSES>(layout, lane);
                 let job = if PASSES { &jobs[g] } else { first };
                 pixels[k] = job.pixel_index((x0 + tx) as u32, (y0 + ty) as u32);
@@ -1181,7 +1198,7 @@ fn shade_tile_batched<'p, const PASSES: bool>(
         }
         let batch = &mut batches[filled / shade_batch::LANES];
         if id.kind() == PrimitiveKind::Triangle && !*textured {
-            let input = TriangleHitInput::new(id.index(), pk.bary[i], pk.best_t.0[i], pk.rays[i].dir);
+            let input = TriangleHitInput::new(id.index(), pk.weights(i), pk.best_t.0[i], pk.rays[i].dir);
             batch.push_ray_triangle(input, pixel, job.sample, i);
         } else {
             let mut hit = pk.hit(query, i);
