@@ -1348,6 +1348,76 @@ mod tests {
         }
     }
 
+    /// A child that the interval test proves entered by every ray of a
+    /// packet is entered by each of them in its own box test, and every
+    /// child a ray enters is one the test leaves possible: eye packets of
+    /// every built-in scene, against every node of its tree, with far
+    /// ends at the eye rays' limits and cut short to half of them.
+    #[test]
+    fn children_proved_entered_are_entered_by_every_ray() {
+        let proved = dispatch!(simd_level(), simd => check_proofs(simd));
+        // The proof is not vacuous: eye packets lie inside many boxes.
+        assert!(proved > 100, "only {proved} children proved entered");
+    }
+
+    fn check_proofs<S: Simd>(simd: S) -> usize {
+        let mut proved = 0;
+        for name in builtin::names() {
+            let prepared = PreparedScene::new(builtin::load_builtin(name).unwrap().unwrap());
+            let bvh = &prepared.bvh;
+            if bvh.deep || bvh.root & LEAF_BIT != 0 {
+                continue;
+            }
+            // The nodes of the tree's top four levels, where packets lie
+            // wholly inside boxes.
+            let mut nodes = vec![bvh.root];
+            let mut level = vec![bvh.root];
+            for _ in 0..3 {
+                level = level.iter().flat_map(|&n| bvh.nodes[n as usize].child.iter().zip(0..8).filter(move |&(&c, k)| bvh.nodes[n as usize].valid & 1 << k != 0 && c & LEAF_BIT == 0).map(|(&c, _)| c)).collect();
+                nodes.extend(&level);
+            }
+            // Benchmark-sized pixels, every fifth tile of them.
+            let (w, h) = (640u32, 400u32);
+            let view = prepared.scene.camera.view(w, h);
+            let mut pk = Packet::new();
+            for (y0, x0) in (0..h as usize).step_by(5 * TILE_H).flat_map(|y| (0..w as usize).step_by(5 * TILE_W).map(move |x| (y, x))) {
+                for i in 0..P {
+                    let (x, y) = ((x0 + lane_xy(i).0) as f32 + 0.5, (y0 + lane_xy(i).1) as f32 + 0.5);
+                    pk.rays[i] = view.eye_ray(x, y);
+                    pk.t_max[i] = view.far_t(x, y);
+                }
+                for g in 0..P / 8 {
+                    pk.prepare_group(simd, g, bvh);
+                }
+                for shorten in [1.0f32, 0.5] {
+                    let far: Vec<f32> = (0..P).map(|i| pk.best_t.0[i] * shorten).collect();
+                    let bounds = PacketBounds::new(simd, &pk, u64::MAX);
+                    assert!(bounds.finite(), "{name}");
+                    let (far_min, far_max) = (far.iter().copied().fold(f32::INFINITY, f32::min), far.iter().copied().fold(0.0, f32::max));
+                    for node in nodes.iter().map(|&n| &bvh.nodes[n as usize]) {
+                        let (possible, certain, _) = bounds.children_bounds::<S, true>(simd, node, far_max, far_min);
+                        for c in 0..8 {
+                            let planes: [f32x8<S>; 6] = std::array::from_fn(|k| f32x8::splat(simd, node.planes[k][c]));
+                            let mut entered = 0u64;
+                            for g in 0..P / 8 {
+                                let t_far = f32x8::from_slice(simd, &far[8 * g..8 * g + 8]);
+                                entered |= (mask_bits(slab_test_rays8(simd, &planes, &pk, 8 * g, t_far).0) as u64) << (8 * g);
+                            }
+                            if node.valid & 1 << c != 0 && entered != 0 {
+                                assert!(possible & 1 << c != 0, "{name}: a child entered but culled");
+                            }
+                            if certain & 1 << c != 0 {
+                                assert_eq!(entered, u64::MAX, "{name}: a child proved entered by all, missed by some");
+                                proved += 1;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        proved
+    }
+
     /// Incoherent rays (bounces: from each eye hit of a small image, one
     /// random direction off the surface) in packets, walked together and
     /// then alone from every switch point (`closest_hybrid`, from never to
