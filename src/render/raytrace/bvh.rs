@@ -33,7 +33,7 @@ use crate::render::{BatchHit, Occluder, PreparedScene, RayCounts, SceneQuery};
 use crate::scene::hit_lanes::TriangleHitInput;
 use crate::scene::{PrimitiveId, PrimitiveKind, SurfaceHit};
 use std::sync::Arc;
-use glam::{Vec3, Vec3A};
+use glam::Vec3;
 
 mod build;
 use build::{aabb, triangle_box, Bounds};
@@ -92,6 +92,12 @@ pub(super) struct Node8 {
 
 impl Node8 {
     pub(super) const EMPTY: Node8 = Node8 { planes: [[0.0; 8]; 6], child: [0; 8], valid: 0 };
+
+    /// Child slot `i`'s box, as the traversal tests it.
+    fn child_box(&self, i: usize) -> Aabb {
+        let p = &self.planes;
+        Aabb { min: Vec3::new(p[0][i], p[2][i], p[4][i]), max: Vec3::new(p[1][i], p[3][i], p[5][i]) }
+    }
 }
 
 /// The hierarchy: 8-wide nodes, with the primitives in leaf order.
@@ -172,8 +178,8 @@ impl Bvh {
             let n = &self.nodes[id as usize];
             let mut b = Bounds::EMPTY;
             for i in (0..8).filter(|i| n.valid & 1 << i != 0) {
-                let (lo, hi) = (Vec3A::new(n.planes[0][i], n.planes[2][i], n.planes[4][i]), Vec3A::new(n.planes[1][i], n.planes[3][i], n.planes[5][i]));
-                b.grow(lo, hi);
+                let c = n.child_box(i);
+                b.grow(c.min.into(), c.max.into());
             }
             aabb(b)
         } else {
@@ -213,7 +219,7 @@ impl Bvh {
                 if level < levels && n.child[i] & LEAF_BIT == 0 {
                     nodes.push((n.child[i], level + 1));
                 } else {
-                    boxes.push(Aabb { min: Vec3::new(n.planes[0][i], n.planes[2][i], n.planes[4][i]), max: Vec3::new(n.planes[1][i], n.planes[3][i], n.planes[5][i]) });
+                    boxes.push(n.child_box(i));
                 }
             }
         }
@@ -633,6 +639,7 @@ mod tests {
     use crate::render::pixel_record::NoRecord;
     use crate::scene::{builtin, Scene, Sphere, Triangle};
     use proptest::prelude::*;
+    use glam::Vec3A;
 
     /// SplitMix64: a tiny seeded generator for reproducible rays.
     struct Rng(u64);

@@ -230,7 +230,8 @@ impl Packet {
         if id.is_none() {
             return None;
         }
-        Some(query.prepared.scene.primitive_hit(id, self.best_t.0[i], self.bary[0].0[i], self.bary[1].0[i], &self.rays[i]))
+        let (b1, b2) = self.weights(i);
+        Some(query.prepared.scene.primitive_hit(id, self.best_t.0[i], b1, b2, &self.rays[i]))
     }
 
     /// The hit of lane `i` after `closest_packet` or `closest_hybrid`, as
@@ -1164,11 +1165,9 @@ fn shade_tile_batched<'p, const PASSES: bool>(
         if i % 8 == 0 && (m >> i) & 0xff == 0xff && filled % shade_batch::LANES == 0 && !*textured && pk.best_id[i..i + 8].iter().all(|id| !id.is_none() && id.kind() == PrimitiveKind::Triangle) {
             let group = i..i + 8;
             let mut index = [0u32; 8];
-            let (mut b1, mut b2) = ([0.0f32; 8], [0.0f32; 8]);
             let (mut pixels, mut samples, mut slots) = ([0u32; 8], [0u32; 8], [0usize; 8]);
             for (k, lane) in group.clone().enumerate() {
                 index[k] = pk.best_id[lane].index();
-                (b1[k], b2[k]) = pk.weights(lane);
                 let (g, tx, ty) = lane_of::<PASSES>(layout, lane);
                 let job = if PASSES { &jobs[g] } else { first };
                 pixels[k] = job.pixel_index((x0 + tx) as u32, (y0 + ty) as u32);
@@ -1176,9 +1175,10 @@ fn shade_tile_batched<'p, const PASSES: bool>(
                 slots[k] = lane;
             }
             let t: &[f32; 8] = pk.best_t.0[group.clone()].try_into().expect("eight lanes");
+            let (b1, b2): (&[f32; 8], &[f32; 8]) = (pk.bary[0].0[group.clone()].try_into().expect("eight lanes"), pk.bary[1].0[group.clone()].try_into().expect("eight lanes"));
             let dir: [[f32; 8]; 3] = std::array::from_fn(|a| pk.dir[a].0[group.clone()].try_into().expect("eight lanes"));
             debug_assert!(group.clone().enumerate().all(|(k, lane)| (0..3).all(|a| dir[a][k].to_bits() == pk.rays[lane].dir[a].to_bits())));
-            batches[filled / shade_batch::LANES].fill_ray_triangles(scene, settings.interpolation, &index, (&b1, &b2), t, &dir, pixels, samples, slots);
+            batches[filled / shade_batch::LANES].fill_ray_triangles(scene, settings.interpolation, &index, (b1, b2), t, &dir, pixels, samples, slots);
             filled += 8;
             m &= !(0xff << i);
             continue;
