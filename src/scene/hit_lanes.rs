@@ -254,7 +254,7 @@ fn triangle_eye_hits8<S: Simd>(simd: S, scene: &Scene, view: &CameraView, s: &Ey
 struct CornerLanes<S: Simd> {
     attr: [[f32x8<S>; 8]; 3],
     /// Bit i set when lane i's triangle is flat: its normals are the
-    /// geometric one (its rows' normals are zero).
+    /// geometric one (a stored triangle's rows hold zero normals).
     flat: u8,
     material: [u32; HIT_LANES],
     object: [u32; HIT_LANES],
@@ -322,6 +322,7 @@ fn gather_placed_corners<S: Simd>(simd: S, scene: &Scene, index: &[u32; HIT_LANE
                 let (v, nrm, uv) = (tri.v[k], tri.n[k], tri.uv[k]);
                 placed[lane][k] = [v.x, v.y, v.z, nrm.x, nrm.y, nrm.z, uv.x, uv.y];
             }
+            flat |= (tri.is_flat() as u8) << lane;
             material[lane] = tri.material;
             object[lane] = tri.object;
         }
@@ -368,11 +369,15 @@ fn triangle_hits8<S: Simd>(simd: S, scene: &Scene, index: &[u32; HIT_LANES], n: 
     let (v0, v1, v2) = (V3 { x: a[0][0], y: a[0][1], z: a[0][2] }, V3 { x: a[1][0], y: a[1][1], z: a[1][2] }, V3 { x: a[2][0], y: a[2][1], z: a[2][2] });
     // `Triangle::geometric_normal`, then `hit_on`'s steps in order.
     let geometric = (v1 - v0).cross(v2 - v0).normalize();
-    let flat = mask_from_bits(simd, c.flat);
-    let n0 = V3::select(flat, geometric, V3 { x: a[0][3], y: a[0][4], z: a[0][5] });
-    let n1 = V3::select(flat, geometric, V3 { x: a[1][3], y: a[1][4], z: a[1][5] });
-    let n2 = V3::select(flat, geometric, V3 { x: a[2][3], y: a[2][4], z: a[2][5] });
-    let shading = interpolate(n0, n1, n2, &w).normalize_or(geometric);
+    // `hit_on`'s shading normal: the geometric one on flat triangles (all
+    // lanes, the common batch, skip the blend), else the blend of the
+    // corners' normals, renormalised.
+    let shading = if c.flat == u8::MAX {
+        geometric
+    } else {
+        let (n0, n1, n2) = (V3 { x: a[0][3], y: a[0][4], z: a[0][5] }, V3 { x: a[1][3], y: a[1][4], z: a[1][5] }, V3 { x: a[2][3], y: a[2][4], z: a[2][5] });
+        V3::select(mask_from_bits(simd, c.flat), geometric, interpolate(n0, n1, n2, &w).normalize_or(geometric))
+    };
     let back = geometric.dot(dir).gt(w[0].splat(0.0));
     out.geometric_normal = V3::select(back, -geometric, geometric).to_soa();
     out.shading_normal = V3::select(back, -shading, shading).to_soa();
@@ -480,6 +485,48 @@ mod tests {
             }
         }
         assert!(compared > 10_000 && layer_compared > 100 && one_triangle > 1000, "{compared} records compared, {layer_compared} of layer copies, {one_triangle} in batches of one triangle");
+    }
+
+    /// A flat triangle is shaded with its geometric normal itself, not a
+    /// renormalised blend of three copies of it (which differs in the last
+    /// bits for some weights), one hit at a time and in lanes, batches of
+    /// one triangle and of several.
+    #[test]
+    fn flat_triangles_shade_with_their_geometric_normal() {
+        let mut state = 5u64;
+        let mut flat_hits = 0;
+        // The built-ins' flat triangles are mostly axis-aligned quads, whose
+        // blend renormalises to the same bits anyway: the bunny made flat
+        // has normals in every direction.
+        let flat_bunny = include_str!("../../assets/scenes/bunny.toml").replace("\"smooth\"", "\"flat\"");
+        let base = std::path::Path::new(crate::scene::assets::BUILTIN_ROOT).join("scenes");
+        let scenes = builtin::names().into_iter().map(|name| (name, builtin::load_builtin(name).unwrap().unwrap()));
+        for (name, scene) in scenes.chain([("flat bunny", crate::scene::file::parse_scene(&flat_bunny, "flat bunny", &base, "flat-bunny").unwrap())]) {
+            let flat: Vec<u32> = (0..scene.triangles.len() as u32).filter(|&i| scene.triangle(i).is_flat()).take(20_000).collect();
+            // Several weights on each triangle of the small scenes.
+            let rounds = (8000 / flat.len().max(1)).clamp(1, 64);
+            for (c, chunk) in flat.chunks(HIT_LANES).cycle().take(rounds * flat.len().div_ceil(HIT_LANES)).enumerate() {
+                let inputs: Vec<TriangleHitInput> = chunk
+                    .iter()
+                    .map(|&index| {
+                        let index = if c % 2 == 1 { chunk[0] } else { index };
+                        let (b1, b2) = (next(&mut state), next(&mut state));
+                        let (b1, b2) = if b1 + b2 > 1.0 { (1.0 - b1, 1.0 - b2) } else { (b1, b2) };
+                        TriangleHitInput { index, b: Vec3::new(1.0 - b1 - b2, b1, b2), t: 1.0, dir: Vec3::new(0.3, -0.5, -0.81).normalize() }
+                    })
+                    .collect();
+                let mut got = HitLanes::new();
+                scene.triangle_hits(&inputs, &mut got);
+                for (lane, input) in inputs.iter().enumerate() {
+                    let one = scene.triangle_hit(input.index, input.b, input.t, &Ray::new(Vec3::ZERO, input.dir));
+                    for h in [one, got.get(lane)] {
+                        assert_eq!(h.shading_normal.to_array().map(f32::to_bits), h.geometric_normal.to_array().map(f32::to_bits), "{name}: triangle {} at {:?}", input.index, input.b);
+                    }
+                    flat_hits += 1;
+                }
+            }
+        }
+        assert!(flat_hits > 25_000, "{flat_hits} hits on flat triangles");
     }
 
     /// A rasterizer's eye samples built in lanes give, bit for bit, the

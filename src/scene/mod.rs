@@ -462,7 +462,12 @@ impl Scene {
     fn hit_on(tri: &Triangle, index: u32, b: Vec3, t: f32, ray: &Ray) -> SurfaceHit {
         let position = tri.v[0] * b.x + tri.v[1] * b.y + tri.v[2] * b.z;
         let mut geometric_normal = tri.geometric_normal();
-        let mut shading_normal = (tri.n[0] * b.x + tri.n[1] * b.y + tri.n[2] * b.z).normalize_or(geometric_normal);
+        // A flat triangle's normals are all the geometric one: its shading
+        // normal is that, not a blend of three equal vectors renormalised
+        // (which only adds rounding, and a square root per hit).
+        let g = geometric_normal.to_array().map(f32::to_bits);
+        let flat = tri.n.iter().all(|n| n.to_array().map(f32::to_bits) == g);
+        let mut shading_normal = if flat { geometric_normal } else { (tri.n[0] * b.x + tri.n[1] * b.y + tri.n[2] * b.z).normalize_or(geometric_normal) };
         let back_face = geometric_normal.dot(ray.dir) > 0.0;
         if back_face {
             geometric_normal = -geometric_normal;
