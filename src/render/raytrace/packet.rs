@@ -1021,12 +1021,12 @@ impl<'p> TileContext<'p> {
 }
 
 /// Which tiles of a pass's rows can see the scene at all. An eye ray runs
-/// along the line from the eye through its image position; a line that
-/// meets a box passes through the box's projection, inside the rectangle
-/// of its corners' projections when they all lie in front of the eye. So a
-/// tile outside the rectangles of boxes that hold every primitive (the
-/// tree's boxes a few levels down, `Bvh::cut_boxes`) sees only the
-/// background, exactly as its rays would.
+/// forward from the near plane along the line from the eye through its
+/// image position; a line that meets the part of a box in front of the
+/// near plane passes inside the rectangle that part projects to
+/// (`rect_in_front`). So a tile outside the rectangles of boxes that hold
+/// every primitive (the tree's boxes a few levels down, `Bvh::cut_boxes`)
+/// sees only the background, exactly as its rays would.
 struct SeenTiles {
     /// Per tile (row-major, `columns` a row), whether some box's rectangle
     /// reaches it.
@@ -1055,13 +1055,11 @@ impl SeenTiles {
         let mut seen = vec![false; columns * tile_rows];
         let top = job.rows.start as f32;
         for b in query.prepared.bvh.cut_boxes(levels) {
-            let rect = b.corners().into_iter().try_fold((f32::INFINITY, f32::NEG_INFINITY, f32::INFINITY, f32::NEG_INFINITY), |r, corner| {
-                let (p, _) = job.view.project(corner)?;
-                Some((r.0.min(p.x), r.1.max(p.x), r.2.min(p.y), r.3.max(p.y)))
-            });
-            // A box reaching behind the near plane (or not finite): every tile.
+            // A box wholly behind the eye rays' start is seen by no tile;
+            // one that is not finite, by every tile.
+            let Some(rect) = Self::rect_in_front(job.view, b.corners()) else { continue };
             let (x0, x1, y0, y1) = match rect {
-                Some(r) if [r.0, r.1, r.2, r.3].iter().all(|v| v.is_finite()) => (r.0 - Self::MARGIN, r.1 + Self::MARGIN, r.2 - top - Self::MARGIN, r.3 - top + Self::MARGIN),
+                r if [r.0, r.1, r.2, r.3].iter().all(|v| v.is_finite()) => (r.0 - Self::MARGIN, r.1 + Self::MARGIN, r.2 - top - Self::MARGIN, r.3 - top + Self::MARGIN),
                 _ => (f32::NEG_INFINITY, f32::INFINITY, f32::NEG_INFINITY, f32::INFINITY),
             };
             if x1 < 0.0 || y1 < 0.0 || x0 > width as f32 || y0 > rows as f32 {
@@ -1074,6 +1072,57 @@ impl SeenTiles {
             }
         }
         SeenTiles { seen, columns, tile: (tile_w, tile_h) }
+    }
+
+    /// The image rectangle (x0, x1, y0, y1) in pixels of the part of the
+    /// box with world corners `corners` (indexed by bits: 1 x, 2 y, 4 z)
+    /// that lies in front of the plane at half the near distance; `None`
+    /// when none of it does. Eye rays start on the near plane and run
+    /// forward, so they meet only that part (the half keeps points their
+    /// rounding puts just behind the near plane); it is the box clipped by
+    /// the plane, a convex solid whose corners are the box's corners in
+    /// front and the points where its edges cross the plane, and a line
+    /// through the eye that meets it projects inside the rectangle of
+    /// those corners. (A box reaching behind the eye, as a floor under the
+    /// camera does, still leaves out the tiles above its horizon.)
+    fn rect_in_front(view: &CameraView, corners: [Vec3; 8]) -> Option<(f32, f32, f32, f32)> {
+        let clip = 0.5 * view.near;
+        let camera = corners.map(|c| view.to_camera(c));
+        let mut rect = (f32::INFINITY, f32::NEG_INFINITY, f32::INFINITY, f32::NEG_INFINITY);
+        let mut add = |c: Vec3| {
+            let p = view.project_camera(c);
+            rect = (rect.0.min(p.x), rect.1.max(p.x), rect.2.min(p.y), rect.3.max(p.y));
+        };
+        let in_front = |c: Vec3| -c.z >= clip;
+        let mut any = false;
+        for (i, &a) in camera.iter().enumerate() {
+            if in_front(a) {
+                add(a);
+                any = true;
+            }
+            for bit in [1, 2, 4] {
+                let b = camera[i | bit];
+                if i & bit == 0 && in_front(a) != in_front(b) {
+                    // Where the edge a-b crosses z = -clip.
+                    let s = (-clip - a.z) / (b.z - a.z);
+                    add(Vec3::new(a.x + (b.x - a.x) * s, a.y + (b.y - a.y) * s, -clip));
+                }
+            }
+        }
+        // A NaN corner compares false above and leaves its mark here.
+        if camera.iter().any(|c| !c.is_finite()) {
+            return Some((f32::NEG_INFINITY, f32::INFINITY, f32::NEG_INFINITY, f32::INFINITY));
+        }
+        // The points above are off by their rounding, up to a few units in
+        // the last place of the coordinates' magnitude (that of the box and
+        // the eye), which the projection magnifies by up to 1 / clip: the
+        // rectangle grows by a generous bound of that in pixels (a
+        // thousandth of a pixel near an ordinary scene; much more for a
+        // huge box whose edges cross the plane near the eye).
+        let magnitude = corners.iter().fold(view.eye.abs().max_element(), |m, c| m.max(c.abs().max_element()));
+        let pixels = 0.5 * (view.width as f32 / view.half_x).max(view.height as f32 / view.half_y);
+        let grow = 64.0 * f32::EPSILON * magnitude / clip * pixels;
+        any.then_some((rect.0 - grow, rect.1 + grow, rect.2 - grow, rect.3 + grow))
     }
 
     /// `SeenTiles` for `job`'s tiles where tiles that see nothing can be
@@ -1260,16 +1309,39 @@ mod tests {
     /// anything: on every built-in scene without instances or CSG, from its
     /// own camera and from cameras turned so that the scene lies partly off
     /// the image or behind the eye, in passes of rows starting mid-image.
+    /// Boxes reaching behind the eye leave out the tiles that cannot see
+    /// the part of them in front: the built-in bunny's floor runs under
+    /// and behind the camera, and the tiles above its horizon (the top
+    /// rows of the image) are left out; `tiles_left_out_see_nothing` holds
+    /// every left-out tile to seeing nothing.
+    #[test]
+    fn a_floor_behind_the_eye_leaves_the_sky_out() {
+        let scene = builtin::load_builtin("bunny").unwrap().unwrap();
+        let prepared = PreparedScene::new(scene);
+        let query = BvhQuery::new(&prepared);
+        let (w, h) = (160u32, 100u32);
+        let view = prepared.scene.camera.view(w, h);
+        let floor_behind = prepared.scene.triangles.iter().any(|t| t.v.iter().any(|&v| view.project(v).is_none()));
+        assert!(floor_behind, "the floor should reach behind the near plane");
+        let settings = RenderSettings::for_scene(&prepared.scene);
+        let cancel = std::sync::atomic::AtomicBool::new(false);
+        let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: Vec2::splat(0.5), sample: 0, photons: None, active: None, rows: 0..h, cancel: &cancel };
+        let tiles = SeenTiles::new(&query, &job, (TILE_W, TILE_H), SeenTiles::LEVELS_WHOLE);
+        let top_row_left_out = (0..w as usize).step_by(TILE_W).filter(|&x0| !tiles.may_see(0, x0)).count();
+        assert!(top_row_left_out >= 10, "only {top_row_left_out} of the top row's {} tiles left out", (w as usize).div_ceil(TILE_W));
+    }
+
     #[test]
     fn tiles_left_out_see_nothing() {
         let mut left_out = 0;
         for name in builtin::names() {
             let mut scene = builtin::load_builtin(name).unwrap().unwrap();
             let camera = scene.camera.clone();
-            let turns = [Vec3::ZERO, Vec3::new(0.3, 0.0, 0.0), Vec3::new(-0.45, 0.2, 0.0), Vec3::new(0.0, -0.35, 0.1)];
-            for (turn, rows) in turns.iter().zip([0..41u32, 7..41, 13..30, 0..41]) {
+            // The last turn looks back, the scene behind the eye.
+            let turns = [Vec3::ZERO, Vec3::new(0.3, 0.0, 0.0), Vec3::new(-0.45, 0.2, 0.0), Vec3::new(0.0, -0.35, 0.1), Vec3::NAN];
+            for (turn, rows) in turns.iter().zip([0..41u32, 7..41, 13..30, 0..41, 0..41]) {
                 let forward = (camera.target - camera.eye).length();
-                scene.camera.target = camera.target + *turn * forward * 2.0;
+                scene.camera.target = if turn.is_nan() { 2.0 * camera.eye - camera.target } else { camera.target + *turn * forward * 2.0 };
                 let prepared = PreparedScene::new(scene.clone());
                 let query = BvhQuery::new(&prepared);
                 if query.bvh_packets().is_none() {
