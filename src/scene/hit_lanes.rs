@@ -415,6 +415,14 @@ mod tests {
         ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
     }
 
+    /// Corner weights (b0, b1, b2) of a point inside a triangle: two draws,
+    /// folded back into the triangle when they leave it.
+    fn weights_inside(state: &mut u64) -> Vec3 {
+        let (b1, b2) = (next(state), next(state));
+        let (b1, b2) = if b1 + b2 > 1.0 { (1.0 - b1, 1.0 - b2) } else { (b1, b2) };
+        Vec3::new(1.0 - b1 - b2, b1, b2)
+    }
+
     /// What two records must share: every field's bits.
     #[allow(clippy::type_complexity)]
     fn record_bits(h: &SurfaceHit) -> ([[u32; 3]; 4], [u32; 2], u32, u32, u32, u32, bool) {
@@ -466,10 +474,9 @@ mod tests {
                         // Every third chunk puts all its lanes on one
                         // triangle (read once, not gathered lane by lane).
                         let index = if c % 3 == 2 { chunk[0] } else { index };
-                        let (b1, b2) = (next(&mut state), next(&mut state));
-                        let (b1, b2) = if b1 + b2 > 1.0 { (1.0 - b1, 1.0 - b2) } else { (b1, b2) };
+                        let b = weights_inside(&mut state);
                         let dir = Vec3::new(next(&mut state) - 0.5, next(&mut state) - 0.5, next(&mut state) - 0.5).normalize_or(Vec3::Z);
-                        TriangleHitInput { index, b: Vec3::new(1.0 - b1 - b2, b1, b2), t: next(&mut state) * 10.0, dir: if c % 2 == 0 { dir } else { -dir } }
+                        TriangleHitInput { index, b, t: next(&mut state) * 10.0, dir: if c % 2 == 0 { dir } else { -dir } }
                     })
                     .collect();
                 let mut got = HitLanes::new();
@@ -510,9 +517,7 @@ mod tests {
                     .iter()
                     .map(|&index| {
                         let index = if c % 2 == 1 { chunk[0] } else { index };
-                        let (b1, b2) = (next(&mut state), next(&mut state));
-                        let (b1, b2) = if b1 + b2 > 1.0 { (1.0 - b1, 1.0 - b2) } else { (b1, b2) };
-                        TriangleHitInput { index, b: Vec3::new(1.0 - b1 - b2, b1, b2), t: 1.0, dir: Vec3::new(0.3, -0.5, -0.81).normalize() }
+                        TriangleHitInput { index, b: weights_inside(&mut state), t: 1.0, dir: Vec3::new(0.3, -0.5, -0.81).normalize() }
                     })
                     .collect();
                 let mut got = HitLanes::new();
