@@ -1089,8 +1089,12 @@ impl SeenTiles {
         let clip = 0.5 * view.near;
         let camera = corners.map(|c| view.to_camera(c));
         let mut rect = (f32::INFINITY, f32::NEG_INFINITY, f32::INFINITY, f32::NEG_INFINITY);
+        // Whether every point projected to finite pixels (min and max would
+        // pass over a NaN, and the rectangle would miss its point).
+        let mut finite = true;
         let mut add = |c: Vec3| {
             let p = view.project_camera(c);
+            finite &= p.is_finite();
             rect = (rect.0.min(p.x), rect.1.max(p.x), rect.2.min(p.y), rect.3.max(p.y));
         };
         let in_front = |c: Vec3| -c.z >= clip;
@@ -1109,8 +1113,9 @@ impl SeenTiles {
                 }
             }
         }
-        // A NaN corner compares false above and leaves its mark here.
-        if camera.iter().any(|c| !c.is_finite()) {
+        // A NaN corner compares false above and leaves its mark here; a
+        // point beyond the floats (a tiny near distance) is not bounded.
+        if !finite || camera.iter().any(|c| !c.is_finite()) {
             return Some((f32::NEG_INFINITY, f32::INFINITY, f32::NEG_INFINITY, f32::INFINITY));
         }
         // The points above are off by their rounding, up to a few units in
@@ -1122,6 +1127,8 @@ impl SeenTiles {
         let magnitude = corners.iter().fold(view.eye.abs().max_element(), |m, c| m.max(c.abs().max_element()));
         let pixels = 0.5 * (view.width as f32 / view.half_x).max(view.height as f32 / view.half_y);
         let grow = 64.0 * f32::EPSILON * magnitude / clip * pixels;
+        // (A grow that is not finite leaves a rectangle that is not, which
+        // the caller takes as every tile.)
         any.then_some((rect.0 - grow, rect.1 + grow, rect.2 - grow, rect.3 + grow))
     }
 
@@ -1309,6 +1316,31 @@ mod tests {
     /// anything: on every built-in scene without instances or CSG, from its
     /// own camera and from cameras turned so that the scene lies partly off
     /// the image or behind the eye, in passes of rows starting mid-image.
+    /// `rect_in_front` by hand, the camera at the origin looking down -z
+    /// (800x500): a box behind the eye has no rectangle; one reaching from
+    /// behind the eye to beyond the near plane has the rectangle of its
+    /// part in front (here, through the image's centre); a near distance
+    /// so small that its points project beyond the floats gives every tile.
+    #[test]
+    fn boxes_are_clipped_at_the_near_plane() {
+        let box_corners = |lo: Vec3, hi: Vec3| std::array::from_fn(|k| Vec3::new(if k & 1 == 0 { lo.x } else { hi.x }, if k & 2 == 0 { lo.y } else { hi.y }, if k & 4 == 0 { lo.z } else { hi.z }));
+        let view = crate::scene::Camera::default().view(800, 500);
+        assert_eq!(SeenTiles::rect_in_front(&view, box_corners(Vec3::new(-1.0, -1.0, 1.0), Vec3::new(1.0, 1.0, 2.0))), None);
+        // Only a sliver of a thin slab behind the near plane: nothing.
+        assert_eq!(SeenTiles::rect_in_front(&view, box_corners(Vec3::new(-1.0, -1.0, -0.04), Vec3::new(1.0, 1.0, 1.0))), None);
+        let (x0, x1, y0, y1) = SeenTiles::rect_in_front(&view, box_corners(Vec3::new(-0.01, -0.01, -5.0), Vec3::new(0.01, 0.01, 5.0))).expect("a part in front");
+        assert!([x0, x1, y0, y1].iter().all(|v| v.is_finite()));
+        // Its part in front projects around the centre, no wider than at
+        // the clip plane (half the near distance: 0.01 / 0.05 of the
+        // image's half height, tan 30 degrees, over 250 pixels).
+        let half = 0.01 / 0.05 / 30f32.to_radians().tan() * 250.0;
+        assert!(x0 <= 400.0 && x1 >= 400.0 && y0 <= 250.0 && y1 >= 250.0, "{x0} {x1} {y0} {y1}");
+        assert!(x1 - x0 <= 2.0 * half + 1.0 && x1 - x0 >= 2.0 * half - 1.0, "{x0} {x1} against half width {half}");
+        let tiny = crate::scene::Camera { near: 1e-40, ..crate::scene::Camera::default() }.view(800, 500);
+        let every = SeenTiles::rect_in_front(&tiny, box_corners(Vec3::new(-1.0, -1.0, -5.0), Vec3::new(1.0, 1.0, 5.0))).expect("a part in front");
+        assert!(![every.0, every.1, every.2, every.3].iter().all(|v| v.is_finite()), "{every:?}");
+    }
+
     /// Boxes reaching behind the eye leave out the tiles that cannot see
     /// the part of them in front: the built-in bunny's floor runs under
     /// and behind the camera, and the tiles above its horizon (the top
