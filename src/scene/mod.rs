@@ -63,8 +63,14 @@ impl Triangle {
     /// Flat-shaded: every corner's normal is exactly (bit for bit) the
     /// geometric normal, so it can be recomputed instead of stored.
     pub fn is_flat(&self) -> bool {
-        let g = self.geometric_normal().to_array().map(f32::to_bits);
-        self.n.iter().all(|n| n.to_array().map(f32::to_bits) == g)
+        self.normals_are(self.geometric_normal())
+    }
+
+    /// Whether every corner's normal is `n`, bit for bit.
+    #[inline]
+    pub fn normals_are(&self, n: Vec3) -> bool {
+        let bits = n.to_array().map(f32::to_bits);
+        self.n.iter().all(|c| c.to_array().map(f32::to_bits) == bits)
     }
 
     pub fn area(&self) -> f32 {
@@ -465,9 +471,7 @@ impl Scene {
         // A flat triangle's normals are all the geometric one: its shading
         // normal is that, not a blend of three equal vectors renormalised
         // (which only adds rounding, and a square root per hit).
-        let g = geometric_normal.to_array().map(f32::to_bits);
-        let flat = tri.n.iter().all(|n| n.to_array().map(f32::to_bits) == g);
-        let mut shading_normal = if flat { geometric_normal } else { (tri.n[0] * b.x + tri.n[1] * b.y + tri.n[2] * b.z).normalize_or(geometric_normal) };
+        let mut shading_normal = if tri.normals_are(geometric_normal) { geometric_normal } else { (tri.n[0] * b.x + tri.n[1] * b.y + tri.n[2] * b.z).normalize_or(geometric_normal) };
         let back_face = geometric_normal.dot(ray.dir) > 0.0;
         if back_face {
             geometric_normal = -geometric_normal;

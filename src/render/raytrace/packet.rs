@@ -1312,10 +1312,6 @@ mod tests {
     use crate::render::{with_shading_hit, Interpolation, PreparedScene, SceneQuery};
     use crate::scene::builtin;
 
-    /// A tile `SeenTiles` leaves out holds no pixel whose eye ray meets
-    /// anything: on every built-in scene without instances or CSG, from its
-    /// own camera and from cameras turned so that the scene lies partly off
-    /// the image or behind the eye, in passes of rows starting mid-image.
     /// `rect_in_front` by hand, the camera at the origin looking down -z
     /// (800x500): a box behind the eye has no rectangle; one reaching from
     /// behind the eye to beyond the near plane has the rectangle of its
@@ -1323,7 +1319,7 @@ mod tests {
     /// so small that its points project beyond the floats gives every tile.
     #[test]
     fn boxes_are_clipped_at_the_near_plane() {
-        let box_corners = |lo: Vec3, hi: Vec3| std::array::from_fn(|k| Vec3::new(if k & 1 == 0 { lo.x } else { hi.x }, if k & 2 == 0 { lo.y } else { hi.y }, if k & 4 == 0 { lo.z } else { hi.z }));
+        let box_corners = |min: Vec3, max: Vec3| crate::render::raytrace::bvh::Aabb { min, max }.corners();
         let view = crate::scene::Camera::default().view(800, 500);
         assert_eq!(SeenTiles::rect_in_front(&view, box_corners(Vec3::new(-1.0, -1.0, 1.0), Vec3::new(1.0, 1.0, 2.0))), None);
         // Only a sliver of a thin slab behind the near plane: nothing.
@@ -1363,6 +1359,11 @@ mod tests {
         assert!(top_row_left_out >= 10, "only {top_row_left_out} of the top row's {} tiles left out", (w as usize).div_ceil(TILE_W));
     }
 
+    /// A tile `SeenTiles` leaves out holds no pixel whose eye ray meets
+    /// anything: on every built-in scene without instances or CSG, from its
+    /// own camera, from cameras turned so that the scene lies partly off
+    /// the image or behind the eye, and from one looking away from it, in
+    /// passes of rows starting mid-image.
     #[test]
     fn tiles_left_out_see_nothing() {
         let mut left_out = 0;
