@@ -190,3 +190,35 @@ fn affine_interpolation_bends_the_uv_checker() {
         assert!(differing(&affine) > 0.05, "{r}: affine differs on only {}", differing(&affine));
     }
 }
+
+/// In every view that colours only what is hit, the rasterizers fill the
+/// pixels no primitive covers with the view's miss colour without making
+/// their eye rays: each such pixel, and each covered one, is what the pixel
+/// replay (the eye ray made and resolved) gives. The teapot leaves most of
+/// the image empty.
+#[test]
+fn rasterized_views_fill_empty_pixels_as_their_replays_show_them() {
+    use pinhole::render::debug::miss_color;
+    use pinhole::render::frame::replay_pixel;
+    let views: Vec<View> = View::ALL.into_iter().filter(|v| miss_color(*v).is_some()).collect();
+    assert!(views.contains(&View::Depth) && views.len() >= 8);
+    let scene = builtin("teapot");
+    let prepared = PreparedScene::new(scene.clone());
+    for view in views {
+        let mut settings = RenderSettings::for_scene(&scene);
+        (settings.width, settings.height, settings.view) = (W, H, view);
+        for name in ["rasterize:fixed", "rasterize:tiled", "rasterize:barycentric"] {
+            let image = render(name, &prepared, &settings);
+            let renderer = pinhole::render::renderer_by_name(name).unwrap();
+            let (mut empty, mut covered) = (0, 0);
+            for y in (0..H).step_by(7) {
+                for x in (0..W).step_by(5) {
+                    let replayed = replay_pixel(renderer.as_ref(), &prepared, &settings, x, y).unwrap().radiance;
+                    assert_eq!(replayed.to_array().map(f32::to_bits), at(&image, x, y).to_array().map(f32::to_bits), "{name}, {view:?}, pixel ({x}, {y})");
+                    if replayed == Vec3::ZERO { empty += 1 } else { covered += 1 }
+                }
+            }
+            assert!(empty > 200 && covered > 50, "{name}, {view:?}: {empty} empty, {covered} covered");
+        }
+    }
+}

@@ -134,6 +134,17 @@ pub fn view_color(view: View, camera: &CameraView, ray: &Ray, hit: Option<&Surfa
     }
 }
 
+/// What `view_color` shows where the eye ray meets nothing, for the views
+/// whose colour there does not depend on the ray: black in the views that
+/// colour only what is hit. `None` for the others (the ray direction view,
+/// and those `view_color` does not draw).
+pub fn miss_color(view: View) -> Option<Radiance> {
+    match view {
+        View::Barycentric | View::Depth | View::Zbuffer | View::Normal | View::GeometricNormal | View::Id | View::TriangleId | View::MaterialId | View::Uv => Some(Vec3::ZERO),
+        View::Shaded | View::Raydir | View::Cost | View::Diff | View::Shadowmap | View::Wireframe | View::Mip => None,
+    }
+}
+
 /// A distinct, stable colour for an id (golden-ratio hue steps).
 pub fn id_color(id: u32) -> Vec3 {
     let h = (id as f32 * 0.618_034).fract();
@@ -264,6 +275,26 @@ mod tests {
             assert!((back - cost).abs() < 0.01 * cost.max(1.0), "{cost} -> {back}");
             assert!((cost_of_t(t_of_cost(cost)) - cost).abs() < 0.01 * cost.max(1.0));
         }
+    }
+
+    /// Where `miss_color` names a view's colour for a miss, `view_color`
+    /// gives exactly that colour whatever the ray (rasterizers fill their
+    /// empty pixels with it without making the ray); the ray direction view
+    /// is not among them.
+    #[test]
+    fn miss_colours_are_what_a_miss_shows() {
+        let cam = crate::scene::Camera::default().view(16, 9);
+        let rays = [Ray::new(Vec3::ZERO, Vec3::X), Ray::new(Vec3::new(1.0, 2.0, 3.0), Vec3::new(0.0, -0.6, 0.8))];
+        let mut named = 0;
+        for view in View::ALL {
+            let Some(c) = miss_color(view) else { continue };
+            named += 1;
+            for ray in &rays {
+                assert_eq!(view_color(view, &cam, ray, None), c, "{view:?}");
+            }
+        }
+        assert_eq!(named, 9, "the views that colour only what is hit");
+        assert!(miss_color(View::Raydir).is_none() && miss_color(View::Shaded).is_none());
     }
 
     #[test]

@@ -467,6 +467,13 @@ pub fn miss_without_ray(job: &PassJob) -> Option<Radiance> {
     (job.settings.view == debug::View::Shaded && scene.environment.is_none()).then_some(scene.render.background)
 }
 
+/// `miss_without_ray`, and in the debug views that colour only what is hit,
+/// their colour for a miss (`debug::miss_color`): what a rasterizer shows
+/// at a pixel no primitive covers, without making its eye ray.
+pub fn view_miss_without_ray(job: &PassJob) -> Option<Radiance> {
+    miss_without_ray(job).or_else(|| debug::miss_color(job.settings.view))
+}
+
 /// The value one sample contributes, given what it sees: `shade()` for the
 /// shaded view, a debug colour otherwise, the background on a miss.
 #[inline]

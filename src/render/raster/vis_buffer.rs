@@ -24,7 +24,7 @@ use super::setup::ScreenTri;
 use crate::math::{Radiance, Ray, Vec3};
 use crate::render::debug::{cost_color, View};
 use crate::render::pixel_record::{CsgABufferRecord, FragmentRecord, NoRecord, PixelTrace, Recorder};
-use crate::render::{miss_without_ray, resolve_counted, resolve_sample, PassJob, RayCounts, SceneQuery};
+use crate::render::{miss_without_ray, resolve_counted, resolve_sample, view_miss_without_ray, PassJob, RayCounts, SceneQuery};
 use crate::render::path_batch::PathPool;
 use super::shade_queue::ShadeQueue;
 use crate::render::shade_batch;
@@ -590,7 +590,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             return Radiance::ZERO;
         }
         if self.id[i].is_none() && !self.is_focus(x, y) {
-            if let Some(background) = miss_without_ray(self.job) {
+            if let Some(background) = view_miss_without_ray(self.job) {
                 return background;
             }
         }
