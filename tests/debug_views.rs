@@ -193,8 +193,9 @@ fn affine_interpolation_bends_the_uv_checker() {
 
 /// In every view that colours only what is hit, the rasterizers fill the
 /// pixels no primitive covers with the view's miss colour without making
-/// their eye rays: each such pixel, and each covered one, is what the pixel
-/// replay (the eye ray made and resolved) gives. The teapot leaves most of
+/// their eye rays, and colour the covered ones from hit records built eight
+/// at a time: each such pixel, empty or covered, is what the pixel replay
+/// (its eye ray made, its hit built alone) gives. The teapot leaves most of
 /// the image empty.
 #[test]
 fn rasterized_views_fill_empty_pixels_as_their_replays_show_them() {

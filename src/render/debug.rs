@@ -105,7 +105,15 @@ pub fn view_color(view: View, camera: &CameraView, ray: &Ray, hit: Option<&Surfa
     if view == View::Raydir {
         return (ray.dir + Vec3::ONE) * 0.5;
     }
-    let Some(h) = hit else { return Vec3::ZERO };
+    match hit {
+        Some(h) => surface_color(view, camera, h),
+        None => Vec3::ZERO,
+    }
+}
+
+/// `view_color` of a sample that sees `h`, for every view but the ray
+/// direction's (which `view_color` answers from the ray alone).
+pub fn surface_color(view: View, camera: &CameraView, h: &SurfaceHit) -> Radiance {
     match view {
         // Shaded is resolved by shade(); cost by the renderer, which counted the work.
         // Cost is coloured by the renderer, which counted the work; diff is a

@@ -31,6 +31,20 @@ pub fn batchable(job: &PassJob) -> bool {
         && matches!(job.settings.shadows, ShadowMode::Ray | ShadowMode::None)
 }
 
+/// Whether a rasterizer resolves `job`'s visible samples through batches:
+/// shading that `batchable` takes, or a debug view that colours only what
+/// is hit (`debug::miss_color`), which then colours each batch's records.
+pub fn resolved_in_batches(job: &PassJob) -> bool {
+    batchable(job) || (job.settings.view != View::Shaded && crate::render::debug::miss_color(job.settings.view).is_some())
+}
+
+/// The interpolation a batch of `job`'s samples is built with: the
+/// shading's in the shaded view; debug views colour the hit as the eye ray
+/// found it (`Scene::triangle_hit`'s record, which Phong's is).
+pub fn build_interpolation(job: &PassJob) -> Interpolation {
+    if job.settings.view == View::Shaded { job.settings.interpolation } else { Interpolation::Phong }
+}
+
 /// Up to eight samples that see a surface, with where their results go.
 pub struct Batch {
     len: usize,
@@ -95,9 +109,8 @@ impl Batch {
         self.pending_ray_count = 0;
     }
 
-    /// Sample `i`'s surface as `shade()` is handed it (for tests; shading
-    /// assembles records from `hits` itself).
-    #[cfg(test)]
+    /// Sample `i`'s surface as `shade()` is handed it (debug views colour
+    /// it; shading assembles records from `hits` itself).
     pub fn hit(&self, i: usize) -> SurfaceHit {
         self.hits.get(i)
     }

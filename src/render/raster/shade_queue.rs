@@ -10,6 +10,7 @@ use crate::math::Radiance;
 use crate::render::path_batch::{self, PathPool};
 use crate::render::raytrace::packet::{shadow_packets, Packet};
 use crate::render::shade_batch::{self, Batch, LANES};
+use crate::render::debug::{self, View};
 use crate::render::{PassJob, RayCounts, SceneQuery, ShadowMode};
 
 /// Batches queued before their shadow packets are traced: eight batches of
@@ -67,7 +68,18 @@ impl ShadeQueue {
         }
         let batches = &mut self.batches[..queued];
         for batch in batches.iter_mut() {
-            batch.build_pending(&job.prepared.scene, job.view, job.settings.interpolation);
+            batch.build_pending(&job.prepared.scene, job.view, shade_batch::build_interpolation(job));
+        }
+        let view = job.settings.view;
+        if view != View::Shaded {
+            // A debug view that colours only what is hit: each record's colour.
+            for batch in batches.iter_mut() {
+                for j in 0..batch.len() {
+                    out[batch.slots[j]] = debug::surface_color(view, job.view, &batch.hit(j));
+                }
+                batch.clear();
+            }
+            return;
         }
         let packets = if job.settings.shadows == ShadowMode::Ray { query.bvh_packets() } else { None };
         if let Some(bvh) = packets {

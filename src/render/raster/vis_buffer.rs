@@ -24,7 +24,7 @@ use super::setup::ScreenTri;
 use crate::math::{Radiance, Ray, Vec3};
 use crate::render::debug::{cost_color, View};
 use crate::render::pixel_record::{CsgABufferRecord, FragmentRecord, NoRecord, PixelTrace, Recorder};
-use crate::render::{miss_without_ray, resolve_counted, resolve_sample, view_miss_without_ray, PassJob, RayCounts, SceneQuery};
+use crate::render::{resolve_counted, resolve_sample, view_miss_without_ray, PassJob, RayCounts, SceneQuery};
 use crate::render::path_batch::PathPool;
 use super::shade_queue::ShadeQueue;
 use crate::render::shade_batch;
@@ -658,7 +658,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
     /// visible surface once here; forward mode already shaded it. Counts one
     /// primary sample per pixel.
     pub fn resolve_into(&mut self, out: &mut [Radiance], out_stride: usize, x_offset: usize) -> RayCounts {
-        if !self.forward && !self.cost_view() && self.stencil.is_empty() && shade_batch::batchable(self.job) {
+        if !self.forward && !self.cost_view() && self.stencil.is_empty() && shade_batch::resolved_in_batches(self.job) {
             return self.resolve_batched(out, out_stride, x_offset);
         }
         let r = self.rect;
@@ -678,7 +678,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
     /// one, as `resolve` does them.
     fn resolve_batched(&mut self, out: &mut [Radiance], out_stride: usize, x_offset: usize) -> RayCounts {
         let r = self.rect;
-        let interpolation = self.job.settings.interpolation;
+        let interpolation = shade_batch::build_interpolation(self.job);
         let lights = self.job.prepared.scene.lights.len();
         let mut queue = self.queue.take().unwrap_or_else(|| ShadeQueue::new(lights));
         let mut paths = std::mem::take(&mut self.paths);
@@ -691,7 +691,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         let plain = !scene.has_textures() && self.key == DepthKey::NegInvZ;
         // What an empty pixel shows when no ray is needed for it (most of a
         // frame): `resolve`'s answer there without its per-pixel checks.
-        let background = miss_without_ray(self.job);
+        let background = view_miss_without_ray(self.job);
         // No pixel is recorded or left out by this pass: `ordinary` below
         // holds everywhere, without its per-pixel lookups.
         let all_ordinary = !R::ENABLED && self.job.active.is_none();
