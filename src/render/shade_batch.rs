@@ -35,7 +35,7 @@ pub fn batchable(job: &PassJob) -> bool {
 /// shading that `batchable` takes, or a debug view that colours only what
 /// is hit (`debug::miss_color`), which then colours each batch's records.
 pub fn resolved_in_batches(job: &PassJob) -> bool {
-    batchable(job) || (job.settings.view != View::Shaded && crate::render::debug::miss_color(job.settings.view).is_some())
+    batchable(job) || crate::render::debug::miss_color(job.settings.view).is_some()
 }
 
 /// The interpolation a batch of `job`'s samples is built with: the

@@ -72,7 +72,8 @@ impl ShadeQueue {
         }
         let view = job.settings.view;
         if view != View::Shaded {
-            // A debug view that colours only what is hit: each record's colour.
+            // Only the debug views that colour what is hit come here
+            // (`shade_batch::resolved_in_batches`): each record's colour.
             for batch in batches.iter_mut() {
                 for j in 0..batch.len() {
                     out[batch.slots[j]] = debug::surface_color(view, job.view, &batch.hit(j));
