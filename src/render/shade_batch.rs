@@ -423,14 +423,9 @@ pub fn shadow_rays_of(scene: &Scene, hits: &HitLanes, len: usize, light: &Light,
     if len == 0 {
         return;
     }
-    // Filled in place: a value this large (about 260 bytes) returned from
-    // the dispatched closure is copied out through a call to `memcpy`.
-    let mut rays = ShadowRays::EMPTY;
-    let mut lit = 0u8;
-    dispatch!(simd_level(), simd => {
+    let (rays, lit) = dispatch!(simd_level(), simd => {
         let inc = lighting::incidence(light, V3::from_soa(simd, &hits.position), V3::from_soa(simd, &hits.shading_normal));
-        rays.fill(hits, &inc, bump, lift);
-        lit = mask_bits(inc.illuminates());
+        (ShadowRays::new(hits, &inc, bump, lift), mask_bits(inc.illuminates()))
     });
     let mut m = lit & ((1u32 << len) - 1) as u8;
     while m != 0 {
@@ -516,35 +511,28 @@ struct ShadowRays {
 }
 
 impl ShadowRays {
-    const EMPTY: ShadowRays = ShadowRays { origin: [[0.0; 8]; 3], w_i: [[0.0; 8]; 3], distance: [0.0; 8], t_max: [0.0; 8], bump: 0.0, lifted: 0 };
-
-    /// The rays `new` makes, written over `self`.
     #[inline(always)]
-    fn fill<S: Simd>(&mut self, hits: &HitLanes, inc: &IncidenceLanes<f32x8<S>>, bump: f32, lift: bool) {
+    fn new<S: Simd>(hits: &HitLanes, inc: &IncidenceLanes<f32x8<S>>, bump: f32, lift: bool) -> ShadowRays {
         let simd = inc.distance.simd;
         let position = V3::from_soa(simd, &hits.position);
         let bump_lanes = inc.distance.splat(bump);
-        self.lifted = 0;
+        let mut lifted = 0;
         if lift {
             let mut triangles = 0u8;
             for (i, kind) in hits.kind.iter().enumerate() {
                 triangles |= ((*kind == PrimitiveKind::Triangle) as u8) << i;
             }
             let facing = V3::from_soa(simd, &hits.geometric_normal).dot(inc.w_i).gt(bump_lanes.splat(0.0));
-            self.lifted = triangles & !mask_bits(facing);
+            lifted = triangles & !mask_bits(facing);
         }
-        self.origin = (position + inc.w_i.scale(bump_lanes)).to_soa();
-        self.w_i = inc.w_i.to_soa();
-        self.distance = inc.distance.into();
-        self.t_max = (inc.distance - bump_lanes).into();
-        self.bump = bump;
-    }
-
-    #[inline(always)]
-    fn new<S: Simd>(hits: &HitLanes, inc: &IncidenceLanes<f32x8<S>>, bump: f32, lift: bool) -> ShadowRays {
-        let mut rays = ShadowRays::EMPTY;
-        rays.fill(hits, inc, bump, lift);
-        rays
+        ShadowRays {
+            origin: (position + inc.w_i.scale(bump_lanes)).to_soa(),
+            w_i: inc.w_i.to_soa(),
+            distance: inc.distance.into(),
+            t_max: (inc.distance - bump_lanes).into(),
+            bump,
+            lifted,
+        }
     }
 
     /// Lane `i`'s ray and far end, as `Incidence::shadow_ray` gives them
