@@ -9,6 +9,7 @@ pub mod bsdf_sampling;
 pub mod csg;
 pub mod debug;
 pub mod differentials;
+pub mod finite;
 pub mod frame;
 pub mod gi;
 pub mod kd_tree;
@@ -342,7 +343,8 @@ pub struct PassJob<'a> {
     /// `--gi photons`: the photon map, built before the passes.
     pub photons: Option<&'a photon_map::PhotonMap>,
     /// Adaptive sampling: which pixels of `rows` (row-major, `width` per row)
-    /// still take samples; the others are left as they are in `out`.
+    /// still take samples; the others are left as they are in `out` (but
+    /// a renderer that admits its samples blackens a non-finite one there).
     pub active: Option<&'a [bool]>,
     /// Rows to render; `out` holds `width * rows.len()` pixels.
     pub rows: Range<u32>,
@@ -387,6 +389,13 @@ pub trait Renderer: Sync + Send {
     /// may trace a pixel's samples of several passes together.
     fn render_passes(&self, jobs: &[PassJob], out: &mut [Radiance]) -> RayCounts {
         render_passes_in_turn(self, jobs, out)
+    }
+
+    /// Whether `render_pass` leaves only finite values in `out`: each band
+    /// put through `finite::admit_all` as soon as it is written, while it
+    /// is in cache. A one-sample frame then skips its own scan of the pass.
+    fn admits_its_samples(&self) -> bool {
+        false
     }
 
     /// The rows of a chunk when a frame of many passes is rendered chunk by

@@ -10,22 +10,13 @@ use crate::render::sampling::luminance;
 use crate::render::debug::{self, View};
 use crate::render::raytrace::brute::BruteForce;
 use crate::render::wireframe::{self, LineAlgorithm};
+use crate::render::finite::admit_all;
 use crate::render::{sample_offset, PassJob, PreparedScene, RayCounts, RenderSettings, Renderer};
 use rayon::prelude::*;
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
-/// What a sample adds to its pixel: itself when finite, nothing otherwise.
-/// A NaN or infinite sample (a degenerate hit, a division by zero in a
-/// shading formula) would otherwise poison the pixel for every later pass.
-#[inline]
-pub fn admitted(sample: Radiance) -> Radiance {
-    // x * 0 is a zero exactly when x is finite (NaN for NaN and the
-    // infinities): one comparison, no branch per channel, where every pixel
-    // of every pass comes through.
-    let finite = (sample * 0.0).dot(Radiance::ONE) == 0.0;
-    if finite { sample } else { Radiance::ZERO }
-}
+pub use crate::render::finite::admitted;
 
 /// Adds one pass's sample to a pixel's sum. With one sample per pixel the
 /// sample is stored as it is: adding it to zero would turn -0 into +0.
@@ -302,16 +293,12 @@ impl Accumulator {
                 }
             }
             if self.spp == 1 {
-                // A read-only scan in parallel: a chunk is rewritten only
-                // when one of its samples is not finite (rarely), so the
-                // frame costs one pass of loads.
-                self.sum[span.clone()].par_chunks_mut(8192).for_each(|chunk| {
-                    if !crate::math::lanes::all_finite(bytemuck::cast_slice(chunk)) {
-                        for s in chunk.iter_mut() {
-                            *s = admitted(*s);
-                        }
-                    }
-                });
+                // A renderer that checks its bands as it writes them has
+                // left nothing to do; for the others, a read-only scan in
+                // parallel (`admit_all`).
+                if !renderer.admits_its_samples() {
+                    self.sum[span.clone()].par_chunks_mut(8192).for_each(admit_all);
+                }
             } else {
                 let adaptive = self.adaptive.as_mut().map(|a| (&a.active[span.clone()], &mut a.samples[span.clone()]));
                 add_pass(&mine, &mut self.sum[span.clone()], &mut self.sum_sq[span.clone()], adaptive, self.spp);
@@ -590,8 +577,6 @@ mod tests {
             a.render_band(&Poisoned, &p, 5, &AtomicBool::new(false)).unwrap();
             assert!(a.mean_rows(0..s.height).iter().all(|c| c.is_finite()), "spp {spp}");
         }
-        assert_eq!(admitted(Radiance::new(1.0, f32::NAN, 0.0)), Radiance::ZERO);
-        assert_eq!(admitted(Radiance::new(1.0, 2.0, 3.0)), Radiance::new(1.0, 2.0, 3.0));
     }
 
     #[test]

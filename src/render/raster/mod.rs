@@ -86,6 +86,11 @@ impl Renderer for Rasterizer {
         pass::render(self.method, job, out)
     }
 
+    /// `pass::render` checks each band (or row of tiles) as it resolves it.
+    fn admits_its_samples(&self) -> bool {
+        true
+    }
+
     fn check(&self, scene: &crate::scene::Scene, settings: &super::RenderSettings) -> Result<(), String> {
         if self.method == Method::Painter && !scene.csgs.is_empty() {
             return Err("rasterize:painter cannot draw csg objects (a draw order cannot resolve their intervals); use another rasterizer".into());

@@ -39,6 +39,11 @@ impl Renderer for BvhRayTracer {
         passes.unwrap_or_else(|| crate::render::render_passes_in_turn(self, jobs, out))
     }
 
+    /// `cast_pass_packets` and `cast_pass` check each band as they finish it.
+    fn admits_its_samples(&self) -> bool {
+        true
+    }
+
     fn passes_at_once(&self) -> u32 {
         super::packet::MAX_PASSES as u32
     }

@@ -36,6 +36,7 @@ pub fn cast_pass<Q: SceneQuery>(job: &PassJob, query: &Q, out: &mut [Radiance]) 
                     *px = cast_pixel(job, query, x as u32, y, &mut counts, &mut NoRecord);
                 }
             }
+            crate::render::finite::admit_all(row);
             counts
         })
         .reduce(RayCounts::default, |mut a, b| {

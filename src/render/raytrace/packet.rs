@@ -785,6 +785,7 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
                     }
                 }
                 context.paths.follow_into(job, query, &mut counts, band);
+                crate::render::finite::admit_all(band);
                 counts
             },
         )

@@ -1,0 +1,93 @@
+//! Keeping NaN and infinity out of pixels. A degenerate hit or a division
+//! by zero in a shading formula can make a sample non-finite; it would then
+//! poison its pixel for every later pass. A sample is admitted as itself
+//! when finite and as black otherwise.
+//!
+//! A one-sample frame is rendered straight into the frame's sum, so its
+//! values must be checked after they are written. Renderers that write in
+//! bands check each band (`admit_all`) as soon as it is finished, while it
+//! is still in cache, and say so (`Renderer::admits_its_samples`); for the
+//! others the frame scans the whole pass afterwards, a second trip through
+//! memory.
+
+use crate::math::Radiance;
+
+/// What a sample adds to its pixel: itself when finite, nothing otherwise.
+#[inline]
+pub fn admitted(sample: Radiance) -> Radiance {
+    // x * 0 is a zero exactly when x is finite (NaN for NaN and the
+    // infinities): one comparison, no branch per channel, where every pixel
+    // of every pass comes through.
+    let finite = (sample * 0.0).dot(Radiance::ONE) == 0.0;
+    if finite { sample } else { Radiance::ZERO }
+}
+
+/// Replaces every non-finite value of `values` by black. A read-only scan
+/// in lanes: the values are rewritten only when one of them is not finite
+/// (rarely).
+pub fn admit_all(values: &mut [Radiance]) {
+    if !crate::math::lanes::all_finite(bytemuck::cast_slice(values)) {
+        for v in values.iter_mut() {
+            *v = admitted(*v);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn non_finite_values_become_black_and_the_others_stay() {
+        assert_eq!(admitted(Radiance::new(1.0, f32::NAN, 0.0)), Radiance::ZERO);
+        assert_eq!(admitted(Radiance::new(1.0, 2.0, 3.0)), Radiance::new(1.0, 2.0, 3.0));
+        let fine: Vec<Radiance> = (0..37).map(|i| Radiance::new(i as f32, -(i as f32), f32::MAX)).collect();
+        for at in 0..fine.len() {
+            for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+                let mut v = fine.clone();
+                v[at].y = bad;
+                admit_all(&mut v);
+                assert_eq!(v[at], Radiance::ZERO, "{bad} at {at}");
+                assert!(v.iter().enumerate().all(|(i, &x)| i == at || x == fine[i]), "{bad} at {at}");
+            }
+        }
+        let mut same = fine.clone();
+        admit_all(&mut same);
+        assert_eq!(same, fine);
+    }
+}
+
+#[cfg(test)]
+mod renderer_tests {
+    use crate::math::Radiance;
+    use crate::render::raytrace::bvh_renderer::BvhRayTracer;
+    use crate::render::{raster, PassJob, PreparedScene, RenderSettings, Renderer};
+    use crate::scene::builtin;
+    use std::sync::atomic::AtomicBool;
+
+    /// A renderer that says it admits its samples leaves nothing but finite
+    /// values in its output, whatever was there before: here a pass whose
+    /// pixels are all inactive (so none is written) over an output full of
+    /// NaN. Without the band check the NaN would stay, and a one-sample
+    /// frame, which then skips its own scan, would show it.
+    #[test]
+    fn renderers_that_admit_their_samples_leave_no_nan_in_their_output() {
+        let prepared = PreparedScene::new(builtin::load_builtin("spheres").unwrap().unwrap());
+        let (w, h) = (40u32, 21u32);
+        let view = prepared.scene.camera.view(w, h);
+        let settings = RenderSettings::for_scene(&prepared.scene);
+        let cancel = AtomicBool::new(false);
+        let inactive = vec![false; (w * h) as usize];
+        let mut renderers: Vec<Box<dyn Renderer>> = raster::renderers();
+        renderers.push(Box::new(BvhRayTracer));
+        for renderer in &renderers {
+            assert!(renderer.admits_its_samples(), "{}", renderer.name());
+            for active in [Some(&inactive[..]), None] {
+                let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: glam::Vec2::splat(0.5), sample: 0, photons: None, active, rows: 0..h, cancel: &cancel };
+                let mut out = vec![Radiance::splat(f32::NAN); (w * h) as usize];
+                renderer.render_pass(&job, &mut out);
+                assert!(out.iter().all(|v| v.is_finite()), "{} (active: {})", renderer.name(), active.is_none());
+            }
+        }
+    }
+}
