@@ -60,7 +60,8 @@ mod tests {
 #[cfg(test)]
 mod renderer_tests {
     use crate::math::Radiance;
-    use crate::render::raytrace::bvh_renderer::BvhRayTracer;
+    use crate::render::raytrace::brute::BruteForce;
+use crate::render::raytrace::bvh_renderer::BvhRayTracer;
     use crate::render::{raster, PassJob, PreparedScene, RenderSettings, Renderer};
     use crate::scene::builtin;
     use std::sync::atomic::AtomicBool;
@@ -80,6 +81,7 @@ mod renderer_tests {
         let inactive = vec![false; (w * h) as usize];
         let mut renderers: Vec<Box<dyn Renderer>> = raster::renderers();
         renderers.push(Box::new(BvhRayTracer));
+        renderers.push(Box::new(BruteForce));
         for renderer in &renderers {
             assert!(renderer.admits_its_samples(), "{}", renderer.name());
             for active in [Some(&inactive[..]), None] {

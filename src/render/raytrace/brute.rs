@@ -24,6 +24,11 @@ impl Renderer for BruteForce {
         cast_pass(job, &BruteQuery(job.prepared), out)
     }
 
+    /// `cast_pass` checks each row as it finishes it.
+    fn admits_its_samples(&self) -> bool {
+        true
+    }
+
     fn trace_pixel(&self, job: &PassJob, x: u32, y: u32, rec: &mut PixelTrace) -> Option<Radiance> {
         Some(cast_pixel(job, &BruteQuery(job.prepared), x, y, &mut RayCounts::default(), rec))
     }
