@@ -61,7 +61,7 @@ mod tests {
 mod renderer_tests {
     use crate::math::Radiance;
     use crate::render::raytrace::brute::BruteForce;
-use crate::render::raytrace::bvh_renderer::BvhRayTracer;
+    use crate::render::raytrace::bvh_renderer::BvhRayTracer;
     use crate::render::{raster, PassJob, PreparedScene, RenderSettings, Renderer};
     use crate::scene::builtin;
     use std::sync::atomic::AtomicBool;
