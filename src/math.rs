@@ -2,6 +2,7 @@
 
 pub mod lanes;
 pub mod prefetch;
+pub mod streaming;
 pub mod rounding;
 
 pub use glam::{Mat3, Vec2, Vec3};

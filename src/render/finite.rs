@@ -8,9 +8,12 @@
 //! bands check each band (`admit_all`) as soon as it is finished, while it
 //! is still in cache, and say so (`Renderer::admits_its_samples`); for the
 //! others the frame scans the whole pass afterwards, a second trip through
-//! memory.
+//! memory. A value streamed past the cache (`math::streaming`) is admitted
+//! before it is stored, and the band's check leaves it out
+//! (`admit_rows_except`).
 
 use crate::math::Radiance;
+use std::ops::Range;
 
 /// What a sample adds to its pixel: itself when finite, nothing otherwise.
 #[inline]
@@ -33,9 +36,41 @@ pub fn admit_all(values: &mut [Radiance]) {
     }
 }
 
+/// `admit_all` over each range of `rows` (in ascending order, apart) of
+/// `values`, except the ranges `skipped` (ascending, each within one row):
+/// values a renderer streamed past the cache, admitted before they were
+/// stored, which a scan would read back from memory.
+pub fn admit_rows_except(values: &mut [Radiance], rows: impl Iterator<Item = Range<usize>>, skipped: &[Range<usize>]) {
+    let mut skip = skipped.iter().peekable();
+    for row in rows {
+        let mut from = row.start;
+        while let Some(s) = skip.next_if(|s| s.start < row.end) {
+            admit_all(&mut values[from..s.start]);
+            from = s.end;
+        }
+        admit_all(&mut values[from..row.end]);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Rows of ten values out of every twelve, with zero, one or two
+    /// ranges skipped in a row (at its start, middle and end): every NaN
+    /// outside the skipped ranges becomes black, those inside stay.
+    #[test]
+    fn rows_are_admitted_except_the_skipped_ranges() {
+        let rows = (0..4).map(|r| 12 * r + 1..12 * r + 11);
+        let skipped = [13..16, 18..20, 25..35, 42..47];
+        let mut values = vec![Radiance::NAN; 48];
+        admit_rows_except(&mut values, rows.clone(), &skipped);
+        for (i, v) in values.iter().enumerate() {
+            let in_row = rows.clone().any(|r| r.contains(&i));
+            let kept = skipped.iter().any(|s| s.contains(&i));
+            assert_eq!(v.is_nan(), !in_row || kept, "value {i}");
+        }
+    }
 
     #[test]
     fn non_finite_values_become_black_and_the_others_stay() {

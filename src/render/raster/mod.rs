@@ -86,7 +86,8 @@ impl Renderer for Rasterizer {
         pass::render(self.method, job, out)
     }
 
-    /// `pass::render` checks each band (or row of tiles) as it resolves it.
+    /// Each region's resolve (`VisBuffer::resolve_into`) checks the values it
+    /// writes as it finishes them.
     fn admits_its_samples(&self) -> bool {
         true
     }

@@ -14,6 +14,7 @@
 use super::vis_buffer::{FragmentRecorder, VisBuffer};
 use crate::math::{Radiance, Vec2};
 use crate::render::debug::cost_color;
+use crate::render::finite::admit_all;
 use crate::render::{RayCounts, SceneQuery};
 use crate::scene::PrimitiveId;
 
@@ -84,6 +85,7 @@ pub fn resolve<Q: SceneQuery, R: FragmentRecorder>(vbs: &mut [VisBuffer<Q, R>], 
 
 /// Resolves the common region of `vbs` into rows of `out_stride` pixels
 /// starting at column `x_offset`, and returns the counts of every layer.
+/// Each row is put through `admit_all` as soon as it is written.
 pub fn resolve_into<Q: SceneQuery, R: FragmentRecorder>(vbs: &mut [VisBuffer<Q, R>], out: &mut [Radiance], out_stride: usize, x_offset: usize) -> RayCounts {
     let r = vbs[0].rect;
     let w = r.width() as usize;
@@ -94,6 +96,7 @@ pub fn resolve_into<Q: SceneQuery, R: FragmentRecorder>(vbs: &mut [VisBuffer<Q, 
             *px = resolve(vbs, i, x, y);
             i += 1;
         }
+        admit_all(line);
     }
     let mut counts = RayCounts::default();
     for vb in vbs {

@@ -36,7 +36,6 @@ use crate::math::{Radiance, Vec2};
 use crate::render::raytrace::bvh::BvhQuery;
 use crate::render::pixel_record::PixelTrace;
 use crate::render::{debug, PassJob, PreparedScene, RayCounts, SceneQuery, ShadowMode};
-use crate::render::finite::admit_all;
 use rayon::prelude::*;
 use std::ops::Range;
 
@@ -342,7 +341,6 @@ fn render_regions(method: Method, job: &PassJob, out: &mut [Radiance]) -> RayCou
                     }
                     counts += resolve_region(&mut vbs, chunk, width as usize, rect.x0 as usize);
                 }
-                admit_all(chunk);
                 counts
             })
             .reduce(RayCounts::default, sum);
@@ -372,9 +370,7 @@ fn render_regions(method: Method, job: &PassJob, out: &mut [Radiance]) -> RayCou
                 for (l, vb) in layers.iter().zip(vbs.iter_mut()) {
                     l.raster(vb, b);
                 }
-                let counts = resolve_region(vbs, chunk, width as usize, 0);
-                admit_all(chunk);
-                counts
+                resolve_region(vbs, chunk, width as usize, 0)
             },
         )
         .reduce(RayCounts::default, sum)

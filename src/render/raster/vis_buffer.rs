@@ -21,7 +21,9 @@ use crate::math::lanes::{mask_bits, simd_level};
 use fearless_simd::{dispatch, f32x8, Simd, SimdBase, SimdFrom};
 use super::rect::{PixelRect, TestCounter};
 use super::setup::ScreenTri;
-use crate::math::{Radiance, Ray, Vec3};
+use crate::math::{streaming, Radiance, Ray, Vec3};
+use crate::render::finite::{admit_all, admit_rows_except, admitted};
+use std::ops::Range;
 use crate::render::debug::{cost_color, View};
 use crate::render::pixel_record::{CsgABufferRecord, FragmentRecord, NoRecord, PixelTrace, Recorder};
 use crate::render::{resolve_counted, resolve_sample, view_miss_without_ray, PassJob, RayCounts, SceneQuery};
@@ -139,6 +141,10 @@ pub struct VisBuffer<'j, 'a, Q: SceneQuery, R: FragmentRecorder = NoRecord> {
     /// with the buffer (empty between regions), made at the first region
     /// that shades in batches rather than in every region or tile.
     queue: Option<ShadeQueue>,
+    /// `resolve_batched`'s runs of the output streamed past the cache
+    /// (ranges of slots): the rest is admitted once the region is shaded;
+    /// kept like `queue`.
+    streamed: Vec<Range<usize>>,
 }
 
 impl<'j, 'a, Q: SceneQuery> VisBuffer<'j, 'a, Q, NoRecord> {
@@ -192,6 +198,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             stencil_lights: 0,
             paths: PathPool::new(),
             queue: None,
+            streamed: Vec::new(),
         }
     }
 
@@ -656,7 +663,8 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
     /// Resolves every pixel of the region into rows of `out_stride` pixels of
     /// `out` starting at column `x_offset`: early-depth mode shades each
     /// visible surface once here; forward mode already shaded it. Counts one
-    /// primary sample per pixel.
+    /// primary sample per pixel. Every value written is admitted
+    /// (`finite::admitted`) before this returns, while it is in cache.
     pub fn resolve_into(&mut self, out: &mut [Radiance], out_stride: usize, x_offset: usize) -> RayCounts {
         if !self.forward && !self.cost_view() && self.stencil.is_empty() && shade_batch::resolved_in_batches(self.job) {
             return self.resolve_batched(out, out_stride, x_offset);
@@ -669,6 +677,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
                 *px = self.resolve(i, x, y);
                 i += 1;
             }
+            admit_all(line);
         }
         std::mem::take(&mut self.counts)
     }
@@ -700,20 +709,34 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         // Where that holds and no ray is needed, a row's empty pixels are
         // filled at once, and the loop below visits only the others
         // (`visible`, columns of the row); else it visits every pixel.
-        let fill = if all_ordinary { background } else { None };
+        // (Admitted here: streamed past the cache, it is not read back.)
+        let fill = if all_ordinary { background.map(admitted) } else { None };
         let mut visible: Vec<u32> = Vec::with_capacity(self.stride);
+        // The runs of `out` streamed (not in cache), by row: the rest of
+        // each row is admitted at the end.
+        let mut streamed = std::mem::take(&mut self.streamed);
         for (row, y) in (r.y0..r.y1).enumerate() {
             let line = row * out_stride + x_offset;
             let start = row * self.stride;
             visible.clear();
             match fill {
                 Some(value) => {
-                    for (col, (o, id)) in out[line..line + self.stride].iter_mut().zip(&self.id[start..start + self.stride]).enumerate() {
-                        if id.is_none() {
-                            *o = value;
-                            primary += 1;
-                        } else {
+                    // Runs of empty pixels, filled at once (streamed past
+                    // the cache: nothing reads them while the frame is drawn).
+                    let (ids, row_out) = (&self.id[start..start + self.stride], &mut out[line..line + self.stride]);
+                    let mut col = 0;
+                    while col < ids.len() {
+                        let empty_from = col;
+                        while col < ids.len() && ids[col].is_none() {
+                            col += 1;
+                        }
+                        if streaming::fill(&mut row_out[empty_from..col], value) {
+                            streamed.push(line + empty_from..line + col);
+                        }
+                        primary += (col - empty_from) as u64;
+                        while col < ids.len() && !ids[col].is_none() {
                             visible.push(col as u32);
+                            col += 1;
                         }
                     }
                 }
@@ -755,6 +778,11 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         }
         queue.flush(self.job, self.query, &mut paths, &mut self.counts, out);
         paths.follow_into(self.job, self.query, &mut self.counts, out);
+        streaming::fence();
+        let rows = (0..r.height() as usize).map(|row| row * out_stride + x_offset..row * out_stride + x_offset + self.stride);
+        admit_rows_except(out, rows, &streamed);
+        streamed.clear();
+        self.streamed = streamed;
         self.paths = paths;
         self.queue = Some(queue);
         self.counts.primary += primary;
