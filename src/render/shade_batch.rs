@@ -164,6 +164,18 @@ impl Batch {
         self.len += 1;
     }
 
+    /// Eight `push_eye_triangle`s at once into an empty batch: lane k is
+    /// the sample of `samples` lane k, of pixel index `pixels[k]`, meant
+    /// for `slots[k]`; `sample` is the pass's sample index.
+    #[inline]
+    pub fn fill_eye_triangles(&mut self, samples: &EyeSamples, pixels: [u32; LANES], sample: u32, slots: [usize; LANES]) {
+        assert!(self.len == 0 && samples.len == LANES, "fill_eye_triangles needs an empty batch and eight samples");
+        self.pending = *samples;
+        self.pending_lanes = IN_ORDER;
+        (self.pixels, self.samples, self.slots) = (pixels, [sample; LANES], slots);
+        self.len = LANES;
+    }
+
     /// Builds the records `push_eye_triangle` left pending, as `push` hands
     /// them to `shade()` with `interpolation`; `view` makes the eye rays.
     pub fn build_pending(&mut self, scene: &Scene, view: &CameraView, interpolation: Interpolation) {

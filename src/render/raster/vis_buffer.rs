@@ -30,6 +30,7 @@ use crate::render::{resolve_counted, resolve_sample, view_miss_without_ray, Pass
 use crate::render::path_batch::PathPool;
 use super::shade_queue::ShadeQueue;
 use crate::render::shade_batch;
+use crate::scene::hit_lanes::EyeSamples;
 use crate::render::shadow_volume::split_depth;
 use super::stencil::{PixelRay, StencilSetup};
 use crate::render::csg::{Boundary, SurfaceRef};
@@ -715,6 +716,10 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         // The runs of `out` streamed (not in cache), by row: the rest of
         // each row is admitted at the end.
         let mut streamed = std::mem::take(&mut self.streamed);
+        // Plain triangles' samples gathered eight at a time, handed to the
+        // queue together (a batch's counters are not touched per sample).
+        let mut eight = EyeSamples::default();
+        let (mut eight_pixels, mut eight_slots) = ([0u32; shade_batch::LANES], [0usize; shade_batch::LANES]);
         for (row, y) in (r.y0..r.y1).enumerate() {
             let line = row * out_stride + x_offset;
             let start = row * self.stride;
@@ -722,20 +727,38 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             match fill {
                 Some(value) => {
                     // Runs of empty pixels, filled at once (streamed past
-                    // the cache: nothing reads them while the frame is drawn).
-                    let (ids, row_out) = (&self.id[start..start + self.stride], &mut out[line..line + self.stride]);
+                    // the cache: nothing reads them while the frame is
+                    // drawn), and runs of covered ones, whose plain
+                    // triangles go straight into the queue; the loop below
+                    // takes the others.
+                    let ids = &self.id[start..start + self.stride];
+                    let payload = &self.payload[start..start + self.stride];
                     let mut col = 0;
                     while col < ids.len() {
                         let empty_from = col;
                         while col < ids.len() && ids[col].is_none() {
                             col += 1;
                         }
-                        if streaming::fill(&mut row_out[empty_from..col], value) {
+                        if streaming::fill(&mut out[line + empty_from..line + col], value) {
                             streamed.push(line + empty_from..line + col);
                         }
                         primary += (col - empty_from) as u64;
                         while col < ids.len() && !ids[col].is_none() {
-                            visible.push(col as u32);
+                            let id = ids[col];
+                            if plain && id.kind() == crate::scene::PrimitiveKind::Triangle {
+                                let x = r.x0 + col as u32;
+                                primary += 1;
+                                shaded += 1;
+                                let [b1, b2] = payload[col];
+                                let k = eight.len;
+                                (eight_pixels[k], eight_slots[k]) = (self.job.pixel_index(x, y), line + col);
+                                eight.push(id.index(), b1, b2, self.job.sample_position(x, y));
+                                if eight.len == shade_batch::LANES {
+                                    queue_eye_samples(self.job, self.query, &mut self.counts, &mut queue, &mut eight, &eight_pixels, &eight_slots, &mut paths, out);
+                                }
+                            } else {
+                                visible.push(col as u32);
+                            }
                             col += 1;
                         }
                     }
@@ -776,6 +799,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
                 }
             }
         }
+        queue_eye_samples(self.job, self.query, &mut self.counts, &mut queue, &mut eight, &eight_pixels, &eight_slots, &mut paths, out);
         queue.flush(self.job, self.query, &mut paths, &mut self.counts, out);
         paths.follow_into(self.job, self.query, &mut self.counts, out);
         streaming::fence();
@@ -820,4 +844,27 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             }
         }
     }
+}
+
+/// Puts the eye samples `eight` (of pixel indices `pixels`, meant for
+/// `slots`) into `queue`, a whole batch at once when it starts one, and
+/// empties `eight`; flushes the queue into `out` when it fills.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn queue_eye_samples<'p, Q: SceneQuery>(job: &PassJob<'p>, query: &Q, counts: &mut RayCounts, queue: &mut ShadeQueue, eight: &mut EyeSamples, pixels: &[u32; shade_batch::LANES], slots: &[usize; shade_batch::LANES], paths: &mut PathPool<'p>, out: &mut [Radiance]) {
+    if eight.len == shade_batch::LANES && queue.batch().is_empty() {
+        queue.batch().fill_eye_triangles(eight, *pixels, job.sample, *slots);
+        if queue.advance() {
+            queue.flush(job, query, paths, counts, out);
+        }
+    } else {
+        for k in 0..eight.len {
+            let p = crate::math::Vec2::new(eight.px[k], eight.py[k]);
+            queue.batch().push_eye_triangle(eight.index[k], (eight.b1[k], eight.b2[k]), p, pixels[k], job.sample, slots[k]);
+            if queue.advance() {
+                queue.flush(job, query, paths, counts, out);
+            }
+        }
+    }
+    eight.len = 0;
 }
