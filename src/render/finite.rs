@@ -97,8 +97,9 @@ mod renderer_tests {
     use crate::math::Radiance;
     use crate::render::raytrace::brute::BruteForce;
     use crate::render::raytrace::bvh_renderer::BvhRayTracer;
-    use crate::render::{raster, PassJob, PreparedScene, RenderSettings, Renderer};
-    use crate::scene::builtin;
+    use crate::math::Vec3;
+    use crate::render::{raster, PassJob, PreparedScene, RenderSettings, Renderer, ShadowMode};
+    use crate::scene::{builtin, Light};
     use std::sync::atomic::AtomicBool;
 
     /// A renderer that says it admits its samples leaves nothing but finite
@@ -125,6 +126,40 @@ mod renderer_tests {
                 renderer.render_pass(&job, &mut out);
                 assert!(out.iter().all(|v| v.is_finite()), "{} (active: {})", renderer.name(), active.is_none());
             }
+        }
+    }
+
+    /// The same renderers shading with a light of infinite power, which
+    /// makes every lit sample infinite or NaN: each one becomes black in
+    /// the output (over a hundred pixels that are not black with the
+    /// light's own power), and the rest stays finite. The rasterizers
+    /// stream the background of rows this wide.
+    #[test]
+    fn renderers_admit_the_non_finite_samples_they_shade() {
+        let finite_power = PreparedScene::new(builtin::load_builtin("teapot").unwrap().unwrap());
+        let mut scene = builtin::load_builtin("teapot").unwrap().unwrap();
+        for light in &mut scene.lights {
+            if let Light::Point { power, .. } | Light::Directional { irradiance: power, .. } = light {
+                *power = Vec3::splat(f32::INFINITY);
+            }
+        }
+        let prepared = PreparedScene::new(scene);
+        let (w, h) = (96u32, 40u32);
+        let view = prepared.scene.camera.view(w, h);
+        let settings = RenderSettings { shadows: ShadowMode::None, ..RenderSettings::for_scene(&prepared.scene) };
+        let cancel = AtomicBool::new(false);
+        let mut renderers: Vec<Box<dyn Renderer>> = raster::renderers();
+        renderers.push(Box::new(BvhRayTracer));
+        renderers.push(Box::new(BruteForce));
+        for renderer in &renderers {
+            let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: glam::Vec2::splat(0.5), sample: 0, photons: None, active: None, rows: 0..h, cancel: &cancel };
+            let mut out = vec![Radiance::splat(-1.0); (w * h) as usize];
+            renderer.render_pass(&job, &mut out);
+            assert!(out.iter().all(|v| v.is_finite()), "{}", renderer.name());
+            let mut lit = vec![Radiance::splat(-1.0); (w * h) as usize];
+            renderer.render_pass(&PassJob { prepared: &finite_power, ..job }, &mut lit);
+            let blackened = out.iter().zip(&lit).filter(|(v, l)| **v == Radiance::ZERO && **l != Radiance::ZERO).count();
+            assert!(blackened > 100, "{}: only {blackened} pixels blackened", renderer.name());
         }
     }
 }
