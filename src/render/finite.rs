@@ -139,9 +139,8 @@ mod renderer_tests {
         let finite_power = PreparedScene::new(builtin::load_builtin("teapot").unwrap().unwrap());
         let mut scene = builtin::load_builtin("teapot").unwrap().unwrap();
         for light in &mut scene.lights {
-            if let Light::Point { power, .. } | Light::Directional { irradiance: power, .. } = light {
-                *power = Vec3::splat(f32::INFINITY);
-            }
+            let (Light::Point { power, .. } | Light::Directional { irradiance: power, .. }) = light;
+            *power = Vec3::splat(f32::INFINITY);
         }
         let prepared = PreparedScene::new(scene);
         let (w, h) = (96u32, 40u32);
