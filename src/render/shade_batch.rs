@@ -168,11 +168,18 @@ impl Batch {
     /// the sample of `samples` lane k, of pixel index `pixels[k]`, meant
     /// for `slots[k]`; `sample` is the pass's sample index.
     #[inline]
-    pub fn fill_eye_triangles(&mut self, samples: &EyeSamples, pixels: [u32; LANES], sample: u32, slots: [usize; LANES]) {
+    pub fn fill_eye_triangles(&mut self, samples: &EyeSamples, pixels: &[u32; LANES], sample: u32, slots: &[usize; LANES]) {
         assert!(self.len == 0 && samples.len == LANES, "fill_eye_triangles needs an empty batch and eight samples");
-        self.pending = *samples;
+        let pending = &mut self.pending;
+        copy_lanes(&mut pending.index, &samples.index);
+        for (to, from) in [(&mut pending.b1, &samples.b1), (&mut pending.b2, &samples.b2), (&mut pending.px, &samples.px), (&mut pending.py, &samples.py)] {
+            copy_lanes(to, from);
+        }
+        pending.len = samples.len;
         self.pending_lanes = IN_ORDER;
-        (self.pixels, self.samples, self.slots) = (pixels, [sample; LANES], slots);
+        copy_lanes(&mut self.pixels, pixels);
+        copy_lanes(&mut self.slots, slots);
+        self.samples = [sample; LANES];
         self.len = LANES;
     }
 
@@ -236,6 +243,20 @@ impl Batch {
         self.samples[i] = sample;
         self.slots[i] = slot;
         self.len += 1;
+    }
+}
+
+/// Copies eight lanes that were just written one at a time, a lane at a
+/// time. Copied as a whole (as the compiler otherwise does, with vector
+/// loads or a call to memcpy), each wide load would span several of those
+/// recent narrow stores, which the processor cannot forward to it: it waits
+/// until they reach the cache. The volatile reads keep the loads one lane
+/// wide.
+#[inline(always)]
+fn copy_lanes<T: Copy>(to: &mut [T; LANES], from: &[T; LANES]) {
+    for (to, from) in to.iter_mut().zip(from) {
+        // SAFETY: `from` is a valid reference to an initialised `T`.
+        *to = unsafe { std::ptr::read_volatile(from) };
     }
 }
 
@@ -435,17 +456,27 @@ pub fn shadow_rays_of(scene: &Scene, hits: &HitLanes, len: usize, light: &Light,
     if len == 0 {
         return;
     }
-    let (rays, lit) = dispatch!(simd_level(), simd => {
+    // The rays are handed out inside the dispatched code: returned from
+    // it, their 256 bytes went through a call to memcpy that read back
+    // the lanes just stored.
+    dispatch!(simd_level(), simd => {
         let inc = lighting::incidence(light, V3::from_soa(simd, &hits.position), V3::from_soa(simd, &hits.shading_normal));
-        (ShadowRays::new(hits, &inc, bump, lift), mask_bits(inc.illuminates()))
-    });
-    let mut m = lit & ((1u32 << len) - 1) as u8;
-    while m != 0 {
-        let i = m.trailing_zeros() as usize;
-        m &= m - 1;
-        let (ray, t_max) = rays.get(scene, hits, i);
-        put(i, ray, t_max);
-    }
+        let rays = ShadowRays::new(hits, &inc, bump, lift);
+        let mut m = mask_bits(inc.illuminates()) & ((1u32 << len) - 1) as u8;
+        while m != 0 {
+            let i = m.trailing_zeros() as usize;
+            m &= m - 1;
+            // Each case hands its ray over on its own: joined, the two
+            // became one ray in memory, written a float at a time and read
+            // back at once, which waits for the writes to reach the cache.
+            if rays.lifted & 1 << i != 0 {
+                let (ray, t_max) = rays.lifted_ray(scene, hits, i);
+                put(i, ray, t_max);
+            } else {
+                put(i, rays.plain_ray(i), rays.t_max[i]);
+            }
+        }
+    })
 }
 
 /// Visibility for a batch: the packet's answers when it traced them, else
@@ -551,13 +582,28 @@ impl ShadowRays {
     /// for surface `i` of `hits`.
     #[inline]
     fn get(&self, scene: &Scene, hits: &HitLanes, i: usize) -> (Ray, f32) {
-        let lane = |a: &[Floats; 3]| Vec3::new(a[0][i], a[1][i], a[2][i]);
         if self.lifted & 1 << i != 0 {
-            // Only the direction and distance matter to `shadow_ray`.
-            let incidence = Incidence { w_i: lane(&self.w_i), distance: self.distance[i], incident: Vec3::ZERO, cos_theta: 0.0 };
-            return incidence.shadow_ray(scene, &hits.get(i), self.bump, true);
+            return self.lifted_ray(scene, hits, i);
         }
-        (Ray::new(lane(&self.origin), lane(&self.w_i)), self.t_max[i])
+        (self.plain_ray(i), self.t_max[i])
+    }
+
+    /// Lane `i`'s ray (its far end is `t_max[i]`), as
+    /// `Incidence::shadow_ray` gives it for surface `i` of `hits` when the
+    /// lane is not `lifted`.
+    #[inline(always)]
+    fn plain_ray(&self, i: usize) -> Ray {
+        let lane = |a: &[Floats; 3]| Vec3::new(a[0][i], a[1][i], a[2][i]);
+        Ray::new(lane(&self.origin), lane(&self.w_i))
+    }
+
+    /// Lane `i`'s ray and far end when the lane is `lifted` (rare).
+    #[inline(never)]
+    fn lifted_ray(&self, scene: &Scene, hits: &HitLanes, i: usize) -> (Ray, f32) {
+        let lane = |a: &[Floats; 3]| Vec3::new(a[0][i], a[1][i], a[2][i]);
+        // Only the direction and distance matter to `shadow_ray`.
+        let incidence = Incidence { w_i: lane(&self.w_i), distance: self.distance[i], incident: Vec3::ZERO, cos_theta: 0.0 };
+        incidence.shadow_ray(scene, &hits.get(i), self.bump, true)
     }
 }
 

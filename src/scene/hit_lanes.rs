@@ -228,6 +228,10 @@ impl Scene {
         if n == 0 {
             return;
         }
+        if n == HIT_LANES {
+            dispatch!(simd_level(), simd => triangle_eye_hits8(simd, self, view, samples, out, dirs));
+            return;
+        }
         let mut s = *samples;
         for k in n..HIT_LANES {
             (s.index[k], s.b1[k], s.b2[k], s.px[k], s.py[k]) = (s.index[0], s.b1[0], s.b2[0], s.px[0], s.py[0]);

@@ -853,7 +853,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
 #[inline]
 fn queue_eye_samples<'p, Q: SceneQuery>(job: &PassJob<'p>, query: &Q, counts: &mut RayCounts, queue: &mut ShadeQueue, eight: &mut EyeSamples, pixels: &[u32; shade_batch::LANES], slots: &[usize; shade_batch::LANES], paths: &mut PathPool<'p>, out: &mut [Radiance]) {
     if eight.len == shade_batch::LANES && queue.batch().is_empty() {
-        queue.batch().fill_eye_triangles(eight, *pixels, job.sample, *slots);
+        queue.batch().fill_eye_triangles(eight, pixels, job.sample, slots);
         if queue.advance() {
             queue.flush(job, query, paths, counts, out);
         }
