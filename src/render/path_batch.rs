@@ -390,7 +390,10 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
                     let valid = u64::MAX >> (64 - chunk.len());
                     bvh.closest_hybrid(pk, valid, HYBRID_ALONE, self.counts);
                     for (k, &(s, ray)) in chunk.iter().enumerate() {
-                        self.found(s, &ray, pk.batch_hit(bvh, k));
+                        match pk.triangle_hit_input(k) {
+                            Some(input) => self.found(s, &ray, Some(BatchHit::Triangle(input))),
+                            None => self.found(s, &ray, pk.batch_hit(bvh, k)),
+                        }
                     }
                 }
             }

@@ -242,6 +242,16 @@ impl Packet {
         (!best.id.is_none()).then(|| query.batch_hit(&best, &self.rays[i]))
     }
 
+    /// `batch_hit` of lane `i` when it found a triangle (what nearly every
+    /// hit is), inlined into the caller: the enum of both kinds, joined
+    /// from its two branches, went through memory, written a float at a
+    /// time and read back in wider loads, which wait for those writes.
+    #[inline(always)]
+    pub fn triangle_hit_input(&self, i: usize) -> Option<TriangleHitInput> {
+        let id = self.best_id[i];
+        (id.kind() == PrimitiveKind::Triangle && !id.is_none()).then(|| TriangleHitInput::new(id.index(), self.weights(i), self.best_t.0[i], self.rays[i].dir))
+    }
+
     /// Lane `i`'s closest hit so far, as a single ray's walk keeps it.
     #[inline(always)]
     fn best(&self, i: usize) -> BestHit {
