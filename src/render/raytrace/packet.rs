@@ -1578,6 +1578,10 @@ mod tests {
                     for (k, ray) in chunk.iter().enumerate() {
                         let single = query.closest_for_batch(ray, f32::INFINITY, false, &mut RayCounts::default());
                         assert_eq!(key(pk.batch_hit(&query, k)), key(single), "{name}: switch {switch}, ray {k}");
+                        // The triangle-only shortcut is `batch_hit` where that names a triangle.
+                        let triangle = pk.triangle_hit_input(k).map(BatchHit::Triangle);
+                        let expected = pk.batch_hit(&query, k).filter(|h| matches!(h, BatchHit::Triangle(_)));
+                        assert_eq!(key(triangle), key(expected), "{name}: triangle input, switch {switch}, ray {k}");
                     }
                     // As shadow rays, with far ends that cut some of them
                     // short of what they hit.
