@@ -228,15 +228,20 @@ impl Scene {
         if n == 0 {
             return;
         }
-        if n == HIT_LANES {
-            dispatch!(simd_level(), simd => triangle_eye_hits8(simd, self, view, samples, out, dirs));
-            return;
-        }
-        let mut s = *samples;
-        for k in n..HIT_LANES {
-            (s.index[k], s.b1[k], s.b2[k], s.px[k], s.py[k]) = (s.index[0], s.b1[0], s.b2[0], s.px[0], s.py[0]);
-        }
-        dispatch!(simd_level(), simd => triangle_eye_hits8(simd, self, view, &s, out, dirs));
+        // Only a partial group is copied to pad it: a full one (the common
+        // case) was just written lane by lane, and a whole copy of it would
+        // wait for those writes to reach the cache.
+        let mut padded;
+        let s = if n == HIT_LANES {
+            samples
+        } else {
+            padded = *samples;
+            for k in n..HIT_LANES {
+                (padded.index[k], padded.b1[k], padded.b2[k], padded.px[k], padded.py[k]) = (padded.index[0], padded.b1[0], padded.b2[0], padded.px[0], padded.py[0]);
+            }
+            &padded
+        };
+        dispatch!(simd_level(), simd => triangle_eye_hits8(simd, self, view, s, out, dirs));
     }
 }
 
