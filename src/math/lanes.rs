@@ -9,7 +9,7 @@
 //!
 //! No fused multiply-add anywhere: a CPU without FMA could not match it.
 
-use fearless_simd::{f32x8, mask32x8, u32x8, Select, Simd, SimdBase, SimdFloat, SimdFrom, SimdInt};
+use fearless_simd::{f32x16, f32x8, mask32x16, mask32x8, u32x16, u32x8, Select, Simd, SimdBase, SimdFloat, SimdFrom, SimdInt};
 use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
 
 /// Lanes of `f32` computed together.
@@ -112,67 +112,77 @@ impl Lane for f32 {
     }
 }
 
-impl<S: Simd> Lane for f32x8<S> {
-    type Mask = mask32x8<S>;
+/// The `Lane` operations of a fearless_simd float vector: the same
+/// calls whatever its width (`f32x16` is one AVX-512 register, or two
+/// AVX2 halves that compute exactly what two `f32x8` would).
+macro_rules! simd_lane {
+    ($f:ident, $m:ident, $u:ident, $copysign:ident) => {
+        impl<S: Simd> Lane for $f<S> {
+            type Mask = $m<S>;
 
-    #[inline(always)]
-    fn splat(self, x: f32) -> Self {
-        <f32x8<S> as SimdBase<S>>::splat(self.simd, x)
-    }
-    #[inline(always)]
-    fn sqrt(self) -> Self {
-        SimdFloat::sqrt(self)
-    }
-    #[inline(always)]
-    fn floor(self) -> Self {
-        SimdFloat::floor(self)
-    }
-    #[inline(always)]
-    fn gt(self, other: Self) -> Self::Mask {
-        self.simd_gt(other)
-    }
-    #[inline(always)]
-    fn ge(self, other: Self) -> Self::Mask {
-        self.simd_ge(other)
-    }
-    #[inline(always)]
-    fn lt(self, other: Self) -> Self::Mask {
-        self.simd_lt(other)
-    }
-    #[inline(always)]
-    fn le(self, other: Self) -> Self::Mask {
-        self.simd_le(other)
-    }
-    #[inline(always)]
-    fn eq(self, other: Self) -> Self::Mask {
-        self.simd_eq(other)
-    }
-    #[inline(always)]
-    fn select(mask: Self::Mask, a: Self, b: Self) -> Self {
-        mask.select(a, b)
-    }
-    #[inline(always)]
-    fn any(mask: Self::Mask) -> bool {
-        fearless_simd::SimdMask::to_bitmask(mask) != 0
-    }
-    #[inline(always)]
-    fn exponent_mantissa(self) -> (Self, Self) {
-        let bits: u32x8<S> = self.to_bits();
-        let biased: u32x8<S> = (bits >> 23) & 0xff;
-        let e: f32x8<S> = biased.to_float::<f32x8<S>>() - 127.0;
-        let m_bits: u32x8<S> = (bits & 0x007f_ffff) | 0x3f80_0000;
-        (e, f32x8::from_bits(m_bits))
-    }
-    #[inline(always)]
-    fn exp2_integer(self) -> Self {
-        let biased: u32x8<S> = (self + 127.0).to_int::<u32x8<S>>();
-        f32x8::from_bits(biased << 23)
-    }
-    #[inline(always)]
-    fn copysign(self, sign: Self) -> Self {
-        self.simd.copysign_f32x8(self, sign)
-    }
+            #[inline(always)]
+            fn splat(self, x: f32) -> Self {
+                <$f<S> as SimdBase<S>>::splat(self.simd, x)
+            }
+            #[inline(always)]
+            fn sqrt(self) -> Self {
+                SimdFloat::sqrt(self)
+            }
+            #[inline(always)]
+            fn floor(self) -> Self {
+                SimdFloat::floor(self)
+            }
+            #[inline(always)]
+            fn gt(self, other: Self) -> Self::Mask {
+                self.simd_gt(other)
+            }
+            #[inline(always)]
+            fn ge(self, other: Self) -> Self::Mask {
+                self.simd_ge(other)
+            }
+            #[inline(always)]
+            fn lt(self, other: Self) -> Self::Mask {
+                self.simd_lt(other)
+            }
+            #[inline(always)]
+            fn le(self, other: Self) -> Self::Mask {
+                self.simd_le(other)
+            }
+            #[inline(always)]
+            fn eq(self, other: Self) -> Self::Mask {
+                self.simd_eq(other)
+            }
+            #[inline(always)]
+            fn select(mask: Self::Mask, a: Self, b: Self) -> Self {
+                mask.select(a, b)
+            }
+            #[inline(always)]
+            fn any(mask: Self::Mask) -> bool {
+                fearless_simd::SimdMask::to_bitmask(mask) != 0
+            }
+            #[inline(always)]
+            fn exponent_mantissa(self) -> (Self, Self) {
+                let bits: $u<S> = self.to_bits();
+                let biased: $u<S> = (bits >> 23) & 0xff;
+                let e: $f<S> = biased.to_float::<$f<S>>() - 127.0;
+                let m_bits: $u<S> = (bits & 0x007f_ffff) | 0x3f80_0000;
+                (e, $f::from_bits(m_bits))
+            }
+            #[inline(always)]
+            fn exp2_integer(self) -> Self {
+                let biased: $u<S> = (self + 127.0).to_int::<$u<S>>();
+                $f::from_bits(biased << 23)
+            }
+            #[inline(always)]
+            fn copysign(self, sign: Self) -> Self {
+                self.simd.$copysign(self, sign)
+            }
+        }
+    };
 }
+
+simd_lane!(f32x8, mask32x8, u32x8, copysign_f32x8);
+simd_lane!(f32x16, mask32x16, u32x16, copysign_f32x16);
 
 /// `(cos 2 pi u, sin 2 pi u)` for `u` in [0, 1] (a fraction of a turn), to
 /// within about 1e-7, for sampling directions. Written here rather than
@@ -544,6 +554,47 @@ mod tests {
                 assert_eq!(wide[i].to_bits(), pow(c[i], s[i]).to_bits(), "c {} s {}", c[i], s[i]);
             }
         }
+    }
+
+    /// Sixteen lanes compute what one lane does, bit for bit, at every SIMD
+    /// level this CPU offers (AVX-512 runs `f32x16` as one register, AVX2
+    /// and SSE4.2 as halves or quarters): the power, the normalised
+    /// direction and the selects that lighting builds from them.
+    #[test]
+    fn sixteen_lanes_match_one_lane_at_every_level() {
+        fn check<S: Simd>(simd: S) {
+            for k in 0..500 {
+                let f = |i: usize, m: f32| ((k * 16 + i) as f32 * m).fract();
+                let c: [f32; 16] = std::array::from_fn(|i| f(i, 0.618_034));
+                let s: [f32; 16] = std::array::from_fn(|i| 1.0 + f(i, 0.414_214) * 500.0);
+                let v: [[f32; 16]; 3] = [0.1, 0.7, 0.3].map(|m| std::array::from_fn(|i| f(i, m) - 0.5));
+                let p: [f32; 16] = pow(f32x16::simd_from(simd, c), f32x16::simd_from(simd, s)).into();
+                let n = V3::new(f32x16::simd_from(simd, v[0]), f32x16::simd_from(simd, v[1]), f32x16::simd_from(simd, v[2])).normalize_or_zero();
+                let n: [[f32; 16]; 3] = [n.x.into(), n.y.into(), n.z.into()];
+                let m: [f32; 16] = Lane::max(f32x16::simd_from(simd, c), f32x16::simd_from(simd, v[0])).into();
+                for i in 0..16 {
+                    assert_eq!(p[i].to_bits(), pow(c[i], s[i]).to_bits(), "pow lane {i}");
+                    let one: glam::Vec3 = V3::new(v[0][i], v[1][i], v[2][i]).normalize_or_zero().into();
+                    assert_eq!([n[0][i], n[1][i], n[2][i]].map(f32::to_bits), one.to_array().map(f32::to_bits), "normalize lane {i}");
+                    assert_eq!(m[i].to_bits(), Lane::max(c[i], v[0][i]).to_bits(), "max lane {i}");
+                }
+            }
+        }
+        let level = Level::new();
+        let mut levels = 0;
+        if let Some(simd) = level.as_avx512() {
+            check(simd);
+            levels += 1;
+        }
+        if let Some(simd) = level.as_avx2() {
+            check(simd);
+            levels += 1;
+        }
+        if let Some(simd) = level.as_sse4_2() {
+            check(simd);
+            levels += 1;
+        }
+        assert!(levels > 0, "no SIMD level to check on this CPU");
     }
 
     #[test]

@@ -17,7 +17,7 @@ use crate::math::lanes::{mask_bits, mask_from_bits, simd_level, Lane, V3};
 use crate::math::{Radiance, Ray, Vec2, Vec3};
 use crate::scene::hit_lanes::{EyeSamples, Floats, HitLanes, TriangleHitInput};
 use crate::scene::{CameraView, Light, PrimitiveKind, Scene, SurfaceHit};
-use fearless_simd::{dispatch, f32x8, Simd, SimdFrom};
+use fearless_simd::{dispatch, f32x16, f32x8, Simd, SimdCombine, SimdFrom};
 
 /// Samples per batch.
 pub const LANES: usize = 8;
@@ -450,6 +450,115 @@ fn direct_light8<S: Simd, Q: SceneQuery>(simd: S, job: &PassJob, geometry: &Geom
     lighting::direct_light(&job.prepared.scene.lights, &surface, start, visibility).scatter()
 }
 
+/// `shade_batch` for two full batches at once, where direct light and the
+/// constant ambient term are all there is to it and one untextured
+/// material covers all sixteen lanes: `lighting::direct_light` runs over
+/// `f32x16` (one AVX-512 register, or two AVX2 halves). Each lane goes
+/// through the same operations as in `shade_batch`, so the values are the
+/// same bits; what changes is that the two batches' chains of square
+/// roots, divisions and the glossy lobe's power run side by side, where
+/// one batch alone leaves the CPU waiting on each step. `blocked` as in
+/// `shade_batch`, per batch. `None` when the pair does not qualify: the
+/// caller then shades each batch alone.
+pub fn shade_batch_pair<Q: SceneQuery>(job: &PassJob, query: &Q, pair: [&Batch; 2], blocked: [Option<&[u8]>; 2], counts: &mut RayCounts) -> Option<[[Radiance; LANES]; 2]> {
+    let settings = job.settings;
+    let traced = match blocked {
+        [Some(_), Some(_)] => true,
+        [None, None] => false,
+        _ => return None,
+    };
+    // Without traced shadows, `BatchVisibility` casts the rays one lane at
+    // a time: those pairs are left to it.
+    if settings.gi.mode != GiMode::None || (!traced && settings.shadows != ShadowMode::None) {
+        return None;
+    }
+    let [a, b] = pair;
+    if !(a.is_full() && b.is_full()) {
+        return None;
+    }
+    assert!(a.pending.len == 0 && a.pending_ray_count == 0 && b.pending.len == 0 && b.pending_ray_count == 0, "shade_batch_pair on a batch with hits not built (`build_pending`)");
+    let scene = &job.prepared.scene;
+    let index = a.hits.material[0];
+    if !a.hits.material.iter().chain(&b.hits.material).all(|&m| m == index) {
+        return None;
+    }
+    let material = &scene.materials[index as usize];
+    if material.texture.is_some() || shade::adds_after_direct(settings, material) {
+        return None;
+    }
+    // `direct_in_lanes`' one-material case, for each batch: the albedo
+    // and ambient term are worked out from lane 0 and must agree.
+    let mut uniform = |batch: &Batch| {
+        let albedo = shade::albedo_at(material, Vec2::ZERO, &batch.hits.diff[0], settings);
+        let mut path = PathState::new(batch.pixels[0], batch.samples[0], settings.spp, &settings.gi, job.photons);
+        let mut sh = Shading { scene, query, settings, path: &mut path, counts: &mut *counts, rec: &mut NoRecord };
+        (albedo, shade::ambient_term(&mut sh, || batch.hits.get(0), albedo))
+    };
+    let ((albedo, ambient), other) = (uniform(a), uniform(b));
+    if (albedo, ambient) != other {
+        return None;
+    }
+    let materials = MaterialLanes::Uniform { albedo, glossy: material.glossy, sharpness: material.sharpness, ambient };
+    let mut visibility = PairVisibility { shadows: settings.shadows, blocked, counts };
+    Some(dispatch!(simd_level(), simd => direct_light16(simd, job, pair, &materials, &mut visibility)))
+}
+
+/// `direct_light8` over the sixteen lanes of two full batches (`a`'s in
+/// lanes 0-7, `b`'s in 8-15), one material in all of them.
+#[inline(always)]
+fn direct_light16<S: Simd, V: LightVisibility<f32x16<S>>>(simd: S, job: &PassJob, [a, b]: [&Batch; 2], materials: &MaterialLanes, visibility: &mut V) -> [[Radiance; LANES]; 2] {
+    let like = <f32x16<S> as fearless_simd::SimdBase<S>>::splat(simd, 0.0);
+    let MaterialLanes::Uniform { albedo, glossy, sharpness, ambient } = materials else {
+        unreachable!("pairs are one material")
+    };
+    let join = |x: &[Floats; 3], y: &[Floats; 3]| {
+        let (x, y) = (V3::from_soa(simd, x), V3::from_soa(simd, y));
+        V3::new(x.x.combine(y.x), x.y.combine(y.y), x.z.combine(y.z))
+    };
+    let surface = SurfaceLanes {
+        position: join(&a.hits.position, &b.hits.position),
+        normal: join(&a.hits.shading_normal, &b.hits.shading_normal),
+        w_o: join(&a.w_o, &b.w_o),
+        albedo: V3::splat(like, *albedo),
+        glossy: V3::splat(like, *glossy),
+        sharpness: like.splat(*sharpness),
+    };
+    let l_o = lighting::direct_light(&job.prepared.scene.lights, &surface, V3::splat(like, *ambient), visibility);
+    let (x, y, z): ([f32; 16], [f32; 16], [f32; 16]) = (l_o.x.into(), l_o.y.into(), l_o.z.into());
+    // A plain loop: `array::map` over `from_fn` was left as a call that
+    // passed the lanes through the stack several times.
+    let mut out = [[Radiance::ZERO; LANES]; 2];
+    for i in 0..LANES {
+        out[0][i] = Vec3::new(x[i], y[i], z[i]);
+        out[1][i] = Vec3::new(x[LANES + i], y[LANES + i], z[LANES + i]);
+    }
+    out
+}
+
+/// Visibility for `shade_batch_pair`: `BatchVisibility`'s answers (no
+/// shadows, or the packets' blocked lanes) over sixteen lanes.
+struct PairVisibility<'b> {
+    shadows: ShadowMode,
+    blocked: [Option<&'b [u8]>; 2],
+    counts: &'b mut RayCounts,
+}
+
+impl<S: Simd> LightVisibility<f32x16<S>> for PairVisibility<'_> {
+    #[inline(always)]
+    fn visible(&mut self, light: usize, inc: &IncidenceLanes<f32x16<S>>, lit: fearless_simd::mask32x16<S>) -> fearless_simd::mask32x16<S> {
+        let simd = inc.cos_theta.simd;
+        let all = fearless_simd::SimdMask::from_bitmask(simd, 0xffff);
+        if self.shadows == ShadowMode::None {
+            return all;
+        }
+        let [Some(a), Some(b)] = self.blocked else {
+            return all;
+        };
+        self.counts.shadow += (fearless_simd::SimdMask::to_bitmask(lit) & 0xffff).count_ones() as u64;
+        fearless_simd::SimdMask::from_bitmask(simd, !(a[light] as u64 | (b[light] as u64) << LANES) & 0xffff)
+    }
+}
+
 /// `Batch::shadow_rays` for the surfaces in lanes `0..len` of `hits`.
 #[inline]
 pub fn shadow_rays_of(scene: &Scene, hits: &HitLanes, len: usize, light: &Light, bump: f32, lift: bool, mut put: impl FnMut(usize, Ray, f32)) {
@@ -668,6 +777,66 @@ mod tests {
             }
         }
         assert!(compared > 3000, "only {compared} samples compared");
+    }
+
+    /// Two full batches shaded together (`shade_batch_pair`, sixteen lanes)
+    /// give each sample's one-wide `shade()` value bit for bit, with and
+    /// without shadow rays (traced ahead as packets, as frames do), flat
+    /// and Phong; and pairs that need more than direct light (mirrors,
+    /// glass, textures, ambient occlusion) are refused, not shaded wrong.
+    #[test]
+    fn batch_pairs_equal_one_sample_shading() {
+        use crate::render::raytrace::packet::{shadow_packets, Packet};
+        let (mut paired, mut refused) = (0, 0);
+        for name in builtin::names() {
+            let prepared = PreparedScene::new(builtin::load_builtin(name).unwrap().unwrap());
+            let query = BvhQuery::new(&prepared);
+            let (w, h) = (29u32, 19u32);
+            let view = prepared.scene.camera.view(w, h);
+            let cancel = AtomicBool::new(false);
+            let lights = prepared.scene.lights.len();
+            for (interpolation, shadows, gi) in [
+                (Interpolation::Phong, ShadowMode::Ray, GiMode::None),
+                (Interpolation::Flat, ShadowMode::None, GiMode::None),
+                (Interpolation::Phong, ShadowMode::Ray, GiMode::Ao),
+            ] {
+                let mut settings = RenderSettings { interpolation, shadows, ..RenderSettings::for_scene(&prepared.scene) };
+                settings.gi.mode = gi;
+                let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: glam::Vec2::splat(0.5), sample: 0, photons: None, active: None, rows: 0..h, cancel: &cancel };
+                let (mut batches, mut expected) = ([Batch::new(), Batch::new()], Vec::new());
+                let mut pk = Packet::new();
+                for (x, y) in (0..h).flat_map(|y| (0..w).map(move |x| (x, y))) {
+                    let p = job.sample_position(x, y);
+                    let ray = view.eye_ray(p.x, p.y);
+                    let Some(hit) = query.closest(&ray, view.far_t(p.x, p.y), false, &mut RayCounts::default(), &mut NoRecord) else { continue };
+                    let pixel = job.pixel_index(x, y);
+                    expected.push(crate::render::resolve_sample(&job, &query, &ray, Some(&hit), pixel, &mut RayCounts::default(), &mut NoRecord));
+                    let b = usize::from(batches[0].is_full());
+                    batches[b].push(interpolation, &hit, ray.dir, pixel, job.sample, 0);
+                    if !batches[1].is_full() {
+                        continue;
+                    }
+                    let mut queue_blocked = vec![0u64; lights];
+                    if shadows == ShadowMode::Ray {
+                        shadow_packets(&query, &settings, &batches, |b, j| LANES * b + j, &mut pk, &mut queue_blocked, &mut RayCounts::default());
+                    }
+                    let bits: [Vec<u8>; 2] = [0, 1].map(|b| queue_blocked.iter().map(|q| (q >> (LANES * b)) as u8).collect());
+                    let blocked = [&bits[0], &bits[1]].map(|v| (shadows == ShadowMode::Ray).then_some(&v[..]));
+                    match shade_batch_pair(&job, &query, [&batches[0], &batches[1]], blocked, &mut RayCounts::default()) {
+                        Some(got) => {
+                            for (k, (got, want)) in got.iter().flatten().zip(&expected).enumerate() {
+                                assert_eq!(got.to_array().map(f32::to_bits), want.to_array().map(f32::to_bits), "{name} {interpolation:?} {shadows:?} {gi:?} lane {k} of 16");
+                            }
+                            paired += 1;
+                        }
+                        None => refused += 1,
+                    }
+                    batches.iter_mut().for_each(Batch::clear);
+                    expected.clear();
+                }
+            }
+        }
+        assert!(paired > 50 && refused > 20, "{paired} pairs shaded, {refused} refused");
     }
 
     /// Eight ray hits filled into a batch at once (`fill_ray_triangles`,

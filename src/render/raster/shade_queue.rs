@@ -30,6 +30,8 @@ pub struct ShadeQueue {
     queue_blocked: Vec<u64>,
     /// Per light, one batch's blocked lanes, as `shade_batch` takes them.
     batch_blocked: Vec<u8>,
+    /// The same for the batch after it, when the two are shaded together.
+    next_blocked: Vec<u8>,
 }
 
 impl ShadeQueue {
@@ -40,6 +42,7 @@ impl ShadeQueue {
             shadow_pk: Packet::new(),
             queue_blocked: vec![0; lights],
             batch_blocked: vec![0; lights],
+            next_blocked: vec![0; lights],
         }
     }
 
@@ -86,10 +89,32 @@ impl ShadeQueue {
         if let Some(bvh) = packets {
             shadow_packets(bvh, job.settings, batches, |b, j| LANES * b + j, &mut self.shadow_pk, &mut self.queue_blocked, counts);
         }
-        for (b, batch) in batches.iter_mut().enumerate() {
-            for (bits, queue_bits) in self.batch_blocked.iter_mut().zip(&self.queue_blocked) {
-                *bits = (queue_bits >> (LANES * b)) as u8;
+        let mut b = 0;
+        while b < queued {
+            let unpack = |bits: &mut Vec<u8>, b: usize| {
+                for (bits, queue_bits) in bits.iter_mut().zip(&self.queue_blocked) {
+                    *bits = (queue_bits >> (LANES * b)) as u8;
+                }
+            };
+            unpack(&mut self.batch_blocked, b);
+            // Two batches shaded together where they qualify
+            // (`shade_batch_pair`), else one at a time.
+            if b + 1 < queued && !path_batch::takes(job) {
+                unpack(&mut self.next_blocked, b + 1);
+                let blocked = [&self.batch_blocked, &self.next_blocked].map(|bits| packets.is_some().then_some(&bits[..]));
+                if let Some(values) = shade_batch::shade_batch_pair(job, query, [&batches[b], &batches[b + 1]], blocked, counts) {
+                    for (batch, values) in batches[b..b + 2].iter_mut().zip(values) {
+                        for (j, value) in values.iter().enumerate() {
+                            out[batch.slots[j]] = *value;
+                        }
+                        batch.clear();
+                    }
+                    b += 2;
+                    continue;
+                }
             }
+            let batch = &mut batches[b];
+            b += 1;
             // Without packets the lanes' rays are cast one by one in shading.
             let blocked = packets.is_some().then_some(&self.batch_blocked[..]);
             if path_batch::takes(job) {

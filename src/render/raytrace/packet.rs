@@ -1003,6 +1003,8 @@ fn eye_rays_eight_wide<S: Simd>(simd: S, job: &PassJob, pk: &mut Packet, (x0, y0
 struct TileContext<'p> {
     tile: Vec<u64>,
     batch: Vec<u8>,
+    /// `batch` for the batch after it, when the two are shaded together.
+    next_batch: Vec<u8>,
     /// Whether hits need ray differentials (`with_eye_differentials`).
     textured: bool,
     /// What a sample that sees nothing shows, when no ray is needed for it
@@ -1023,6 +1025,7 @@ impl<'p> TileContext<'p> {
         TileContext {
             tile: vec![0; scene.lights.len()],
             batch: vec![0; scene.lights.len()],
+            next_batch: vec![0; scene.lights.len()],
             textured: scene.has_textures(),
             background: miss_without_ray(job),
             batches: (0..P / shade_batch::LANES).map(|_| Batch::new()).collect(),
@@ -1215,7 +1218,7 @@ fn shade_tile_batched<'p, const PASSES: bool>(
     width: usize,
     counts: &mut RayCounts,
 ) {
-    let TileContext { tile: blocked, batch: lane_blocked, textured, background, batches, paths } = context;
+    let TileContext { tile: blocked, batch: lane_blocked, next_batch: next_blocked, textured, background, batches, paths } = context;
     let scene = &query.prepared.scene;
     let first = &jobs[0];
     let settings = first.settings;
@@ -1303,10 +1306,33 @@ fn shade_tile_batched<'p, const PASSES: bool>(
         }
         return;
     }
-    for batch in batches.iter_mut() {
-        for (k, bits) in lane_blocked.iter_mut().enumerate() {
+    // Each batch's lanes' bits of the tile's blocked rays, per light.
+    let unpack = |bits: &mut Vec<u8>, batch: &Batch| {
+        for (k, bits) in bits.iter_mut().enumerate() {
             *bits = (0..batch.len()).fold(0u8, |acc, j| acc | (((blocked[k] >> batch.slots[j]) & 1) as u8) << j);
         }
+    };
+    let mut b = 0;
+    while b < batches.len() {
+        unpack(lane_blocked, &batches[b]);
+        // Two batches shaded together where they qualify
+        // (`shade_batch_pair`), else one at a time.
+        if b + 1 < batches.len() {
+            unpack(next_blocked, &batches[b + 1]);
+            let blocked = [&lane_blocked[..], &next_blocked[..]].map(|bits| shadows.then_some(bits));
+            if let Some(values) = shade_batch::shade_batch_pair(first, query, [&batches[b], &batches[b + 1]], blocked, counts) {
+                for (batch, values) in batches[b..b + 2].iter_mut().zip(values) {
+                    for (j, value) in values.iter().enumerate() {
+                        band[out_index(batch.slots[j])] = *value;
+                    }
+                    batch.clear();
+                }
+                b += 2;
+                continue;
+            }
+        }
+        let batch = &mut batches[b];
+        b += 1;
         let values = shade_batch::shade_batch(first, query, batch, shadows.then_some(&lane_blocked[..]), counts);
         for j in 0..batch.len() {
             band[out_index(batch.slots[j])] = values[j];
