@@ -36,7 +36,7 @@ use crate::render::shade_batch::{self, Batch};
 use crate::render::{miss_without_ray, resolve_sample, Occluder, PassJob, RayCounts, RenderSettings, SceneQuery, ShadowMode};
 use crate::scene::hit_lanes::{HitLanes, TriangleHitInput, HIT_LANES};
 use crate::scene::{CameraView, PrimitiveId, PrimitiveKind, Sphere, SurfaceHit};
-use fearless_simd::{dispatch, f32x8, mask32x8, u32x8, Bytes, Select, Simd, SimdBase, SimdFloat, SimdFrom};
+use fearless_simd::{dispatch, f32x16, f32x8, mask32x8, u32x16, u32x8, Bytes, Select, Simd, SimdBase, SimdFloat, SimdFrom};
 use glam::Vec3;
 use rayon::prelude::*;
 use std::mem::MaybeUninit;
@@ -656,52 +656,76 @@ fn test_leaf_packet<S: Simd, const ANY: bool>(
             }
             continue;
         }
-        let mut groups = active;
-        while groups != 0 {
-            let g = groups.trailing_zeros() as usize / 8;
-            groups &= !(0xff << (8 * g));
-            let lanes = (active >> (8 * g)) as u8;
-            let base = 8 * g;
-            let origin = V3::load(simd, [&pk.origin[0].0, &pk.origin[1].0, &pk.origin[2].0], base);
-            let dir = V3::load(simd, [&pk.dir[0].0, &pk.dir[1].0, &pk.dir[2].0], base);
-            let limit = f32x8::from_slice(simd, &pk.limit[base..base + 8]);
-            let (hit, t, b1, b2) = intersect_triangle_lanes(origin, dir, tri, limit);
-            let found = mask_bits(hit) & lanes;
-            if found == 0 {
-                continue;
-            }
-            // Every lane's update at once (each lane is its own ray): as
-            // `test_leaf`, t <= best here, and the hit is taken when nearer
-            // or, on a tie, when its id is lower; a shadow ray takes its
-            // first and is done.
-            let ids: &mut [u32] = bytemuck::cast_slice_mut(&mut pk.best_id[base..base + 8]);
-            let old_id = u32x8::from_slice(simd, ids);
-            let new_id = u32x8::splat(simd, bytemuck::cast(id));
-            let best = f32x8::from_slice(simd, &pk.best_t.0[base..base + 8]);
-            let take = if ANY {
-                mask_from_bits(simd, found)
+        // Two neighbouring groups of eight with active rays are tested as
+        // sixteen lanes (one AVX-512 register, or two AVX2 halves that
+        // compute what two groups of eight would): half the instructions,
+        // and the two groups' divisions side by side.
+        let mut pairs = active;
+        while pairs != 0 {
+            let base = 16 * (pairs.trailing_zeros() as usize / 16);
+            pairs &= !(0xffff << base);
+            let lanes = (active >> base) & 0xffff;
+            if lanes & 0xff != 0 && lanes >> 8 != 0 {
+                let found = test_triangle_lanes!(simd, f32x16, u32x16, 16, ANY, pk, tri, id, base, lanes);
+                if ANY {
+                    *done |= found << base;
+                    active &= !(found << base);
+                }
             } else {
-                let nearer = t.simd_lt(best) | new_id.simd_lt(old_id);
-                nearer & mask_from_bits(simd, found)
-            };
-            take.select(t, best).store_slice(&mut pk.best_t.0[base..base + 8]);
-            take.select(new_id, old_id).store_slice(ids);
-            for (w, lanes) in [b1, b2].into_iter().zip(&mut pk.bary) {
-                let slot = &mut lanes.0[base..base + 8];
-                take.select(w, f32x8::from_slice(simd, slot)).store_slice(slot);
-            }
-            if ANY {
-                *done |= (found as u64) << base;
-                active &= !((found as u64) << base);
-            } else {
-                // Just above the new best, so that a tie can still be won.
-                let above: f32x8<S> = (t.bitcast::<u32x8<S>>() + 1).bitcast();
-                let limit = &mut pk.limit[base..base + 8];
-                take.select(above, f32x8::from_slice(simd, limit)).store_slice(limit);
+                let base = if lanes & 0xff != 0 { base } else { base + 8 };
+                let lanes = (active >> base) & 0xff;
+                let found = test_triangle_lanes!(simd, f32x8, u32x8, 8, ANY, pk, tri, id, base, lanes);
+                if ANY {
+                    *done |= found << base;
+                    active &= !(found << base);
+                }
             }
         }
     }
 }
+
+/// `test_leaf_packet`'s step for one triangle `tri` (primitive `id`)
+/// against the `$n` rays of lanes `base..base + $n` whose bits are set in
+/// `lanes` (`$f`/`$u`: the float and integer vectors of that width).
+/// Updates each ray's best hit as `test_leaf` would; returns the rays that
+/// hit it, as bits from `base`.
+macro_rules! test_triangle_lanes {
+    ($simd:expr, $f:ident, $u:ident, $n:expr, $any:expr, $pk:expr, $tri:expr, $id:expr, $base:expr, $lanes:expr) => {{
+        let (simd, pk, base): (_, &mut Packet, usize) = ($simd, $pk, $base);
+        let lanes = base..base + $n;
+        let origin = V3::new($f::from_slice(simd, &pk.origin[0].0[lanes.clone()]), $f::from_slice(simd, &pk.origin[1].0[lanes.clone()]), $f::from_slice(simd, &pk.origin[2].0[lanes.clone()]));
+        let dir = V3::new($f::from_slice(simd, &pk.dir[0].0[lanes.clone()]), $f::from_slice(simd, &pk.dir[1].0[lanes.clone()]), $f::from_slice(simd, &pk.dir[2].0[lanes.clone()]));
+        let limit = $f::from_slice(simd, &pk.limit[lanes.clone()]);
+        let (hit, t, b1, b2) = intersect_triangle_lanes(origin, dir, $tri, limit);
+        let found = fearless_simd::SimdMask::to_bitmask(hit) & $lanes;
+        if found != 0 {
+            // Every lane's update at once (each lane is its own ray): as
+            // `test_leaf`, t <= best here, and the hit is taken when nearer
+            // or, on a tie, when its id is lower; a shadow ray takes its
+            // first and is done.
+            let found_mask = fearless_simd::SimdMask::from_bitmask(simd, found);
+            let ids: &mut [u32] = bytemuck::cast_slice_mut(&mut pk.best_id[lanes.clone()]);
+            let old_id = $u::from_slice(simd, ids);
+            let new_id = $u::splat(simd, bytemuck::cast($id));
+            let best = $f::from_slice(simd, &pk.best_t.0[lanes.clone()]);
+            let take = if $any { found_mask } else { (t.simd_lt(best) | new_id.simd_lt(old_id)) & found_mask };
+            take.select(t, best).store_slice(&mut pk.best_t.0[lanes.clone()]);
+            take.select(new_id, old_id).store_slice(ids);
+            for (w, bary) in [b1, b2].into_iter().zip(&mut pk.bary) {
+                let slot = &mut bary.0[lanes.clone()];
+                take.select(w, $f::from_slice(simd, slot)).store_slice(slot);
+            }
+            if !$any {
+                // Just above the new best, so that a tie can still be won.
+                let above: $f<_> = (t.bitcast::<$u<_>>() + 1).bitcast();
+                let limit = &mut pk.limit[lanes];
+                take.select(above, $f::from_slice(simd, limit)).store_slice(limit);
+            }
+        }
+        found
+    }};
+}
+use test_triangle_lanes;
 
 /// The shadow rays `shade()` casts from the surfaces of `batches` (hits
 /// built) towards each light, traced as one packet per light: lane j of
