@@ -1,7 +1,8 @@
 //! `shade()` for eight samples at once, as frames use it: the ray caster
 //! hands over a row of its packet's tile, the rasterizers a run of visible
 //! samples. Direct light runs eight lanes wide (`lighting::direct_light` on
-//! `f32x8`, at the best SIMD level the CPU has). Frames hand path-traced
+//! `f32x8`, at the best SIMD level the CPU has), or sixteen for two batches
+//! lit by direct light alone (`shade_batch_pair`). Frames hand path-traced
 //! samples on to a `path_batch::PathPool` (`start_paths`); everything else that
 //! follows rays one sample at a time (ambient occlusion, photon gathers,
 //! mirrors and glass) is `shade()`'s own one-sample code, called per lane in
@@ -725,13 +726,11 @@ mod tests {
     use crate::scene::builtin;
     use std::sync::atomic::AtomicBool;
 
-    /// Eight (or fewer) samples shaded together give each sample's
-    /// one-wide `shade()` value bit for bit: on every built-in scene (glossy,
-    /// mirror, glass, several lights), with flat and Phong normals, with and
-    /// without shadow rays, and with ambient occlusion's random rays.
-    #[test]
-    fn batches_equal_one_sample_shading() {
-        let mut compared = 0;
+    /// Every built-in scene (glossy, mirror, glass, several lights) as a
+    /// 29x19 pass under the shadings the batch tests cover: Phong normals
+    /// with shadow rays, flat normals without, and ambient occlusion's
+    /// random rays. `check` gets the scene's name, the pass and its query.
+    fn for_each_shading_case(mut check: impl FnMut(&str, &PassJob, &BvhQuery)) {
         for name in builtin::names() {
             let prepared = PreparedScene::new(builtin::load_builtin(name).unwrap().unwrap());
             let query = BvhQuery::new(&prepared);
@@ -746,36 +745,61 @@ mod tests {
                 let mut settings = RenderSettings { interpolation, shadows, ..RenderSettings::for_scene(&prepared.scene) };
                 settings.gi.mode = gi;
                 let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: glam::Vec2::splat(0.5), sample: 0, photons: None, active: None, rows: 0..h, cancel: &cancel };
-                assert!(batchable(&job));
-                let mut batch = Batch::new();
-                let mut expected = Vec::new();
-                let mut check = |batch: &mut Batch, expected: &mut Vec<Radiance>| {
-                    let got = shade_batch(&job, &query, batch, None, &mut RayCounts::default());
-                    for j in 0..batch.len() {
-                        assert_eq!(got[j].to_array().map(f32::to_bits), expected[j].to_array().map(f32::to_bits), "{name} {interpolation:?} {shadows:?} {gi:?} lane {j} of {}", batch.len());
-                    }
-                    compared += batch.len();
-                    batch.clear();
-                    expected.clear();
-                };
-                for (x, y) in (0..h).flat_map(|y| (0..w).map(move |x| (x, y))) {
-                    let p = job.sample_position(x, y);
-                    let ray = view.eye_ray(p.x, p.y);
-                    let Some(hit) = query.closest(&ray, view.far_t(p.x, p.y), false, &mut RayCounts::default(), &mut NoRecord) else { continue };
-                    let pixel = job.pixel_index(x, y);
-                    let one = crate::render::resolve_sample(&job, &query, &ray, Some(&hit), pixel, &mut RayCounts::default(), &mut NoRecord);
-                    batch.push(interpolation, &hit, ray.dir, pixel, job.sample, 0);
-                    expected.push(one);
-                    // Odd-sized batches too: flush after five when the pixel index says so.
-                    if batch.is_full() || (pixel % 7 == 0 && batch.len() == 5) {
-                        check(&mut batch, &mut expected);
-                    }
+                check(name, &job, &query);
+            }
+        }
+    }
+
+    /// The surfaces a pass's eye rays see, in scan order: each sample's
+    /// hit, eye ray direction and pixel index, with `shade()`'s one-wide
+    /// value for it (what pixel replays run).
+    fn seen_samples(job: &PassJob, query: &BvhQuery) -> Vec<(SurfaceHit, Vec3, u32, Radiance)> {
+        let (w, h) = (job.view.width, job.view.height);
+        let mut seen = Vec::new();
+        for (x, y) in (0..h).flat_map(|y| (0..w).map(move |x| (x, y))) {
+            let p = job.sample_position(x, y);
+            let ray = job.view.eye_ray(p.x, p.y);
+            let Some(hit) = query.closest(&ray, job.view.far_t(p.x, p.y), false, &mut RayCounts::default(), &mut NoRecord) else { continue };
+            let pixel = job.pixel_index(x, y);
+            let one = crate::render::resolve_sample(job, query, &ray, Some(&hit), pixel, &mut RayCounts::default(), &mut NoRecord);
+            seen.push((hit, ray.dir, pixel, one));
+        }
+        seen
+    }
+
+    /// Eight (or fewer) samples shaded together give each sample's
+    /// one-wide `shade()` value bit for bit: on every built-in scene (glossy,
+    /// mirror, glass, several lights), with flat and Phong normals, with and
+    /// without shadow rays, and with ambient occlusion's random rays.
+    #[test]
+    fn batches_equal_one_sample_shading() {
+        let mut compared = 0;
+        for_each_shading_case(|name, job, query| {
+            assert!(batchable(job));
+            let settings = job.settings;
+            let mut batch = Batch::new();
+            let mut expected = Vec::new();
+            let mut check = |batch: &mut Batch, expected: &mut Vec<Radiance>| {
+                let got = shade_batch(job, query, batch, None, &mut RayCounts::default());
+                for j in 0..batch.len() {
+                    assert_eq!(got[j].to_array().map(f32::to_bits), expected[j].to_array().map(f32::to_bits), "{name} {:?} {:?} {:?} lane {j} of {}", settings.interpolation, settings.shadows, settings.gi.mode, batch.len());
                 }
-                if !batch.is_empty() {
+                compared += batch.len();
+                batch.clear();
+                expected.clear();
+            };
+            for (hit, dir, pixel, one) in seen_samples(job, query) {
+                batch.push(settings.interpolation, &hit, dir, pixel, job.sample, 0);
+                expected.push(one);
+                // Odd-sized batches too: flush after five when the pixel index says so.
+                if batch.is_full() || (pixel % 7 == 0 && batch.len() == 5) {
                     check(&mut batch, &mut expected);
                 }
             }
-        }
+            if !batch.is_empty() {
+                check(&mut batch, &mut expected);
+            }
+        });
         assert!(compared > 3000, "only {compared} samples compared");
     }
 
@@ -788,54 +812,37 @@ mod tests {
     fn batch_pairs_equal_one_sample_shading() {
         use crate::render::raytrace::packet::{shadow_packets, Packet};
         let (mut paired, mut refused) = (0, 0);
-        for name in builtin::names() {
-            let prepared = PreparedScene::new(builtin::load_builtin(name).unwrap().unwrap());
-            let query = BvhQuery::new(&prepared);
-            let (w, h) = (29u32, 19u32);
-            let view = prepared.scene.camera.view(w, h);
-            let cancel = AtomicBool::new(false);
-            let lights = prepared.scene.lights.len();
-            for (interpolation, shadows, gi) in [
-                (Interpolation::Phong, ShadowMode::Ray, GiMode::None),
-                (Interpolation::Flat, ShadowMode::None, GiMode::None),
-                (Interpolation::Phong, ShadowMode::Ray, GiMode::Ao),
-            ] {
-                let mut settings = RenderSettings { interpolation, shadows, ..RenderSettings::for_scene(&prepared.scene) };
-                settings.gi.mode = gi;
-                let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: glam::Vec2::splat(0.5), sample: 0, photons: None, active: None, rows: 0..h, cancel: &cancel };
-                let (mut batches, mut expected) = ([Batch::new(), Batch::new()], Vec::new());
-                let mut pk = Packet::new();
-                for (x, y) in (0..h).flat_map(|y| (0..w).map(move |x| (x, y))) {
-                    let p = job.sample_position(x, y);
-                    let ray = view.eye_ray(p.x, p.y);
-                    let Some(hit) = query.closest(&ray, view.far_t(p.x, p.y), false, &mut RayCounts::default(), &mut NoRecord) else { continue };
-                    let pixel = job.pixel_index(x, y);
-                    expected.push(crate::render::resolve_sample(&job, &query, &ray, Some(&hit), pixel, &mut RayCounts::default(), &mut NoRecord));
-                    let b = usize::from(batches[0].is_full());
-                    batches[b].push(interpolation, &hit, ray.dir, pixel, job.sample, 0);
-                    if !batches[1].is_full() {
-                        continue;
-                    }
-                    let mut queue_blocked = vec![0u64; lights];
-                    if shadows == ShadowMode::Ray {
-                        shadow_packets(&query, &settings, &batches, |b, j| LANES * b + j, &mut pk, &mut queue_blocked, &mut RayCounts::default());
-                    }
-                    let bits: [Vec<u8>; 2] = [0, 1].map(|b| queue_blocked.iter().map(|q| (q >> (LANES * b)) as u8).collect());
-                    let blocked = [&bits[0], &bits[1]].map(|v| (shadows == ShadowMode::Ray).then_some(&v[..]));
-                    match shade_batch_pair(&job, &query, [&batches[0], &batches[1]], blocked, &mut RayCounts::default()) {
-                        Some(got) => {
-                            for (k, (got, want)) in got.iter().flatten().zip(&expected).enumerate() {
-                                assert_eq!(got.to_array().map(f32::to_bits), want.to_array().map(f32::to_bits), "{name} {interpolation:?} {shadows:?} {gi:?} lane {k} of 16");
-                            }
-                            paired += 1;
-                        }
-                        None => refused += 1,
-                    }
-                    batches.iter_mut().for_each(Batch::clear);
-                    expected.clear();
+        let mut pk = Packet::new();
+        for_each_shading_case(|name, job, query| {
+            let settings = job.settings;
+            let traced = settings.shadows == ShadowMode::Ray;
+            let (mut batches, mut expected) = ([Batch::new(), Batch::new()], Vec::new());
+            for (hit, dir, pixel, one) in seen_samples(job, query) {
+                expected.push(one);
+                let b = usize::from(batches[0].is_full());
+                batches[b].push(settings.interpolation, &hit, dir, pixel, job.sample, 0);
+                if !batches[1].is_full() {
+                    continue;
                 }
+                let mut queue_blocked = vec![0u64; job.prepared.scene.lights.len()];
+                if traced {
+                    shadow_packets(query, settings, &batches, |b, j| LANES * b + j, &mut pk, &mut queue_blocked, &mut RayCounts::default());
+                }
+                let bits: [Vec<u8>; 2] = [0, 1].map(|b| queue_blocked.iter().map(|q| (q >> (LANES * b)) as u8).collect());
+                let blocked = [&bits[0], &bits[1]].map(|v| traced.then_some(&v[..]));
+                match shade_batch_pair(job, query, [&batches[0], &batches[1]], blocked, &mut RayCounts::default()) {
+                    Some(got) => {
+                        for (k, (got, want)) in got.iter().flatten().zip(&expected).enumerate() {
+                            assert_eq!(got.to_array().map(f32::to_bits), want.to_array().map(f32::to_bits), "{name} {:?} {:?} {:?} lane {k} of 16", settings.interpolation, settings.shadows, settings.gi.mode);
+                        }
+                        paired += 1;
+                    }
+                    None => refused += 1,
+                }
+                batches.iter_mut().for_each(Batch::clear);
+                expected.clear();
             }
-        }
+        });
         assert!(paired > 50 && refused > 20, "{paired} pairs shaded, {refused} refused");
     }
 

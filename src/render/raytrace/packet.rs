@@ -1,8 +1,8 @@
 //! Eye rays traced as packets: the rays of a TILE_W x TILE_H pixel tile walk
 //! the 8-wide BVH together. Each node is fetched once per packet and its eight
 //! child boxes are tested against eight rays at a time, and each leaf
-//! triangle against eight rays at a time (one SIMD lane per ray, at the
-//! widest level the CPU has: `math::lanes::simd_level`), so the per-ray
+//! triangle against eight or sixteen rays at a time (one SIMD lane per ray,
+//! at the widest level the CPU has: `math::lanes::simd_level`), so the per-ray
 //! latency chain of single-ray traversal becomes independent work.
 //!
 //! Every ray ends with exactly the hit `BvhQuery::closest` finds for it alone:
@@ -622,7 +622,8 @@ fn reduce_lanes(l: [f32; 8], pick: impl Fn(f32, f32) -> f32) -> f32 {
 }
 
 /// The leaf loop of `traverse::test_leaf` for the rays of `mask`, each
-/// triangle tested against eight rays at a time (`intersect_triangle_lanes`,
+/// triangle tested against eight or sixteen rays at a time
+/// (`intersect_triangle_lanes`,
 /// the single test's arithmetic lane by lane) with each lane's own limit,
 /// and the same tie rule applied per ray in the same primitive order: every
 /// ray ends with the hit it finds alone. Spheres are tested ray by ray.
