@@ -451,6 +451,53 @@ fn direct_light8<S: Simd, Q: SceneQuery>(simd: S, job: &PassJob, geometry: &Geom
     lighting::direct_light(&job.prepared.scene.lights, &surface, start, visibility).scatter()
 }
 
+/// Shades each of `batches` (hits built) with `shade_batch`, two at a time
+/// through `shade_batch_pair` where a pair qualifies, handing lane j of
+/// batch b's value to `put(batch, j, value)`, and empties them. With
+/// shadows traced ahead, `unpack(b, batch, bits)` writes batch b's blocked
+/// lanes per light into `bits` (`bits` holds one buffer for each batch of
+/// a pair); without, the lanes' shadow rays are cast in shading.
+pub fn shade_batches<Q: SceneQuery>(
+    job: &PassJob,
+    query: &Q,
+    batches: &mut [Batch],
+    unpack: Option<impl Fn(usize, &Batch, &mut [u8])>,
+    bits: [&mut Vec<u8>; 2],
+    counts: &mut RayCounts,
+    mut put: impl FnMut(&Batch, usize, Radiance),
+) {
+    let [first, second] = bits;
+    let mut b = 0;
+    while b < batches.len() {
+        if let Some(unpack) = &unpack {
+            unpack(b, &batches[b], first);
+        }
+        if b + 1 < batches.len() {
+            if let Some(unpack) = &unpack {
+                unpack(b + 1, &batches[b + 1], second);
+            }
+            let blocked = [&first[..], &second[..]].map(|bits| unpack.is_some().then_some(bits));
+            if let Some(values) = shade_batch_pair(job, query, [&batches[b], &batches[b + 1]], blocked, counts) {
+                for (batch, values) in batches[b..b + 2].iter_mut().zip(values) {
+                    for (j, &value) in values.iter().enumerate() {
+                        put(batch, j, value);
+                    }
+                    batch.clear();
+                }
+                b += 2;
+                continue;
+            }
+        }
+        let batch = &mut batches[b];
+        let values = shade_batch(job, query, batch, unpack.is_some().then_some(&first[..]), counts);
+        for (j, &value) in values.iter().enumerate().take(batch.len()) {
+            put(batch, j, value);
+        }
+        batch.clear();
+        b += 1;
+    }
+}
+
 /// `shade_batch` for two full batches at once, where direct light and the
 /// constant ambient term are all there is to it and one untextured
 /// material covers all sixteen lanes: `lighting::direct_light` runs over
@@ -512,14 +559,10 @@ fn direct_light16<S: Simd, V: LightVisibility<f32x16<S>>>(simd: S, job: &PassJob
     let MaterialLanes::Uniform { albedo, glossy, sharpness, ambient } = materials else {
         unreachable!("pairs are one material")
     };
-    let join = |x: &[Floats; 3], y: &[Floats; 3]| {
-        let (x, y) = (V3::from_soa(simd, x), V3::from_soa(simd, y));
-        V3::new(x.x.combine(y.x), x.y.combine(y.y), x.z.combine(y.z))
-    };
     let surface = SurfaceLanes {
-        position: join(&a.hits.position, &b.hits.position),
-        normal: join(&a.hits.shading_normal, &b.hits.shading_normal),
-        w_o: join(&a.w_o, &b.w_o),
+        position: join_lanes(simd, &a.hits.position, &b.hits.position),
+        normal: join_lanes(simd, &a.hits.shading_normal, &b.hits.shading_normal),
+        w_o: join_lanes(simd, &a.w_o, &b.w_o),
         albedo: V3::splat(like, *albedo),
         glossy: V3::splat(like, *glossy),
         sharpness: like.splat(*sharpness),
@@ -534,6 +577,15 @@ fn direct_light16<S: Simd, V: LightVisibility<f32x16<S>>>(simd: S, job: &PassJob
         out[1][i] = Vec3::new(x[LANES + i], y[LANES + i], z[LANES + i]);
     }
     out
+}
+
+/// Sixteen lanes of 3-vectors: `low`'s eight, then `high`'s. (A function,
+/// not a closure: a closure would be compiled apart from the SIMD level
+/// `dispatch` compiles its caller for.)
+#[inline(always)]
+fn join_lanes<S: Simd>(simd: S, low: &[Floats; 3], high: &[Floats; 3]) -> V3<f32x16<S>> {
+    let (low, high) = (V3::from_soa(simd, low), V3::from_soa(simd, high));
+    V3::new(low.x.combine(high.x), low.y.combine(high.y), low.z.combine(high.z))
 }
 
 /// Visibility for `shade_batch_pair`: `BatchVisibility`'s answers (no

@@ -89,44 +89,25 @@ impl ShadeQueue {
         if let Some(bvh) = packets {
             shadow_packets(bvh, job.settings, batches, |b, j| LANES * b + j, &mut self.shadow_pk, &mut self.queue_blocked, counts);
         }
-        let mut b = 0;
-        while b < queued {
-            let unpack = |bits: &mut Vec<u8>, b: usize| {
-                for (bits, queue_bits) in bits.iter_mut().zip(&self.queue_blocked) {
-                    *bits = (queue_bits >> (LANES * b)) as u8;
-                }
-            };
-            unpack(&mut self.batch_blocked, b);
-            // Two batches shaded together where they qualify
-            // (`shade_batch_pair`), else one at a time.
-            if b + 1 < queued && !path_batch::takes(job) {
-                unpack(&mut self.next_blocked, b + 1);
-                let blocked = [&self.batch_blocked, &self.next_blocked].map(|bits| packets.is_some().then_some(&bits[..]));
-                if let Some(values) = shade_batch::shade_batch_pair(job, query, [&batches[b], &batches[b + 1]], blocked, counts) {
-                    for (batch, values) in batches[b..b + 2].iter_mut().zip(values) {
-                        for (j, value) in values.iter().enumerate() {
-                            out[batch.slots[j]] = *value;
-                        }
-                        batch.clear();
-                    }
-                    b += 2;
-                    continue;
-                }
+        // Without packets the lanes' rays are cast one by one in shading.
+        let queue_blocked = &self.queue_blocked;
+        let unpack = packets.is_some().then_some(|b: usize, _: &Batch, bits: &mut [u8]| {
+            for (bits, queue_bits) in bits.iter_mut().zip(queue_blocked) {
+                *bits = (queue_bits >> (LANES * b)) as u8;
             }
-            let batch = &mut batches[b];
-            b += 1;
-            // Without packets the lanes' rays are cast one by one in shading.
-            let blocked = packets.is_some().then_some(&self.batch_blocked[..]);
-            if path_batch::takes(job) {
-                shade_batch::start_paths(job, query, batch, blocked, &batch.slots[..batch.len()], counts, paths);
-                if paths.len() >= PATH_SAMPLES {
-                    paths.follow_into(job, query, counts, out);
-                }
-            } else {
-                let values = shade_batch::shade_batch(job, query, batch, blocked, counts);
-                for (j, value) in values.iter().enumerate().take(batch.len()) {
-                    out[batch.slots[j]] = *value;
-                }
+        });
+        if !path_batch::takes(job) {
+            shade_batch::shade_batches(job, query, batches, unpack, [&mut self.batch_blocked, &mut self.next_blocked], counts, |batch, j, value| out[batch.slots[j]] = value);
+            return;
+        }
+        for (b, batch) in batches.iter_mut().enumerate() {
+            if let Some(unpack) = &unpack {
+                unpack(b, batch, &mut self.batch_blocked);
+            }
+            let blocked = unpack.is_some().then_some(&self.batch_blocked[..]);
+            shade_batch::start_paths(job, query, batch, blocked, &batch.slots[..batch.len()], counts, paths);
+            if paths.len() >= PATH_SAMPLES {
+                paths.follow_into(job, query, counts, out);
             }
             batch.clear();
         }

@@ -1,8 +1,8 @@
 //! Eye rays traced as packets: the rays of a TILE_W x TILE_H pixel tile walk
 //! the 8-wide BVH together. Each node is fetched once per packet and its eight
 //! child boxes are tested against eight rays at a time, and each leaf
-//! triangle against eight or sixteen rays at a time (one SIMD lane per ray,
-//! at the widest level the CPU has: `math::lanes::simd_level`), so the per-ray
+//! triangle against eight rays at a time (one SIMD lane per ray, at the
+//! widest level the CPU has: `math::lanes::simd_level`), so the per-ray
 //! latency chain of single-ray traversal becomes independent work.
 //!
 //! Every ray ends with exactly the hit `BvhQuery::closest` finds for it alone:
@@ -36,7 +36,7 @@ use crate::render::shade_batch::{self, Batch};
 use crate::render::{miss_without_ray, resolve_sample, Occluder, PassJob, RayCounts, RenderSettings, SceneQuery, ShadowMode};
 use crate::scene::hit_lanes::{HitLanes, TriangleHitInput, HIT_LANES};
 use crate::scene::{CameraView, PrimitiveId, PrimitiveKind, Sphere, SurfaceHit};
-use fearless_simd::{dispatch, f32x16, f32x8, mask32x8, u32x16, u32x8, Bytes, Select, Simd, SimdBase, SimdFloat, SimdFrom};
+use fearless_simd::{dispatch, f32x8, mask32x8, u32x8, Bytes, Select, Simd, SimdBase, SimdFloat, SimdFrom};
 use glam::Vec3;
 use rayon::prelude::*;
 use std::mem::MaybeUninit;
@@ -622,8 +622,7 @@ fn reduce_lanes(l: [f32; 8], pick: impl Fn(f32, f32) -> f32) -> f32 {
 }
 
 /// The leaf loop of `traverse::test_leaf` for the rays of `mask`, each
-/// triangle tested against eight or sixteen rays at a time
-/// (`intersect_triangle_lanes`,
+/// triangle tested against eight rays at a time (`intersect_triangle_lanes`,
 /// the single test's arithmetic lane by lane) with each lane's own limit,
 /// and the same tie rule applied per ray in the same primitive order: every
 /// ray ends with the hit it finds alone. Spheres are tested ray by ray.
@@ -657,76 +656,52 @@ fn test_leaf_packet<S: Simd, const ANY: bool>(
             }
             continue;
         }
-        // Two neighbouring groups of eight with active rays are tested as
-        // sixteen lanes (one AVX-512 register, or two AVX2 halves that
-        // compute what two groups of eight would): half the instructions,
-        // and the two groups' divisions side by side.
-        let mut pairs = active;
-        while pairs != 0 {
-            let base = 16 * (pairs.trailing_zeros() as usize / 16);
-            pairs &= !(0xffff << base);
-            let lanes = (active >> base) & 0xffff;
-            if lanes & 0xff != 0 && lanes >> 8 != 0 {
-                let found = test_triangle_lanes!(simd, f32x16, u32x16, 16, ANY, pk, tri, id, base, lanes);
-                if ANY {
-                    *done |= found << base;
-                    active &= !(found << base);
-                }
-            } else {
-                let base = if lanes & 0xff != 0 { base } else { base + 8 };
-                let lanes = (active >> base) & 0xff;
-                let found = test_triangle_lanes!(simd, f32x8, u32x8, 8, ANY, pk, tri, id, base, lanes);
-                if ANY {
-                    *done |= found << base;
-                    active &= !(found << base);
-                }
+        let mut groups = active;
+        while groups != 0 {
+            let g = groups.trailing_zeros() as usize / 8;
+            groups &= !(0xff << (8 * g));
+            let lanes = (active >> (8 * g)) as u8;
+            let base = 8 * g;
+            let origin = V3::load(simd, [&pk.origin[0].0, &pk.origin[1].0, &pk.origin[2].0], base);
+            let dir = V3::load(simd, [&pk.dir[0].0, &pk.dir[1].0, &pk.dir[2].0], base);
+            let limit = f32x8::from_slice(simd, &pk.limit[base..base + 8]);
+            let (hit, t, b1, b2) = intersect_triangle_lanes(origin, dir, tri, limit);
+            let found = mask_bits(hit) & lanes;
+            if found == 0 {
+                continue;
             }
-        }
-    }
-}
-
-/// `test_leaf_packet`'s step for one triangle `tri` (primitive `id`)
-/// against the `$n` rays of lanes `base..base + $n` whose bits are set in
-/// `lanes` (`$f`/`$u`: the float and integer vectors of that width).
-/// Updates each ray's best hit as `test_leaf` would; returns the rays that
-/// hit it, as bits from `base`.
-macro_rules! test_triangle_lanes {
-    ($simd:expr, $f:ident, $u:ident, $n:expr, $any:expr, $pk:expr, $tri:expr, $id:expr, $base:expr, $lanes:expr) => {{
-        let (simd, pk, base): (_, &mut Packet, usize) = ($simd, $pk, $base);
-        let lanes = base..base + $n;
-        let origin = V3::new($f::from_slice(simd, &pk.origin[0].0[lanes.clone()]), $f::from_slice(simd, &pk.origin[1].0[lanes.clone()]), $f::from_slice(simd, &pk.origin[2].0[lanes.clone()]));
-        let dir = V3::new($f::from_slice(simd, &pk.dir[0].0[lanes.clone()]), $f::from_slice(simd, &pk.dir[1].0[lanes.clone()]), $f::from_slice(simd, &pk.dir[2].0[lanes.clone()]));
-        let limit = $f::from_slice(simd, &pk.limit[lanes.clone()]);
-        let (hit, t, b1, b2) = intersect_triangle_lanes(origin, dir, $tri, limit);
-        let found = fearless_simd::SimdMask::to_bitmask(hit) & $lanes;
-        if found != 0 {
             // Every lane's update at once (each lane is its own ray): as
             // `test_leaf`, t <= best here, and the hit is taken when nearer
             // or, on a tie, when its id is lower; a shadow ray takes its
             // first and is done.
-            let found_mask = fearless_simd::SimdMask::from_bitmask(simd, found);
-            let ids: &mut [u32] = bytemuck::cast_slice_mut(&mut pk.best_id[lanes.clone()]);
-            let old_id = $u::from_slice(simd, ids);
-            let new_id = $u::splat(simd, bytemuck::cast($id));
-            let best = $f::from_slice(simd, &pk.best_t.0[lanes.clone()]);
-            let take = if $any { found_mask } else { (t.simd_lt(best) | new_id.simd_lt(old_id)) & found_mask };
-            take.select(t, best).store_slice(&mut pk.best_t.0[lanes.clone()]);
+            let ids: &mut [u32] = bytemuck::cast_slice_mut(&mut pk.best_id[base..base + 8]);
+            let old_id = u32x8::from_slice(simd, ids);
+            let new_id = u32x8::splat(simd, bytemuck::cast(id));
+            let best = f32x8::from_slice(simd, &pk.best_t.0[base..base + 8]);
+            let take = if ANY {
+                mask_from_bits(simd, found)
+            } else {
+                let nearer = t.simd_lt(best) | new_id.simd_lt(old_id);
+                nearer & mask_from_bits(simd, found)
+            };
+            take.select(t, best).store_slice(&mut pk.best_t.0[base..base + 8]);
             take.select(new_id, old_id).store_slice(ids);
-            for (w, bary) in [b1, b2].into_iter().zip(&mut pk.bary) {
-                let slot = &mut bary.0[lanes.clone()];
-                take.select(w, $f::from_slice(simd, slot)).store_slice(slot);
+            for (w, lanes) in [b1, b2].into_iter().zip(&mut pk.bary) {
+                let slot = &mut lanes.0[base..base + 8];
+                take.select(w, f32x8::from_slice(simd, slot)).store_slice(slot);
             }
-            if !$any {
+            if ANY {
+                *done |= (found as u64) << base;
+                active &= !((found as u64) << base);
+            } else {
                 // Just above the new best, so that a tie can still be won.
-                let above: $f<_> = (t.bitcast::<$u<_>>() + 1).bitcast();
-                let limit = &mut pk.limit[lanes];
-                take.select(above, $f::from_slice(simd, limit)).store_slice(limit);
+                let above: f32x8<S> = (t.bitcast::<u32x8<S>>() + 1).bitcast();
+                let limit = &mut pk.limit[base..base + 8];
+                take.select(above, f32x8::from_slice(simd, limit)).store_slice(limit);
             }
         }
-        found
-    }};
+    }
 }
-use test_triangle_lanes;
 
 /// The shadow rays `shade()` casts from the surfaces of `batches` (hits
 /// built) towards each light, traced as one packet per light: lane j of
@@ -1313,17 +1288,23 @@ fn shade_tile_batched<'p, const PASSES: bool>(
     if shadows {
         shadow_packets(query, settings, batches, |b, j| batches[b].slots[j], shadow_pk, blocked, counts);
     }
+    // Each batch's lanes' bits of the tile's blocked rays, per light.
+    let unpack = shadows.then_some(|_: usize, batch: &Batch, bits: &mut [u8]| {
+        for (k, bits) in bits.iter_mut().enumerate() {
+            *bits = (0..batch.len()).fold(0u8, |acc, j| acc | (((blocked[k] >> batch.slots[j]) & 1) as u8) << j);
+        }
+    });
     if path_batch::takes(first) {
         // The paths wait for those of the next tiles, to be followed
         // together (`PathPool::follow_into`, once it holds `PATH_SAMPLES`
         // and at the end of the band, or of the call with several passes).
-        for batch in batches.iter_mut() {
-            for (k, bits) in lane_blocked.iter_mut().enumerate() {
-                *bits = (0..batch.len()).fold(0u8, |acc, j| acc | (((blocked[k] >> batch.slots[j]) & 1) as u8) << j);
+        for (b, batch) in batches.iter_mut().enumerate() {
+            if let Some(unpack) = &unpack {
+                unpack(b, batch, lane_blocked);
             }
             // Where each lane's radiance goes in the band.
             let slots: [usize; shade_batch::LANES] = std::array::from_fn(|j| out_index(batch.slots[j]));
-            shade_batch::start_paths(first, query, batch, shadows.then_some(&lane_blocked[..]), &slots[..batch.len()], counts, paths);
+            shade_batch::start_paths(first, query, batch, unpack.is_some().then_some(&lane_blocked[..]), &slots[..batch.len()], counts, paths);
             batch.clear();
         }
         if paths.len() >= PATH_SAMPLES {
@@ -1331,39 +1312,7 @@ fn shade_tile_batched<'p, const PASSES: bool>(
         }
         return;
     }
-    // Each batch's lanes' bits of the tile's blocked rays, per light.
-    let unpack = |bits: &mut Vec<u8>, batch: &Batch| {
-        for (k, bits) in bits.iter_mut().enumerate() {
-            *bits = (0..batch.len()).fold(0u8, |acc, j| acc | (((blocked[k] >> batch.slots[j]) & 1) as u8) << j);
-        }
-    };
-    let mut b = 0;
-    while b < batches.len() {
-        unpack(lane_blocked, &batches[b]);
-        // Two batches shaded together where they qualify
-        // (`shade_batch_pair`), else one at a time.
-        if b + 1 < batches.len() {
-            unpack(next_blocked, &batches[b + 1]);
-            let blocked = [&lane_blocked[..], &next_blocked[..]].map(|bits| shadows.then_some(bits));
-            if let Some(values) = shade_batch::shade_batch_pair(first, query, [&batches[b], &batches[b + 1]], blocked, counts) {
-                for (batch, values) in batches[b..b + 2].iter_mut().zip(values) {
-                    for (j, value) in values.iter().enumerate() {
-                        band[out_index(batch.slots[j])] = *value;
-                    }
-                    batch.clear();
-                }
-                b += 2;
-                continue;
-            }
-        }
-        let batch = &mut batches[b];
-        b += 1;
-        let values = shade_batch::shade_batch(first, query, batch, shadows.then_some(&lane_blocked[..]), counts);
-        for j in 0..batch.len() {
-            band[out_index(batch.slots[j])] = values[j];
-        }
-        batch.clear();
-    }
+    shade_batch::shade_batches(first, query, batches, unpack, [lane_blocked, next_blocked], counts, |batch, j, value| band[out_index(batch.slots[j])] = value);
 }
 
 #[cfg(test)]
