@@ -184,6 +184,31 @@ impl Batch {
         self.len = LANES;
     }
 
+    /// Eight `push_eye_triangle`s at once into an empty batch, for eight
+    /// neighbouring samples of one row: lane k sees triangle `index[k]`
+    /// with weights `bary[k]`, at column `x + k` of image row `y` (the
+    /// pass's sample offset `offset` added, as `PassJob::sample_position`
+    /// does), of pixel index `pixel + k`, meant for `slot + k`; `sample` is
+    /// the pass's sample index. Every field is computed and stored lanes
+    /// wide: nothing is written one lane at a time and read back.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    pub fn fill_eye_row(&mut self, index: &[u32; LANES], bary: &[[f32; 2]; LANES], (x, y): (u32, u32), offset: Vec2, pixel: u32, sample: u32, slot: usize) {
+        assert!(self.len == 0, "fill_eye_row needs an empty batch");
+        let pending = &mut self.pending;
+        pending.index = *index;
+        pending.b1 = bary.map(|b| b[0]);
+        pending.b2 = bary.map(|b| b[1]);
+        pending.px = std::array::from_fn(|k| x.wrapping_add(k as u32) as f32 + offset.x);
+        pending.py = [y as f32 + offset.y; LANES];
+        pending.len = LANES;
+        self.pending_lanes = IN_ORDER;
+        self.pixels = std::array::from_fn(|k| pixel.wrapping_add(k as u32));
+        self.slots = std::array::from_fn(|k| slot + k);
+        self.samples = [sample; LANES];
+        self.len = LANES;
+    }
+
     /// Builds the records `push_eye_triangle` left pending, as `push` hands
     /// them to `shade()` with `interpolation`; `view` makes the eye rays.
     pub fn build_pending(&mut self, scene: &Scene, view: &CameraView, interpolation: Interpolation) {
@@ -777,6 +802,34 @@ mod tests {
     use crate::render::{PreparedScene, RenderSettings};
     use crate::scene::builtin;
     use std::sync::atomic::AtomicBool;
+
+    /// A row of eight samples put in at once holds, field by field, what
+    /// eight `push_eye_triangle`s of the same samples leave: the positions
+    /// `PassJob::sample_position` gives, consecutive pixels and slots.
+    #[test]
+    fn a_row_of_eye_samples_fills_a_batch_as_eight_pushes_do() {
+        let prepared = PreparedScene::new(builtin::load_builtin("teapot").unwrap().unwrap());
+        let view = prepared.scene.camera.view(100, 40);
+        let settings = RenderSettings::for_scene(&prepared.scene);
+        let cancel = AtomicBool::new(false);
+        let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: glam::Vec2::new(0.3, 0.85), sample: 5, photons: None, active: None, rows: 0..40, cancel: &cancel };
+        let index = [7, 3, 3, 90, 1, 0, 44, 12];
+        let bary: [[f32; 2]; LANES] = std::array::from_fn(|k| [0.1 * k as f32, 0.35 - 0.03 * k as f32]);
+        let (x, y, slot) = (61u32, 17u32, 977usize);
+        let mut pushed = Batch::new();
+        for k in 0..LANES {
+            let xk = x + k as u32;
+            pushed.push_eye_triangle(index[k], (bary[k][0], bary[k][1]), job.sample_position(xk, y), job.pixel_index(xk, y), job.sample, slot + k);
+        }
+        let mut filled = Batch::new();
+        filled.fill_eye_row(&index, &bary, (x, y), job.offset, job.pixel_index(x, y), job.sample, slot);
+        let (a, b) = (&pushed.pending, &filled.pending);
+        assert_eq!((a.len, a.index), (b.len, b.index));
+        for (from_pushes, from_row) in [(a.b1, b.b1), (a.b2, b.b2), (a.px, b.px), (a.py, b.py)] {
+            assert_eq!(from_pushes.map(f32::to_bits), from_row.map(f32::to_bits));
+        }
+        assert_eq!((pushed.len, pushed.pending_lanes, pushed.pixels, pushed.samples, pushed.slots), (filled.len, filled.pending_lanes, filled.pixels, filled.samples, filled.slots));
+    }
 
     /// Every built-in scene (glossy, mirror, glass, several lights) as a
     /// 29x19 pass under the shadings the batch tests cover: Phong normals

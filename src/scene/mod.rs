@@ -186,6 +186,16 @@ impl PrimitiveId {
     pub fn decode(self) -> Option<(PrimitiveKind, u32)> {
         (!self.is_none()).then(|| (self.kind(), self.index()))
     }
+
+    /// The triangle indices of `ids` when every one is a triangle, else
+    /// `None` (a sphere, a CSG object or `NONE` among them). One test of
+    /// the kind bits of all of them together: a triangle's are clear, and
+    /// its id is its index.
+    #[inline(always)]
+    pub fn triangle_indices<const N: usize>(ids: &[PrimitiveId; N]) -> Option<[u32; N]> {
+        let bits = ids.map(|id| id.0);
+        (bits.iter().fold(0, |kinds, b| kinds | b) & Self::CSG_BITS == 0).then_some(bits)
+    }
 }
 
 /// One `[[object]]` of the scene file, for id views and the inspector.
@@ -588,5 +598,18 @@ mod tests {
         assert!(c.is_csg() && !c.is_sphere() && !s.is_csg() && !t.is_csg() && !PrimitiveId::NONE.is_csg());
         assert!(s < c && c < PrimitiveId::NONE);
         assert!(s < PrimitiveId::NONE);
+    }
+
+    #[test]
+    fn triangle_indices_only_of_triangles() {
+        let ids = [3, 0, 9, 9, 1 << 29, 4, 5, 6].map(PrimitiveId::triangle);
+        assert_eq!(PrimitiveId::triangle_indices(&ids), Some([3, 0, 9, 9, 1 << 29, 4, 5, 6]));
+        for other in [PrimitiveId::sphere(0), PrimitiveId::csg(4), PrimitiveId::NONE] {
+            for k in [0, 7] {
+                let mut mixed = ids;
+                mixed[k] = other;
+                assert_eq!(PrimitiveId::triangle_indices(&mixed), None, "{other:?} in lane {k}");
+            }
+        }
     }
 }

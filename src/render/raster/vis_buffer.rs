@@ -744,6 +744,25 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
                         }
                         primary += (col - empty_from) as u64;
                         while col < ids.len() && !ids[col].is_none() {
+                            // Eight plain triangle samples in a row, nothing
+                            // gathered yet and the queue's batch empty (the
+                            // usual case inside a surface): the batch is
+                            // filled at once, lanes wide.
+                            if plain && eight.len == 0 && col + shade_batch::LANES <= ids.len() && queue.batch().is_empty() {
+                                let run: &[PrimitiveId; shade_batch::LANES] = ids[col..col + shade_batch::LANES].try_into().unwrap();
+                                if let Some(index) = PrimitiveId::triangle_indices(run) {
+                                    let x = r.x0 + col as u32;
+                                    let bary = payload[col..col + shade_batch::LANES].try_into().unwrap();
+                                    queue.batch().fill_eye_row(&index, bary, (x, y), self.job.offset, self.job.pixel_index(x, y), self.job.sample, line + col);
+                                    if queue.advance() {
+                                        queue.flush(self.job, self.query, &mut paths, &mut self.counts, out);
+                                    }
+                                    primary += shade_batch::LANES as u64;
+                                    shaded += shade_batch::LANES as u64;
+                                    col += shade_batch::LANES;
+                                    continue;
+                                }
+                            }
                             let id = ids[col];
                             if plain && id.kind() == crate::scene::PrimitiveKind::Triangle {
                                 let x = r.x0 + col as u32;
