@@ -492,6 +492,7 @@ pub fn shade_batches<Q: SceneQuery>(
     mut put: impl FnMut(&Batch, usize, Radiance),
 ) {
     let [first, second] = bits;
+    let mut pair_values = [[Radiance::ZERO; LANES]; 2];
     let mut b = 0;
     while b < batches.len() {
         if let Some(unpack) = &unpack {
@@ -502,8 +503,8 @@ pub fn shade_batches<Q: SceneQuery>(
                 unpack(b + 1, &batches[b + 1], second);
             }
             let blocked = [&first[..], &second[..]].map(|bits| unpack.is_some().then_some(bits));
-            if let Some(values) = shade_batch_pair(job, query, [&batches[b], &batches[b + 1]], blocked, counts) {
-                for (batch, values) in batches[b..b + 2].iter_mut().zip(values) {
+            if shade_batch_pair(job, query, [&batches[b], &batches[b + 1]], blocked, counts, &mut pair_values) {
+                for (batch, values) in batches[b..b + 2].iter_mut().zip(&pair_values) {
                     for (j, &value) in values.iter().enumerate() {
                         put(batch, j, value);
                     }
@@ -531,33 +532,35 @@ pub fn shade_batches<Q: SceneQuery>(
 /// same bits; what changes is that the two batches' chains of square
 /// roots, divisions and the glossy lobe's power run side by side, where
 /// one batch alone leaves the CPU waiting on each step. `blocked` as in
-/// `shade_batch`, per batch. `None` when the pair does not qualify: the
-/// caller then shades each batch alone.
-pub fn shade_batch_pair<Q: SceneQuery>(job: &PassJob, query: &Q, pair: [&Batch; 2], blocked: [Option<&[u8]>; 2], counts: &mut RayCounts) -> Option<[[Radiance; LANES]; 2]> {
+/// `shade_batch`, per batch. The values go into `out` (batch by batch,
+/// lane by lane; written in place rather than returned, which cost two
+/// copies whose wide loads waited on the lanes' narrow stores). False when
+/// the pair does not qualify: the caller then shades each batch alone.
+pub fn shade_batch_pair<Q: SceneQuery>(job: &PassJob, query: &Q, pair: [&Batch; 2], blocked: [Option<&[u8]>; 2], counts: &mut RayCounts, out: &mut [[Radiance; LANES]; 2]) -> bool {
     let settings = job.settings;
     let traced = match blocked {
         [Some(_), Some(_)] => true,
         [None, None] => false,
-        _ => return None,
+        _ => return false,
     };
     // Without traced shadows, `BatchVisibility` casts the rays one lane at
     // a time: those pairs are left to it.
     if settings.gi.mode != GiMode::None || (!traced && settings.shadows != ShadowMode::None) {
-        return None;
+        return false;
     }
     let [a, b] = pair;
     if !(a.is_full() && b.is_full()) {
-        return None;
+        return false;
     }
     assert!(a.pending.len == 0 && a.pending_ray_count == 0 && b.pending.len == 0 && b.pending_ray_count == 0, "shade_batch_pair on a batch with hits not built (`build_pending`)");
     let scene = &job.prepared.scene;
     let index = a.hits.material[0];
     if !a.hits.material.iter().chain(&b.hits.material).all(|&m| m == index) {
-        return None;
+        return false;
     }
     let material = &scene.materials[index as usize];
     if material.texture.is_some() || shade::adds_after_direct(settings, material) {
-        return None;
+        return false;
     }
     // `direct_in_lanes`' one-material case, for each batch: the albedo
     // and ambient term are worked out from lane 0 and must agree.
@@ -569,17 +572,18 @@ pub fn shade_batch_pair<Q: SceneQuery>(job: &PassJob, query: &Q, pair: [&Batch; 
     };
     let ((albedo, ambient), other) = (uniform(a), uniform(b));
     if (albedo, ambient) != other {
-        return None;
+        return false;
     }
     let materials = MaterialLanes::Uniform { albedo, glossy: material.glossy, sharpness: material.sharpness, ambient };
     let mut visibility = PairVisibility { shadows: settings.shadows, blocked, counts };
-    Some(dispatch!(simd_level(), simd => direct_light16(simd, job, pair, &materials, &mut visibility)))
+    dispatch!(simd_level(), simd => direct_light16(simd, job, pair, &materials, &mut visibility, out));
+    true
 }
 
 /// `direct_light8` over the sixteen lanes of two full batches (`a`'s in
-/// lanes 0-7, `b`'s in 8-15), one material in all of them.
+/// lanes 0-7, `b`'s in 8-15), one material in all of them, into `out`.
 #[inline(always)]
-fn direct_light16<S: Simd, V: LightVisibility<f32x16<S>>>(simd: S, job: &PassJob, [a, b]: [&Batch; 2], materials: &MaterialLanes, visibility: &mut V) -> [[Radiance; LANES]; 2] {
+fn direct_light16<S: Simd, V: LightVisibility<f32x16<S>>>(simd: S, job: &PassJob, [a, b]: [&Batch; 2], materials: &MaterialLanes, visibility: &mut V, out: &mut [[Radiance; LANES]; 2]) {
     let like = <f32x16<S> as fearless_simd::SimdBase<S>>::splat(simd, 0.0);
     let MaterialLanes::Uniform { albedo, glossy, sharpness, ambient } = materials else {
         unreachable!("pairs are one material")
@@ -596,12 +600,10 @@ fn direct_light16<S: Simd, V: LightVisibility<f32x16<S>>>(simd: S, job: &PassJob
     let (x, y, z): ([f32; 16], [f32; 16], [f32; 16]) = (l_o.x.into(), l_o.y.into(), l_o.z.into());
     // A plain loop: `array::map` over `from_fn` was left as a call that
     // passed the lanes through the stack several times.
-    let mut out = [[Radiance::ZERO; LANES]; 2];
     for i in 0..LANES {
         out[0][i] = Vec3::new(x[i], y[i], z[i]);
         out[1][i] = Vec3::new(x[LANES + i], y[LANES + i], z[LANES + i]);
     }
-    out
 }
 
 /// Sixteen lanes of 3-vectors: `low`'s eight, then `high`'s. (A function,
@@ -935,14 +937,14 @@ mod tests {
                 }
                 let bits: [Vec<u8>; 2] = [0, 1].map(|b| queue_blocked.iter().map(|q| (q >> (LANES * b)) as u8).collect());
                 let blocked = [&bits[0], &bits[1]].map(|v| traced.then_some(&v[..]));
-                match shade_batch_pair(job, query, [&batches[0], &batches[1]], blocked, &mut RayCounts::default()) {
-                    Some(got) => {
-                        for (k, (got, want)) in got.iter().flatten().zip(&expected).enumerate() {
-                            assert_eq!(got.to_array().map(f32::to_bits), want.to_array().map(f32::to_bits), "{name} {:?} {:?} {:?} lane {k} of 16", settings.interpolation, settings.shadows, settings.gi.mode);
-                        }
-                        paired += 1;
+                let mut got = [[Radiance::NAN; LANES]; 2];
+                if shade_batch_pair(job, query, [&batches[0], &batches[1]], blocked, &mut RayCounts::default(), &mut got) {
+                    for (k, (got, want)) in got.iter().flatten().zip(&expected).enumerate() {
+                        assert_eq!(got.to_array().map(f32::to_bits), want.to_array().map(f32::to_bits), "{name} {:?} {:?} {:?} lane {k} of 16", settings.interpolation, settings.shadows, settings.gi.mode);
                     }
-                    None => refused += 1,
+                    paired += 1;
+                } else {
+                    refused += 1;
                 }
                 batches.iter_mut().for_each(Batch::clear);
                 expected.clear();
