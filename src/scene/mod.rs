@@ -187,6 +187,13 @@ impl PrimitiveId {
         (!self.is_none()).then(|| (self.kind(), self.index()))
     }
 
+    /// Whether every one of `ids` is `NONE`: one test of all their bits
+    /// together (`NONE` is the only id with every bit set).
+    #[inline(always)]
+    pub fn all_none<const N: usize>(ids: &[PrimitiveId; N]) -> bool {
+        ids.iter().fold(u32::MAX, |all, id| all & id.0) == u32::MAX
+    }
+
     /// The triangle indices of `ids` when every one is a triangle, else
     /// `None` (a sphere, a CSG object or `NONE` among them). One test of
     /// the kind bits of all of them together: a triangle's are clear, and
@@ -598,6 +605,18 @@ mod tests {
         assert!(c.is_csg() && !c.is_sphere() && !s.is_csg() && !t.is_csg() && !PrimitiveId::NONE.is_csg());
         assert!(s < c && c < PrimitiveId::NONE);
         assert!(s < PrimitiveId::NONE);
+    }
+
+    #[test]
+    fn all_none_only_when_every_id_is_none() {
+        assert!(PrimitiveId::all_none(&[PrimitiveId::NONE; 16]));
+        for other in [PrimitiveId::triangle(0), PrimitiveId::triangle((1 << 30) - 1), PrimitiveId::sphere((1 << 30) - 1), PrimitiveId::csg(4)] {
+            for k in [0, 9, 15] {
+                let mut ids = [PrimitiveId::NONE; 16];
+                ids[k] = other;
+                assert!(!PrimitiveId::all_none(&ids), "{other:?} in lane {k}");
+            }
+        }
     }
 
     #[test]

@@ -736,6 +736,13 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
                     let mut col = 0;
                     while col < ids.len() {
                         let empty_from = col;
+                        // Sixteen empty samples at a time, then one by one.
+                        while let Some(next) = ids.get(col..col + 16) {
+                            if !PrimitiveId::all_none::<16>(next.try_into().unwrap()) {
+                                break;
+                            }
+                            col += 16;
+                        }
                         while col < ids.len() && ids[col].is_none() {
                             col += 1;
                         }
