@@ -187,6 +187,12 @@ impl PrimitiveId {
         (!self.is_none()).then(|| (self.kind(), self.index()))
     }
 
+    /// The id's bits, as buffers of ids hold them.
+    #[inline(always)]
+    pub fn bits(self) -> u32 {
+        self.0
+    }
+
     /// Whether every one of `ids` is `NONE`: one test of all their bits
     /// together (`NONE` is the only id with every bit set).
     #[inline(always)]

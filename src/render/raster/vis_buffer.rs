@@ -17,8 +17,8 @@
 use crate::render::differentials::{with_ray_differentials, RayDifferential};
 use super::depth_format::{DepthEncoding, DepthFormat};
 use super::fixed::FixedTri;
-use crate::math::lanes::{mask_bits, simd_level};
-use fearless_simd::{dispatch, f32x8, Simd, SimdBase, SimdFrom};
+use crate::math::lanes::{mask_bits, mask_from_bits, simd_level};
+use fearless_simd::{dispatch, f32x8, u32x8, Select, Simd, SimdBase, SimdFrom};
 use super::rect::{PixelRect, TestCounter};
 use super::setup::ScreenTri;
 use crate::math::{streaming, Radiance, Ray, Vec3};
@@ -339,18 +339,28 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         let key = -inv_z;
         let stored = f32x8::from_slice(simd, &self.depth[i..i + 8]);
         let passed = mask_bits(key.simd_lt(stored)) & bits;
-        let [b1, b2] = st.bary_lanes(&l, inv_z);
-        let (key, b1, b2): ([f32; 8], [f32; 8], [f32; 8]) = (key.into(), b1.into(), b2.into());
         self.counts.samples_covered += bits.count_ones() as u64;
         self.counts.depth_fails += (bits & !passed).count_ones() as u64;
-        let id = PrimitiveId::triangle(st.tri);
-        let mut m = passed;
-        while m != 0 {
-            let k = m.trailing_zeros() as usize;
-            m &= m - 1;
-            self.depth[i + k] = key[k];
-            self.id[i + k] = id;
-            self.payload[i + k] = [b1[k], b2[k]];
+        if passed == 0 {
+            return;
+        }
+        let [b1, b2] = st.bary_lanes(&l, inv_z);
+        // The samples that pass take the new values, the others keep
+        // theirs: each buffer's eight entries blended and stored whole, not
+        // written one passing sample at a time.
+        let m = mask_from_bits(simd, passed);
+        self.depth[i..i + 8].copy_from_slice(&<[f32; 8]>::from(m.select(key, stored)));
+        let ids: &mut [u32] = bytemuck::cast_slice_mut(&mut self.id[i..i + 8]);
+        let id = u32x8::splat(simd, PrimitiveId::triangle(st.tri).bits());
+        ids.copy_from_slice(&<[u32; 8]>::from(m.select(id, u32x8::from_slice(simd, ids))));
+        // The payload's pairs (b1, b2) of samples 0-3, then of 4-7.
+        let payload: &mut [f32] = bytemuck::cast_slice_mut(&mut self.payload[i..i + 8]);
+        let pairs = b1.interleave(b2);
+        for (half, new) in [pairs.0, pairs.1].into_iter().enumerate() {
+            let taken = mask_from_bits(simd, each_bit_twice(passed >> (4 * half)));
+            let old = &mut payload[8 * half..8 * half + 8];
+            let blended = taken.select(new, f32x8::from_slice(simd, old));
+            old.copy_from_slice(&<[f32; 8]>::from(blended));
         }
     }
 
@@ -872,6 +882,16 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
     }
 }
 
+/// The low four bits of `bits`, each repeated: bit k goes to bits 2k and
+/// 2k + 1 (a mask of four samples' lanes over their payload pairs).
+#[inline(always)]
+fn each_bit_twice(bits: u8) -> u8 {
+    let mut x = bits & 0x0f;
+    x = (x | x << 2) & 0x33;
+    x = (x | x << 1) & 0x55;
+    x | x << 1
+}
+
 /// Puts the eye samples `eight` (of pixel indices `pixels`, meant for
 /// `slots`) into `queue`, a whole batch at once when it starts one, and
 /// empties `eight`; flushes the queue into `out` when it fills.
@@ -893,4 +913,24 @@ fn queue_eye_samples<'p, Q: SceneQuery>(job: &PassJob<'p>, query: &Q, counts: &m
         }
     }
     eight.len = 0;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::each_bit_twice;
+
+    #[test]
+    fn each_of_four_bits_covers_its_pair_of_lanes() {
+        assert_eq!(each_bit_twice(0b0000), 0);
+        assert_eq!(each_bit_twice(0b0001), 0b0000_0011);
+        assert_eq!(each_bit_twice(0b0100), 0b0011_0000);
+        assert_eq!(each_bit_twice(0b1010), 0b1100_1100);
+        assert_eq!(each_bit_twice(0b1111_0101), 0b0011_0011, "the high four bits are not its");
+        for bits in 0..16u8 {
+            for k in 0..4 {
+                let set = bits >> k & 1;
+                assert_eq!((each_bit_twice(bits) >> (2 * k) & 0b11), set * 0b11, "{bits:04b} bit {k}");
+            }
+        }
+    }
 }
