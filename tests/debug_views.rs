@@ -193,12 +193,13 @@ fn affine_interpolation_bends_the_uv_checker() {
 
 /// In every view that colours only what is hit, the rasterizers fill the
 /// pixels no primitive covers with the view's miss colour without making
-/// their eye rays, and colour the covered ones from hit records built eight
-/// at a time: each such pixel, empty or covered, is what the pixel replay
-/// (its eye ray made, its hit built alone) gives. The teapot leaves most of
-/// the image empty.
+/// their eye rays, and the ray caster the tiles that cannot see the scene;
+/// both colour the covered pixels from hit records built eight at a time.
+/// Each such pixel, empty or covered, is what the pixel replay (its eye ray
+/// made and traced alone, its hit built alone) gives. The teapot leaves
+/// most of the image empty.
 #[test]
-fn rasterized_views_fill_empty_pixels_as_their_replays_show_them() {
+fn views_fill_empty_pixels_as_their_replays_show_them() {
     use pinhole::render::debug::miss_color;
     use pinhole::render::frame::replay_pixel;
     let views: Vec<View> = View::ALL.into_iter().filter(|v| miss_color(*v).is_some()).collect();
@@ -208,7 +209,7 @@ fn rasterized_views_fill_empty_pixels_as_their_replays_show_them() {
     for view in views {
         let mut settings = RenderSettings::for_scene(&scene);
         (settings.width, settings.height, settings.view) = (W, H, view);
-        for name in ["rasterize:fixed", "rasterize:tiled", "rasterize:barycentric"] {
+        for name in ["rasterize:fixed", "rasterize:tiled", "rasterize:barycentric", "raytrace"] {
             let image = render(name, &prepared, &settings);
             let renderer = pinhole::render::renderer_by_name(name).unwrap();
             let (mut empty, mut covered) = (0, 0);

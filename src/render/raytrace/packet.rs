@@ -33,7 +33,7 @@ use crate::render::pixel_record::NoRecord;
 use crate::render::BatchHit;
 use crate::render::path_batch::{self, PathPool};
 use crate::render::shade_batch::{self, Batch};
-use crate::render::{miss_without_ray, resolve_sample, Occluder, PassJob, RayCounts, RenderSettings, SceneQuery, ShadowMode};
+use crate::render::{resolve_sample, view_miss_without_ray, Occluder, PassJob, RayCounts, RenderSettings, SceneQuery, ShadowMode};
 use crate::scene::hit_lanes::{HitLanes, TriangleHitInput, HIT_LANES};
 use crate::scene::{CameraView, PrimitiveId, PrimitiveKind, Sphere, SurfaceHit};
 use fearless_simd::{dispatch, f32x8, mask32x8, u32x8, Bytes, Select, Simd, SimdBase, SimdFloat, SimdFrom};
@@ -745,7 +745,8 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
         return cast_pass(job, query, out);
     }
     let width = job.view.width as usize;
-    let batched = shade_batch::batchable(job);
+    // Shading in batches, or a debug view that colours each batch's records.
+    let batched = shade_batch::resolved_in_batches(job);
     // Tiles that cannot see the scene are filled at once, where they can be.
     let empty = SeenTiles::where_useful(query, job, (TILE_W, TILE_H), SeenTiles::LEVELS_WHOLE);
     out.par_chunks_mut(width * TILE_H)
@@ -1008,7 +1009,7 @@ struct TileContext<'p> {
     /// Whether hits need ray differentials (`with_eye_differentials`).
     textured: bool,
     /// What a sample that sees nothing shows, when no ray is needed for it
-    /// (`miss_without_ray`).
+    /// (`view_miss_without_ray`).
     background: Option<Radiance>,
     /// The tile's surfaces in batches of eight, in lane order.
     batches: Vec<Batch>,
@@ -1027,7 +1028,7 @@ impl<'p> TileContext<'p> {
             batch: vec![0; scene.lights.len()],
             next_batch: vec![0; scene.lights.len()],
             textured: scene.has_textures(),
-            background: miss_without_ray(job),
+            background: view_miss_without_ray(job),
             batches: (0..P / shade_batch::LANES).map(|_| Batch::new()).collect(),
             paths: if path_batch::takes(job) { PathPool::with_capacity(PATH_SAMPLES) } else { PathPool::new() },
         }
@@ -1147,11 +1148,12 @@ impl SeenTiles {
     }
 
     /// `SeenTiles` for `job`'s tiles where tiles that see nothing can be
-    /// filled without rays: a miss shows the background without a ray
-    /// (that value is returned too), every pixel is in the pass, and the
+    /// filled without rays: a miss shows the background, or the debug
+    /// view's colour for a miss, without a ray (that value is returned
+    /// too), every pixel is in the pass, and the
     /// tree is all that rays meet.
     fn where_useful(query: &BvhQuery, job: &PassJob, tile: (usize, usize), levels: u32) -> Option<(SeenTiles, Radiance)> {
-        match (miss_without_ray(job), job.active) {
+        match (view_miss_without_ray(job), job.active) {
             (Some(value), None) if query.bvh_packets().is_some() && !job.rows.is_empty() => Some((SeenTiles::new(query, job, tile, levels), value)),
             _ => None,
         }
@@ -1197,7 +1199,9 @@ fn lane_of<const PASSES: bool>(layout: &TileLayout, i: usize) -> (usize, usize, 
 /// record built in its batch, eight at a time; each lane keeps its own
 /// pass's sample index), then the tile's shadow rays towards every light go as one
 /// packet per light, then the batches are shaded, each light's visibility
-/// read from its packet. Lane i holds the sample `layout` names, of pass
+/// read from its packet. In a debug view that colours what is hit
+/// (`shade_batch::resolved_in_batches`) the batches' records are coloured
+/// instead, with no shadow rays. Lane i holds the sample `layout` names, of pass
 /// `jobs[layout.lanes[i].0]`; `band` holds the tile's rows from `row`, each
 /// `width` pixels. Compiled apart for one pass (`PASSES` false: lanes as
 /// `lane_xy`, every batch the one job's), which frames of one sample take
@@ -1222,6 +1226,7 @@ fn shade_tile_batched<'p, const PASSES: bool>(
     let scene = &query.prepared.scene;
     let first = &jobs[0];
     let settings = first.settings;
+    let interpolation = shade_batch::build_interpolation(first);
     let out_index = |i: usize| {
         let (g, tx, ty) = lane_of::<PASSES>(layout, i);
         g * layout.pass_stride + (row + ty) * width + x0 + tx
@@ -1248,7 +1253,7 @@ fn shade_tile_batched<'p, const PASSES: bool>(
             let (b1, b2): (&[f32; 8], &[f32; 8]) = (pk.bary[0].0[group.clone()].try_into().expect("eight lanes"), pk.bary[1].0[group.clone()].try_into().expect("eight lanes"));
             let dir: [[f32; 8]; 3] = std::array::from_fn(|a| pk.dir[a].0[group.clone()].try_into().expect("eight lanes"));
             debug_assert!(group.clone().enumerate().all(|(k, lane)| (0..3).all(|a| dir[a][k].to_bits() == pk.rays[lane].dir[a].to_bits())));
-            batches[filled / shade_batch::LANES].fill_ray_triangles(scene, settings.interpolation, &index, (b1, b2), t, &dir, pixels, samples, slots);
+            batches[filled / shade_batch::LANES].fill_ray_triangles(scene, interpolation, &index, (b1, b2), t, &dir, pixels, samples, slots);
             filled += 8;
             m &= !(0xff << i);
             continue;
@@ -1276,13 +1281,24 @@ fn shade_tile_batched<'p, const PASSES: bool>(
                 with_eye_differentials(job, job.sample_position(x, y), &pk.rays[i], &mut hit);
             }
             let hit = hit.expect("a lane with an id has a hit");
-            batch.push(settings.interpolation, &hit, pk.rays[i].dir, pixel, job.sample, i);
+            batch.push(interpolation, &hit, pk.rays[i].dir, pixel, job.sample, i);
         }
         filled += 1;
     }
     let batches = &mut batches[..filled.div_ceil(shade_batch::LANES)];
     for batch in batches.iter_mut() {
-        batch.build_pending(scene, first.view, settings.interpolation);
+        batch.build_pending(scene, first.view, interpolation);
+    }
+    if settings.view != View::Shaded {
+        // A debug view that colours what is hit (`resolved_in_batches`):
+        // each record's colour, as `resolve_sample` gives it.
+        for batch in batches.iter_mut() {
+            for j in 0..batch.len() {
+                band[out_index(batch.slots[j])] = crate::render::debug::surface_color(settings.view, first.view, &batch.hit(j));
+            }
+            batch.clear();
+        }
+        return;
     }
     let shadows = settings.shadows == ShadowMode::Ray;
     if shadows {
