@@ -476,6 +476,19 @@ fn direct_light8<S: Simd, Q: SceneQuery>(simd: S, job: &PassJob, geometry: &Geom
     lighting::direct_light(&job.prepared.scene.lights, &surface, start, visibility).scatter()
 }
 
+/// Colours each of `batches` (hits built) in a debug view that colours
+/// only what is hit (`resolved_in_batches`), handing lane j of batch b's
+/// colour to `put(batch, j, colour)` as `shade_batches` hands its values,
+/// and empties them: each record's colour, as `resolve_sample` gives it.
+pub fn colour_batches(job: &PassJob, batches: &mut [Batch], mut put: impl FnMut(&Batch, usize, Radiance)) {
+    for batch in batches.iter_mut() {
+        for j in 0..batch.len() {
+            put(batch, j, super::debug::surface_color(job.settings.view, job.view, &batch.hit(j)));
+        }
+        batch.clear();
+    }
+}
+
 /// Shades each of `batches` (hits built) with `shade_batch`, two at a time
 /// through `shade_batch_pair` where a pair qualifies, handing lane j of
 /// batch b's value to `put(batch, j, value)`, and empties them. With

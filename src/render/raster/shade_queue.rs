@@ -10,7 +10,7 @@ use crate::math::Radiance;
 use crate::render::path_batch::{self, PathPool};
 use crate::render::raytrace::packet::{shadow_packets, Packet};
 use crate::render::shade_batch::{self, Batch, LANES};
-use crate::render::debug::{self, View};
+use crate::render::debug::View;
 use crate::render::{PassJob, RayCounts, SceneQuery, ShadowMode};
 
 /// Batches queued before their shadow packets are traced: eight batches of
@@ -76,13 +76,8 @@ impl ShadeQueue {
         let view = job.settings.view;
         if view != View::Shaded {
             // Only the debug views that colour what is hit come here
-            // (`shade_batch::resolved_in_batches`): each record's colour.
-            for batch in batches.iter_mut() {
-                for j in 0..batch.len() {
-                    out[batch.slots[j]] = debug::surface_color(view, job.view, &batch.hit(j));
-                }
-                batch.clear();
-            }
+            // (`shade_batch::resolved_in_batches`).
+            shade_batch::colour_batches(job, batches, |batch, j, colour| out[batch.slots[j]] = colour);
             return;
         }
         let packets = if job.settings.shadows == ShadowMode::Ray { query.bvh_packets() } else { None };

@@ -1290,14 +1290,7 @@ fn shade_tile_batched<'p, const PASSES: bool>(
         batch.build_pending(scene, first.view, interpolation);
     }
     if settings.view != View::Shaded {
-        // A debug view that colours what is hit (`resolved_in_batches`):
-        // each record's colour, as `resolve_sample` gives it.
-        for batch in batches.iter_mut() {
-            for j in 0..batch.len() {
-                band[out_index(batch.slots[j])] = crate::render::debug::surface_color(settings.view, first.view, &batch.hit(j));
-            }
-            batch.clear();
-        }
+        shade_batch::colour_batches(first, batches, |batch, j, colour| band[out_index(batch.slots[j])] = colour);
         return;
     }
     let shadows = settings.shadows == ShadowMode::Ray;
