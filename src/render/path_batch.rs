@@ -27,7 +27,7 @@ use super::shade::{self, Shading};
 use super::shade_batch::{direct_in_lanes, shadow_rays_of, LANES};
 use super::raytrace::packet::{Packet, HYBRID_ALONE, PACKET_RAYS};
 use super::{BatchHit, PassJob, RayCounts, SceneQuery, ShadowMode};
-use super::sampling::{luminance, permute, permute_pow2_lanes, Draw2d};
+use super::sampling::{luminance, permute, permute_pow2_lanes, StreamLanes};
 use crate::math::lanes::{mask_bits, simd_level, Lane, V3};
 use crate::math::{Radiance, Ray, Vec2, Vec3};
 use fearless_simd::{dispatch, f32x8, Simd, SimdFrom};
@@ -251,12 +251,8 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
         // Paths at their last permitted bounce finish in `shade()`'s code.
         let last = self.depth >= settings.gi.max_path_depth();
         let mut lambertian = 0u8;
-        let mut u = [[0.0f32; LANES]; 2];
-        // Lanes whose stratified point waits for its cell (`next_2d_begin`):
-        // their jitter and shuffle key.
-        let mut unplaced = 0u8;
-        let mut jitter = [Vec2::ZERO; LANES];
-        let mut shuffle = [0u64; LANES];
+        // The Lambertian lanes' streams, which make their draws together.
+        let mut streams = StreamLanes::default();
         for k in 0..group.len {
             let s = group.sample[k];
             let kind = self.kinds[group.hits.material[k] as usize];
@@ -270,15 +266,7 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
                 continue;
             }
             if kind == SurfaceKind::Lambertian {
-                // `sample_bounce`'s draws; the lobe is sampled below.
-                let _choice = path.rng.next_f32();
-                match path.rng.next_2d_begin() {
-                    Draw2d::Point(d) => (u[0][k], u[1][k]) = (d.x, d.y),
-                    Draw2d::Unplaced { jitter: j, shuffle: key } => {
-                        (jitter[k], shuffle[k]) = (j, key);
-                        unplaced |= 1 << k;
-                    }
-                }
+                streams.load(k, &path.rng);
                 lambertian |= 1 << k;
                 continue;
             }
@@ -291,6 +279,18 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
         }
         if lambertian == 0 {
             return;
+        }
+        // `sample_bounce`'s draws (the lobe choice, unused by a single
+        // lobe, then the 2D point), made by the eight streams together.
+        let _choice = streams.next_f32();
+        let (jitter, shuffle, stratified) = streams.next_2d_begin();
+        let mut u = jitter;
+        let unplaced = stratified & lambertian;
+        let mut m = lambertian;
+        while m != 0 {
+            let k = m.trailing_zeros() as usize;
+            m &= m - 1;
+            streams.store(k, &mut self.paths[group.sample[k]].rng);
         }
         if unplaced != 0 {
             self.place_points(simd, group, unplaced, &jitter, &shuffle, &mut u);
@@ -320,7 +320,7 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
     /// at a time where the sample count is a power of two (the common
     /// counts), one by one otherwise.
     #[inline(always)]
-    fn place_points<S: Simd>(&self, simd: S, group: &Group, lanes: u8, jitter: &[Vec2; LANES], shuffle: &[u64; LANES], u: &mut [Floats; 2]) {
+    fn place_points<S: Simd>(&self, simd: S, group: &Group, lanes: u8, jitter: &[Floats; 2], shuffle: &[u64; LANES], u: &mut [Floats; 2]) {
         let rng = |k: usize| &self.paths[group.sample[k]].rng;
         let first = lanes.trailing_zeros() as usize;
         let (spp, second) = (rng(first).spp(), rng(first).uses_second());
@@ -350,7 +350,7 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
         while m != 0 {
             let k = m.trailing_zeros() as usize;
             m &= m - 1;
-            let d = rng(k).place_2d(jitter[k], low[k], high[k]);
+            let d = rng(k).place_2d(Vec2::new(jitter[0][k], jitter[1][k]), low[k], high[k]);
             (u[0][k], u[1][k]) = (d.x, d.y);
         }
     }

@@ -162,6 +162,99 @@ impl SampleRng {
     }
 }
 
+/// Up to eight streams' states side by side, for a draw that each of them
+/// makes at the same point: the 64-bit hashes of eight streams are then
+/// computed together in vector lanes, giving each stream the very bits its
+/// own draws give (lanes not loaded hold a zero stream whose results are
+/// ignored).
+pub struct StreamLanes {
+    key: [u64; 8],
+    counter: [u64; 8],
+    pairs: [u32; 8],
+    spp: [u32; 8],
+}
+
+impl Default for StreamLanes {
+    fn default() -> Self {
+        StreamLanes { key: [0; 8], counter: [1; 8], pairs: [0; 8], spp: [1; 8] }
+    }
+}
+
+/// `mix64` of eight values: plain loops over arrays, which the compiler
+/// turns into vector multiplies where the SIMD level has them.
+#[inline(always)]
+fn mix64_lanes(z: [u64; 8]) -> [u64; 8] {
+    let mut z = z;
+    for v in &mut z {
+        *v = (*v ^ (*v >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    }
+    for v in &mut z {
+        *v = (*v ^ (*v >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    }
+    for v in &mut z {
+        *v ^= *v >> 31;
+    }
+    z
+}
+
+impl StreamLanes {
+    /// Lane `k` takes `rng`'s state.
+    #[inline(always)]
+    pub fn load(&mut self, k: usize, rng: &SampleRng) {
+        (self.key[k], self.counter[k], self.pairs[k], self.spp[k]) = (rng.key, rng.counter, rng.pairs, rng.spp);
+    }
+
+    /// `rng` takes lane `k`'s state (after the draws), as if it had drawn them itself.
+    #[inline(always)]
+    pub fn store(&self, k: usize, rng: &mut SampleRng) {
+        (rng.key, rng.counter, rng.pairs) = (self.key[k], self.counter[k], self.pairs[k]);
+    }
+
+    /// `SampleRng::next_bits` in every lane.
+    #[inline(always)]
+    fn next_bits(&mut self) -> [u64; 8] {
+        // The key is scrambled at a sample's first draw only (a counter's
+        // low half is zero then), rarely in lanes together.
+        if self.counter.iter().any(|c| c & 0xffff_ffff == 0) {
+            let mixed = mix64_lanes(self.key);
+            for k in 0..8 {
+                if self.counter[k] & 0xffff_ffff == 0 {
+                    self.key[k] = mixed[k];
+                }
+            }
+        }
+        let mut z = [0u64; 8];
+        for k in 0..8 {
+            self.counter[k] += 1;
+            z[k] = self.key[k].wrapping_add(self.counter[k].wrapping_mul(GOLDEN));
+        }
+        mix64_lanes(z)
+    }
+
+    /// `SampleRng::next_f32` in every lane.
+    #[inline(always)]
+    pub fn next_f32(&mut self) -> [f32; 8] {
+        self.next_bits().map(|b| (b >> 40) as f32 * (1.0 / 16_777_216.0))
+    }
+
+    /// `SampleRng::next_2d_begin` in every lane: the jitters, the shuffle
+    /// keys, and the lanes whose draw is stratified (`Draw2d::Unplaced`;
+    /// the others' point is their jitter).
+    #[inline(always)]
+    pub fn next_2d_begin(&mut self) -> ([[f32; 8]; 2], [u64; 8], u8) {
+        let jitter = [self.next_f32(), self.next_f32()];
+        let mut stratified = 0u8;
+        let mut z = [0u64; 8];
+        for k in 0..8 {
+            let s = self.spp[k] != 1 && self.pairs[k] < STRATIFIED_PAIRS;
+            stratified |= (s as u8) << k;
+            z[k] = self.key[k] ^ (self.pairs[k] as u64 + 1).wrapping_mul(GOLDEN);
+            self.pairs[k] += s as u32;
+        }
+        (jitter, mix64_lanes(z), stratified)
+    }
+}
+
 /// A 2D draw begun by `SampleRng::next_2d_begin`.
 pub enum Draw2d {
     /// The point itself (this draw is not stratified).
@@ -460,6 +553,53 @@ mod tests {
                     };
                     assert_eq!(got.to_array().map(f32::to_bits), want.to_array().map(f32::to_bits), "spp {spp}, sample {sample}");
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn draws_in_lanes_are_each_streams_own() {
+        // Streams at their first draw (the key is scrambled then), midway,
+        // past the stratified pairs, with one sample, and one whose
+        // counter's low half wraps at the second draw.
+        let mut streams: Vec<SampleRng> = (0..8u32).map(|k| SampleRng::stratified(1000 + k, k % 4, [16, 16, 1, 9, 16, 5, 16, 16][k as usize], 3)).collect();
+        for _ in 0..3 {
+            streams[1].next_2d();
+        }
+        for _ in 0..9 {
+            streams[4].next_2d();
+        }
+        streams[6].counter |= 0xffff_ffff;
+        for round in 0..12 {
+            let mut lanes = StreamLanes::default();
+            // Lane 3 is left out in odd rounds, as a lane without a sample is.
+            let loaded = if round % 2 == 1 { 0b1111_0111u8 } else { 0xff };
+            for (k, r) in streams.iter().enumerate() {
+                if loaded & 1 << k != 0 {
+                    lanes.load(k, r);
+                }
+            }
+            let skipped = lanes.next_f32();
+            let (jitter, shuffle, stratified) = lanes.next_2d_begin();
+            for (k, r) in streams.iter_mut().enumerate() {
+                if loaded & 1 << k == 0 {
+                    continue;
+                }
+                let mut one = r.clone();
+                assert_eq!(skipped[k].to_bits(), one.next_f32().to_bits(), "lane {k}, round {round}");
+                match one.next_2d_begin() {
+                    Draw2d::Point(p) => {
+                        assert_eq!(stratified & 1 << k, 0);
+                        assert_eq!([jitter[0][k], jitter[1][k]].map(f32::to_bits), p.to_array().map(f32::to_bits));
+                    }
+                    Draw2d::Unplaced { jitter: j, shuffle: key } => {
+                        assert_ne!(stratified & 1 << k, 0);
+                        assert_eq!([jitter[0][k], jitter[1][k]].map(f32::to_bits), j.to_array().map(f32::to_bits));
+                        assert_eq!(shuffle[k], key, "lane {k}, round {round}");
+                    }
+                }
+                lanes.store(k, r);
+                assert_eq!((r.key, r.counter, r.pairs), (one.key, one.counter, one.pairs), "lane {k}, round {round}");
             }
         }
     }
