@@ -27,9 +27,9 @@ use super::shade::{self, Shading};
 use super::shade_batch::{direct_in_lanes, shadow_rays_of, LANES};
 use super::raytrace::packet::{Packet, HYBRID_ALONE, PACKET_RAYS};
 use super::{BatchHit, PassJob, RayCounts, SceneQuery, ShadowMode};
-use super::sampling::{luminance, permute, permute_pow2_lanes, StreamLanes};
+use super::sampling::{luminance, StreamLanes};
 use crate::math::lanes::{mask_bits, simd_level, Lane, V3};
-use crate::math::{Radiance, Ray, Vec2, Vec3};
+use crate::math::{Radiance, Ray, Vec3};
 use fearless_simd::{dispatch, f32x8, Simd, SimdFrom};
 use crate::scene::hit_lanes::{Floats, HitLanes, TriangleHitInput};
 
@@ -283,17 +283,12 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
         // `sample_bounce`'s draws (the lobe choice, unused by a single
         // lobe, then the 2D point), made by the eight streams together.
         let _choice = streams.next_f32();
-        let (jitter, shuffle, stratified) = streams.next_2d_begin();
-        let mut u = jitter;
-        let unplaced = stratified & lambertian;
+        let u = streams.next_2d(simd, lambertian);
         let mut m = lambertian;
         while m != 0 {
             let k = m.trailing_zeros() as usize;
             m &= m - 1;
             streams.store(k, &mut self.paths[group.sample[k]].rng);
-        }
-        if unplaced != 0 {
-            self.place_points(simd, group, unplaced, &jitter, &shuffle, &mut u);
         }
         let (w_i, usable) = cosine_lobes8(simd, &group.hits, &u);
         let mut m = lambertian;
@@ -312,46 +307,6 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
                 Some((scale, _)) => self.go_on(group, k, Vec3::new(w_i[0][k], w_i[1][k], w_i[2][k]), albedo * scale),
                 None => self.beyond[s] = group.direct[k] + Vec3::ZERO,
             }
-        }
-    }
-
-    /// `next_2d`'s points of the lanes in `lanes`, from `next_2d_begin`'s
-    /// jitter and shuffle keys, into `u`: the sample indices permuted eight
-    /// at a time where the sample count is a power of two (the common
-    /// counts), one by one otherwise.
-    #[inline(always)]
-    fn place_points<S: Simd>(&self, simd: S, group: &Group, lanes: u8, jitter: &[Floats; 2], shuffle: &[u64; LANES], u: &mut [Floats; 2]) {
-        let rng = |k: usize| &self.paths[group.sample[k]].rng;
-        let first = lanes.trailing_zeros() as usize;
-        let (spp, second) = (rng(first).spp(), rng(first).uses_second());
-        let (mut low, mut high) = ([0u32; LANES], [0u32; LANES]);
-        // A pool's paths share their frame's sample count (`PathState::new`
-        // takes the frame's): the lanes are permuted with one count.
-        debug_assert!((0..LANES).all(|k| lanes & 1 << k == 0 || rng(k).spp() == spp));
-        if spp.is_power_of_two() {
-            let index: [u32; LANES] = std::array::from_fn(|k| if lanes & 1 << k != 0 { rng(k).sample() } else { 0 });
-            low = permute_pow2_lanes(simd, index, spp, shuffle.map(|key| key as u32));
-            if second {
-                high = permute_pow2_lanes(simd, index, spp, shuffle.map(|key| (key >> 32) as u32));
-            }
-        } else {
-            let mut m = lanes;
-            while m != 0 {
-                let k = m.trailing_zeros() as usize;
-                m &= m - 1;
-                let (n, i) = (rng(k).spp(), rng(k).sample());
-                low[k] = permute(i, n, shuffle[k] as u32);
-                if rng(k).uses_second() {
-                    high[k] = permute(i, n, (shuffle[k] >> 32) as u32);
-                }
-            }
-        }
-        let mut m = lanes;
-        while m != 0 {
-            let k = m.trailing_zeros() as usize;
-            m &= m - 1;
-            let d = rng(k).place_2d(Vec2::new(jitter[0][k], jitter[1][k]), low[k], high[k]);
-            (u[0][k], u[1][k]) = (d.x, d.y);
         }
     }
 

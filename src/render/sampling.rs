@@ -130,16 +130,7 @@ impl SampleRng {
     /// half (`second`, read only for a Latin hypercube).
     #[inline]
     pub fn place_2d(&self, jitter: Vec2, first: u32, second: u32) -> Vec2 {
-        let n = self.grid;
-        if n != 0 {
-            let cell = first;
-            let (column, row) = if n.is_power_of_two() { (cell & (n - 1), cell >> n.trailing_zeros()) } else { (cell % n, cell / n) };
-            Vec2::new(over(column as f32 + jitter.x, n), over(row as f32 + jitter.y, n))
-        } else {
-            // Latin hypercube: a shuffled stratum per axis.
-            Vec2::new(over(first as f32 + jitter.x, self.spp), over(second as f32 + jitter.y, self.spp))
-        }
-        .min(Vec2::splat(1.0 - f32::EPSILON / 2.0))
+        place_in_cell(jitter, first, second, self.grid, self.spp)
     }
 
     /// This sample's index among its pixel's.
@@ -172,11 +163,12 @@ pub struct StreamLanes {
     counter: [u64; 8],
     pairs: [u32; 8],
     spp: [u32; 8],
+    sample: [u32; 8],
 }
 
 impl Default for StreamLanes {
     fn default() -> Self {
-        StreamLanes { key: [0; 8], counter: [1; 8], pairs: [0; 8], spp: [1; 8] }
+        StreamLanes { key: [0; 8], counter: [1; 8], pairs: [0; 8], spp: [1; 8], sample: [0; 8] }
     }
 }
 
@@ -201,7 +193,7 @@ impl StreamLanes {
     /// Lane `k` takes `rng`'s state.
     #[inline(always)]
     pub fn load(&mut self, k: usize, rng: &SampleRng) {
-        (self.key[k], self.counter[k], self.pairs[k], self.spp[k]) = (rng.key, rng.counter, rng.pairs, rng.spp);
+        (self.key[k], self.counter[k], self.pairs[k], self.spp[k], self.sample[k]) = (rng.key, rng.counter, rng.pairs, rng.spp, rng.sample);
     }
 
     /// `rng` takes lane `k`'s state (after the draws), as if it had drawn them itself.
@@ -253,6 +245,66 @@ impl StreamLanes {
         }
         (jitter, mix64_lanes(z), stratified)
     }
+
+    /// `SampleRng::next_2d` in every lane (the points of lanes outside
+    /// `lanes` mean nothing). Streams that share a power-of-two sample
+    /// count (a frame's) have their cells chosen in lanes too.
+    #[inline(always)]
+    pub fn next_2d<S: Simd>(&mut self, simd: S, lanes: u8) -> [[f32; 8]; 2] {
+        let (mut u, shuffle, stratified) = self.next_2d_begin();
+        let placed = stratified & lanes;
+        if placed == 0 {
+            return u;
+        }
+        let spp = self.spp[placed.trailing_zeros() as usize];
+        let grid = grid_side(spp);
+        let shared = (0..8).all(|k| placed & 1 << k == 0 || self.spp[k] == spp);
+        let (mut low, mut high) = ([0u32; 8], [0u32; 8]);
+        if shared && spp.is_power_of_two() {
+            low = permute_pow2_lanes(simd, self.sample, spp, shuffle.map(|key| key as u32));
+            if grid != 0 {
+                // A grid whose side is a power of two (spp = 4^k).
+                let shift = grid.trailing_zeros();
+                let x: [f32; 8] = std::array::from_fn(|k| over((low[k] & (grid - 1)) as f32 + u[0][k], grid).min(BELOW_ONE));
+                let y: [f32; 8] = std::array::from_fn(|k| over((low[k] >> shift) as f32 + u[1][k], grid).min(BELOW_ONE));
+                for k in 0..8 {
+                    if placed & 1 << k != 0 {
+                        (u[0][k], u[1][k]) = (x[k], y[k]);
+                    }
+                }
+                return u;
+            }
+            high = permute_pow2_lanes(simd, self.sample, spp, shuffle.map(|key| (key >> 32) as u32));
+        } else {
+            for k in (0..8).filter(|k| placed & 1 << k != 0) {
+                low[k] = permute(self.sample[k], self.spp[k], shuffle[k] as u32);
+                high[k] = permute(self.sample[k], self.spp[k], (shuffle[k] >> 32) as u32);
+            }
+        }
+        for k in (0..8).filter(|k| placed & 1 << k != 0) {
+            let p = place_in_cell(Vec2::new(u[0][k], u[1][k]), low[k], high[k], grid_side(self.spp[k]), self.spp[k]);
+            (u[0][k], u[1][k]) = (p.x, p.y);
+        }
+        u
+    }
+}
+
+/// The largest float below 1: a point placed in the last cell stays in [0, 1).
+const BELOW_ONE: f32 = 1.0 - f32::EPSILON / 2.0;
+
+/// `SampleRng::place_2d` for a stream with `grid` and `spp`.
+#[inline]
+fn place_in_cell(jitter: Vec2, first: u32, second: u32, grid: u32, spp: u32) -> Vec2 {
+    let n = grid;
+    if n != 0 {
+        let cell = first;
+        let (column, row) = if n.is_power_of_two() { (cell & (n - 1), cell >> n.trailing_zeros()) } else { (cell % n, cell / n) };
+        Vec2::new(over(column as f32 + jitter.x, n), over(row as f32 + jitter.y, n))
+    } else {
+        // Latin hypercube: a shuffled stratum per axis.
+        Vec2::new(over(first as f32 + jitter.x, spp), over(second as f32 + jitter.y, spp))
+    }
+    .min(Vec2::splat(BELOW_ONE))
 }
 
 /// A 2D draw begun by `SampleRng::next_2d_begin`.
@@ -580,13 +632,21 @@ mod tests {
                 }
             }
             let skipped = lanes.next_f32();
-            let (jitter, shuffle, stratified) = lanes.next_2d_begin();
+            // Every third round draws whole points, the others begin them.
+            let whole = (round % 3 == 2).then(|| fearless_simd::dispatch!(crate::math::lanes::simd_level(), simd => lanes.next_2d(simd, loaded)));
+            let (jitter, shuffle, stratified) = if whole.is_none() { lanes.next_2d_begin() } else { Default::default() };
             for (k, r) in streams.iter_mut().enumerate() {
                 if loaded & 1 << k == 0 {
                     continue;
                 }
                 let mut one = r.clone();
                 assert_eq!(skipped[k].to_bits(), one.next_f32().to_bits(), "lane {k}, round {round}");
+                if let Some(u) = whole {
+                    assert_eq!([u[0][k], u[1][k]].map(f32::to_bits), one.next_2d().to_array().map(f32::to_bits), "lane {k}, round {round}");
+                    lanes.store(k, r);
+                    assert_eq!((r.key, r.counter, r.pairs), (one.key, one.counter, one.pairs));
+                    continue;
+                }
                 match one.next_2d_begin() {
                     Draw2d::Point(p) => {
                         assert_eq!(stratified & 1 << k, 0);
@@ -600,6 +660,32 @@ mod tests {
                 }
                 lanes.store(k, r);
                 assert_eq!((r.key, r.counter, r.pairs), (one.key, one.counter, one.pairs), "lane {k}, round {round}");
+            }
+        }
+    }
+
+    #[test]
+    fn whole_points_in_lanes_are_each_streams_own_at_a_shared_count() {
+        // A frame's streams share their sample count: squares of powers of
+        // two (cells in lanes), other powers of two (a Latin hypercube),
+        // and counts that are no powers of two.
+        for spp in [4u32, 16, 64, 2, 8, 32, 9, 6] {
+            let mut streams: Vec<SampleRng> = (0..8u32).map(|k| SampleRng::stratified(500 + k / 2, (k * 3) % spp, spp, 9)).collect();
+            for round in 0..12 {
+                let mut lanes = StreamLanes::default();
+                let loaded = if round % 2 == 1 { 0b0110_1101u8 } else { 0xff };
+                for (k, r) in streams.iter().enumerate() {
+                    if loaded & 1 << k != 0 {
+                        lanes.load(k, r);
+                    }
+                }
+                let u = fearless_simd::dispatch!(crate::math::lanes::simd_level(), simd => lanes.next_2d(simd, loaded));
+                for (k, r) in streams.iter_mut().enumerate() {
+                    if loaded & 1 << k != 0 {
+                        let want = r.next_2d();
+                        assert_eq!([u[0][k], u[1][k]].map(f32::to_bits), want.to_array().map(f32::to_bits), "spp {spp}, lane {k}, round {round}");
+                    }
+                }
             }
         }
     }
