@@ -144,14 +144,24 @@ impl<'p> PathPool<'p> {
         self.paths.is_empty()
     }
 
-    /// Puts in the eye samples whose rays see `hits` (lanes `0..n`, n =
-    /// `slots.len()`) from directions `w_o`, following `paths`, with the
-    /// albedo and direct light `direct_in_lanes` found there; lane k's
-    /// radiance goes to `out[slots[k]]` of `follow_into`.
-    pub fn add(&mut self, hits: &HitLanes, w_o: &[Floats; 3], slots: &[usize], paths: [PathState<'p>; LANES], albedo: &[Vec3; LANES], direct: &[Radiance; LANES]) {
-        let n = slots.len();
+    /// Starts the paths of `n` eye samples, path k made by `start(k)`, and
+    /// lends them out (for the direct light at their surfaces, which may
+    /// draw from their random numbers); `add` puts in their surfaces. Made
+    /// in place, the paths are not copied in afterwards.
+    pub fn start(&mut self, n: usize, start: impl Fn(usize) -> PathState<'p>) -> &mut [PathState<'p>] {
         let first = self.paths.len();
-        self.paths.extend(paths.into_iter().take(n));
+        self.paths.extend((0..n).map(start));
+        &mut self.paths[first..]
+    }
+
+    /// Puts in the eye samples whose rays see `hits` (lanes `0..n`, n =
+    /// `slots.len()`) from directions `w_o`, following the `n` paths last
+    /// `start`ed, with the albedo and direct light `direct_in_lanes` found
+    /// there; lane k's radiance goes to `out[slots[k]]` of `follow_into`.
+    pub fn add(&mut self, hits: &HitLanes, w_o: &[Floats; 3], slots: &[usize], albedo: &[Vec3; LANES], direct: &[Radiance; LANES]) {
+        let n = slots.len();
+        let first = self.slots.len();
+        debug_assert_eq!(self.paths.len(), first + n, "`add` follows `start` of as many paths");
         self.slots.extend_from_slice(slots);
         self.beyond.resize(first + n, Radiance::ZERO);
         let group = slot(&mut self.front, self.live);

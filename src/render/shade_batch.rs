@@ -369,11 +369,9 @@ pub fn start_paths<'p, Q: SceneQuery>(job: &PassJob<'p>, query: &Q, batch: &Batc
     assert_eq!(slots.len(), batch.len);
     assert!(batch.pending.len == 0 && batch.pending_ray_count == 0, "start_paths on a batch with hits not built (`build_pending`)");
     let settings = job.settings;
-    let mut paths: [PathState; LANES] = std::array::from_fn(|i| {
-        PathState::new(batch.pixels[i], batch.samples[i], settings.spp, &settings.gi, job.photons)
-    });
-    let (albedo, direct) = direct_in_lanes(job, query, &batch.hits, &batch.w_o, batch.len, &mut paths, &IN_ORDER, blocked, counts);
-    pool.add(&batch.hits, &batch.w_o, slots, paths, &albedo, &direct);
+    let paths = pool.start(batch.len, |i| PathState::new(batch.pixels[i], batch.samples[i], settings.spp, &settings.gi, job.photons));
+    let (albedo, direct) = direct_in_lanes(job, query, &batch.hits, &batch.w_o, batch.len, paths, &IN_ORDER, blocked, counts);
+    pool.add(&batch.hits, &batch.w_o, slots, &albedo, &direct);
 }
 
 /// Lane i's path is path i.
