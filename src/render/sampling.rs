@@ -109,11 +109,10 @@ impl SampleRng {
         }
     }
 
-    /// `next_2d` up to the choice of the sample's cell (see `Draw2d`).
-    /// Split so that a caller with many streams can permute them together
-    /// (`permute_pow2_lanes`).
+    /// `next_2d` up to the choice of the sample's cell (see `Draw2d`):
+    /// the steps `StreamLanes::next_2d` takes in lanes.
     #[inline(always)]
-    pub fn next_2d_begin(&mut self) -> Draw2d {
+    fn next_2d_begin(&mut self) -> Draw2d {
         let jitter = Vec2::new(self.next_f32(), self.next_f32());
         if self.spp == 1 || self.pairs >= STRATIFIED_PAIRS {
             return Draw2d::Point(jitter);
@@ -129,27 +128,14 @@ impl SampleRng {
     /// sample index under the shuffle key's low half (`first`) and high
     /// half (`second`, read only for a Latin hypercube).
     #[inline]
-    pub fn place_2d(&self, jitter: Vec2, first: u32, second: u32) -> Vec2 {
+    fn place_2d(&self, jitter: Vec2, first: u32, second: u32) -> Vec2 {
         place_in_cell(jitter, first, second, self.grid, self.spp)
-    }
-
-    /// This sample's index among its pixel's.
-    #[inline]
-    pub fn sample(&self) -> u32 {
-        self.sample
     }
 
     /// The pixel's sample count (at least 1).
     #[inline]
     pub fn spp(&self) -> u32 {
         self.spp
-    }
-
-    /// Whether `place_2d` reads its `second` permutation (a Latin
-    /// hypercube, for a count that is not a square).
-    #[inline]
-    pub fn uses_second(&self) -> bool {
-        self.grid == 0
     }
 }
 
@@ -233,7 +219,7 @@ impl StreamLanes {
     /// keys, and the lanes whose draw is stratified (`Draw2d::Unplaced`;
     /// the others' point is their jitter).
     #[inline(always)]
-    pub fn next_2d_begin(&mut self) -> ([[f32; 8]; 2], [u64; 8], u8) {
+    fn next_2d_begin(&mut self) -> ([[f32; 8]; 2], [u64; 8], u8) {
         let jitter = [self.next_f32(), self.next_f32()];
         let mut stratified = 0u8;
         let mut z = [0u64; 8];
@@ -308,12 +294,12 @@ fn place_in_cell(jitter: Vec2, first: u32, second: u32, grid: u32, spp: u32) -> 
 }
 
 /// A 2D draw begun by `SampleRng::next_2d_begin`.
-pub enum Draw2d {
+enum Draw2d {
     /// The point itself (this draw is not stratified).
     Point(Vec2),
     /// The jitter within the sample's cell, and the shuffle key whose
     /// permutations of the sample's index among the pixel's
-    /// (`permute(sample(), spp(), key)` with the key's low half, and for a
+    /// (`permute(sample, spp, key)` with the key's low half, and for a
     /// Latin hypercube also with its high half) pick the cell:
     /// `SampleRng::place_2d` takes them.
     Unplaced { jitter: Vec2, shuffle: u64 },
@@ -378,7 +364,7 @@ pub fn permute(mut i: u32, len: u32, key: u32) -> u32 {
 /// of 32-bit ones on x86, where this chain of six waits on them): the
 /// answer is the same bit for bit.
 #[inline(always)]
-pub fn permute_pow2_lanes<S: Simd>(simd: S, i: [u32; 8], len: u32, key: [u32; 8]) -> [u32; 8] {
+fn permute_pow2_lanes<S: Simd>(simd: S, i: [u32; 8], len: u32, key: [u32; 8]) -> [u32; 8] {
     debug_assert!(len.is_power_of_two());
     if len <= 1 {
         return [0; 8];
@@ -599,8 +585,8 @@ mod tests {
                     let got = match two.next_2d_begin() {
                         Draw2d::Point(p) => p,
                         Draw2d::Unplaced { jitter, shuffle: key } => {
-                            let (n, i) = (two.spp(), two.sample());
-                            two.place_2d(jitter, permute(i, n, key as u32), if two.uses_second() { permute(i, n, (key >> 32) as u32) } else { u32::MAX })
+                            let (n, i) = (two.spp, two.sample);
+                            two.place_2d(jitter, permute(i, n, key as u32), if two.grid == 0 { permute(i, n, (key >> 32) as u32) } else { u32::MAX })
                         }
                     };
                     assert_eq!(got.to_array().map(f32::to_bits), want.to_array().map(f32::to_bits), "spp {spp}, sample {sample}");
