@@ -154,25 +154,10 @@ pub struct StreamLanes {
 
 impl Default for StreamLanes {
     fn default() -> Self {
+        // Counters past a first draw, so that lanes never loaded do not
+        // make every draw scramble keys.
         StreamLanes { key: [0; 8], counter: [1; 8], pairs: [0; 8], spp: [1; 8], sample: [0; 8] }
     }
-}
-
-/// `mix64` of eight values: plain loops over arrays, which the compiler
-/// turns into vector multiplies where the SIMD level has them.
-#[inline(always)]
-fn mix64_lanes(z: [u64; 8]) -> [u64; 8] {
-    let mut z = z;
-    for v in &mut z {
-        *v = (*v ^ (*v >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    }
-    for v in &mut z {
-        *v = (*v ^ (*v >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    }
-    for v in &mut z {
-        *v ^= *v >> 31;
-    }
-    z
 }
 
 impl StreamLanes {
@@ -194,7 +179,9 @@ impl StreamLanes {
         // The key is scrambled at a sample's first draw only (a counter's
         // low half is zero then), rarely in lanes together.
         if self.counter.iter().any(|c| c & 0xffff_ffff == 0) {
-            let mixed = mix64_lanes(self.key);
+            // Array maps of `mix64` compile to vector multiplies where the
+            // SIMD level has them.
+            let mixed = self.key.map(mix64);
             for k in 0..8 {
                 if self.counter[k] & 0xffff_ffff == 0 {
                     self.key[k] = mixed[k];
@@ -206,7 +193,7 @@ impl StreamLanes {
             self.counter[k] += 1;
             z[k] = self.key[k].wrapping_add(self.counter[k].wrapping_mul(GOLDEN));
         }
-        mix64_lanes(z)
+        z.map(mix64)
     }
 
     /// `SampleRng::next_f32` in every lane.
@@ -229,12 +216,12 @@ impl StreamLanes {
             z[k] = self.key[k] ^ (self.pairs[k] as u64 + 1).wrapping_mul(GOLDEN);
             self.pairs[k] += s as u32;
         }
-        (jitter, mix64_lanes(z), stratified)
+        (jitter, z.map(mix64), stratified)
     }
 
     /// `SampleRng::next_2d` in every lane (the points of lanes outside
     /// `lanes` mean nothing). Streams that share a power-of-two sample
-    /// count (a frame's) have their cells chosen in lanes too.
+    /// count (a frame's) have their cells' permutations made in lanes too.
     #[inline(always)]
     pub fn next_2d<S: Simd>(&mut self, simd: S, lanes: u8) -> [[f32; 8]; 2] {
         let (mut u, shuffle, stratified) = self.next_2d_begin();
@@ -248,19 +235,10 @@ impl StreamLanes {
         let (mut low, mut high) = ([0u32; 8], [0u32; 8]);
         if shared && spp.is_power_of_two() {
             low = permute_pow2_lanes(simd, self.sample, spp, shuffle.map(|key| key as u32));
-            if grid != 0 {
-                // A grid whose side is a power of two (spp = 4^k).
-                let shift = grid.trailing_zeros();
-                let x: [f32; 8] = std::array::from_fn(|k| over((low[k] & (grid - 1)) as f32 + u[0][k], grid).min(BELOW_ONE));
-                let y: [f32; 8] = std::array::from_fn(|k| over((low[k] >> shift) as f32 + u[1][k], grid).min(BELOW_ONE));
-                for k in 0..8 {
-                    if placed & 1 << k != 0 {
-                        (u[0][k], u[1][k]) = (x[k], y[k]);
-                    }
-                }
-                return u;
+            // Only a Latin hypercube (no square grid) reads the second.
+            if grid == 0 {
+                high = permute_pow2_lanes(simd, self.sample, spp, shuffle.map(|key| (key >> 32) as u32));
             }
-            high = permute_pow2_lanes(simd, self.sample, spp, shuffle.map(|key| (key >> 32) as u32));
         } else {
             for k in (0..8).filter(|k| placed & 1 << k != 0) {
                 low[k] = permute(self.sample[k], self.spp[k], shuffle[k] as u32);
@@ -595,6 +573,17 @@ mod tests {
         }
     }
 
+    /// The lanes of `streams` whose bit is set in `loaded`, side by side.
+    fn load_lanes(streams: &[SampleRng], loaded: u8) -> StreamLanes {
+        let mut lanes = StreamLanes::default();
+        for (k, r) in streams.iter().enumerate() {
+            if loaded & 1 << k != 0 {
+                lanes.load(k, r);
+            }
+        }
+        lanes
+    }
+
     #[test]
     fn draws_in_lanes_are_each_streams_own() {
         // Streams at their first draw (the key is scrambled then), midway,
@@ -609,14 +598,9 @@ mod tests {
         }
         streams[6].counter |= 0xffff_ffff;
         for round in 0..12 {
-            let mut lanes = StreamLanes::default();
             // Lane 3 is left out in odd rounds, as a lane without a sample is.
             let loaded = if round % 2 == 1 { 0b1111_0111u8 } else { 0xff };
-            for (k, r) in streams.iter().enumerate() {
-                if loaded & 1 << k != 0 {
-                    lanes.load(k, r);
-                }
-            }
+            let mut lanes = load_lanes(&streams, loaded);
             let skipped = lanes.next_f32();
             // Every third round draws whole points, the others begin them.
             let whole = (round % 3 == 2).then(|| fearless_simd::dispatch!(crate::math::lanes::simd_level(), simd => lanes.next_2d(simd, loaded)));
@@ -658,13 +642,8 @@ mod tests {
         for spp in [4u32, 16, 64, 2, 8, 32, 9, 6] {
             let mut streams: Vec<SampleRng> = (0..8u32).map(|k| SampleRng::stratified(500 + k / 2, (k * 3) % spp, spp, 9)).collect();
             for round in 0..12 {
-                let mut lanes = StreamLanes::default();
                 let loaded = if round % 2 == 1 { 0b0110_1101u8 } else { 0xff };
-                for (k, r) in streams.iter().enumerate() {
-                    if loaded & 1 << k != 0 {
-                        lanes.load(k, r);
-                    }
-                }
+                let mut lanes = load_lanes(&streams, loaded);
                 let u = fearless_simd::dispatch!(crate::math::lanes::simd_level(), simd => lanes.next_2d(simd, loaded));
                 for (k, r) in streams.iter_mut().enumerate() {
                     if loaded & 1 << k != 0 {
