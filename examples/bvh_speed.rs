@@ -8,12 +8,14 @@
 //! rays as 8x8 packets (what `render_pass` traces, like rtcIntersect8), the depth
 //! view (`render_pass`, primary rays only) and the shaded frame with shadow rays.
 
-use pinhole::render::raytrace::bvh::{Bvh, BvhQuery};
+use pinhole::render::accel::bvh::{Bvh, BvhQuery};
 use pinhole::render::raytrace::bvh_renderer::BvhRayTracer;
-use pinhole::render::raytrace::packet::{self, Packet, TILE_H, TILE_W};
-use pinhole::render::pixel_record::NoRecord;
-use pinhole::render::sampling::{cosine_hemisphere, from_local, SampleRng};
-use pinhole::render::{debug::View, PassJob, PreparedScene, RayCounts, RenderSettings, Renderer, SceneQuery, ShadowMode};
+use pinhole::render::accel::packet;
+use pinhole::render::accel::packet::{Packet, TILE_H, TILE_W};
+use pinhole::render::inspect::pixel_record::NoRecord;
+use pinhole::render::transport::sampling::{cosine_hemisphere, from_local, SampleRng};
+use pinhole::render::inspect::debug::View;
+use pinhole::render::{PassJob, PreparedScene, RayCounts, RenderSettings, Renderer, SceneQuery, ShadowMode};
 use pinhole::math::{Radiance, Vec2};
 use rayon::prelude::*;
 use std::path::Path;

@@ -2,7 +2,9 @@
 //! without a subcommand it asks `main` to open the viewer. Errors are returned
 //! as one sentence; `main` prints them and exits non-zero.
 
-use crate::render::{self, debug::View, PreparedScene, RayCounts, RenderSettings, ShadowMode};
+use crate::render;
+use crate::render::inspect::debug::View;
+use crate::render::{PreparedScene, RayCounts, RenderSettings, ShadowMode};
 use crate::scene::Scene;
 use clap::{Args, Parser, Subcommand};
 use serde_json::json;
@@ -288,7 +290,7 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
     let interpolation = render::Interpolation::parse(&opts.interpolation)?;
     let texture_filter = crate::scene::texture::TextureFilter::parse(&opts.texture_filter).map_err(|e| format!("--texture-filter: {e}"))?;
     let reflections = render::Reflections::parse(&opts.reflections).map_err(|e| format!("--reflections: {e}"))?;
-    let shadow_volume = render::shadow_volume::VolumeMode::parse(&opts.shadow_volume).map_err(|e| format!("--shadow-volume: {e}"))?;
+    let shadow_volume = render::shadow::volume::VolumeMode::parse(&opts.shadow_volume).map_err(|e| format!("--shadow-volume: {e}"))?;
     if opts.spp == 0 || opts.spp > 65536 {
         return Err(format!("--spp {} is not between 1 and 65536", opts.spp));
     }
@@ -338,8 +340,8 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
         settings.shadow_bump = b;
     }
     if let Some(n) = opts.shadow_map_size {
-        if !(1..=render::shadow_map::MAX_SIZE).contains(&n) {
-            return Err(format!("--shadow-map-size {n} is not between 1 and {}", render::shadow_map::MAX_SIZE));
+        if !(1..=render::shadow::map::MAX_SIZE).contains(&n) {
+            return Err(format!("--shadow-map-size {n} is not between 1 and {}", render::shadow::map::MAX_SIZE));
         }
         settings.shadow_map_size = n;
     }
@@ -356,7 +358,7 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
     settings.early_depth = opts.early_depth && !opts.forward;
     settings.gi = gi_settings(opts)?;
     settings.depth_buffer = render::raster::depth_format::DepthFormat::parse(&opts.depth_buffer).map_err(|e| format!("--depth-buffer: {e}"))?;
-    settings.lines = render::wireframe::LineAlgorithm::parse(&opts.lines).map_err(|e| format!("--lines: {e}"))?;
+    settings.lines = render::inspect::wireframe::LineAlgorithm::parse(&opts.lines).map_err(|e| format!("--lines: {e}"))?;
     if let Some(t) = opts.adaptive {
         if !(t > 0.0 && t.is_finite()) {
             return Err(format!("--adaptive {t} must be a relative error > 0 (e.g. 0.05)"));
@@ -377,7 +379,7 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
         settings.subsample.contrast = Some(c);
     }
     if settings.shadows == ShadowMode::Map {
-        render::shadow_map::check_memory(&scene, settings.shadow_map_size)?;
+        render::shadow::map::check_memory(&scene, settings.shadow_map_size)?;
     }
     render::layer_support::check(renderer.name(), &scene, &settings)?;
     renderer.check(&scene, &settings)?;
@@ -386,13 +388,13 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
 }
 
 /// The indirect-light options, checked.
-fn gi_settings(opts: &RenderOpts) -> Result<render::gi::GiSettings, String> {
-    let mut gi = render::gi::GiSettings { mode: render::gi::GiMode::parse(&opts.gi)?, seed: opts.seed, ..Default::default() };
+fn gi_settings(opts: &RenderOpts) -> Result<render::transport::gi::GiSettings, String> {
+    let mut gi = render::transport::gi::GiSettings { mode: render::transport::gi::GiMode::parse(&opts.gi)?, seed: opts.seed, ..Default::default() };
     gi.bounces = match opts.bounces.as_str() {
         "inf" => None,
         n => match n.parse::<u32>() {
-            Ok(b) if b <= render::gi::MAX_BOUNCES => Some(b),
-            _ => return Err(format!("--bounces {n} is neither inf nor a number from 0 to {}", render::gi::MAX_BOUNCES)),
+            Ok(b) if b <= render::transport::gi::MAX_BOUNCES => Some(b),
+            _ => return Err(format!("--bounces {n} is neither inf nor a number from 0 to {}", render::transport::gi::MAX_BOUNCES)),
         },
     };
     if let Some(n) = opts.ao_samples {
@@ -469,7 +471,7 @@ fn stats_json(l: &Loaded, render_ms: f64, counts: &RayCounts, spp: u32) -> serde
         "shadow_volume_ms": (l.settings.shadows == ShadowMode::Volume).then(|| l.prepared.shadow_volumes().build_ms),
         "gi": l.settings.gi.mode.name(),
         "seed": l.settings.gi.seed,
-        "photons": (l.settings.gi.mode == render::gi::GiMode::Photons).then(|| l.prepared.photon_map(&l.settings.gi, l.settings.shadow_bump).len()),
+        "photons": (l.settings.gi.mode == render::transport::gi::GiMode::Photons).then(|| l.prepared.photon_map(&l.settings.gi, l.settings.shadow_bump).len()),
     })
 }
 
@@ -609,9 +611,9 @@ fn cmd_pixel(scene_arg: &str, x: u32, y: u32, opts: &RenderOpts, as_json: bool) 
     let replay = render::replay_pixel(l.renderer.as_ref(), &l.prepared, &l.settings, x, y)?;
     let scene = &l.prepared.scene;
     if as_json {
-        write_json("-", &crate::render::pixel_report::to_json(l.renderer.name(), scene, x, y, &replay))
+        write_json("-", &crate::render::inspect::pixel_report::to_json(l.renderer.name(), scene, x, y, &replay))
     } else {
-        print_stdout(&crate::render::pixel_report::to_text(l.renderer.name(), scene, x, y, &replay))
+        print_stdout(&crate::render::inspect::pixel_report::to_text(l.renderer.name(), scene, x, y, &replay))
     }
 }
 

@@ -66,7 +66,7 @@ fn the_gallery_menu_opens_a_case_with_its_failing_setting_then_its_cure() {
     settle(&mut h);
     let app = h.state();
     let s = app.effective_settings();
-    assert_eq!((s.shadows, s.shadow_map_bias), (ShadowMode::Map, render::shadow_map::DEFAULT_BIAS));
+    assert_eq!((s.shadows, s.shadow_map_bias), (ShadowMode::Map, render::shadow::map::DEFAULT_BIAS));
     assert_eq!(app.gallery.as_ref().map(|g| g.cured), Some(true));
     assert_eq!(app.with_output(|o| o.linear.clone()), reference(app));
 }

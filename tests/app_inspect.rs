@@ -9,7 +9,7 @@ use egui_kittest::Harness;
 use pinhole::app::panels::inspector::final_radiance_text;
 use pinhole::app::PinholeApp;
 use pinhole::math::Radiance;
-use pinhole::render::debug::View;
+use pinhole::render::inspect::debug::View;
 use pinhole::scene::Scene;
 
 #[path = "common/app.rs"]

@@ -161,7 +161,7 @@ fn ctrl_s_exports_png_as_displayed_and_linear_exr() {
     let dir = std::env::temp_dir().join(format!("pinhole-app-export-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     // A debug view is exported as displayed, too.
-    h.state_mut().settings.view = render::debug::View::Barycentric;
+    h.state_mut().settings.view = render::inspect::debug::View::Barycentric;
     settle(&mut h);
     h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::S);
     h.step();
@@ -384,7 +384,7 @@ fn rasterizer_knobs_in_the_shading_panel_reach_the_pixels() {
     // checker (screen-space interpolation), and MSAA 4x changes edge pixels.
     let mut h = harness(small_scene("teapot"));
     h.state_mut().settings.renderer = "rasterize".into();
-    h.state_mut().settings.view = pinhole::render::debug::View::Uv;
+    h.state_mut().settings.view = pinhole::render::inspect::debug::View::Uv;
     h.state_mut().settings.panels.shading = true;
     settle(&mut h);
     let before = shown(h.state());
@@ -416,7 +416,7 @@ fn indirect_light_selector_reaches_the_pixels() {
     h.run();
     h.get_by_label("path").click();
     settle(&mut h);
-    assert_eq!(h.state().settings.gi.mode, pinhole::render::gi::GiMode::Path);
+    assert_eq!(h.state().settings.gi.mode, pinhole::render::transport::gi::GiMode::Path);
     let path = shown(h.state());
     assert_eq!(path, reference(h.state()), "the viewer shows what render_frame gives");
     let mean = |img: &[pinhole::math::Radiance]| img.iter().map(|c| c.x + c.y + c.z).sum::<f32>() / img.len() as f32;

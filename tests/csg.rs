@@ -6,10 +6,10 @@ mod common;
 
 use common::{builtin, render};
 use pinhole::math::{Ray, Vec3};
-use pinhole::render::debug::View;
-use pinhole::render::pixel_record::NoRecord;
-use pinhole::render::raytrace::brute::BruteQuery;
-use pinhole::render::raytrace::bvh::BvhQuery;
+use pinhole::render::inspect::debug::View;
+use pinhole::render::inspect::pixel_record::NoRecord;
+use pinhole::render::accel::brute::BruteQuery;
+use pinhole::render::accel::bvh::BvhQuery;
 use pinhole::render::{renderer_by_name, replay_pixel, PreparedScene, RayCounts, RenderSettings, SceneQuery, ShadowMode};
 use pinhole::scene::file::{load_scene_file, parse_scene};
 use pinhole::scene::{PrimitiveKind, Scene, SurfaceHit};
@@ -251,9 +251,9 @@ fn a_csg_pixel_replays_as_the_frame_drew_it() {
         let eye = trace.rays[0].closest.expect("the pixel sees something");
         assert_eq!(eye.kind, PrimitiveKind::Csg, "{name}");
         assert_eq!(eye.material, prepared.scene.materials.iter().position(|m| m.name == "cavity").unwrap() as u32, "{name}: the cavity's wall");
-        let report = pinhole::render::pixel_report::to_text(name, &prepared.scene, x, y, &replay);
+        let report = pinhole::render::inspect::pixel_report::to_text(name, &prepared.scene, x, y, &replay);
         assert!(report.contains("combined (difference at the top)") && report.contains("won: t ="), "{report}");
-        let json = pinhole::render::pixel_report::to_json(name, &prepared.scene, x, y, &replay);
+        let json = pinhole::render::inspect::pixel_report::to_json(name, &prepared.scene, x, y, &replay);
         let csg = &json["samples"][0]["rays"][0]["csg"];
         assert_eq!(csg["op"], "difference", "{json}");
         assert_eq!(csg["operands"].as_array().map(Vec::len), Some(2), "{json}");
@@ -265,7 +265,7 @@ fn a_csg_pixel_replays_as_the_frame_drew_it() {
 
 #[test]
 fn the_rasterizers_scan_convert_operand_triangles_into_an_a_buffer() {
-    use pinhole::render::csg::SurfaceRef;
+    use pinhole::render::accel::csg::SurfaceRef;
     let scene = builtin("csg");
     let mut settings = RenderSettings::for_scene(&scene);
     settings.width = 160;
@@ -316,9 +316,9 @@ fn the_rasterizers_scan_convert_operand_triangles_into_an_a_buffer() {
         assert!(close(eye.t, reference.t) && close3(eye.position, reference.position), "{name}: {eye:?} vs {reference:?}");
         assert_eq!(eye.geometric_normal, reference.geometric_normal, "{name}");
         // The report lists the A-buffer.
-        let text = pinhole::render::pixel_report::to_text(name, &prepared.scene, x, y, &replay);
+        let text = pinhole::render::inspect::pixel_report::to_text(name, &prepared.scene, x, y, &replay);
         assert!(text.contains("A-buffer: 4 fragment(s) sorted by depth") && text.contains("operand a.a (mesh triangle") && text.contains("entry  <- won"), "{text}");
-        let json = pinhole::render::pixel_report::to_json(name, &prepared.scene, x, y, &replay);
+        let json = pinhole::render::inspect::pixel_report::to_json(name, &prepared.scene, x, y, &replay);
         let list = json["samples"][0]["rays"][0]["csg"]["a_buffer"].as_array().cloned().unwrap_or_default();
         assert_eq!(list.len(), 4, "{json}");
         assert_eq!(list.iter().filter(|f| f["won"] == true).count(), 1, "{json}");
@@ -328,7 +328,7 @@ fn the_rasterizers_scan_convert_operand_triangles_into_an_a_buffer() {
     let r = renderer_by_name("raytrace:bvh").unwrap();
     let replay = replay_pixel(r.as_ref(), &prepared, &settings, x, y).unwrap();
     assert!(replay.samples[0].1.csg_abuffers.is_empty());
-    let json = pinhole::render::pixel_report::to_json("raytrace:bvh", &prepared.scene, x, y, &replay);
+    let json = pinhole::render::inspect::pixel_report::to_json("raytrace:bvh", &prepared.scene, x, y, &replay);
     assert!(json["samples"][0]["rays"][0]["csg"]["a_buffer"].is_null() && json["samples"][0]["rays"][0]["csg"]["won"].is_object(), "{json}");
 }
 

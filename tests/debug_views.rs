@@ -4,7 +4,7 @@
 mod common;
 use common::*;
 use pinhole::math::{Radiance, Vec3};
-use pinhole::render::debug::View;
+use pinhole::render::inspect::debug::View;
 use pinhole::render::{renderer_names, PreparedScene, RenderSettings};
 
 const W: u32 = 200;
@@ -143,7 +143,7 @@ fn diff_view_counts_differences_from_the_reference() {
     let marked = raster.pixels.iter().filter(|c| c.x >= 0.5 || c.z >= 0.5).count() as u64;
     assert_eq!(marked, n);
     // A real error is counted: a scene with a brighter light differs everywhere it is lit.
-    let (img, count) = pinhole::render::debug::diff_image(&bvh.pixels.iter().map(|c| *c * 1.01 + Vec3::splat(1e-3)).collect::<Vec<_>>(), &bvh.pixels);
+    let (img, count) = pinhole::render::inspect::debug::diff_image(&bvh.pixels.iter().map(|c| *c * 1.01 + Vec3::splat(1e-3)).collect::<Vec<_>>(), &bvh.pixels);
     assert_eq!(count, (W * H) as u64);
     assert!(img.iter().all(|c| c.x >= 0.5));
 }
@@ -200,7 +200,7 @@ fn affine_interpolation_bends_the_uv_checker() {
 /// most of the image empty.
 #[test]
 fn views_fill_empty_pixels_as_their_replays_show_them() {
-    use pinhole::render::debug::miss_color;
+    use pinhole::render::inspect::debug::miss_color;
     use pinhole::render::frame::replay_pixel;
     let views: Vec<View> = View::ALL.into_iter().filter(|v| miss_color(*v).is_some()).collect();
     assert!(views.contains(&View::Depth) && views.len() >= 8);

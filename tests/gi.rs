@@ -7,7 +7,7 @@ mod common;
 use common::*;
 use pinhole::math::Radiance;
 use pinhole::metrics::compare;
-use pinhole::render::gi::GiMode;
+use pinhole::render::transport::gi::GiMode;
 use pinhole::render::{self, PreparedScene, RenderSettings};
 use pinhole::scene::Scene;
 
@@ -106,7 +106,7 @@ fn both_families_give_the_same_indirect_light() {
             let (prepared, s) = small(scene, mode, 2);
             let a = render("raytrace", &prepared, &s);
             let b = render("rasterize", &prepared, &s);
-            let depth = RenderSettings { view: render::debug::View::Depth, ..s.clone() };
+            let depth = RenderSettings { view: render::inspect::debug::View::Depth, ..s.clone() };
             let (da, db) = (render("raytrace", &prepared, &depth), render("rasterize", &prepared, &depth));
             let (mut same_hit, mut close) = (0usize, 0usize);
             for i in 0..a.len() {

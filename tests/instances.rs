@@ -260,7 +260,7 @@ fn pixel_report_names_the_instance_hit() {
     let view = prepared.scene.camera.view(settings.width, settings.height);
     let (px, _) = view.project(glam::Vec3::new(-1.5, 0.5, 0.5)).unwrap();
     let replay = render::replay_pixel(r.as_ref(), &prepared, &settings, px.x as u32, px.y as u32).unwrap();
-    let j = render::pixel_report::to_json("raytrace", &prepared.scene, px.x as u32, px.y as u32, &replay);
+    let j = render::inspect::pixel_report::to_json("raytrace", &prepared.scene, px.x as u32, px.y as u32, &replay);
     let text = j.to_string();
     assert!(text.contains("\"instance_name\":\"cube instance 0\""), "{text}");
 }

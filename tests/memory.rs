@@ -2,7 +2,7 @@
 //! BVH's primitive slots) and read back in scene order unchanged, and
 //! `bench` reports the bytes per triangle.
 
-use pinhole::render::raytrace::intersect::TriangleEdges;
+use pinhole::render::accel::intersect::TriangleEdges;
 use pinhole::render::PreparedScene;
 use std::process::Command;
 

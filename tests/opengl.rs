@@ -361,7 +361,7 @@ fn debug_views_from_gl_render_targets_agree_with_the_rasterizers() {
     // `view_color` as every renderer, against `rasterize`'s view. What
     // differs lies on silhouettes (coverage), and where a view quantizes
     // (the uv checker's squares, an id's colour) a rounding apart.
-    use pinhole::render::debug::View;
+    use pinhole::render::inspect::debug::View;
     use pinhole::render::Reflections;
     let Some(_) = driver() else { return };
     let gl = renderer_by_name("opengl").unwrap();

@@ -7,7 +7,7 @@
 
 use pinhole::math::{Radiance, Vec2, Vec3};
 use pinhole::render::raster::{Method, Rasterizer};
-use pinhole::render::raytrace::intersect::intersect_sphere;
+use pinhole::render::accel::intersect::intersect_sphere;
 use pinhole::render::{render_frame, sample_offset, PassJob, PreparedScene, RenderSettings, Renderer};
 use pinhole::scene::{CameraView, Scene};
 use std::sync::atomic::AtomicBool;

@@ -7,9 +7,9 @@
 mod common;
 use common::*;
 use pinhole::math::{Radiance, Vec3};
-use pinhole::render::debug::View;
+use pinhole::render::inspect::debug::View;
 use pinhole::render::raster::Method;
-use pinhole::render::pixel_record::FragmentRecord;
+use pinhole::render::inspect::pixel_record::FragmentRecord;
 use pinhole::render::{renderer_by_name, replay_pixel, PreparedScene, RenderSettings};
 use pinhole::scene::PrimitiveKind;
 

@@ -3,7 +3,7 @@
 //! spellings (`geometricnormal`, `triangleid`, `materialid`) still load.
 
 use pinhole::app::settings_store::ViewerSettings;
-use pinhole::render::debug::View;
+use pinhole::render::inspect::debug::View;
 use pinhole::render::{Interpolation, ShadowMode};
 
 use pinhole::app::settings_store::MemoryStorage as Mem;

@@ -10,8 +10,8 @@
 mod common;
 
 use pinhole::math::{luminance, Radiance, Vec3};
-use pinhole::render::debug::View;
-use pinhole::render::shadow_map::{cube_face, ShadowMaps, DEFAULT_BIAS, DEFAULT_SIZE};
+use pinhole::render::inspect::debug::View;
+use pinhole::render::shadow::map::{cube_face, ShadowMaps, DEFAULT_BIAS, DEFAULT_SIZE};
 use pinhole::render::{replay_pixel, renderer_by_name, PreparedScene, RenderSettings, ShadowMode};
 use pinhole::scene::{Light, PrimitiveId, Scene};
 use std::time::Instant;

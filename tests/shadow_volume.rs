@@ -10,8 +10,8 @@
 mod common;
 use common::*;
 use pinhole::math::Radiance;
-use pinhole::render::pixel_report::to_text;
-use pinhole::render::shadow_volume::VolumeMode;
+use pinhole::render::inspect::pixel_report::to_text;
+use pinhole::render::shadow::volume::VolumeMode;
 use pinhole::render::{render_frame, renderer_by_name, replay_pixel, PreparedScene, RenderSettings, ShadowMode};
 use std::sync::atomic::AtomicBool;
 

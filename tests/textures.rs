@@ -116,7 +116,7 @@ fn a_flat_normal_map_changes_nothing_bit_for_bit() {
 /// same in both families.
 #[test]
 fn the_mip_view_shows_the_level_read() {
-    use pinhole::render::debug::{mip_color, View, MIP_UNTEXTURED};
+    use pinhole::render::inspect::debug::{mip_color, View, MIP_UNTEXTURED};
     let scene: Scene = pinhole::scene::builtin::load_builtin("textures").unwrap().unwrap();
     let prepared = PreparedScene::new(scene);
     let frame = |renderer: &str| {

@@ -5,8 +5,8 @@
 mod common;
 use common::*;
 use pinhole::math::Vec2;
-use pinhole::render::debug::View;
-use pinhole::render::wireframe::{line_mask, LineAlgorithm, LINE_COLOR};
+use pinhole::render::inspect::debug::View;
+use pinhole::render::inspect::wireframe::{line_mask, LineAlgorithm, LINE_COLOR};
 use pinhole::render::{renderer_by_name, replay_pixel, PreparedScene, RenderSettings};
 
 fn settings(scene: &pinhole::scene::Scene, lines: LineAlgorithm) -> RenderSettings {

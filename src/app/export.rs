@@ -3,7 +3,7 @@
 //! renderer and time; files are written atomically.
 
 use eframe::egui;
-use super::PinholeApp;
+use crate::app::PinholeApp;
 use crate::image_io;
 use std::path::{Path, PathBuf};
 

@@ -4,7 +4,7 @@
 //! (and one that brings the failure back).
 
 use eframe::egui;
-use super::PinholeApp;
+use crate::app::PinholeApp;
 use crate::gallery::{self, GalleryCase, Setting};
 use crate::render::RenderSettings;
 

@@ -6,10 +6,10 @@
 //! (`Worker::replay`), through the renderer's own code path with a recorder,
 //! so the UI never waits for it and its radiance is the frame's pixel.
 
-use super::worker::{ReplayRequest, ReplayResult};
-use super::PinholeApp;
+use crate::app::worker::{ReplayRequest, ReplayResult};
+use crate::app::PinholeApp;
 use crate::math::{Radiance, Vec3};
-use crate::render::debug::{depth_distance, invert_cost, object_of_id_color, zbuffer_depth, COST_SCALE};
+use crate::render::inspect::debug::{depth_distance, invert_cost, object_of_id_color, zbuffer_depth, COST_SCALE};
 use crate::render::PixelReplay;
 use crate::scene::{CameraView, PrimitiveKind, Scene};
 use eframe::egui;

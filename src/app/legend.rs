@@ -4,10 +4,10 @@
 //! Views are told apart by name, so views added to the core later get a
 //! plain legend (their name) without a change here.
 
-use crate::render::debug::{cost_of_t, depth_distance, t_of_cost, zbuffer_depth};
-use super::PinholeApp;
+use crate::render::inspect::debug::{cost_of_t, depth_distance, t_of_cost, zbuffer_depth};
+use crate::app::PinholeApp;
 use crate::math::Vec3;
-use crate::render::debug::{cost_color, id_color, mip_color, COST_SCALE, MIP_SCALE};
+use crate::render::inspect::debug::{cost_color, id_color, mip_color, COST_SCALE, MIP_SCALE};
 use eframe::egui;
 use egui::{Color32, Pos2, Rect};
 
@@ -130,7 +130,7 @@ pub fn show(app: &PinholeApp, ctx: &egui::Context, viewport: Rect) {
                         if let Some((x, y)) = app.inspect.hover {
                             let v = app.with_output(|o| (x < o.width && y < o.height).then(|| o.linear[(x + y * o.width) as usize]));
                             if let Some(v) = v {
-                                small(ui, &format!("under the cursor: {}", super::inspect::value_text("cost", v, &camera, &app.scene)));
+                                small(ui, &format!("under the cursor: {}", crate::app::inspect::value_text("cost", v, &camera, &app.scene)));
                             }
                         }
                     }

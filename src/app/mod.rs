@@ -188,7 +188,7 @@ fn apply_env_overrides(app: &mut PinholeApp) {
         }
     }
     if let Ok(v) = std::env::var("PINHOLE_VIEW") {
-        match crate::render::debug::View::parse(&v) {
+        match crate::render::inspect::debug::View::parse(&v) {
             Ok(v) => app.settings.view = v,
             Err(e) => eprintln!("pinhole: PINHOLE_VIEW: {e}"),
         }
@@ -198,7 +198,7 @@ fn apply_env_overrides(app: &mut PinholeApp) {
     }
     // PINHOLE_GI=MODE picks the indirect light, PINHOLE_SPP=N the samples.
     if let Ok(m) = std::env::var("PINHOLE_GI") {
-        match crate::render::gi::GiMode::parse(&m) {
+        match crate::render::transport::gi::GiMode::parse(&m) {
             Ok(m) => app.settings.gi.mode = m,
             Err(e) => eprintln!("pinhole: PINHOLE_GI: {e}"),
         }

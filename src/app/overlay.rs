@@ -4,7 +4,7 @@
 //! projected triangle vertex as a dot (CGPP 15.6.2's test).
 
 use crate::math::{Vec2, Vec3};
-use crate::render::pixel_record::PixelTrace;
+use crate::render::inspect::pixel_record::PixelTrace;
 use crate::scene::{CameraView, Light, Scene};
 use eframe::egui;
 use egui::{Color32, Painter, Pos2, Rect, Stroke};

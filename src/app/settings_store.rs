@@ -1,11 +1,12 @@
 //! What the viewer remembers between runs (eframe storage): one struct,
 //! `ViewerSettings`, that the viewer edits live and saves and loads whole.
 
-use crate::render::debug::View;
+use crate::render::inspect::debug::View;
 use crate::render::raster::depth_format::DepthFormat;
-use crate::render::wireframe::LineAlgorithm;
-use crate::render::shadow_volume::VolumeMode;
-use crate::render::{shadow_map, Interpolation, RenderSettings, ShadowMode};
+use crate::render::inspect::wireframe::LineAlgorithm;
+use crate::render::shadow::volume::VolumeMode;
+use crate::render::shadow::map as shadow_map;
+use crate::render::{Interpolation, RenderSettings, ShadowMode};
 use crate::scene::Scene;
 
 pub const STORAGE_KEY: &str = "pinhole";
@@ -31,7 +32,7 @@ pub struct ViewerSettings {
     pub view: View,
     pub interpolation: Interpolation,
     /// Indirect light and its knobs.
-    pub gi: crate::render::gi::GiSettings,
+    pub gi: crate::render::transport::gi::GiSettings,
     /// How textures are read.
     pub texture_filter: crate::scene::texture::TextureFilter,
     /// Traced reflections or environment lookups.

@@ -4,8 +4,8 @@
 //! wipe with a draggable divider or as their difference, and the error
 //! between them over the whole view and over a dragged rectangle.
 
-use super::settings_store::ViewerSettings;
-use super::worker::{Request, Worker};
+use crate::app::settings_store::ViewerSettings;
+use crate::app::worker::{Request, Worker};
 use crate::math::Radiance;
 use eframe::egui;
 use std::sync::Arc;
@@ -188,7 +188,7 @@ impl SplitView {
         }
         self.measured = Some(key);
         self.error = Some(split_error(a_linear, &b_linear, aw, self.region));
-        let (diff, _) = crate::render::debug::diff_image(&b_linear, a_linear);
+        let (diff, _) = crate::render::inspect::debug::diff_image(&b_linear, a_linear);
         let rgb = crate::image_io::to_rgb8(&diff, exposure, gamma);
         let image = egui::ColorImage::from_rgb([aw as usize, ah as usize], &rgb);
         match &mut self.diff_texture {

@@ -4,11 +4,11 @@
 //! end of each frame a change becomes a render request.
 
 use eframe::egui;
-use super::export::ExportDialog;
-use super::open_dialog::OpenDialog;
-use super::panels::Requests;
-use super::settings_store::{SceneKnobs, ViewerSettings};
-use super::worker::{Output, Request, SceneParams, Worker};
+use crate::app::export::ExportDialog;
+use crate::app::open_dialog::OpenDialog;
+use crate::app::panels::Requests;
+use crate::app::settings_store::{SceneKnobs, ViewerSettings};
+use crate::app::worker::{Output, Request, SceneParams, Worker};
 use crate::render::{self, RenderSettings};
 use crate::scene::{builtin, Camera, Scene};
 use std::path::PathBuf;
@@ -49,7 +49,7 @@ pub struct PinholeApp {
     last_watch_check: Instant,
     pub open_dialog: OpenDialog,
     pub export: ExportDialog,
-    pub screenshot: Option<super::ScreenshotState>,
+    pub screenshot: Option<crate::app::ScreenshotState>,
     /// Where the image was drawn last frame, in points, and its size in pixels.
     pub viewport_rect: Option<egui::Rect>,
     /// Index of the light being dragged in the viewport.
@@ -61,15 +61,15 @@ pub struct PinholeApp {
     /// Whether `save()` writes eframe storage (off for tests and screenshots).
     pub persist: bool,
     /// `PINHOLE_BENCH_UI`: orbit continuously for this long, print fps, quit.
-    pub bench: Option<super::UiBench>,
+    pub bench: Option<crate::app::UiBench>,
     /// Selected pixel and its replay, zoom, overlays (visual debugging).
-    pub inspect: super::inspect::Inspect,
+    pub inspect: crate::app::inspect::Inspect,
     /// The Compare window's measurements.
-    pub compare: super::compare_lab::CompareLab,
+    pub compare: crate::app::compare_lab::CompareLab,
     /// A second configuration shown beside the live one (A|B).
-    pub split: super::split_view::SplitView,
+    pub split: crate::app::split_view::SplitView,
     /// The stress-gallery case on show, whose setting overrides the knobs.
-    pub gallery: Option<super::gallery::GalleryView>,
+    pub gallery: Option<crate::app::gallery::GalleryView>,
 }
 
 impl PinholeApp {
@@ -237,7 +237,7 @@ impl PinholeApp {
 
     /// The image size: the scene's, times the resolution scale.
     pub fn image_size(&self) -> (u32, u32) {
-        scaled_size(self.scene.render.width, self.scene.render.height, self.settings.res_scale)
+        crate::app::panels::camera::scaled_size(self.scene.render.width, self.scene.render.height, self.settings.res_scale)
     }
 
     /// Sends a request when anything that affects the image changed.
@@ -371,7 +371,7 @@ impl PinholeApp {
             return;
         }
         let current = crate::chart::describe(&self.settings.renderer, &self.effective_settings());
-        let req = super::panels::compare::show(ctx, &mut self.compare, &current);
+        let req = crate::app::panels::compare::show(ctx, &mut self.compare, &current);
         if req.measure {
             self.start_compare();
         }
@@ -471,7 +471,7 @@ impl PinholeApp {
         }
         // V / shift+V: next / previous debug view.
         if let Some(step) = ctx.input(|i| i.key_pressed(Key::V).then_some(if i.modifiers.shift { -1 } else { 1 })) {
-            use crate::render::debug::View;
+            use crate::render::inspect::debug::View;
             let n = View::ALL.len() as i64;
             let at = View::ALL.iter().position(|v| *v == self.settings.view).unwrap_or(0) as i64;
             self.settings.view = View::ALL[(at + step).rem_euclid(n) as usize];
@@ -524,7 +524,7 @@ impl PinholeApp {
             let report = b.done && !b.reported;
             b.reported |= b.done;
             if report {
-                println!("ui-bench: {}", super::panels::status::status_text(self));
+                println!("ui-bench: {}", crate::app::panels::status::status_text(self));
             }
             ctx.request_repaint();
         }
@@ -532,11 +532,11 @@ impl PinholeApp {
         self.update_split(&ctx);
 
         let mut requests = Requests::default();
-        requests |= super::panels::menu::show(ui, &mut self.settings, &self.renderer_names, &mut self.inspect, &self.scene.name);
+        requests |= crate::app::panels::menu::show(ui, &mut self.settings, &self.renderer_names, &mut self.inspect, &self.scene.name);
         if self.split.enabled {
             let a_label = crate::chart::describe(&self.settings.renderer, &self.effective_settings());
             let b_label = self.split.b_label(&self.settings, &self.scene);
-            let r = super::panels::split_bar::show(ui, &mut self.split, &a_label, &b_label);
+            let r = crate::app::panels::split_bar::show(ui, &mut self.split, &a_label, &b_label);
             if r.swap {
                 self.split.swap(&mut self.settings);
             }
@@ -559,39 +559,34 @@ impl PinholeApp {
                     });
                 });
         }
-        super::gallery::show(self, ui);
-        super::panels::status::show(self, ui);
+        crate::app::gallery::show(self, ui);
+        crate::app::panels::status::show(self, ui);
         if self.settings.panels.side {
             egui::Panel::left("side-panel").default_size(300.0).resizable(true).show(ui, |ui| {
                 egui::ScrollArea::vertical().show(ui, |ui| {
                     let (width, height) = (self.scene.render.width, self.scene.render.height);
                     let panels = &mut self.settings.panels;
-                    requests |= super::panels::camera::show(ui, &mut panels.camera, &mut self.params.camera, &mut self.settings.res_scale, (width, height));
-                    super::panels::lights::show(ui, &mut panels.lights, &mut self.params.lights, &self.params.camera, &self.scene);
-                    super::panels::materials::show(ui, &mut panels.materials, &mut self.params.materials);
-                    super::panels::shading::show(ui, &mut self.settings, &mut self.params.render);
+                    requests |= crate::app::panels::camera::show(ui, &mut panels.camera, &mut self.params.camera, &mut self.settings.res_scale, (width, height));
+                    crate::app::panels::lights::show(ui, &mut panels.lights, &mut self.params.lights, &self.params.camera, &self.scene);
+                    crate::app::panels::materials::show(ui, &mut panels.materials, &mut self.params.materials);
+                    crate::app::panels::shading::show(ui, &mut self.settings, &mut self.params.render);
                 });
             });
         }
-        super::panels::inspector::show(self, ui);
+        crate::app::panels::inspector::show(self, ui);
         egui::CentralPanel::default().frame(egui::Frame::new().fill(egui::Color32::from_gray(24))).show(ui, |ui| {
-            super::viewport::show(self, ui);
+            crate::app::viewport::show(self, ui);
         });
         self.apply(requests, &ctx);
         if let Some(path) = self.open_dialog.show(&ctx) {
             self.open(path);
         }
-        super::export::show_dialog(self, &ctx);
+        crate::app::export::show_dialog(self, &ctx);
         self.compare_window(&ctx);
 
         self.sync_worker();
         self.sync_split();
         self.sync_inspector();
-        super::screenshot_frame(self, &ctx);
+        crate::app::screenshot_frame(self, &ctx);
     }
-}
-
-/// `width` x `height` times `scale`, rounded, at least one pixel each way.
-pub fn scaled_size(width: u32, height: u32, scale: f32) -> (u32, u32) {
-    (((width as f32 * scale).round() as u32).max(1), ((height as f32 * scale).round() as u32).max(1))
 }

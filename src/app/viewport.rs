@@ -5,8 +5,8 @@
 
 use eframe::egui;
 use crate::scene::camera::control as cc;
-use super::overlay::{self, ImageMap};
-use super::PinholeApp;
+use crate::app::overlay::{self, ImageMap};
+use crate::app::PinholeApp;
 use crate::math::{Vec2, Vec3};
 use crate::scene::Light;
 use egui::{Color32, Pos2, Rect, Sense, Stroke};
@@ -191,7 +191,7 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
         painter.rect_stroke(avail.shrink(1.0), 0.0, Stroke::new(1.0, Color32::from_rgb(80, 120, 200)), egui::StrokeKind::Inside);
     }
     hover_readout(app, &painter, avail, &view);
-    super::legend::show(app, ui.ctx(), avail);
+    crate::app::legend::show(app, ui.ctx(), avail);
 }
 
 /// Configuration B over the image (right of the divider, or as the
@@ -199,7 +199,7 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
 /// the divider moves it; alt+drag measures a rectangle. Returns whether a
 /// drag of the primary button was taken here (so it does not orbit).
 fn split_view(app: &mut PinholeApp, ui: &egui::Ui, response: &egui::Response, painter: &egui::Painter, map: &ImageMap) -> bool {
-    use super::split_view::SplitMode;
+    use crate::app::split_view::SplitMode;
     let split = &mut app.split;
     if !split.enabled {
         return false;
@@ -265,12 +265,12 @@ fn hover_readout(app: &PinholeApp, painter: &egui::Painter, avail: Rect, view: &
     let Some((x, y)) = app.inspect.hover else { return };
     let exposure = app.params.render.exposure;
     let Some(v) = app.with_output(|o| (x < o.width && y < o.height && o.linear.len() == (o.width * o.height) as usize).then(|| o.linear[(x + y * o.width) as usize])) else { return };
-    let meaning = super::inspect::value_text(app.settings.view.name(), v, view, &app.scene);
+    let meaning = crate::app::inspect::value_text(app.settings.view.name(), v, view, &app.scene);
     let d = crate::image_io::display_pixel(v, exposure, app.settings.gamma);
     let text = if meaning.starts_with("linear") {
         format!("({x}, {y})  {meaning}  -> {d:?}")
     } else {
-        format!("({x}, {y})  {meaning}  linear {}", super::inspect::fmt3(v))
+        format!("({x}, {y})  {meaning}  linear {}", crate::app::inspect::fmt3(v))
     };
     let galley = painter.layout_no_wrap(text, egui::FontId::monospace(12.0), Color32::WHITE);
     let pos = avail.left_bottom() + egui::vec2(6.0, -6.0 - galley.size().y);

@@ -7,7 +7,7 @@
 
 use crate::image_io;
 use crate::math::Radiance;
-use crate::render::debug::View;
+use crate::render::inspect::debug::View;
 use crate::render::frame::Accumulator;
 use crate::render::{self, PreparedScene, RayCounts, RenderSettings, Renderer};
 use crate::scene::{Camera, Light, Material, RenderDefaults, Scene};
@@ -431,7 +431,7 @@ impl WorkerLoop {
         // line, rather than aborting the viewer when it is allocated.
         let maps = settings.shadows == render::ShadowMode::Map || settings.view == View::Shadowmap;
         let too_big = crate::input::check_image_size(width, height)
-            .and_then(|_| if maps { render::shadow_map::check_memory(&prepared.scene, settings.shadow_map_size) } else { Ok(()) });
+            .and_then(|_| if maps { render::shadow::map::check_memory(&prepared.scene, settings.shadow_map_size) } else { Ok(()) });
         let too_big = too_big.and_then(|_| render::layer_support::check(renderer.name(), &prepared.scene, &settings));
         let too_big = too_big.and_then(|_| renderer.check(&prepared.scene, &settings));
         if let Err(e) = too_big {
@@ -476,7 +476,7 @@ impl WorkerLoop {
                     pool.install(|| guarded(|| render::replay_pixel(renderer, prepared_ref, &settings, r.x, r.y))).and_then(|x| x)
                 };
                 let result = render::renderer_by_name(&r.renderer).and_then(|renderer| run(renderer.as_ref()));
-                reference = diff.then(|| run(&render::raytrace::brute::BruteForce));
+                reference = diff.then(|| run(&render::accel::brute::BruteForce));
                 // The frame in flight goes on with its own values.
                 if let Some(f) = &self.frame {
                     f.req.params.apply(&mut prepared.scene);

@@ -3,10 +3,12 @@
 //! that buy accuracy with time. Every configuration is a renderer and the
 //! `RenderSettings` it renders with, so the viewer can apply one as it is.
 
-use crate::render::gi::GiMode;
-use crate::render::{debug, shadow_map, Interpolation, RenderSettings, ShadowMode, DEFAULT_RAYTRACE};
+use crate::render::transport::gi::GiMode;
+use crate::render::inspect::debug;
+use crate::render::shadow::map as shadow_map;
+use crate::render::{Interpolation, RenderSettings, ShadowMode, DEFAULT_RAYTRACE};
 use crate::render::raster::depth_format::DepthFormat;
-use crate::render::shadow_volume::VolumeMode;
+use crate::render::shadow::volume::VolumeMode;
 use crate::render::raster::DEFAULT_RASTERIZE;
 use crate::render::Reflections;
 use crate::scene::texture::TextureFilter;
@@ -112,7 +114,7 @@ pub fn plain_settings(scene: &Scene, base: &RenderSettings) -> RenderSettings {
         width: base.width,
         height: base.height,
         view: debug::View::Shaded,
-        gi: crate::render::gi::GiSettings { seed: base.gi.seed, ..Default::default() },
+        gi: crate::render::transport::gi::GiSettings { seed: base.gi.seed, ..Default::default() },
         ..RenderSettings::for_scene(scene)
     }
 }
@@ -153,7 +155,7 @@ pub fn method_configurations(scene: &Scene, base: &RenderSettings) -> Vec<Config
     if casts_shadows {
         add("shadows", raster, with(&|s| s.shadows = ShadowMode::None));
         // Sizes whose maps for all the scene's lights would not fit in memory are left out.
-        let fits = |size| crate::render::shadow_map::check_memory(scene, size).is_ok();
+        let fits = |size| crate::render::shadow::map::check_memory(scene, size).is_ok();
         for size in [256, 1024, 2048].into_iter().filter(|&n| fits(n)) {
             add("shadows", raster, with(&|s| {
                 s.shadows = ShadowMode::Map;

@@ -3,10 +3,10 @@
 //! methods can be compared where they meet, and a peer renderer's curve
 //! (`--peer FILE.csv`) can be laid over them.
 
-use super::configurations::Configuration;
-use super::measure::{measure, Measurement};
-use super::reference::Reference;
-use crate::render::gi::GiMode;
+use crate::chart::configurations::Configuration;
+use crate::chart::measure::{measure, Measurement};
+use crate::chart::reference::Reference;
+use crate::render::transport::gi::GiMode;
 use crate::render::{frame, PreparedScene, RenderSettings, DEFAULT_RAYTRACE};
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
@@ -17,7 +17,7 @@ use std::time::Instant;
 /// Every configuration is the ray tracer at `base`'s size and seed; the
 /// rasterizers give the same images (their first hits are the same).
 pub fn gi_configurations(base: &RenderSettings, scene: &crate::scene::Scene, path_spps: &[u32]) -> Vec<Configuration> {
-    let plain = super::configurations::plain_settings(scene, base);
+    let plain = crate::chart::configurations::plain_settings(scene, base);
     let with = |f: &dyn Fn(&mut RenderSettings)| {
         let mut s = plain.clone();
         f(&mut s);
@@ -49,7 +49,7 @@ pub fn gi_configurations(base: &RenderSettings, scene: &crate::scene::Scene, pat
             s.spp = spp;
         })));
     }
-    out.retain(|c| super::configurations::accepted(scene, c));
+    out.retain(|c| crate::chart::configurations::accepted(scene, c));
     out
 }
 

@@ -1,8 +1,8 @@
 //! Measuring configurations: time a frame, compare it with the reference,
 //! and find which configurations are worth their time (the Pareto front).
 
-use super::configurations::Configuration;
-use super::reference::Reference;
+use crate::chart::configurations::Configuration;
+use crate::chart::reference::Reference;
 use crate::render::{self, PreparedScene};
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;

@@ -1,7 +1,7 @@
 //! Charts as PNG (plotters): error against frame time on log axes.
 
-use super::measure::{ErrorMetric, Measurement};
-use super::spp_sweep::SweepPoint;
+use crate::chart::measure::{ErrorMetric, Measurement};
+use crate::chart::spp_sweep::SweepPoint;
 use plotters::prelude::*;
 
 /// Registering twice is harmless; the font is egui's own Ubuntu Light.
@@ -136,7 +136,7 @@ fn bounds(values: impl Iterator<Item = f64>) -> (f64, f64) {
 /// of those labelled. Returns PNG bytes.
 pub fn draw_methods_png(points: &[Measurement], metric: ErrorMetric, title: &str, width: u32, height: u32) -> Result<Vec<u8>, String> {
     let err = |p: &Measurement| metric.of(p).max(1e-6);
-    let front = super::measure::pareto_front(points, metric);
+    let front = crate::chart::measure::pareto_front(points, metric);
     let frame = Frame {
         title,
         size: (width, height),
@@ -176,7 +176,7 @@ pub fn draw_methods_png(points: &[Measurement], metric: ErrorMetric, title: &str
 /// The curves chart (`--sweep gi`): one line per group through its points in
 /// the order they were measured, each point labelled with the knob that moves it, and each
 /// peer series as a dashed black line with crosses. Returns PNG bytes.
-pub fn draw_curves_png(points: &[Measurement], peers: &[super::gi_sweep::PeerPoint], metric: ErrorMetric, title: &str, width: u32, height: u32) -> Result<Vec<u8>, String> {
+pub fn draw_curves_png(points: &[Measurement], peers: &[crate::chart::gi_sweep::PeerPoint], metric: ErrorMetric, title: &str, width: u32, height: u32) -> Result<Vec<u8>, String> {
     let err = |p: &Measurement| metric.of(p).max(1e-6);
     let frame = Frame {
         title,
@@ -202,7 +202,7 @@ pub fn draw_curves_png(points: &[Measurement], peers: &[super::gi_sweep::PeerPoi
                 .draw_series(curve.iter().map(|p| {
                     EmptyElement::at((p.ms, err(p)))
                         + Circle::new((0, 0), 4, color.filled())
-                        + Text::new(super::gi_sweep::point_label(&p.label), (6, -14), ("sans-serif", 12))
+                        + Text::new(crate::chart::gi_sweep::point_label(&p.label), (6, -14), ("sans-serif", 12))
                 }))
                 .map_err(|e| e.to_string())?;
         }
@@ -214,7 +214,7 @@ pub fn draw_curves_png(points: &[Measurement], peers: &[super::gi_sweep::PeerPoi
         }
         // Peer values are rmse / mean: they belong on the chart only when it plots that.
         for name in series.iter().filter(|_| metric == ErrorMetric::RelRmse) {
-            let curve: Vec<&super::gi_sweep::PeerPoint> = peers.iter().filter(|p| p.series == *name).collect();
+            let curve: Vec<&crate::chart::gi_sweep::PeerPoint> = peers.iter().filter(|p| p.series == *name).collect();
             let line: Vec<(f64, f64)> = curve.iter().map(|p| (p.ms, p.rel_rmse.max(1e-6))).collect();
             chart
                 .draw_series(DashedLineSeries::new(line, 8, 5, BLACK.stroke_width(2)))

@@ -5,7 +5,7 @@
 //! they are cached on disk under a hash of the scene and the image settings.
 
 use crate::math::Radiance;
-use crate::render::gi::GiMode;
+use crate::render::transport::gi::GiMode;
 use crate::render::{self, PreparedScene, RenderSettings, ShadowMode};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};

@@ -3,7 +3,7 @@
 //! image is made. To add a case, add an entry to `cases()`.
 
 use crate::render::raster::depth_format::DepthFormat;
-use crate::render::shadow_volume::VolumeMode;
+use crate::render::shadow::volume::VolumeMode;
 use crate::render::{RenderSettings, ShadowMode};
 use crate::scene::Scene;
 

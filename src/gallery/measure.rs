@@ -6,7 +6,7 @@
 //! values (a non-finite value is always wrong): small enough to catch a
 //! shadow that moved or a speckle, large enough to let rounding pass.
 
-use super::cases::{GalleryCase, Setting};
+use crate::gallery::cases::{GalleryCase, Setting};
 use crate::math::Radiance;
 use crate::render::{self, PreparedScene, RenderSettings};
 use std::sync::atomic::AtomicBool;

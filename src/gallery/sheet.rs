@@ -4,7 +4,7 @@
 //! dimmed truth (so a subtle failure is found at a glance).
 //! Text is drawn with plotters in egui's font, as the charts are.
 
-use super::measure::CaseResult;
+use crate::gallery::measure::CaseResult;
 use plotters::prelude::*;
 
 /// Width of one image cell; images are enlarged by a whole factor to fill it.
@@ -93,7 +93,7 @@ fn wrong_pixel_map(r: &CaseResult) -> Vec<u8> {
     let truth = crate::image_io::to_rgb8(&r.truth, r.exposure, true);
     let mut out = Vec::with_capacity(truth.len());
     for (i, (&a, &b)) in r.failing.image.iter().zip(&r.truth).enumerate() {
-        if super::measure::pixel_wrong(a, b) {
+        if crate::gallery::measure::pixel_wrong(a, b) {
             out.extend_from_slice(&[230, 20, 20]);
         } else {
             let t = &truth[3 * i..3 * i + 3];

@@ -7,7 +7,7 @@ pub mod subsample;
 pub use subsample::Subsample;
 pub use accumulator::{add_sample, admitted, final_value, mean, relative_error, wants_more, Accumulator, Band, ADAPTIVE_MIN_SAMPLES};
 
-use super::{sample_offset, PassJob, PreparedScene, RayCounts, RenderSettings, Renderer};
+use crate::render::{sample_offset, PassJob, PreparedScene, RayCounts, RenderSettings, Renderer};
 use crate::math::Radiance;
 use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, Ordering};
 
@@ -69,7 +69,7 @@ fn render_frame_over(
     spare: Vec<Radiance>,
 ) -> Option<FrameResult> {
     // Sub-sampling interpolates shaded images; debug views show every pixel.
-    if settings.subsample.is_on() && settings.view == super::debug::View::Shaded {
+    if settings.subsample.is_on() && settings.view == crate::render::inspect::debug::View::Shaded {
         return subsample::render_subsampled(renderer, prepared, settings, cancel, passes_done);
     }
     let mut frame = Accumulator::reusing(settings, spare);
@@ -99,18 +99,18 @@ fn render_frame_over(
 /// would otherwise build them serially on first use. The same for the shadow
 /// volumes (`--shadows volume`).
 pub fn build_shadow_maps(prepared: &PreparedScene, settings: &RenderSettings) {
-    if settings.shadows == super::ShadowMode::Map || settings.view == super::debug::View::Shadowmap {
+    if settings.shadows == crate::render::ShadowMode::Map || settings.view == crate::render::inspect::debug::View::Shadowmap {
         prepared.shadow_maps(settings.shadow_map_size);
     }
-    if settings.shadows == super::ShadowMode::Volume && settings.view == super::debug::View::Shaded {
+    if settings.shadows == crate::render::ShadowMode::Volume && settings.view == crate::render::inspect::debug::View::Shaded {
         prepared.shadow_volumes();
     }
 }
 
 /// The photon map the passes read, built (once, in parallel) before them,
 /// when the settings ask for photon mapping on the shaded view.
-pub fn build_photon_map(prepared: &PreparedScene, settings: &RenderSettings) -> Option<std::sync::Arc<super::photon_map::PhotonMap>> {
-    (settings.gi.mode == super::gi::GiMode::Photons && matches!(settings.view, super::debug::View::Shaded | super::debug::View::Diff))
+pub fn build_photon_map(prepared: &PreparedScene, settings: &RenderSettings) -> Option<std::sync::Arc<crate::render::transport::photon_map::PhotonMap>> {
+    (settings.gi.mode == crate::render::transport::gi::GiMode::Photons && matches!(settings.view, crate::render::inspect::debug::View::Shaded | crate::render::inspect::debug::View::Diff))
         .then(|| prepared.photon_map(&settings.gi, settings.shadow_bump))
 }
 
@@ -118,7 +118,7 @@ pub fn build_photon_map(prepared: &PreparedScene, settings: &RenderSettings) -> 
 /// renderer returned them), and the final value, which is accumulated exactly
 /// as `render_frame` accumulates it.
 pub struct PixelReplay {
-    pub samples: Vec<(crate::math::Vec2, super::pixel_record::PixelTrace, Radiance)>,
+    pub samples: Vec<(crate::math::Vec2, crate::render::inspect::pixel_record::PixelTrace, Radiance)>,
     pub radiance: Radiance,
 }
 
@@ -129,8 +129,8 @@ pub fn replay_pixel(renderer: &dyn Renderer, prepared: &PreparedScene, settings:
     }
     // The wireframe view is the shaded frame with lines over it: the samples
     // are shaded, and a pixel under a line takes the line's colour.
-    let wireframe = settings.view == super::debug::View::Wireframe;
-    let shaded = RenderSettings { view: super::debug::View::Shaded, ..settings.clone() };
+    let wireframe = settings.view == crate::render::inspect::debug::View::Wireframe;
+    let shaded = RenderSettings { view: crate::render::inspect::debug::View::Shaded, ..settings.clone() };
     let settings = if wireframe { &shaded } else { settings };
     build_shadow_maps(prepared, settings);
     let photons = build_photon_map(prepared, settings);
@@ -149,18 +149,18 @@ pub fn replay_pixel(renderer: &dyn Renderer, prepared: &PreparedScene, settings:
         }
         let offset = sample_offset(i, spp);
         let job = PassJob { prepared, view: &view, settings, offset, sample: i, photons: photons.as_deref(), active: None, rows: y..y + 1, cancel: &cancel };
-        let mut rec = super::pixel_record::PixelTrace::new();
+        let mut rec = crate::render::inspect::pixel_record::PixelTrace::new();
         let value = renderer
             .trace_pixel(&job, x, y, &mut rec)
             .ok_or_else(|| format!("{} cannot replay pixels yet", renderer.name()))?;
         add_sample(&mut sum, value, spp);
-        let l = crate::render::sampling::luminance(admitted(value));
+        let l = crate::render::transport::sampling::luminance(admitted(value));
         sum_sq += l * l;
         samples.push((offset, rec, value));
     }
     let mut radiance = if adaptive.is_some() { mean(sum, samples.len() as u32) } else { final_value(sum, spp) };
-    if wireframe && super::wireframe::line_mask(&prepared.scene, &view, settings.lines)[(x + y * settings.width) as usize] {
-        radiance = super::wireframe::LINE_COLOR;
+    if wireframe && crate::render::inspect::wireframe::line_mask(&prepared.scene, &view, settings.lines)[(x + y * settings.width) as usize] {
+        radiance = crate::render::inspect::wireframe::LINE_COLOR;
     }
     Ok(PixelReplay { samples, radiance })
 }

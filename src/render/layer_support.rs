@@ -4,7 +4,8 @@
 //! renderers with shadow maps too. The rest read `Scene::triangles` alone, so they refuse
 //! such a scene with one sentence instead of drawing it without its copies.
 
-use super::{debug::View, RenderSettings, ShadowMode};
+use crate::render::inspect::debug::View;
+use crate::render::{RenderSettings, ShadowMode};
 use crate::scene::Scene;
 
 /// `Ok` when `renderer` (by name) with `settings` draws every copy of `scene`.

@@ -5,31 +5,19 @@
 //! requested rows it finds the `SurfaceHit` the sample sees and hands it to
 //! `resolve_sample`, which shades it (or draws a debug view).
 
-pub mod bsdf_sampling;
-pub mod csg;
-pub mod debug;
+pub mod accel;
 pub mod differentials;
 pub mod finite;
 pub mod frame;
-pub mod gi;
-pub mod kd_tree;
+pub mod gi_settings;
+pub mod inspect;
 pub mod layer_support;
-pub mod lighting;
-pub mod normal_map;
 pub mod opengl;
-pub mod path_batch;
-pub mod photon_map;
 pub mod prepared;
-pub mod sampling;
 pub mod raster;
 pub mod raytrace;
-pub mod shade;
-pub mod shade_batch;
-pub mod shadow_map;
-pub mod shadow_volume;
-pub mod pixel_record;
-pub mod pixel_report;
-pub mod wireframe;
+pub mod shadow;
+pub mod transport;
 
 pub use frame::{render_frame, render_frame_in_bands, render_frame_reusing, replay_pixel, FrameResult, PixelReplay};
 pub use prepared::PreparedScene;
@@ -39,7 +27,7 @@ use crate::named::named_enum;
 use crate::scene::{CameraView, PrimitiveId, PrimitiveKind, SurfaceHit};
 use std::ops::Range;
 use std::sync::atomic::AtomicBool;
-use pixel_record::Recorder;
+use inspect::pixel_record::Recorder;
 
 named_enum! {
     /// How shadow visibility is resolved.
@@ -93,20 +81,20 @@ pub struct RenderSettings {
     /// CGPP's `rayBumpEpsilon`: how far shadow and secondary rays start off the surface.
     pub shadow_bump: f32,
     /// `--shadows map`: texels per side of each shadow map (per cube face for a point light).
-    #[serde(default = "shadow_map::default_size")]
+    #[serde(default = "shadow::map::default_size")]
     pub shadow_map_size: u32,
     /// `--shadows map`: depth bias in texels of the map, slope-scaled: a point is
     /// shadowed when it lies farther from the light than the stored depth by more
     /// than `bias * texel size * (1 + tan theta)` (see `shadow_map`).
-    #[serde(default = "shadow_map::default_bias")]
+    #[serde(default = "shadow::map::default_bias")]
     pub shadow_map_bias: f32,
     /// `--shadows volume`: count the volume faces in front of the visible
     /// surface (z-pass) or behind it (z-fail).
     #[serde(default)]
-    pub shadow_volume: shadow_volume::VolumeMode,
+    pub shadow_volume: shadow::volume::VolumeMode,
     /// Maximum depth of mirror and refraction rays.
     pub max_depth: u32,
-    pub view: debug::View,
+    pub view: inspect::debug::View,
     #[serde(default)]
     pub interpolation: Interpolation,
     /// Rasterizers: resolve visibility first, then shade once per pixel
@@ -126,7 +114,7 @@ pub struct RenderSettings {
     pub affine: bool,
     /// Indirect light and its knobs.
     #[serde(default)]
-    pub gi: gi::GiSettings,
+    pub gi: transport::gi::GiSettings,
     /// Adaptive sampling: after a few passes, only pixels whose estimated
     /// relative error is above this keep taking samples (up to `spp`).
     #[serde(default)]
@@ -141,7 +129,7 @@ pub struct RenderSettings {
     pub depth_buffer: raster::depth_format::DepthFormat,
     /// The wireframe view: the line algorithm (float DDA or integer Bresenham).
     #[serde(default)]
-    pub lines: wireframe::LineAlgorithm,
+    pub lines: inspect::wireframe::LineAlgorithm,
     /// Rasterizers: cut triangles at the near plane (CGPP 15.6.3). A debug
     /// knob to show why: false drops every triangle that reaches nearer than
     /// the near plane whole, as a rasterizer without a clipper has to (its
@@ -157,7 +145,7 @@ pub struct RenderSettings {
     #[serde(default = "default_true")]
     pub shadow_map_slope_bias: bool,
     /// Shadow rays from smooth-normal triangles facing away from the light
-    /// leave from the surface the normals imply (`shade::shadow_origin`,
+    /// leave from the surface the normals imply (`transport::shade::shadow_origin`,
     /// against the shadow terminator); false: from the hit point, as the book
     /// does, to show the speckles. A debug knob.
     #[serde(default = "default_true")]
@@ -195,20 +183,20 @@ impl RenderSettings {
             spp: 1,
             shadows: ShadowMode::Ray,
             shadow_bump: 1e-4,
-            shadow_map_size: shadow_map::DEFAULT_SIZE,
-            shadow_map_bias: shadow_map::DEFAULT_BIAS,
-            shadow_volume: shadow_volume::VolumeMode::ZFail,
+            shadow_map_size: shadow::map::DEFAULT_SIZE,
+            shadow_map_bias: shadow::map::DEFAULT_BIAS,
+            shadow_volume: shadow::volume::VolumeMode::ZFail,
             max_depth: 4,
-            view: debug::View::Shaded,
+            view: inspect::debug::View::Shaded,
             interpolation: Interpolation::Phong,
             affine: false,
             early_depth: true,
             msaa: 1,
-            gi: gi::GiSettings::default(),
+            gi: transport::gi::GiSettings::default(),
             adaptive: None,
             subsample: frame::Subsample::default(),
             depth_buffer: raster::depth_format::DepthFormat::F32,
-            lines: wireframe::LineAlgorithm::Float,
+            lines: inspect::wireframe::LineAlgorithm::Float,
             near_clip: true,
             shadow_map_slope_bias: true,
             terminator_lift: true,
@@ -286,7 +274,7 @@ pub trait SceneQuery: Sync {
     /// that the batch builds eight records at once (`Scene::triangle_hits`,
     /// the same records `closest` gives).
     fn closest_for_batch(&self, ray: &Ray, t_max: f32, inside: bool, counts: &mut RayCounts) -> Option<BatchHit> {
-        self.closest(ray, t_max, inside, counts, &mut pixel_record::NoRecord).map(BatchHit::Record)
+        self.closest(ray, t_max, inside, counts, &mut inspect::pixel_record::NoRecord).map(BatchHit::Record)
     }
     /// `closest_for_batch` from code already running at SIMD level `simd`
     /// (inside a `dispatch!` around a loop over many rays): a traversal
@@ -300,22 +288,22 @@ pub trait SceneQuery: Sync {
     /// `simd`, as `closest_for_batch_at` is to `closest_for_batch`.
     #[inline(always)]
     fn occluder_at<S: fearless_simd::Simd>(&self, _simd: S, ray: &Ray, t_max: f32, counts: &mut RayCounts) -> Option<Occluder> {
-        self.occluder(ray, t_max, counts, &mut pixel_record::NoRecord)
+        self.occluder(ray, t_max, counts, &mut inspect::pixel_record::NoRecord)
     }
     /// The BVH query behind this one where its packets can trace the
-    /// rays this query would trace one by one (`packet::shadow_packets`):
+    /// rays this query would trace one by one (`transport::shadow_packets`):
     /// the flat tree, no instances or CSG objects. `None` for any other.
-    fn bvh_packets(&self) -> Option<&raytrace::bvh::BvhQuery<'_>> {
+    fn bvh_packets(&self) -> Option<&accel::bvh::BvhQuery<'_>> {
         None
     }
     /// Shadow maps to look light visibility up in (`--shadows map`);
-    /// `resolve_sample` wraps the query in a `shadow_map::MapQuery` that has them.
-    fn shadow_maps(&self) -> Option<&shadow_map::ShadowMaps> {
+    /// `resolve_sample` wraps the query in a `shadow::map::MapQuery` that has them.
+    fn shadow_maps(&self) -> Option<&shadow::map::ShadowMaps> {
         None
     }
     /// The shadow volume count of light `light` at the primary surface
     /// (`--shadows volume`, nonzero = shadow); `resolve_sample` wraps the
-    /// query in a `shadow_volume::VolumeQuery` that has the counts.
+    /// query in a `shadow::volume::VolumeQuery` that has the counts.
     fn volume_count(&self, _light: usize) -> Option<i32> {
         None
     }
@@ -341,7 +329,7 @@ pub struct PassJob<'a> {
     /// sample's random numbers.
     pub sample: u32,
     /// `--gi photons`: the photon map, built before the passes.
-    pub photons: Option<&'a photon_map::PhotonMap>,
+    pub photons: Option<&'a transport::photon_map::PhotonMap>,
     /// Adaptive sampling: which pixels of `rows` (row-major, `width` per row)
     /// still take samples; the others are left as they are in `out` (but
     /// a renderer that admits its samples blackens a non-finite one there).
@@ -417,20 +405,20 @@ pub trait Renderer: Sync + Send {
     /// saying why not (an option it does not support, no driver). Checked
     /// before a frame starts.
     fn check(&self, scene: &crate::scene::Scene, settings: &RenderSettings) -> Result<(), String> {
-        csg::check(scene, settings)
+        accel::csg::check(scene, settings)
     }
 
     /// Replays pixel `(x, y)` of this pass through the same code path with a
     /// recorder, returning the very value `render_pass` stores there; `None`
     /// when this renderer cannot replay pixels.
-    fn trace_pixel(&self, _job: &PassJob, _x: u32, _y: u32, _rec: &mut pixel_record::PixelTrace) -> Option<Radiance> {
+    fn trace_pixel(&self, _job: &PassJob, _x: u32, _y: u32, _rec: &mut inspect::pixel_record::PixelTrace) -> Option<Radiance> {
         None
     }
 }
 
 /// Every registered renderer, reference first.
 pub fn renderers() -> Vec<Box<dyn Renderer>> {
-    let mut all: Vec<Box<dyn Renderer>> = vec![Box::new(raytrace::brute::BruteForce), Box::new(raytrace::bvh_renderer::BvhRayTracer)];
+    let mut all: Vec<Box<dyn Renderer>> = vec![Box::new(accel::brute::BruteForce), Box::new(raytrace::bvh_renderer::BvhRayTracer)];
     all.extend(raster::renderers());
     all.push(Box::new(opengl::OpenGl));
     all
@@ -473,14 +461,14 @@ pub fn render_passes_in_turn<R: Renderer + ?Sized>(renderer: &R, jobs: &[PassJob
 #[inline]
 pub fn miss_without_ray(job: &PassJob) -> Option<Radiance> {
     let scene = &job.prepared.scene;
-    (job.settings.view == debug::View::Shaded && scene.environment.is_none()).then_some(scene.render.background)
+    (job.settings.view == inspect::debug::View::Shaded && scene.environment.is_none()).then_some(scene.render.background)
 }
 
 /// `miss_without_ray`, and in the debug views that colour only what is hit,
-/// their colour for a miss (`debug::miss_color`): what a rasterizer shows
+/// their colour for a miss (`inspect::debug::miss_color`): what a rasterizer shows
 /// at a pixel no primitive covers, without making its eye ray.
 pub fn view_miss_without_ray(job: &PassJob) -> Option<Radiance> {
-    miss_without_ray(job).or_else(|| debug::miss_color(job.settings.view))
+    miss_without_ray(job).or_else(|| inspect::debug::miss_color(job.settings.view))
 }
 
 /// The value one sample contributes, given what it sees: `shade()` for the
@@ -495,17 +483,17 @@ pub fn resolve_sample<Q: SceneQuery, R: Recorder>(
     counts: &mut RayCounts,
     rec: &mut R,
 ) -> Radiance {
-    if job.settings.view == debug::View::Shadowmap {
-        return shadow_map::view_sample(job, ray, rec);
+    if job.settings.view == inspect::debug::View::Shadowmap {
+        return shadow::map::view_sample(job, ray, rec);
     }
-    if job.settings.shadows == ShadowMode::Map && job.settings.view == debug::View::Shaded && hit.is_some() {
-        return shadow_map::with_maps(job.prepared, job.settings, |maps| {
-            resolve_with(job, &shadow_map::MapQuery { inner: query, maps }, ray, hit, pixel, counts, rec)
+    if job.settings.shadows == ShadowMode::Map && job.settings.view == inspect::debug::View::Shaded && hit.is_some() {
+        return shadow::map::with_maps(job.prepared, job.settings, |maps| {
+            resolve_with(job, &shadow::map::MapQuery { inner: query, maps }, ray, hit, pixel, counts, rec)
         });
     }
-    if job.settings.shadows == ShadowMode::Volume && job.settings.view == debug::View::Shaded {
+    if job.settings.shadows == ShadowMode::Volume && job.settings.view == inspect::debug::View::Shaded {
         if let Some(h) = hit {
-            let volume = shadow_volume::ray_counts(job.prepared, job.settings, ray, h.t);
+            let volume = shadow::volume::ray_counts(job.prepared, job.settings, ray, h.t);
             return resolve_counted(job, query, ray, hit, &volume, pixel, counts, rec);
         }
     }
@@ -526,7 +514,7 @@ pub fn resolve_counted<Q: SceneQuery, R: Recorder>(
     counts: &mut RayCounts,
     rec: &mut R,
 ) -> Radiance {
-    resolve_with(job, &shadow_volume::VolumeQuery { inner: query, counts: volume }, ray, hit, pixel, counts, rec)
+    resolve_with(job, &shadow::volume::VolumeQuery { inner: query, counts: volume }, ray, hit, pixel, counts, rec)
 }
 
 #[inline]
@@ -541,27 +529,27 @@ fn resolve_with<Q: SceneQuery, R: Recorder>(
 ) -> Radiance {
     let scene = &job.prepared.scene;
     match (job.settings.view, hit) {
-        (debug::View::Shaded, Some(h)) => {
-            let mut path = gi::PathState::new(pixel, job.sample, job.settings.spp, &job.settings.gi, job.photons);
-            let mut sh = shade::Shading { scene, query, settings: job.settings, path: &mut path, counts, rec };
-            let shaded = with_shading_hit(job.settings.interpolation, h, |s| shade::shade(&mut sh, s, -ray.dir, 0));
+        (inspect::debug::View::Shaded, Some(h)) => {
+            let mut path = transport::gi::PathState::new(pixel, job.sample, job.settings.spp, &job.settings.gi, job.photons);
+            let mut sh = transport::shade::Shading { scene, query, settings: job.settings, path: &mut path, counts, rec };
+            let shaded = with_shading_hit(job.settings.interpolation, h, |s| transport::shade::shade(&mut sh, s, -ray.dir, 0));
             match shaded {
                 Some(radiance) => radiance,
-                None => shade::shade_gouraud(&mut sh, h, job.view.eye),
+                None => transport::shade::shade_gouraud(&mut sh, h, job.view.eye),
             }
         }
-        (debug::View::Shaded, None) => {
+        (inspect::debug::View::Shaded, None) => {
             let l = scene.miss_radiance(ray.dir);
             rec.shaded(0, l);
             l
         }
-        (debug::View::Mip, hit) => {
-            let c = debug::mip_view(scene, job.settings.texture_filter, hit);
+        (inspect::debug::View::Mip, hit) => {
+            let c = inspect::debug::mip_view(scene, job.settings.texture_filter, hit);
             rec.shaded(0, c);
             c
         }
         (view, hit) => {
-            let c = debug::view_color(view, job.view, ray, hit);
+            let c = inspect::debug::view_color(view, job.view, ray, hit);
             rec.shaded(0, c);
             c
         }
@@ -572,7 +560,7 @@ fn resolve_with<Q: SceneQuery, R: Recorder>(
 /// `hit`: the hit itself with Phong interpolation, the hit with its
 /// geometric normal as shading normal with flat shading. `None` with
 /// Gouraud, which shades the triangle's vertices instead
-/// (`shade::shade_gouraud`). A callback rather than a returned hit, so the
+/// (`transport::shade::shade_gouraud`). A callback rather than a returned hit, so the
 /// Phong case copies nothing.
 #[inline(always)]
 pub fn with_shading_hit<T>(interpolation: Interpolation, hit: &SurfaceHit, f: impl FnOnce(&SurfaceHit) -> T) -> Option<T> {

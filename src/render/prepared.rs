@@ -1,8 +1,8 @@
 //! A scene made ready to render: triangle edges for intersection and the BVH.
 //! Built once per scene load; every renderer reads it.
 
-use super::raytrace::bvh::Bvh;
-use super::raytrace::intersect::TriangleEdges;
+use crate::render::accel::bvh::Bvh;
+use crate::render::accel::intersect::TriangleEdges;
 use crate::scene::{PrimitiveId, Scene};
 use std::sync::Arc;
 use std::time::Instant;
@@ -17,14 +17,14 @@ pub struct PreparedScene {
     pub build_ms: f64,
     /// The last shadow maps built (`--shadows map`), keyed by size and lights;
     /// see `PreparedScene::shadow_maps`.
-    pub shadow_cache: super::shadow_map::ShadowMapCache,
+    pub shadow_cache: crate::render::shadow::map::ShadowMapCache,
     /// The last photon map built (`--gi photons`); see `PreparedScene::photon_map`.
-    pub photon_cache: super::photon_map::PhotonMapCache,
+    pub photon_cache: crate::render::transport::photon_map::PhotonMapCache,
     /// The last shadow volumes built (`--shadows volume`), keyed by the
     /// lights; see `PreparedScene::shadow_volumes`.
-    pub volume_cache: super::shadow_volume::ShadowVolumeCache,
+    pub volume_cache: crate::render::shadow::volume::ShadowVolumeCache,
     /// The two-level layer's BVHs, when the scene has one.
-    pub instances: Option<super::raytrace::instances::InstanceAccel>,
+    pub instances: Option<crate::render::accel::instances::InstanceAccel>,
 }
 
 /// The triangles' edges in scene order: a view of the BVH's primitive
@@ -96,7 +96,7 @@ impl PreparedScene {
         let start = Instant::now();
         let bvh = Bvh::build(&scene, &scene.triangles);
         let build_ms = start.elapsed().as_secs_f64() * 1e3;
-        let instances = scene.layer.as_ref().map(|l| super::raytrace::instances::InstanceAccel::build(l));
+        let instances = scene.layer.as_ref().map(|l| crate::render::accel::instances::InstanceAccel::build(l));
         let build_ms = if instances.is_some() { start.elapsed().as_secs_f64() * 1e3 } else { build_ms };
         let edges = bvh.edges_in_scene_order();
         PreparedScene {
@@ -138,7 +138,7 @@ impl PreparedScene {
 
     /// The photon map for the scene's current lights and materials and the
     /// photon settings `gi`, from the cache or built now.
-    pub fn photon_map(&self, gi: &super::gi::GiSettings, bump: f32) -> std::sync::Arc<super::photon_map::PhotonMap> {
+    pub fn photon_map(&self, gi: &crate::render::transport::gi::GiSettings, bump: f32) -> std::sync::Arc<crate::render::transport::photon_map::PhotonMap> {
         self.photon_cache.get(self, gi, bump)
     }
 }

@@ -2,9 +2,9 @@
 //! (the models and textures it uses too, in `assets.rs`), so `pinhole render
 //! teapot` works from anywhere.
 
-use super::assets::BUILTIN_ROOT;
-use super::file::parse_scene;
-use super::Scene;
+use crate::scene::assets::BUILTIN_ROOT;
+use crate::scene::file::parse_scene;
+use crate::scene::Scene;
 use std::path::Path;
 
 const SCENES: &[(&str, &str)] = &[
@@ -52,16 +52,16 @@ pub fn stress_names() -> Vec<&'static str> {
 /// The large scenes (`forest`): loadable by name, listed apart because
 /// only the renderers that draw the two-level instance layer draw them.
 pub fn large_names() -> Vec<&'static str> {
-    super::forest::SCENES.iter().map(|(n, _, _)| *n).collect()
+    crate::scene::forest::SCENES.iter().map(|(n, _, _)| *n).collect()
 }
 
 /// The TOML source of a built-in scene (stress and large scenes included).
 pub fn source(name: &str) -> Option<&'static str> {
-    if let Some(k) = super::forest::SCENES.iter().position(|(n, _, _)| *n == name) {
-        const N: usize = super::forest::SCENES.len();
+    if let Some(k) = crate::scene::forest::SCENES.iter().position(|(n, _, _)| *n == name) {
+        const N: usize = crate::scene::forest::SCENES.len();
         static TEXTS: [std::sync::OnceLock<String>; N] = [const { std::sync::OnceLock::new() }; N];
-        let (_, count, layout) = super::forest::SCENES[k];
-        return Some(TEXTS[k].get_or_init(|| super::forest::source(count, layout)).as_str());
+        let (_, count, layout) = crate::scene::forest::SCENES[k];
+        return Some(TEXTS[k].get_or_init(|| crate::scene::forest::source(count, layout)).as_str());
     }
     SCENES.iter().chain(STRESS_SCENES).find(|(n, _)| *n == name).map(|(_, s)| *s)
 }

@@ -2,10 +2,10 @@
 //! leaves are closed solids (analytic spheres and closed triangle meshes).
 //! The leaves' geometry lives in the object itself, never in
 //! `Scene::triangles` or `Scene::spheres`, so the BVH and the rasterizers'
-//! triangle loops never see it; `render::csg` casts rays at it and
+//! triangle loops never see it; `render::accel::csg` casts rays at it and
 //! `render::raster::csg` scan-converts it into its own A-buffer.
 
-use super::{Sphere, Triangle};
+use crate::scene::{Sphere, Triangle};
 use crate::math::Vec3;
 
 /// Deepest nesting of operations a scene file may give (the ray test recurses).

@@ -2,7 +2,7 @@
 //! infinitely far away, seen by every ray that hits nothing (instead of the
 //! flat `background`), and so by mirrors (Computer Graphics from Scratch ch. 15).
 
-use super::texture::{Texture, Wrap};
+use crate::scene::texture::{Texture, Wrap};
 use crate::math::{Vec2, Vec3};
 use std::f32::consts::PI;
 use std::sync::Arc;

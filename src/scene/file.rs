@@ -2,11 +2,11 @@
 //! descriptions, then checked and turned into a `Scene`. Every error names the
 //! file, the line and the key or table at fault.
 
-use super::mesh_cache::MeshCache;
-use super::obj::{self, NormalMode};
-use super::texture::{load_texture_as, Encoding, Wrap};
-use super::instanced::{InstanceLayer, LayerInstance};
-use super::{Camera, Fov, InstanceInfo, Light, Material, ObjectInfo, RenderDefaults, Scene, Sphere, Triangle};
+use crate::scene::mesh_cache::MeshCache;
+use crate::scene::obj::{self, NormalMode};
+use crate::scene::texture::{load_texture_as, Encoding, Wrap};
+use crate::scene::instanced::{InstanceLayer, LayerInstance};
+use crate::scene::{Camera, Fov, InstanceInfo, Light, Material, ObjectInfo, RenderDefaults, Scene, Sphere, Triangle};
 use crate::input::{MAX_COORDINATE, MAX_LIGHT, MAX_VALUE};
 use crate::math::{Vec2, Vec3};
 
@@ -363,7 +363,7 @@ fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str, two_
         }
     }
     if scene.materials.iter().any(|m| m.normal_map.is_some()) {
-        scene.tangents = super::tangents::build_tangents(&scene);
+        scene.tangents = crate::scene::tangents::build_tangents(&scene);
     }
     if let Some(env) = &desc.environment {
         let where_ = format!("{}: [environment]", at(env.span()));
@@ -373,7 +373,7 @@ fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str, two_
             return Err(format!("{where_}: intensity must be a finite number from 0 to {MAX_VALUE:e}"));
         }
         let texture = load_texture_as(&base.join(&env.file), Encoding::Srgb).map_err(|e| format!("{where_}: file: {e}"))?;
-        scene.environment = Some(super::environment::Environment { texture: Arc::new(texture), intensity });
+        scene.environment = Some(crate::scene::environment::Environment { texture: Arc::new(texture), intensity });
     }
     // Each triangle was pushed with corners of its own; store each corner once.
     scene.triangles.share_corners();
@@ -654,7 +654,7 @@ fn add_object(
             ])?;
             let mut parts = CsgParts::default();
             let root = csg_node(scene, o, object, where_, "", base, meshes, at, explicit_material, 0, &mut parts)?;
-            scene.csgs.push(super::csg::Csg::new(root, parts.spheres, parts.triangles, object));
+            scene.csgs.push(crate::scene::csg::Csg::new(root, parts.spheres, parts.triangles, object));
         }
         other => return Err(format!("{where_}: unknown object type \"{other}\" (expected mesh, triangle, quad, sphere or csg)")),
     }
@@ -745,8 +745,8 @@ fn csg_node(
     inherited: Option<u32>,
     depth: usize,
     parts: &mut CsgParts,
-) -> Result<super::csg::CsgNode, String> {
-    use super::csg::{CsgNode, CsgOp, MAX_DEPTH};
+) -> Result<crate::scene::csg::CsgNode, String> {
+    use crate::scene::csg::{CsgNode, CsgOp, MAX_DEPTH};
     let material = match &o.material {
         Some(name) => Some(
             scene
@@ -784,7 +784,7 @@ fn csg_node(
                     parts.spheres.push(s);
                     return Ok(CsgNode::Sphere(parts.spheres.len() as u32 - 1));
                 }
-                if let Err(e) = super::csg::check_closed(&tris) {
+                if let Err(e) = crate::scene::csg::check_closed(&tris) {
                     let file = d.file.as_deref().unwrap_or("?");
                     return Err(format!("{here}: the mesh \"{file}\" is not closed ({e}); a csg operand must be a closed solid"));
                 }

@@ -8,9 +8,9 @@
 //! lanes for shading; `HitLanes::get` assembles one as a `SurfaceHit` where
 //! one-sample code needs it.
 
-use super::camera::CameraView;
-use super::triangles::CornerRow;
-use super::{Differentials, PrimitiveKind, Scene, SurfaceHit, Triangle};
+use crate::scene::camera::CameraView;
+use crate::scene::triangles::CornerRow;
+use crate::scene::{Differentials, PrimitiveKind, Scene, SurfaceHit, Triangle};
 use crate::math::lanes::{transpose8, mask_bits, mask_from_bits, simd_level, Lane, V3};
 use crate::math::{Vec2, Vec3};
 use fearless_simd::{dispatch, f32x8, Simd, SimdBase, SimdFrom};

@@ -9,8 +9,8 @@
 //! world-space triangle of any index with the very arithmetic flattening
 //! uses, so a copy renders as its flattened triangles would.
 
-use super::file::Placement;
-use super::Triangle;
+use crate::scene::file::Placement;
+use crate::scene::Triangle;
 use std::sync::Arc;
 
 /// One copy in the layer.

@@ -1,10 +1,10 @@
 //! Opening a scene by the argument the command line and the viewer take: a
 //! built-in scene's name, a `.toml` scene file or a bare `.obj`.
 
-use super::builtin;
-use super::file::load_scene_file;
-use super::obj::frame_bare_obj;
-use super::Scene;
+use crate::scene::builtin;
+use crate::scene::file::load_scene_file;
+use crate::scene::obj::frame_bare_obj;
+use crate::scene::Scene;
 use std::path::PathBuf;
 
 /// Where a scene argument points: a built-in name, a `.toml` or a bare `.obj`.

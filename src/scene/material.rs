@@ -1,6 +1,6 @@
 //! Materials: the terms of the scene format's BSDF, plus an optional texture.
 
-use super::texture::{Footprint, Texture, TextureFilter, Wrap};
+use crate::scene::texture::{Footprint, Texture, TextureFilter, Wrap};
 use crate::math::{Vec2, Vec3};
 use std::sync::Arc;
 

@@ -2,8 +2,8 @@
 //! file with the same normal and texture modes shares one parse, and places
 //! its own copy of the triangles.
 
-use super::assets::canonical_path;
-use super::obj::{load_obj, LoadedMesh, MtlTextures, NormalMode};
+use crate::scene::assets::canonical_path;
+use crate::scene::obj::{load_obj, LoadedMesh, MtlTextures, NormalMode};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::rc::Rc;

@@ -296,7 +296,7 @@ pub struct Scene {
     pub triangles: Triangles,
     pub spheres: Vec<Sphere>,
     /// Constructive solid geometry objects, kept apart from the triangles
-    /// and spheres (`render::csg` answers rays for them).
+    /// and spheres (`render::accel::csg` answers rays for them).
     pub csgs: Vec<csg::Csg>,
     pub objects: Vec<ObjectInfo>,
     /// The copies made by `instances` lists, in the order of their triangles.
@@ -542,31 +542,6 @@ impl Scene {
         }
     }
 
-    /// The surface record for a ray that hit primitive `id` at parameter `t`;
-    /// `(b1, b2)` are a triangle hit's barycentric weights of v1 and v2
-    /// (ignored for spheres). Both ray casters build their hits here.
-    #[inline]
-    pub fn primitive_hit(&self, id: PrimitiveId, t: f32, b1: f32, b2: f32, ray: &Ray) -> SurfaceHit {
-        match id.kind() {
-            PrimitiveKind::Triangle => self.triangle_hit(id.index(), Vec3::new(1.0 - b1 - b2, b1, b2), t, ray),
-            PrimitiveKind::Sphere => self.sphere_hit(id.index(), t, ray),
-            // CSG hits are built by `render::csg`, never from an id.
-            PrimitiveKind::Csg => crate::render::csg::closest(self, id.index(), ray, f32::INFINITY, true).unwrap_or(SurfaceHit {
-                position: ray.at(t),
-                geometric_normal: -ray.dir,
-                shading_normal: -ray.dir,
-                barycentric: Vec3::ZERO,
-                uv: Vec2::ZERO,
-                t,
-                kind: PrimitiveKind::Csg,
-                primitive: id.index(),
-                object: 0,
-                material: 0,
-                back_face: false,
-                diff: Differentials::ZERO,
-            }),
-        }
-    }
 
     /// The copy (from an `instances` list) that triangle `index` belongs to.
     pub fn instance_of_triangle(&self, index: u32) -> Option<&InstanceInfo> {

@@ -4,10 +4,10 @@
 //! MTL mapping: `Kd` -> lambertian, `Ks` -> glossy, `Ns` -> sharpness,
 //! `map_Kd` -> texture. Other MTL terms are ignored.
 
-use super::assets::read_asset;
+use crate::scene::assets::read_asset;
 use crate::input::{InputKind, MAX_COORDINATE, MAX_VALUE};
-use super::texture::load_texture;
-use super::{Camera, Fov, Light, Material, ObjectInfo, Scene, Triangle, Triangles};
+use crate::scene::texture::load_texture;
+use crate::scene::{Camera, Fov, Light, Material, ObjectInfo, Scene, Triangle, Triangles};
 use crate::math::{Vec2, Vec3};
 use serde::Deserialize;
 use std::path::Path;

@@ -4,7 +4,7 @@
 //! steps (0.008 at 100,000), so hit points computed there miss their surfaces
 //! by more than any ray bump; near the origin the same scene is exact again.
 
-use super::{Light, Scene};
+use crate::scene::{Light, Scene};
 use crate::math::Vec3;
 
 /// Translates every triangle, sphere, point light and the camera by minus

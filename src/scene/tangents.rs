@@ -4,7 +4,7 @@
 //! position, normal and uv), so that the frame turns smoothly across a mesh
 //! as its normals do.
 
-use super::{PrimitiveKind, Scene, SurfaceHit};
+use crate::scene::{PrimitiveKind, Scene, SurfaceHit};
 use crate::math::Vec3;
 use glam::Vec4;
 use std::collections::HashMap;

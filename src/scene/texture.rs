@@ -2,7 +2,7 @@
 //! once at load time, sampled nearest, bilinear or trilinear (Computer
 //! Graphics from Scratch ch. 14).
 
-use super::assets::read_asset;
+use crate::scene::assets::read_asset;
 use crate::input::{decode_image, InputKind, MAX_VALUE};
 use crate::math::{Vec2, Vec3};
 use crate::named::named_enum;

@@ -13,7 +13,7 @@
 //! corners, so sharing never changes a number: `get(i)` returns exactly the
 //! `Triangle` that was pushed as triangle `i`.
 
-use super::Triangle;
+use crate::scene::Triangle;
 use crate::math::{Vec2, Vec3};
 use rustc_hash::FxHashMap;
 

@@ -2,8 +2,7 @@
 //! resolution scale; reset and frame-all.
 
 use eframe::egui;
-use super::{section, vec3_edit, Requests};
-use crate::app::state::scaled_size;
+use crate::app::panels::{section, vec3_edit, Requests};
 use crate::scene::{Camera, Fov};
 
 /// `scene_size`: the scene's image size, which `res_scale` scales.
@@ -46,4 +45,9 @@ pub fn show(ui: &mut egui::Ui, open: &mut bool, cam: &mut Camera, res_scale: &mu
         ui.label(egui::RichText::new("orbit: left drag · pan: middle or shift drag · dolly: wheel · fly: WASD/QE").small());
     });
     requests
+}
+
+/// `width` x `height` times `scale`, rounded, at least one pixel each way.
+pub fn scaled_size(width: u32, height: u32, scale: f32) -> (u32, u32) {
+    (((width as f32 * scale).round() as u32).max(1), ((height as f32 * scale).round() as u32).max(1))
 }

@@ -11,8 +11,8 @@ use eframe::egui;
 use crate::app::inspect::{fmt3, kind_name, object_name};
 use crate::app::PinholeApp;
 use crate::math::Radiance;
-use crate::render::pixel_report::miss_reason;
-use crate::render::pixel_record::{CsgABufferRecord, FragmentRecord, GlReadback, LightSample, PixelTrace, RayRecord};
+use crate::render::inspect::pixel_report::miss_reason;
+use crate::render::inspect::pixel_record::{CsgABufferRecord, FragmentRecord, GlReadback, LightSample, PixelTrace, RayRecord};
 use crate::render::PixelReplay;
 use crate::scene::{Light, Scene};
 use egui::{Color32, RichText};
@@ -96,7 +96,7 @@ fn record(app: &PinholeApp, ui: &mut egui::Ui, names: &SceneNames, r: &PixelRepl
         match reference {
             Ok(b) => {
                 ui.label(RichText::new(format!("raytrace:brute (shaded) {}", fmt3(b.radiance))).monospace());
-                if crate::render::debug::differs(r.radiance, b.radiance) {
+                if crate::render::inspect::debug::differs(r.radiance, b.radiance) {
                     ui.colored_label(Color32::from_rgb(240, 110, 100), "this pixel differs from the reference");
                 } else {
                     ui.colored_label(Color32::LIGHT_GREEN, "this pixel agrees with the reference");
@@ -255,7 +255,7 @@ fn ray(ui: &mut egui::Ui, names: &SceneNames, r: &RayRecord, index: usize, abuff
             });
             if let Some(a) = abuffer {
                 csg_abuffer(ui, a, index);
-            } else if let Some(e) = crate::render::csg::explain_hit(scene, h, &r.ray, r.t_max) {
+            } else if let Some(e) = crate::render::accel::csg::explain_hit(scene, h, &r.ray, r.t_max) {
                 ui.label(RichText::new("csg intervals (t along the ray)").strong());
                 for line in e.lines() {
                     ui.monospace(line);
@@ -361,8 +361,8 @@ fn csg_abuffer(ui: &mut egui::Ui, a: &CsgABufferRecord, index: usize) {
             ui.monospace(format!("{:.5}", f.t));
             ui.monospace(a.operand(f));
             ui.monospace(match f.surface {
-                crate::render::csg::SurfaceRef::Sphere(_) => "sphere".to_string(),
-                crate::render::csg::SurfaceRef::Triangle { index, .. } => format!("triangle {index}"),
+                crate::render::accel::csg::SurfaceRef::Sphere(_) => "sphere".to_string(),
+                crate::render::accel::csg::SurfaceRef::Triangle { index, .. } => format!("triangle {index}"),
             });
             let b = RichText::new(if f.entering { "entry" } else { "exit" }).monospace();
             ui.label(if a.won(f) { b.color(Color32::LIGHT_GREEN).strong() } else { b });

@@ -2,7 +2,7 @@
 //! position or direction, and power or irradiance as colour times strength.
 
 use eframe::egui;
-use super::{color_edit, section, vec3_edit};
+use crate::app::panels::{color_edit, section, vec3_edit};
 use crate::math::Vec3;
 use crate::scene::{Camera, Light, Scene};
 

@@ -2,7 +2,7 @@
 //! logarithmic slider (the book's advice), mirror, transmission and ior.
 
 use eframe::egui;
-use super::{color_edit, section};
+use crate::app::panels::{color_edit, section};
 use crate::scene::Material;
 
 pub fn show(ui: &mut egui::Ui, open: &mut bool, materials: &mut [Material]) {

@@ -3,10 +3,10 @@
 //! vertex overlay.
 
 use eframe::egui;
-use super::Requests;
+use crate::app::panels::Requests;
 use crate::app::inspect::Inspect;
 use crate::app::settings_store::ViewerSettings;
-use crate::render::debug::View;
+use crate::render::inspect::debug::View;
 use crate::scene::builtin;
 
 /// `settings`: panels, view and renderer; `inspect`: zoom and the vertex overlay.

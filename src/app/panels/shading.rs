@@ -4,13 +4,13 @@
 //! buffer format) and the wireframe view's line algorithm.
 
 use eframe::egui;
-use super::{color_edit, section};
+use crate::app::panels::{color_edit, section};
 use crate::app::settings_store::ViewerSettings;
-use crate::render::gi::{GiMode, GiSettings, MAX_BOUNCES};
+use crate::render::transport::gi::{GiMode, GiSettings, MAX_BOUNCES};
 use crate::render::raster::clip::ClipMode;
 use crate::render::raster::depth_format::DepthFormat;
-use crate::render::wireframe::LineAlgorithm;
-use crate::render::shadow_volume::VolumeMode;
+use crate::render::inspect::wireframe::LineAlgorithm;
+use crate::render::shadow::volume::VolumeMode;
 use crate::render::{Interpolation, Reflections, ShadowMode};
 use crate::scene::texture::TextureFilter;
 use crate::scene::RenderDefaults;

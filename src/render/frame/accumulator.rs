@@ -4,12 +4,14 @@
 //! its lines, drawn over the average). The command line's
 //! `render_frame` and the viewer's worker both drive one of these.
 
-use super::FrameResult;
+use crate::render::frame::FrameResult;
 use crate::math::Radiance;
-use crate::render::sampling::luminance;
-use crate::render::debug::{self, View};
-use crate::render::raytrace::brute::BruteForce;
-use crate::render::wireframe::{self, LineAlgorithm};
+use crate::render::transport::sampling::luminance;
+use crate::render::inspect::debug;
+use crate::render::inspect::debug::View;
+use crate::render::accel::brute::BruteForce;
+use crate::render::inspect::wireframe;
+use crate::render::inspect::wireframe::LineAlgorithm;
 use crate::render::finite::admit_all;
 use crate::render::{sample_offset, PassJob, PreparedScene, RayCounts, RenderSettings, Renderer};
 use rayon::prelude::*;
@@ -143,7 +145,7 @@ pub struct Accumulator {
     /// `--adaptive`: per-pixel sample counts and the pixels still sampling.
     adaptive: Option<Adaptive>,
     /// The photon map every pass reads (`--gi photons`), built with the first band.
-    photons: Option<std::sync::Arc<crate::render::photon_map::PhotonMap>>,
+    photons: Option<std::sync::Arc<crate::render::transport::photon_map::PhotonMap>>,
     /// Wireframe view: the passes are shaded; the lines' pixels (made with
     /// the first band) are painted over the average.
     wireframe: Option<LineAlgorithm>,
@@ -338,8 +340,8 @@ impl Accumulator {
     /// What every pass reads, made once before the first: shadow maps or
     /// volumes, the photon map, the wireframe's lines.
     fn prepare_frame(&mut self, prepared: &PreparedScene) {
-        super::build_shadow_maps(prepared, &self.settings);
-        self.photons = super::build_photon_map(prepared, &self.settings);
+        crate::render::frame::build_shadow_maps(prepared, &self.settings);
+        self.photons = crate::render::frame::build_photon_map(prepared, &self.settings);
         if let Some(algorithm) = self.wireframe {
             let view = prepared.scene.camera.view(self.settings.width, self.settings.height);
             self.lines = Some(wireframe::line_mask(&prepared.scene, &view, algorithm));
@@ -550,7 +552,7 @@ mod tests {
     fn the_noise_estimate_falls_as_samples_add_up() {
         let p = prepared("cornell-gi");
         let mut s = settings(&p, 64, View::Shaded);
-        s.gi.mode = crate::render::gi::GiMode::Path;
+        s.gi.mode = crate::render::transport::gi::GiMode::Path;
         let mut a = Accumulator::new(&s);
         let mut at = Vec::new();
         while !a.is_complete() {
@@ -614,7 +616,7 @@ mod tests {
         let p = prepared("cornell-gi");
         let cancel = AtomicBool::new(false);
         // 19 passes: sixteen handed over together, then three.
-        for (spp, gi) in [(4, crate::render::gi::GiMode::Path), (3, crate::render::gi::GiMode::None), (19, crate::render::gi::GiMode::Path)] {
+        for (spp, gi) in [(4, crate::render::transport::gi::GiMode::Path), (3, crate::render::transport::gi::GiMode::None), (19, crate::render::transport::gi::GiMode::Path)] {
             let mut s = settings(&p, spp, View::Shaded);
             s.height = 2 * BvhRayTracer.chunk_rows().unwrap() + 3;
             s.gi.mode = gi;

@@ -7,8 +7,8 @@
 //! traced in full instead of interpolated. A feature that no corner sees
 //! still goes unnoticed: that is where the method fails.
 
-use super::accumulator::{add_sample, final_value};
-use super::FrameResult;
+use crate::render::frame::accumulator::{add_sample, final_value};
+use crate::render::frame::FrameResult;
 use crate::math::Radiance;
 use crate::render::{sample_offset, PassJob, PreparedScene, RayCounts, RenderSettings, Renderer};
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
@@ -69,8 +69,8 @@ pub fn render_subsampled(
     let (w, h) = (settings.width, settings.height);
     let n = w as usize * h as usize;
     let spp = settings.spp.max(1);
-    super::build_shadow_maps(prepared, settings);
-    let photons = super::build_photon_map(prepared, settings);
+    crate::render::frame::build_shadow_maps(prepared, settings);
+    let photons = crate::render::frame::build_photon_map(prepared, settings);
     let view = prepared.scene.camera.view(w, h);
     let (xs, ys) = (grid_lines(w, settings.subsample.step), grid_lines(h, settings.subsample.step));
     let mut corners = vec![false; n];

@@ -1,7 +1,7 @@
 //! The scene's CSG objects as the fragment shader evaluates them
 //! (`shaders::csg_fragment`): each tree flattened into a postfix program
 //! (operands before their operation, `a` before `b`, so the leaves are
-//! numbered as `render::csg` numbers them), with the leaves' spheres and
+//! numbered as `render::accel::csg` numbers them), with the leaves' spheres and
 //! triangles in buffers of their own.
 
 use crate::scene::csg::{Csg, CsgNode, CsgOp};
@@ -71,7 +71,7 @@ pub fn build(csgs: &[Csg]) -> Result<CsgData, String> {
 }
 
 /// Appends `node`'s postfix program; `flipped` under an odd number of
-/// subtractions (`render::csg::node_intervals`).
+/// subtractions (`render::accel::csg::node_intervals`).
 fn emit(node: &CsgNode, flipped: bool, sphere_base: u32, triangle_base: u32, out: &mut Vec<f32>) {
     let mut push = |kind: u32, a: u32, b: u32, f: bool| out.extend_from_slice(&[kind, a, b, f as u32].map(f32::from_bits));
     match node {

@@ -17,8 +17,10 @@ mod textures;
 mod views;
 
 use crate::math::Radiance;
-use crate::render::{debug, gi, Interpolation, PassJob, RayCounts, Reflections, RenderSettings, Renderer, ShadowMode};
-use crate::render::pixel_record::{GlReadback, PixelTrace};
+use crate::render::inspect::debug;
+use crate::render::transport::gi;
+use crate::render::{Interpolation, PassJob, RayCounts, Reflections, RenderSettings, Renderer, ShadowMode};
+use crate::render::inspect::pixel_record::{GlReadback, PixelTrace};
 use crate::scene::Scene;
 
 static GL: context::Shared<pass::State> = context::Shared::new();
@@ -69,7 +71,7 @@ impl Renderer for OpenGl {
     }
 
     fn check(&self, scene: &Scene, settings: &RenderSettings) -> Result<(), String> {
-        crate::render::csg::check(scene, settings)?;
+        crate::render::accel::csg::check(scene, settings)?;
         csg_data::build(&scene.csgs)?;
         let csg_materials = scene.csgs.iter().flat_map(|c| c.spheres.iter().map(|s| s.material).chain(c.triangles.iter().map(|t| t.material)));
         if let Some(m) = csg_materials.filter_map(|m| scene.materials.get(m as usize)).find(|m| m.texture.is_some() || m.normal_map.is_some()) {

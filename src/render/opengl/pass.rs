@@ -2,9 +2,9 @@
 //! context between passes, the pass drawn into a float framebuffer, read
 //! back and flipped into the frame's row order.
 
-use super::context::Gl;
-use super::scene_data;
-use super::shaders;
+use crate::render::opengl::context::Gl;
+use crate::render::opengl::scene_data;
+use crate::render::opengl::shaders;
 use crate::math::{Radiance, Vec3};
 use crate::render::{Interpolation, PassJob, RayCounts, Reflections, ShadowMode};
 use crate::scene::texture::{TextureFilter, Wrap};
@@ -16,8 +16,8 @@ pub struct State {
     /// of defines (shadow-map lookups, multisampling).
     programs: Vec<(String, Programs)>,
     background: glow::Program,
-    maps: super::shadow_pass::ShadowPass,
-    textures: super::textures::Textures,
+    maps: crate::render::opengl::shadow_pass::ShadowPass,
+    textures: crate::render::opengl::textures::Textures,
     vertex_array: glow::VertexArray,
     vertex_buffer: glow::Buffer,
     cube_array: glow::VertexArray,
@@ -37,7 +37,7 @@ pub struct State {
     /// The CSG objects' buffers (`csg_data`: objects, nodes, spheres,
     /// triangles at bindings 6 to 9) and what they hold.
     csg_buffers: [glow::Buffer; 4],
-    csg_uploaded: Option<super::csg_data::CsgData>,
+    csg_uploaded: Option<crate::render::opengl::csg_data::CsgData>,
     target: Option<Target>,
 }
 
@@ -113,7 +113,7 @@ impl State {
     unsafe fn new(gl: &glow::Context) -> Result<State, String> {
         unsafe {
             let background = compile(gl, shaders::BACKGROUND_VERTEX, &shaders::background_fragment())?;
-            let maps = super::shadow_pass::ShadowPass::new(gl)?;
+            let maps = crate::render::opengl::shadow_pass::ShadowPass::new(gl)?;
             let vertex_array = gl.create_vertex_array()?;
             let vertex_buffer = gl.create_buffer()?;
             gl.bind_vertex_array(Some(vertex_array));
@@ -147,7 +147,7 @@ impl State {
                 programs: Vec::new(),
                 background,
                 maps,
-                textures: super::textures::Textures::new(gl)?,
+                textures: crate::render::opengl::textures::Textures::new(gl)?,
                 vertex_array,
                 vertex_buffer,
                 cube_array,
@@ -234,9 +234,9 @@ impl State {
             gl.framebuffer_renderbuffer(glow::FRAMEBUFFER, glow::DEPTH_ATTACHMENT, glow::RENDERBUFFER, Some(depth));
             let mut surfaces = Vec::new();
             if views {
-                for i in 0..super::views::TARGETS {
+                for i in 0..crate::render::opengl::views::TARGETS {
                     let t = gl.create_texture()?;
-                    let format = if i < super::views::FLOAT_TARGETS { glow::RGBA32F } else { glow::RGBA32UI };
+                    let format = if i < crate::render::opengl::views::FLOAT_TARGETS { glow::RGBA32F } else { glow::RGBA32UI };
                     gl.bind_texture(glow::TEXTURE_2D, Some(t));
                     gl.tex_storage_2d(glow::TEXTURE_2D, 1, format, width as i32, height as i32);
                     gl.framebuffer_texture_2d(glow::FRAMEBUFFER, glow::COLOR_ATTACHMENT1 + i as u32, glow::TEXTURE_2D, Some(t), 0);
@@ -327,7 +327,7 @@ unsafe fn uniforms(gl: &glow::Context, program: glow::Program, job: &PassJob, en
 
 /// Sets what the fragment shader reads of material `m`'s texture and
 /// normal map.
-unsafe fn material_textures(gl: &glow::Context, textures: &super::textures::Textures, program: glow::Program, job: &PassJob, m: u32) {
+unsafe fn material_textures(gl: &glow::Context, textures: &crate::render::opengl::textures::Textures, program: glow::Program, job: &PassJob, m: u32) {
     let Some(material) = job.prepared.scene.materials.get(m as usize) else { return };
     unsafe {
         let at = |name: &str| gl.get_uniform_location(program, name);
@@ -349,7 +349,7 @@ unsafe fn material_textures(gl: &glow::Context, textures: &super::textures::Text
 
 /// Draws `job`'s pass and stores its rows in `out`; with `probe` (a pixel
 /// of the pass's rows), also returns what GL's render targets hold there.
-pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Option<(u32, u32)>) -> Result<(RayCounts, Option<crate::render::pixel_record::GlReadback>), String> {
+pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Option<(u32, u32)>) -> Result<(RayCounts, Option<crate::render::inspect::pixel_record::GlReadback>), String> {
     let gl = &g.gl;
     let scene = &job.prepared.scene;
     let (width, height) = (job.view.width, job.view.height);
@@ -359,8 +359,8 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Opt
         }
         let state = g.state.as_mut().expect("created above");
         let samples = job.settings.msaa.max(1);
-        let views = job.settings.view != crate::render::debug::View::Shaded || probe.is_some();
-        let view_colours = job.settings.view != crate::render::debug::View::Shaded;
+        let views = job.settings.view != crate::render::inspect::debug::View::Shaded || probe.is_some();
+        let view_colours = job.settings.view != crate::render::inspect::debug::View::Shaded;
         let (framebuffer, resolved) = state.target(gl, width, height, samples, views)?;
         state.upload(gl, scene);
         let keep: Vec<_> = scene
@@ -405,13 +405,13 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Opt
         let bg: Vec3 = scene.render.background;
         gl.clear_buffer_f32_slice(glow::COLOR, 0, &[bg.x, bg.y, bg.z, 1.0]);
         gl.clear_buffer_f32_slice(glow::DEPTH, 0, &[0.0]);
-        let all_targets: Vec<u32> = (0..=super::views::TARGETS as u32).map(|i| glow::COLOR_ATTACHMENT0 + i).collect();
+        let all_targets: Vec<u32> = (0..=crate::render::opengl::views::TARGETS as u32).map(|i| glow::COLOR_ATTACHMENT0 + i).collect();
         if views {
             gl.draw_buffers(&all_targets);
-            for i in 1..=super::views::FLOAT_TARGETS as u32 {
+            for i in 1..=crate::render::opengl::views::FLOAT_TARGETS as u32 {
                 gl.clear_buffer_f32_slice(glow::COLOR, i, &[0.0; 4]);
             }
-            gl.clear_buffer_u32_slice(glow::COLOR, super::views::TARGETS as u32, &[0; 4]);
+            gl.clear_buffer_u32_slice(glow::COLOR, crate::render::opengl::views::TARGETS as u32, &[0; 4]);
             // The background writes the colour only.
             gl.draw_buffers(&all_targets[..1]);
         }
@@ -519,7 +519,7 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Opt
             glow::FLOAT,
             glow::PixelPackData::Slice(Some(bytes_mut(&mut pixels))),
         );
-        let surfaces = views.then(|| super::views::Readback::read(gl, first_gl_row, width, rows.len() as u32));
+        let surfaces = views.then(|| crate::render::opengl::views::Readback::read(gl, first_gl_row, width, rows.len() as u32));
         if views {
             gl.draw_buffers(&all_targets[..1]);
         }
@@ -540,7 +540,7 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Opt
                     continue;
                 }
                 out[k * w + x as usize] = match surfaces.as_ref().filter(|_| view_colours) {
-                    Some(s) => super::views::colour(job, s.hit(scene, r, x as usize).as_ref(), x, y),
+                    Some(s) => crate::render::opengl::views::colour(job, s.hit(scene, r, x as usize).as_ref(), x, y),
                     None => {
                         let p = &src[x as usize * 4..x as usize * 4 + 3];
                         let c = Vec3::new(p[0], p[1], p[2]);
@@ -557,7 +557,7 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Opt
                 let ray = job.view.eye_ray(x as f32 + job.offset.x, y as f32 + job.offset.y);
                 crate::scene::SurfaceHit { t: (h.position - ray.origin).length(), ..h }
             });
-            Some(crate::render::pixel_record::GlReadback { surface, output: *out.get(k * w + x as usize)? })
+            Some(crate::render::inspect::pixel_record::GlReadback { surface, output: *out.get(k * w + x as usize)? })
         });
         // GL counts none of this; the counters stay zero.
         Ok((RayCounts::default(), readback))
@@ -569,7 +569,7 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Opt
 /// along their eye ray (`shaders::csg_fragment`).
 unsafe fn draw_csgs(gl: &glow::Context, state: &mut State, program: glow::Program, job: &PassJob, environment: (i32, i32)) -> Result<(), String> {
     let scene = &job.prepared.scene;
-    let data = super::csg_data::build(&scene.csgs)?;
+    let data = crate::render::opengl::csg_data::build(&scene.csgs)?;
     unsafe {
         if state.csg_uploaded.as_ref() != Some(&data) {
             for (buffer, floats) in state.csg_buffers.iter().zip([&data.objects, &data.nodes, &data.spheres, &data.triangles]) {

@@ -1,4 +1,4 @@
-//! The GLSL programs: `shade()` of the CPU renderers (`render::lighting`)
+//! The GLSL programs: `shade()` of the CPU renderers (`render::transport::lighting`)
 //! written again for the fragment shader, a triangle program and an exact
 //! sphere program (a bounding cube whose fragments intersect the sphere).
 
@@ -758,13 +758,13 @@ void main() {
 }
 "#;
 
-/// The CSG objects (`render::csg` in GLSL): along the fragment's eye ray
+/// The CSG objects (`render::accel::csg` in GLSL): along the fragment's eye ray
 /// each operand's inside intervals over the whole line (a sphere's two
 /// roots; a closed mesh's crossings by the two-sided Möller-Trumbore test,
 /// counted into intervals), combined by a stack machine running the tree's
 /// postfix program (`csg_data`), each operation one sweep over the sorted
 /// boundaries of its two operands; the first boundary of the result with
-/// `0 < t < t_max` is the hit, shaded as `render::csg::surface_hit` makes it
+/// `0 < t < t_max` is the hit, shaded as `render::accel::csg::surface_hit` makes it
 /// and written to `gl_FragDepth`. Lists are held in fixed arrays: an
 /// operand with more than `MAX_IV` intervals or a mesh crossed more than
 /// `MAX_CROSS` times along one ray loses the farthest.

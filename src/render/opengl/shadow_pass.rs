@@ -7,9 +7,9 @@
 //! away from the light, as the CPU maps draw them. The fragment shaders look
 //! the maps up as `ShadowMaps::occluder` does (`shaders`, `shadowed`).
 
-use super::pass::{bytes, compile};
-use super::shaders;
-use crate::render::shadow_map::light_views;
+use crate::render::opengl::pass::{bytes, compile};
+use crate::render::opengl::shaders;
+use crate::render::shadow::map::light_views;
 use crate::render::RenderSettings;
 use crate::scene::{CameraView, Light, Scene};
 use glow::HasContext;
@@ -46,10 +46,10 @@ impl ShadowPass {
     pub unsafe fn draw(
         &mut self,
         gl: &glow::Context,
-        clip_control: super::context::ClipControl,
+        clip_control: crate::render::opengl::context::ClipControl,
         scene: &Scene,
         key: u64,
-        runs: &[super::scene_data::Run],
+        runs: &[crate::render::opengl::scene_data::Run],
         size: u32,
         vertex_array: glow::VertexArray,
         cube_array: glow::VertexArray,
@@ -142,7 +142,7 @@ impl ShadowPass {
                 }
                 gl.use_program(Some(self.triangles));
                 gl.bind_vertex_array(Some(vertex_array));
-                for &super::scene_data::Run { first: start, count, two_sided, .. } in runs {
+                for &crate::render::opengl::scene_data::Run { first: start, count, two_sided, .. } in runs {
                     if two_sided {
                         gl.disable(glow::CULL_FACE);
                     } else {

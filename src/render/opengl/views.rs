@@ -4,7 +4,8 @@
 //! renderers' own `debug::view_color`, and a clicked pixel can be reported.
 
 use crate::math::{Radiance, Vec2, Vec3};
-use crate::render::{debug, PassJob};
+use crate::render::inspect::debug;
+use crate::render::PassJob;
 use crate::scene::{Differentials, PrimitiveKind, Scene, SurfaceHit};
 use glow::HasContext;
 
@@ -42,7 +43,7 @@ impl Readback {
                     rows as i32,
                     glow::RGBA,
                     glow::FLOAT,
-                    glow::PixelPackData::Slice(Some(super::pass::bytes_mut(&mut buf))),
+                    glow::PixelPackData::Slice(Some(crate::render::opengl::pass::bytes_mut(&mut buf))),
                 );
                 floats.push(buf);
             }

@@ -5,7 +5,7 @@
 //! lists need no per-sample allocation. CSG objects resolve these lists
 //! (`csg.rs`).
 
-use super::rect::PixelRect;
+use crate::render::raster::rect::PixelRect;
 
 const NONE: u32 = u32::MAX;
 

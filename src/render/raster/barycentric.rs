@@ -4,8 +4,8 @@
 //! when all weights are >= 0; the weights then interpolate 1/z and the
 //! attributes over z (perspective-correct, CGPP 15.6.4.2).
 
-use super::rect::{tested_rect, PixelRect, TestCounter};
-use super::setup::ScreenTri;
+use crate::render::raster::rect::{tested_rect, PixelRect, TestCounter};
+use crate::render::raster::setup::ScreenTri;
 use crate::math::Vec2;
 
 /// Signed distance of `q` from the line through `a` and `b`: the line's normal

@@ -4,8 +4,8 @@
 //! one pixel so that rounding can never lose a sample the ray test would hit;
 //! the images equal the naive rasterizer's. The pass is in `pass.rs`.
 
-use super::rect::PixelRect;
-use super::setup::setup_pass;
+use crate::render::raster::rect::PixelRect;
+use crate::render::raster::setup::setup_pass;
 use crate::render::PassJob;
 
 /// Per scene triangle with any visible piece: its index and the box of all its pieces.

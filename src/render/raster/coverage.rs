@@ -3,13 +3,13 @@
 //! mesh must cover every interior sample exactly once) and suited to a crack
 //! debug view.
 
-use super::fixed::{self, snap_triangles};
-use super::rect::PixelRect;
-use super::setup::ScreenTri;
-use super::subpixel::snap_offset;
-use super::tiled::{self, TileGrid};
-use super::method::Method;
-use super::{barycentric, incremental, scanline};
+use crate::render::raster::fixed::{self, snap_triangles};
+use crate::render::raster::rect::PixelRect;
+use crate::render::raster::setup::ScreenTri;
+use crate::render::raster::subpixel::snap_offset;
+use crate::render::raster::tiled::{self, TileGrid};
+use crate::render::raster::method::Method;
+use crate::render::raster::{barycentric, incremental, scanline};
 use crate::math::Vec2;
 
 /// Runs the coverage loop of `method` over 2D triangles given in image

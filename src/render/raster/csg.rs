@@ -18,27 +18,27 @@
 //! - the fragments go into an A-buffer (`abuffer.rs`): per sample, the list
 //!   of all of them. Per sample the list is sorted by depth, each operand's
 //!   fragments are counted into its inside intervals and the tree combines
-//!   them with the interval rule of `render::csg` (`resolve_lists`, the ray
+//!   them with the interval rule of `render::accel::csg` (`resolve_lists`, the ray
 //!   casters' own combination). An operand whose exits outnumber its entries
 //!   was entered before the near plane, which clipped the entry away: it
 //!   starts with an entry at -infinity.
 //!
 //! The boundary that wins is depth-tested against the frame drawn so far
 //! like a sphere's fragment (`VisBuffer::csg_fragment`), and shading builds
-//! its hit from that boundary and the eye ray (`render::csg::surface_hit`).
+//! its hit from that boundary and the eye ray (`render::accel::csg::surface_hit`).
 //! The recorder gets the focus sample's sorted list and its intervals.
 
-use super::abuffer::ABuffer;
-use super::clip::{clip_near, triangle_vertices};
-use super::fixed::FixedTri;
-use super::rect::PixelRect;
-use super::setup::ScreenTri;
-use super::sphere::sphere_bounds;
-use super::subpixel::snap_offset;
-use super::vis_buffer::{DepthKey, FragmentRecorder, VisBuffer};
+use crate::render::raster::abuffer::ABuffer;
+use crate::render::raster::clip::{clip_near, triangle_vertices};
+use crate::render::raster::fixed::FixedTri;
+use crate::render::raster::rect::PixelRect;
+use crate::render::raster::setup::ScreenTri;
+use crate::render::raster::sphere::sphere_bounds;
+use crate::render::raster::subpixel::snap_offset;
+use crate::render::raster::vis_buffer::{DepthKey, FragmentRecorder, VisBuffer};
 use crate::math::{Vec2, Vec3};
-use crate::render::csg::{count_intervals, leaves, resolve_lists, sphere_interval, Boundary, SurfaceRef};
-use crate::render::pixel_record::{CsgABufferRecord, CsgFragmentRecord};
+use crate::render::accel::csg::{count_intervals, leaves, resolve_lists, sphere_interval, Boundary, SurfaceRef};
+use crate::render::inspect::pixel_record::{CsgABufferRecord, CsgFragmentRecord};
 use crate::render::SceneQuery;
 use crate::scene::csg::{Csg, CsgNode};
 use crate::scene::CameraView;
@@ -56,7 +56,7 @@ pub struct CsgSetup {
     /// Pixels whose sample may see the object (its bounding sphere's box);
     /// `None` when it is off screen.
     pub bounds: Option<PixelRect>,
-    /// Its operands in leaf order (`render::csg::leaves`).
+    /// Its operands in leaf order (`render::accel::csg::leaves`).
     pub operands: Vec<OperandSetup>,
 }
 
@@ -149,7 +149,7 @@ fn scan_convert<Q: SceneQuery, R: FragmentRecorder>(vb: &mut VisBuffer<Q, R>, ci
                 let mut tested = vb.begin_tests();
                 for (ft, entering) in tris {
                     let v = &csg.triangles[ft.st.tri as usize].v;
-                    super::fixed::raster(ft, r, off, &mut tested, |x, y, l| {
+                    crate::render::raster::fixed::raster(ft, r, off, &mut tested, |x, y, l| {
                         let [b1, b2] = ft.st.bary_at(l, ft.st.inv_z_at(l));
                         let p = job.sample_position(x, y);
                         let ray = view.eye_ray(p.x, p.y);
@@ -229,7 +229,7 @@ fn resolve<Q: SceneQuery, R: FragmentRecorder>(vb: &mut VisBuffer<Q, R>, ci: u32
 /// The inside intervals of operand `leaf` from a sample's fragments, counted
 /// as the ray casters count a mesh's crossings. Exits without entries before
 /// them were entered before the near plane: an entry at -infinity each.
-fn operand_intervals(frags: &[CsgFragment], leaf: u32, flipped: bool) -> Vec<crate::render::csg::Interval> {
+fn operand_intervals(frags: &[CsgFragment], leaf: u32, flipped: bool) -> Vec<crate::render::accel::csg::Interval> {
     let mut crossings: Vec<(Boundary, bool)> = Vec::new();
     let mut depth = 0i32;
     let mut unmatched = 0;

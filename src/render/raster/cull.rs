@@ -5,7 +5,7 @@
 //! skipping it changes no pixel; the side planes are those of
 //! `clip::side_planes`, a little outside the image.
 
-use super::clip::side_planes;
+use crate::render::raster::clip::side_planes;
 use crate::render::PassJob;
 use crate::scene::{CameraView, InstanceInfo, Scene};
 use std::ops::Range;

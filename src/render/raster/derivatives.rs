@@ -78,7 +78,7 @@ mod tests {
         let view = Camera::default().view(320, 200);
         for (px, py) in [(160.5, 150.5), (100.25, 120.75), (190.5, 115.5)] {
             let ray = view.eye_ray(px, py);
-            let (t, b1, b2) = crate::render::raytrace::intersect::intersect_triangle(&ray, &crate::render::raytrace::intersect::TriangleEdges::new(&scene.triangles.at(0)), f32::INFINITY).unwrap();
+            let (t, b1, b2) = crate::render::accel::intersect::intersect_triangle(&ray, &crate::render::accel::intersect::TriangleEdges::new(&scene.triangles.at(0)), f32::INFINITY).unwrap();
             let b = Vec3::new(1.0 - b1 - b2, b1, b2);
             let hit = scene.triangle_hit(0, b, t, &ray);
             let traced = with_ray_differentials(&scene, &RayDifferential::eye(&view, px, py), &ray, hit).diff;

@@ -7,11 +7,11 @@
 //! top-left rule gives a sample lying exactly on the edge to exactly one of them:
 //! no cracks and no double hits, whatever the mesh.
 
-use super::rect::{tested_rect, PixelRect, TestCounter};
+use crate::render::raster::rect::{tested_rect, PixelRect, TestCounter};
 use crate::math::lanes::{mask_bits, simd_level};
 use fearless_simd::{dispatch, i32x8, Simd, SimdBase};
-use super::setup::ScreenTri;
-use super::subpixel::{snap, snap_offset, ONE};
+use crate::render::raster::setup::ScreenTri;
+use crate::render::raster::subpixel::{snap, snap_offset, ONE};
 use crate::math::Vec2;
 use std::ops::{Add, Mul, Sub};
 
@@ -94,7 +94,7 @@ impl FixedTri {
     }
 
     /// `new`, except that a triangle whose snapped vertices span fewer than
-    /// `small::LIMIT` units on both axes is kept for the ray test (`ray`),
+    /// `subpixel::SMALL_LIMIT` units on both axes is kept for the ray test (`ray`),
     /// whatever its snapped area, with its float box grown by a pixel (as
     /// `rasterize:bbox` grows it) so that the 3D test can reach every sample
     /// it would hit. Its edge functions are still those of its snapped
@@ -103,7 +103,7 @@ impl FixedTri {
     pub fn new_or_small(st: &ScreenTri, off: [i64; 2], sample_off: Vec2, width: u32, height: u32) -> Option<FixedTri> {
         let v = st.p.map(|p| [snap(p.x), snap(p.y)]);
         let extent = |i: usize| v.iter().map(|p| p[i]).max().unwrap() - v.iter().map(|p| p[i]).min().unwrap();
-        if extent(0).max(extent(1)) >= super::small::LIMIT {
+        if extent(0).max(extent(1)) >= crate::render::raster::subpixel::SMALL_LIMIT {
             return FixedTri::new(st, off, sample_off, width, height);
         }
         let bbox = st.bbox.grown(1, width, height);
@@ -152,9 +152,9 @@ pub fn setup_snapped_or_small(job: &crate::render::PassJob, sample_off: Vec2, wi
 }
 
 /// `setup_snapped_or_small`, run by run as the threads made them.
-pub fn setup_snapped_or_small_runs(job: &crate::render::PassJob, sample_off: Vec2, width: u32, height: u32) -> super::runs::Runs<FixedTri> {
+pub fn setup_snapped_or_small_runs(job: &crate::render::PassJob, sample_off: Vec2, width: u32, height: u32) -> crate::render::raster::runs::Runs<FixedTri> {
     let off = snap_offset(sample_off);
-    super::setup::setup_pass_map(job, |st| FixedTri::new_or_small(&st, off, sample_off, width, height))
+    crate::render::raster::setup::setup_pass_map(job, |st| FixedTri::new_or_small(&st, off, sample_off, width, height))
 }
 
 /// Every triangle snapped (in order; dropped when degenerate after snapping).

@@ -6,8 +6,8 @@
 //! the earlier one; rounding in the stepped sums can leave rare holes, which
 //! the `fixed` variant removes).
 
-use super::rect::{tested_rect, PixelRect, TestCounter};
-use super::setup::{edge_function, ScreenTri};
+use crate::render::raster::rect::{tested_rect, PixelRect, TestCounter};
+use crate::render::raster::setup::{edge_function, ScreenTri};
 use crate::math::Vec2;
 
 /// Visits the covered samples of `st` inside `rect` with their screen-space

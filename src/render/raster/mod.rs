@@ -49,8 +49,12 @@ pub mod subpixel;
 pub mod tiled;
 pub mod vis_buffer;
 
-use super::pixel_record::PixelTrace;
-use super::{PassJob, RayCounts, Renderer};
+/// Rows per band of the band-parallel variants (the pass and the stencil
+/// count of shadow volumes cut the image the same way).
+pub const BAND_ROWS: u32 = 16;
+
+use crate::render::inspect::pixel_record::PixelTrace;
+use crate::render::{PassJob, RayCounts, Renderer};
 use crate::math::Radiance;
 
 pub use coverage::coverage_counts;
@@ -92,11 +96,11 @@ impl Renderer for Rasterizer {
         true
     }
 
-    fn check(&self, scene: &crate::scene::Scene, settings: &super::RenderSettings) -> Result<(), String> {
+    fn check(&self, scene: &crate::scene::Scene, settings: &crate::render::RenderSettings) -> Result<(), String> {
         if self.method == Method::Painter && !scene.csgs.is_empty() {
             return Err("rasterize:painter cannot draw csg objects (a draw order cannot resolve their intervals); use another rasterizer".into());
         }
-        crate::render::csg::check(scene, settings)
+        crate::render::accel::csg::check(scene, settings)
     }
 
     fn trace_pixel(&self, job: &PassJob, x: u32, y: u32, rec: &mut PixelTrace) -> Option<Radiance> {

@@ -11,9 +11,9 @@
 //! the resolve. With `spp` passes the pattern is scaled into the pass's
 //! stratum: sample k sits at `offset + pattern_k / sqrt(spp)`.
 
-use super::vis_buffer::{FragmentRecorder, VisBuffer};
+use crate::render::raster::vis_buffer::{FragmentRecorder, VisBuffer};
 use crate::math::{Radiance, Vec2};
-use crate::render::debug::cost_color;
+use crate::render::inspect::debug::cost_color;
 use crate::render::finite::admit_all;
 use crate::render::{RayCounts, SceneQuery};
 use crate::scene::PrimitiveId;

@@ -5,10 +5,10 @@
 //! strict `<`), so its image is the reference image; it is just slow.
 //! The pass itself (every triangle against the whole region) is in `pass.rs`.
 
-use super::rect::PixelRect;
-use super::vis_buffer::{FragmentRecorder, VisBuffer};
+use crate::render::raster::rect::PixelRect;
+use crate::render::raster::vis_buffer::{FragmentRecorder, VisBuffer};
 use crate::math::Ray;
-use crate::render::raytrace::intersect::{intersect_triangle, Miss};
+use crate::render::accel::intersect::{intersect_triangle, Miss};
 use crate::render::SceneQuery;
 
 /// The eye rays of the pixels of `vb`'s region, row-major.

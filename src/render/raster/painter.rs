@@ -28,8 +28,8 @@
 //! spheres are drawn per pixel with their own front surface, so wherever the
 //! order is right the image equals `rasterize:fixed`'s bit for bit.
 
-use super::fixed::FixedTri;
-use super::rect::PixelRect;
+use crate::render::raster::fixed::FixedTri;
+use crate::render::raster::rect::PixelRect;
 use crate::math::Vec3;
 use crate::render::PassJob;
 use std::collections::VecDeque;

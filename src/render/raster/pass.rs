@@ -17,25 +17,26 @@
 //! coverage loops over the region holding the pixel (its row, or its tile),
 //! with a recording `VisBuffer` that keeps that pixel's fragment history.
 
-use super::fixed::{self, FixedTri};
-use super::msaa;
-use super::naive::{ray_test_rect, region_rays};
-use super::rect::PixelRect;
-use super::runs::Runs;
-use super::setup::{bin_rows, bin_rows_by_id, setup_pass, ScreenTri};
-use super::painter::{self, Paint};
-use super::sphere::{all_sphere_bounds, raster_sphere, raster_spheres};
-use super::stencil::StencilSetup;
-use super::subpixel::snap_offset;
-use super::tiled::{self, RectCoverage, TileGrid};
-use super::vis_buffer::{DepthKey, FragmentRecorder, VisBuffer};
-use super::method::Method;
-use super::{barycentric, bbox, incremental, scanline, small};
+use crate::render::raster::fixed::{self, FixedTri};
+use crate::render::raster::msaa;
+use crate::render::raster::naive::{ray_test_rect, region_rays};
+use crate::render::raster::rect::PixelRect;
+use crate::render::raster::runs::Runs;
+use crate::render::raster::setup::{bin_rows, bin_rows_by_id, setup_pass, ScreenTri};
+use crate::render::raster::painter::{self, Paint};
+use crate::render::raster::sphere::{all_sphere_bounds, raster_sphere, raster_spheres};
+use crate::render::raster::stencil::StencilSetup;
+use crate::render::raster::subpixel::snap_offset;
+use crate::render::raster::tiled::{self, RectCoverage, TileGrid};
+use crate::render::raster::vis_buffer::{DepthKey, FragmentRecorder, VisBuffer};
+use crate::render::raster::method::Method;
+use crate::render::raster::{barycentric, bbox, incremental, scanline, small};
 use crate::math::prefetch::prefetch_value;
 use crate::math::{Radiance, Vec2};
-use crate::render::raytrace::bvh::BvhQuery;
-use crate::render::pixel_record::PixelTrace;
-use crate::render::{debug, PassJob, PreparedScene, RayCounts, SceneQuery, ShadowMode};
+use crate::render::accel::bvh::BvhQuery;
+use crate::render::inspect::pixel_record::PixelTrace;
+use crate::render::inspect::debug;
+use crate::render::{PassJob, PreparedScene, RayCounts, SceneQuery, ShadowMode};
 use rayon::prelude::*;
 use std::ops::Range;
 
@@ -50,8 +51,7 @@ pub fn query(prepared: &PreparedScene) -> Query<'_> {
     BvhQuery::new(prepared)
 }
 
-/// Rows per band of the band-parallel variants.
-pub const BAND_ROWS: u32 = 16;
+use crate::render::raster::BAND_ROWS;
 
 /// What a variant's coverage loop reads, set up once per layer: float screen
 /// triangles, or fixed-point (snapped) ones.
@@ -76,7 +76,7 @@ pub struct Layer<'a> {
     method: Method,
     geometry: Geometry,
     spheres: Vec<Option<PixelRect>>,
-    csgs: Vec<super::csg::CsgSetup>,
+    csgs: Vec<crate::render::raster::csg::CsgSetup>,
     /// MSAA coverage sample index; `None` for the pass's own sample.
     pub sample: Option<u32>,
     /// `--shadows volume`: the volume faces the stencil pass draws.
@@ -95,7 +95,7 @@ impl<'a> Layer<'a> {
         let (r0, r1) = (job.rows.start, job.rows.end);
         let (w, h) = (job.view.width, job.view.height);
         let spheres = all_sphere_bounds(job.view, &job.prepared.scene.spheres, offset);
-        let csgs = super::csg::setup_csgs(job.view, &job.prepared.scene.csgs, offset);
+        let csgs = crate::render::raster::csg::setup_csgs(job.view, &job.prepared.scene.csgs, offset);
         let geometry = match method {
             Method::Naive => Geometry::AllTriangles,
             Method::BBox => {
@@ -237,7 +237,7 @@ impl<'a> Layer<'a> {
         if !matches!(self.geometry, Geometry::Painted { .. }) {
             raster_spheres(vb, &self.spheres);
         }
-        super::csg::raster_csgs(vb, &self.csgs);
+        crate::render::raster::csg::raster_csgs(vb, &self.csgs);
         if let Some(stencil) = &self.stencil {
             vb.count_volumes(stencil);
         }
@@ -300,7 +300,7 @@ fn shades_forward(job: &PassJob) -> bool {
 pub fn render(method: Method, job: &PassJob, out: &mut [Radiance]) -> RayCounts {
     let mut counts = render_regions(method, job, out);
     if method != Method::Naive && !job.prepared.scene.instances.is_empty() {
-        let v = super::cull::visible_spans(job);
+        let v = crate::render::raster::cull::visible_spans(job);
         counts.instances_drawn += v.drawn;
         counts.instances_culled += v.culled;
     }

@@ -7,8 +7,8 @@
 //! barycentrics (the book's 1/z interpolation). It runs on the same clipped
 //! triangles as every other variant and samples at the pass's sample positions.
 
-use super::rect::{PixelRect, TestCounter};
-use super::setup::ScreenTri;
+use crate::render::raster::rect::{PixelRect, TestCounter};
+use crate::render::raster::setup::ScreenTri;
 use crate::math::{Vec2, Vec3};
 
 /// Position and interpolated weights where the edge `a -> b` crosses row `ys`.

@@ -3,10 +3,10 @@
 //! pixel bounding box. The result is a list of screen-space triangles in scene
 //! order, each remembering which scene triangle it came from.
 
-use super::clip::{clip_frustum, clip_near, side_planes, triangle_vertices, ClipMode, FrustumClip};
-use super::rect::{sample_span, PixelRect};
-use super::runs::Runs;
-use super::subpixel;
+use crate::render::raster::clip::{clip_frustum, clip_near, side_planes, triangle_vertices, ClipMode, FrustumClip};
+use crate::render::raster::rect::{sample_span, PixelRect};
+use crate::render::raster::runs::Runs;
+use crate::render::raster::subpixel;
 use crate::math::lanes::Lane;
 use crate::math::{Vec2, Vec3};
 use crate::render::PassJob;
@@ -246,7 +246,7 @@ pub fn setup_pass_map<T: Copy + Send + Sync>(job: &PassJob, keep: impl Fn(Screen
     let view = job.view;
     let rows = PixelRect::new(0, job.rows.start, view.width, job.rows.end);
     let scene = &job.prepared.scene;
-    let spans = super::cull::visible_spans(job).spans;
+    let spans = crate::render::raster::cull::visible_spans(job).spans;
     let chunks = chunks_of(scene, &spans, CHUNK);
     let frustum = (job.settings.clip == ClipMode::Frustum).then(|| side_planes(view));
     // A band of the image (the viewer renders a pass band by band) skips
@@ -452,7 +452,7 @@ mod tests {
 
     #[test]
     fn perspective_correct_matches_the_ray_cast_and_affine_does_not() {
-        use crate::render::raytrace::intersect::{intersect_triangle, TriangleEdges};
+        use crate::render::accel::intersect::{intersect_triangle, TriangleEdges};
         // A triangle slanted in depth: v0 near (depth 1), v1 and v2 far (depth 5).
         let cam = Camera { fov: Fov::Y(90.0), near: 0.1, ..Camera::default() };
         let view = cam.view(100, 100);

@@ -7,10 +7,13 @@
 //! would, so the image is the same.
 
 use crate::math::Radiance;
-use crate::render::path_batch::{self, PathPool};
-use crate::render::raytrace::packet::{shadow_packets, Packet};
-use crate::render::shade_batch::{self, Batch, LANES};
-use crate::render::debug::View;
+use crate::render::transport::path_batch;
+use crate::render::transport::path_batch::PathPool;
+use crate::render::accel::packet::Packet;
+use crate::render::transport::shadow_packets::shadow_packets;
+use crate::render::transport::shade_batch;
+use crate::render::transport::shade_batch::{Batch, LANES};
+use crate::render::inspect::debug::View;
 use crate::render::{PassJob, RayCounts, SceneQuery, ShadowMode};
 
 /// Batches queued before their shadow packets are traced: eight batches of
@@ -100,7 +103,7 @@ impl ShadeQueue {
                 unpack(b, batch, &mut self.batch_blocked);
             }
             let blocked = unpack.is_some().then_some(&self.batch_blocked[..]);
-            shade_batch::start_paths(job, query, batch, blocked, &batch.slots[..batch.len()], counts, paths);
+            path_batch::start_paths(job, query, batch, blocked, &batch.slots[..batch.len()], counts, paths);
             if paths.len() >= PATH_SAMPLES {
                 paths.follow_into(job, query, counts, out);
             }
@@ -114,9 +117,9 @@ const _: () = assert!(BATCHES * LANES <= 64 && LANES == 8, "a queue's lanes fill
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::gi::GiMode;
-    use crate::render::pixel_record::NoRecord;
-    use crate::render::raytrace::bvh::BvhQuery;
+    use crate::render::transport::gi::GiMode;
+    use crate::render::inspect::pixel_record::NoRecord;
+    use crate::render::accel::bvh::BvhQuery;
     use crate::render::{resolve_sample, Interpolation, PreparedScene, RenderSettings};
     use crate::scene::builtin;
     use std::sync::atomic::AtomicBool;

@@ -14,7 +14,7 @@
 //! `rasterize:barycentric` differs from `raytrace` on 2.1% of `forest`'s
 //! pixels at 160x90 for that reason alone).
 //!
-//! So a triangle whose snapped vertices span fewer than `LIMIT` units (half a
+//! So a triangle whose snapped vertices span fewer than `SMALL_LIMIT` units (half a
 //! pixel) on both axes is drawn as `rasterize:bbox` draws every triangle: the
 //! eye ray of each sample in its box grown by a pixel goes through
 //! `intersect_triangle`, as in the ray tracer, and a hit gives the
@@ -32,18 +32,15 @@
 //! `cornell-gi` by more than 1e-4, each to the ray tracer's value.
 //!
 //! The fixed-point edge rule (exact, watertight) holds between triangles at
-//! least `LIMIT` units across; where a small triangle meets another, their
+//! least `SMALL_LIMIT` units across; where a small triangle meets another, their
 //! shared edge is decided as the ray casters decide it.
 
-use super::fixed::FixedTri;
-use super::rect::{PixelRect, TestCounter};
-use super::subpixel::ONE;
-use super::vis_buffer::{FragmentRecorder, VisBuffer};
-use crate::render::raytrace::intersect::intersect_triangle;
+use crate::render::raster::fixed::FixedTri;
+use crate::render::raster::rect::{PixelRect, TestCounter};
+use crate::render::raster::vis_buffer::{FragmentRecorder, VisBuffer};
+use crate::render::accel::intersect::intersect_triangle;
 use crate::render::SceneQuery;
 
-/// Grid units (1/256 pixel) below which, on both axes, a triangle is small: half a pixel.
-pub const LIMIT: i64 = ONE / 2;
 
 /// Tests the small triangle `ft` against the samples of its box inside
 /// `rect` with the eye rays of the buffer's sample position, up to the far

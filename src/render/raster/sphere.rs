@@ -3,10 +3,10 @@
 //! sphere with the ray tracer's own `intersect_sphere`, and the hit is
 //! depth-tested against the triangles already drawn.
 
-use super::rect::{sample_span, PixelRect};
-use super::vis_buffer::{DepthKey, FragmentRecorder, VisBuffer};
+use crate::render::raster::rect::{sample_span, PixelRect};
+use crate::render::raster::vis_buffer::{DepthKey, FragmentRecorder, VisBuffer};
 use crate::math::{Vec2, Vec3};
-use crate::render::raytrace::intersect::intersect_sphere;
+use crate::render::accel::intersect::intersect_sphere;
 use crate::render::SceneQuery;
 use crate::scene::{CameraView, Sphere};
 

@@ -14,14 +14,14 @@
 //! rasterizes the faces with the watertight fixed-point loop (`fixed`), so
 //! faces that share an edge never count a sample twice or miss it.
 
-use super::clip::{clip_near, triangle_vertices};
-use super::fixed::{self, FixedTri};
-use super::pass::BAND_ROWS;
-use super::rect::PixelRect;
-use super::setup::{bin_rows, ScreenTri};
-use super::subpixel::snap_offset;
+use crate::render::raster::clip::{clip_near, triangle_vertices};
+use crate::render::raster::fixed::{self, FixedTri};
+use crate::render::raster::BAND_ROWS;
+use crate::render::raster::rect::PixelRect;
+use crate::render::raster::setup::{bin_rows, ScreenTri};
+use crate::render::raster::subpixel::snap_offset;
 use crate::math::Vec3;
-use crate::render::shadow_volume::{crossing, VolumeMode};
+use crate::render::shadow::volume::{crossing, VolumeMode};
 use crate::render::PassJob;
 use rayon::prelude::*;
 

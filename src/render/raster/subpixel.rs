@@ -8,6 +8,9 @@ use crate::math::Vec2;
 pub const SUBPIXEL_BITS: u32 = 8;
 /// One pixel in fixed-point units.
 pub const ONE: i64 = 1 << SUBPIXEL_BITS;
+/// Grid units below which, on both axes, a triangle is small (half a pixel):
+/// `small.rs` decides its coverage by rays instead of edge functions.
+pub const SMALL_LIMIT: i64 = ONE / 2;
 /// Snapped coordinates are clamped here, far beyond any image, so i128 never overflows.
 const CLAMP: f64 = (1u64 << 60) as f64;
 

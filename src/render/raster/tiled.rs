@@ -7,9 +7,9 @@
 //! same exact fixed-point edge functions as `fixed`, so both variants cover the
 //! same samples with the same weights: identical images, bit for bit.
 
-use super::fixed::{self, FixedTri};
-use super::rect::{PixelRect, TestCounter};
-use super::subpixel::ONE;
+use crate::render::raster::fixed::{self, FixedTri};
+use crate::render::raster::rect::{PixelRect, TestCounter};
+use crate::render::raster::subpixel::ONE;
 
 /// Tile edge length in pixels.
 pub const TILE: u32 = 32;

@@ -15,25 +15,25 @@
 //! keys are still written, for the fragment record.
 
 use crate::render::differentials::{with_ray_differentials, RayDifferential};
-use super::depth_format::{DepthEncoding, DepthFormat};
-use super::fixed::FixedTri;
+use crate::render::raster::depth_format::{DepthEncoding, DepthFormat};
+use crate::render::raster::fixed::FixedTri;
 use crate::math::lanes::{mask_bits, mask_from_bits, simd_level};
 use fearless_simd::{dispatch, f32x8, u32x8, Select, Simd, SimdBase, SimdFrom};
-use super::rect::{PixelRect, TestCounter};
-use super::setup::ScreenTri;
+use crate::render::raster::rect::{PixelRect, TestCounter};
+use crate::render::raster::setup::ScreenTri;
 use crate::math::{streaming, Radiance, Ray, Vec3};
 use crate::render::finite::{admit_all, admit_rows_except, admitted};
 use std::ops::Range;
-use crate::render::debug::{cost_color, View};
-use crate::render::pixel_record::{CsgABufferRecord, FragmentRecord, NoRecord, PixelTrace, Recorder};
+use crate::render::inspect::debug::{cost_color, View};
+use crate::render::inspect::pixel_record::{CsgABufferRecord, FragmentRecord, NoRecord, PixelTrace, Recorder};
 use crate::render::{resolve_counted, resolve_sample, view_miss_without_ray, PassJob, RayCounts, SceneQuery};
-use crate::render::path_batch::PathPool;
-use super::shade_queue::ShadeQueue;
-use crate::render::shade_batch;
+use crate::render::transport::path_batch::PathPool;
+use crate::render::raster::shade_queue::ShadeQueue;
+use crate::render::transport::shade_batch;
 use crate::scene::hit_lanes::EyeSamples;
-use crate::render::shadow_volume::split_depth;
-use super::stencil::{PixelRay, StencilSetup};
-use crate::render::csg::{Boundary, SurfaceRef};
+use crate::render::shadow::volume::split_depth;
+use crate::render::raster::stencil::{PixelRay, StencilSetup};
+use crate::render::accel::csg::{Boundary, SurfaceRef};
 use crate::scene::{PrimitiveId, PrimitiveKind, SurfaceHit};
 
 /// What `VisBuffer::csg` holds where no CSG object won.
@@ -318,7 +318,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             dispatch!(simd_level(), simd => self.triangle_row8(simd, ft, x0, y, bits, i));
             return;
         }
-        for x in super::fixed::row_pixels(x0, bits) {
+        for x in crate::render::raster::fixed::row_pixels(x0, bits) {
             self.triangle_fragment(&ft.st, x, y, ft.weights(x, y));
         }
     }
@@ -437,7 +437,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         self.count_work(i);
         if self.is_focus(x, y) {
             let edges = &self.job.prepared.triangle_edges(tri);
-            if let Ok((t, b1, b2)) = crate::render::raytrace::intersect::intersect_triangle(ray, edges, f32::INFINITY) {
+            if let Ok((t, b1, b2)) = crate::render::accel::intersect::intersect_triangle(ray, edges, f32::INFINITY) {
                 let stored = self.depth[i];
                 self.record(PrimitiveKind::Triangle, tri, None, Vec3::new(1.0 - b1 - b2, b1, b2), t, stored, false, i, x, y);
             }
@@ -523,11 +523,11 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             None
         } else if id.is_csg() {
             // The boundary the A-buffer resolved, built into a hit as the ray casters build theirs.
-            let h = crate::render::csg::surface_hit(scene, id.index(), self.csg[i], &ray);
+            let h = crate::render::accel::csg::surface_hit(scene, id.index(), self.csg[i], &ray);
             // Seen along the eye ray, as in the ray casters: the same differentials.
             if scene.has_textures() {
                 let mut h = with_ray_differentials(scene, &RayDifferential::eye(self.job.view, p.x, p.y), &ray, h);
-                crate::render::normal_map::apply(scene, self.job.settings.texture_filter, &mut h);
+                crate::render::transport::normal_map::apply(scene, self.job.settings.texture_filter, &mut h);
                 Some(h)
             } else {
                 Some(h)
@@ -538,7 +538,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             Some(match scene.has_textures() {
                 true => {
                     let mut hit = with_ray_differentials(scene, &RayDifferential::eye(self.job.view, p.x, p.y), &ray, hit);
-                    crate::render::normal_map::apply(scene, self.job.settings.texture_filter, &mut hit);
+                    crate::render::transport::normal_map::apply(scene, self.job.settings.texture_filter, &mut hit);
                     hit
                 }
                 false => hit,
@@ -547,8 +547,8 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             let (b, t) = self.triangle_b_t(i, &ray);
             let mut hit = scene.triangle_hit(id.index(), b, t, &ray);
             if scene.has_textures() {
-                hit.diff = super::derivatives::screen_differentials(scene, self.job.view, id.index(), b, p.x, p.y);
-                crate::render::normal_map::apply(scene, self.job.settings.texture_filter, &mut hit);
+                hit.diff = crate::render::raster::derivatives::screen_differentials(scene, self.job.view, id.index(), b, p.x, p.y);
+                crate::render::transport::normal_map::apply(scene, self.job.settings.texture_filter, &mut hit);
             }
             Some(hit)
         };

@@ -2,11 +2,11 @@
 //! rays towards the first light, as packets through the BVH (`packet.rs`);
 //! a pixel replay casts the same pixel's rays one at a time (`bvh.rs`).
 
-use super::bvh::BvhQuery;
-use super::cast_pixel;
-use super::packet::{cast_pass_packets, cast_passes_packets};
+use crate::render::accel::bvh::BvhQuery;
+use crate::render::raytrace::cast_pixel;
+use crate::render::raytrace::packet_tiles::{cast_pass_packets, cast_passes_packets};
 use crate::math::Radiance;
-use crate::render::pixel_record::PixelTrace;
+use crate::render::inspect::pixel_record::PixelTrace;
 use crate::render::{PassJob, RayCounts, Renderer};
 
 pub struct BvhRayTracer;
@@ -23,7 +23,7 @@ impl Renderer for BvhRayTracer {
     fn render_pass(&self, job: &PassJob, out: &mut [Radiance]) -> RayCounts {
         if job.prepared.instances.is_some() {
             // Packets walk the one BVH; the two-level layer takes rays one at a time.
-            return super::cast_pass(job, &BvhQuery::new(job.prepared), out);
+            return crate::render::raytrace::cast_pass(job, &BvhQuery::new(job.prepared), out);
         }
         cast_pass_packets(job, &BvhQuery::new(job.prepared), out)
     }
@@ -45,14 +45,14 @@ impl Renderer for BvhRayTracer {
     }
 
     fn passes_at_once(&self) -> u32 {
-        super::packet::MAX_PASSES as u32
+        crate::render::accel::packet::MAX_PASSES as u32
     }
 
     /// Two rows of packet tiles: chunks small enough for two threads to
     /// share the work evenly, large enough that the per-call set-up
     /// (packets, batches, the path pool) is paid rarely.
     fn chunk_rows(&self) -> Option<u32> {
-        Some(2 * super::packet::TILE_H as u32)
+        Some(2 * crate::render::accel::packet::TILE_H as u32)
     }
 
     /// The replay runs the frame's code from the eye ray's hit on: the same
@@ -74,8 +74,8 @@ impl Renderer for BvhRayTracer {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::debug::View;
-    use crate::render::raytrace::brute::BruteForce;
+    use crate::render::inspect::debug::View;
+    use crate::render::accel::brute::BruteForce;
     use crate::render::{render_frame, Interpolation, PreparedScene, RenderSettings, ShadowMode};
     use crate::scene::builtin;
     use std::sync::atomic::AtomicBool;

@@ -1,20 +1,15 @@
-//! Ray casting: for each pixel, find the closest surface along the eye ray.
-//! `brute` is the book's reference (every primitive, in scene order); `bvh`
-//! is the fast method checked against it: the hierarchy and its single-ray
-//! queries (`bvh`), packets of rays (`packet`), the traversal kernels both
-//! share (`traverse`) and the renderer that uses them (`bvh_renderer`).
+//! The ray-casting renderers: for each pixel, find the closest surface along
+//! the eye ray and hand it to shading. The queries that answer the rays live
+//! in `render::accel` (`brute` is the book's reference, `bvh` the fast method
+//! checked against it); this module drives them pass by pass: one ray per
+//! pixel (`cast_pass`) and the BVH renderer (`bvh_renderer`).
 
-pub mod brute;
-pub mod bvh;
 pub mod bvh_renderer;
-pub mod instances;
-pub mod intersect;
-pub mod packet;
-pub mod traverse;
+pub mod packet_tiles;
 
-use super::pixel_record::{NoRecord, Recorder};
-use super::{resolve_sample, PassJob, RayCounts, SceneQuery};
-use super::debug::{cost_color, View};
+use crate::render::inspect::pixel_record::{NoRecord, Recorder};
+use crate::render::{resolve_sample, PassJob, RayCounts, SceneQuery};
+use crate::render::inspect::debug::{cost_color, View};
 use crate::math::{Radiance, Ray, Vec2};
 use crate::render::differentials::{with_ray_differentials, RayDifferential};
 use crate::scene::SurfaceHit;
@@ -76,6 +71,6 @@ pub fn with_eye_differentials(job: &PassJob, p: Vec2, ray: &Ray, hit: &mut Optio
     let scene = &job.prepared.scene;
     if let Some(h) = hit.as_mut().filter(|_| scene.has_textures()) {
         *h = with_ray_differentials(scene, &RayDifferential::eye(job.view, p.x, p.y), ray, *h);
-        crate::render::normal_map::apply(scene, job.settings.texture_filter, h);
+        crate::render::transport::normal_map::apply(scene, job.settings.texture_filter, h);
     }
 }

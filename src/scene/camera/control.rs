@@ -1,7 +1,7 @@
 //! Camera navigation as plain functions on `Camera`: orbit, pan, dolly, fly
 //! and frame-all. The viewer maps mouse and keys onto them.
 
-use super::{Camera, Fov};
+use crate::scene::camera::{Camera, Fov};
 use crate::math::{Mat3, Vec3};
 
 /// Radians of orbit per pixel of drag.

@@ -2,39 +2,19 @@
 //! `SurfaceHit` to `shade()`. Lights, shadows, BSDF and secondary rays live
 //! here and nowhere else.
 
-use super::gi::{self, GiMode, PathState};
-use super::lighting::{self, IncidenceLanes, LightVisibility, SurfaceLanes};
-use super::pixel_record::{LightSample, Recorder};
-use super::differentials::{self, RayDifferential};
-use super::{RayCounts, Reflections, RenderSettings, SceneQuery, ShadowMode};
+use crate::render::transport::bsdf::{surface_lane, DeltaLobes};
+use crate::render::transport::gi;
+use crate::render::transport::gi::{GiMode, PathState};
+use crate::render::transport::lighting;
+use crate::render::transport::lighting::{IncidenceLanes, LightVisibility};
+use crate::render::inspect::pixel_record::{LightSample, Recorder};
+use crate::render::differentials::{self, RayDifferential};
+use crate::render::{RayCounts, Reflections, RenderSettings, SceneQuery, ShadowMode};
 use crate::math::lanes::V3;
 use crate::math::{Radiance, Ray, Vec2, Vec3};
 use crate::scene::{Differentials, Light, Material, Scene, SurfaceHit};
 #[cfg(test)]
 use std::f32::consts::PI;
-
-/// The BSDF of CGPP listing 15.19 for one sample (`lighting::bsdf`, one lane
-/// wide): Lambertian plus normalized Blinn-Phong,
-/// `f = k_L / pi + k_G N(s) max(0, n.h)^s` (`N` is
-/// `lighting::blinn_phong_normalization`).
-#[inline]
-pub fn bsdf(material: &Material, albedo: Vec3, n: Vec3, w_i: Vec3, w_o: Vec3) -> Vec3 {
-    let surface = surface_lane(material, albedo, Vec3::ZERO, n, w_o);
-    lighting::bsdf(&surface, w_i.into()).into()
-}
-
-/// One sample's surface as the lane-generic lighting code reads it.
-#[inline(always)]
-fn surface_lane(material: &Material, albedo: Vec3, position: Vec3, n: Vec3, w_o: Vec3) -> SurfaceLanes<f32> {
-    SurfaceLanes {
-        position: position.into(),
-        normal: n.into(),
-        w_o: w_o.into(),
-        albedo: albedo.into(),
-        glossy: material.glossy.into(),
-        sharpness: material.sharpness,
-    }
-}
 
 /// What shading one sample reads and writes besides the surface: the scene
 /// and its query, the settings, the sample's path (random numbers,
@@ -143,7 +123,7 @@ pub fn after_direct<Q: SceneQuery, R: Recorder>(
 #[derive(Default)]
 struct PendingShadow {
     shadow_ray: Option<(Ray, f32)>,
-    blocker: Option<super::Occluder>,
+    blocker: Option<crate::render::Occluder>,
     volume_count: Option<i32>,
 }
 
@@ -251,7 +231,7 @@ fn indirect_photons<Q: SceneQuery, R: Recorder>(
         for _ in 0..gather {
             let choice = sh.path.rng.next_f32();
             let u = sh.path.rng.next_2d();
-            if let Some(s) = super::bsdf_sampling::sample_bsdf(material, albedo, hit.shading_normal, w_o, choice, u) {
+            if let Some(s) = crate::render::transport::bsdf_sampling::sample_bsdf(material, albedo, hit.shading_normal, w_o, choice, u) {
                 if s.w_i.dot(hit.geometric_normal) > 0.0 {
                     let ray = hit.spawn_ray_front(s.w_i, settings.shadow_bump);
                     sum += s.weight * follow(sh, &ray, depth, false, s.weight);
@@ -268,53 +248,6 @@ fn indirect_photons<Q: SceneQuery, R: Recorder>(
         sh.rec.photons(l);
     }
     l
-}
-
-/// The Fresnel reflectance (Schlick's approximation) at a dielectric seen
-/// from `w_o`, and the refracted direction unless the light is totally
-/// reflected. Entering when the front side faces us (spheres flip
-/// `back_face` inside).
-#[inline]
-pub fn refraction(hit: &SurfaceHit, material: &Material, w_o: Vec3) -> (f32, Option<Vec3>) {
-    let n = hit.geometric_normal;
-    let cos_o = w_o.dot(n).clamp(-1.0, 1.0);
-    let (eta_i, eta_t) = if hit.back_face { (material.ior, 1.0) } else { (1.0, material.ior) };
-    let eta = eta_i / eta_t;
-    let sin2_t = eta * eta * (1.0 - cos_o * cos_o).max(0.0);
-    let r0 = ((eta_i - eta_t) / (eta_i + eta_t)).powi(2);
-    let fresnel = if sin2_t >= 1.0 { 1.0 } else { r0 + (1.0 - r0) * (1.0 - cos_o.abs()).powi(5) };
-    let refracted = (sin2_t < 1.0).then(|| {
-        let cos_t = (1.0 - sin2_t).sqrt();
-        (-w_o * eta + n * (eta * cos_o - cos_t)).normalize()
-    });
-    (fresnel, refracted)
-}
-
-/// The two delta lobes of a surface seen from `w_o`: mirror reflection
-/// (the material's mirror weight plus the Fresnel-reflected part of its
-/// transmission) and refraction (the rest of the transmission, unless the
-/// light is totally reflected).
-struct DeltaLobes {
-    reflect_dir: Vec3,
-    reflect_weight: Vec3,
-    /// Direction and weight.
-    refract: Option<(Vec3, Vec3)>,
-}
-
-impl DeltaLobes {
-    #[inline]
-    fn at(hit: &SurfaceHit, material: &Material, w_o: Vec3) -> DeltaLobes {
-        let n = hit.geometric_normal;
-        let cos_o = w_o.dot(n).clamp(-1.0, 1.0);
-        let mut reflect_weight = material.mirror;
-        let mut refract = None;
-        if material.transmission != Vec3::ZERO {
-            let (fresnel, dir) = refraction(hit, material, w_o);
-            reflect_weight += material.transmission * fresnel;
-            refract = dir.map(|d| (d, material.transmission * (1.0 - fresnel)));
-        }
-        DeltaLobes { reflect_dir: (2.0 * cos_o * n - w_o).normalize(), reflect_weight, refract }
-    }
 }
 
 /// Path tracing's delta lobes: one of mirror reflection and refraction,
@@ -519,7 +452,7 @@ pub fn radiance_along<Q: SceneQuery, R: Recorder>(
         if let Some(rd) = rd.filter(|_| scene.has_textures()) {
             *h = differentials::with_ray_differentials(scene, rd, ray, *h);
         }
-        super::normal_map::apply(scene, sh.settings.texture_filter, h);
+        crate::render::transport::normal_map::apply(scene, sh.settings.texture_filter, h);
     }
     sh.rec.closest(hit.as_ref());
     match &hit {
@@ -535,6 +468,7 @@ pub fn radiance_along<Q: SceneQuery, R: Recorder>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::render::transport::bsdf::bsdf;
 
     #[test]
     fn shadow_origin_lifts_onto_the_smooth_surface() {

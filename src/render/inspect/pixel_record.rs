@@ -3,8 +3,8 @@
 //! away; `pinhole pixel` and the inspector pass a `PixelTrace` through the
 //! very same code.
 
-use super::raytrace::intersect::Miss;
-use super::Occluder;
+use crate::render::accel::intersect::Miss;
+use crate::render::Occluder;
 use crate::math::{Radiance, Ray, Vec3};
 use crate::scene::{PrimitiveKind, SurfaceHit};
 
@@ -131,7 +131,7 @@ pub struct CsgFragmentRecord {
     pub t: f32,
     /// The operand (leaf) it bounds, numbered as `csg::Boundary::leaf`.
     pub leaf: u32,
-    pub surface: crate::render::csg::SurfaceRef,
+    pub surface: crate::render::accel::csg::SurfaceRef,
     /// A front face (or a sphere's near root): the ray enters the operand.
     pub entering: bool,
     /// The scan-converted triangle's screen-space weights at the sample
@@ -149,7 +149,7 @@ pub struct CsgABufferRecord {
     pub sample: Option<u32>,
     pub fragments: Vec<CsgFragmentRecord>,
     /// Each operand's intervals, the combined ones and the winner.
-    pub explanation: crate::render::csg::Explanation,
+    pub explanation: crate::render::accel::csg::Explanation,
 }
 
 impl CsgABufferRecord {
@@ -169,8 +169,8 @@ impl CsgABufferRecord {
         let mut out = vec![format!("A-buffer: {} fragment(s) sorted by depth (t along the eye ray)", self.fragments.len())];
         for f in &self.fragments {
             let surface = match f.surface {
-                crate::render::csg::SurfaceRef::Sphere(_) => "sphere".to_string(),
-                crate::render::csg::SurfaceRef::Triangle { index, .. } => format!("mesh triangle {index}"),
+                crate::render::accel::csg::SurfaceRef::Sphere(_) => "sphere".to_string(),
+                crate::render::accel::csg::SurfaceRef::Triangle { index, .. } => format!("mesh triangle {index}"),
             };
             let screen = f.screen_barycentric.map(|w| format!(", 2D weights ({:.4}, {:.4}, {:.4})", w.x, w.y, w.z)).unwrap_or_default();
             out.push(format!(

@@ -42,15 +42,15 @@
 //! builds them once before its passes, and a pass that finds none builds
 //! them on first use.
 
-use super::raster::clip::{clip_near, triangle_vertices};
-use super::raster::cull::Frustum;
-use super::raster::fixed::{self, FixedTri};
-use super::raster::rect::{sample_span, PixelRect};
-use super::raster::setup::{bin_rows, ScreenTri};
-use super::raster::subpixel::snap_offset;
-use super::raster::sphere::sphere_bounds;
-use super::pixel_record::Recorder;
-use super::{Occluder, PassJob, PreparedScene, RayCounts, RenderSettings, SceneQuery};
+use crate::render::raster::clip::{clip_near, triangle_vertices};
+use crate::render::raster::cull::Frustum;
+use crate::render::raster::fixed::{self, FixedTri};
+use crate::render::raster::rect::{sample_span, PixelRect};
+use crate::render::raster::setup::{bin_rows, ScreenTri};
+use crate::render::raster::subpixel::snap_offset;
+use crate::render::raster::sphere::sphere_bounds;
+use crate::render::inspect::pixel_record::Recorder;
+use crate::render::{Occluder, PassJob, PreparedScene, RayCounts, RenderSettings, SceneQuery};
 use crate::math::{Radiance, Ray, Vec2, Vec3};
 use crate::scene::{Camera, CameraView, Fov, Light, PrimitiveId, Scene, Sphere, SurfaceHit, Triangle};
 use rayon::prelude::*;
@@ -201,7 +201,7 @@ impl ShadowMaps {
     pub fn occluder(&self, scene: &Scene, light: usize, hit: &SurfaceHit, w_i: Vec3, bias: f32, slope_scaled: bool, lift: bool) -> Option<Occluder> {
         let map = self.maps.get(light).filter(|m| !m.faces.is_empty())?;
         // The same point a shadow ray would leave from (lifted on smooth triangles).
-        let p = super::shade::shadow_origin(scene, hit, w_i, lift);
+        let p = crate::render::transport::shade::shadow_origin(scene, hit, w_i, lift);
         let n = self.size as f32;
         let (face, dist, texel_w) = match scene.lights[light] {
             Light::Point { position, .. } => {

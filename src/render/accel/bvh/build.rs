@@ -9,9 +9,9 @@
 //! so every primitive is read twice per level: once to bin it, once to
 //! partition it.
 
-use super::{leaf_word, Aabb, Bvh, Node8, MAX_LEAF, STACK};
+use crate::render::accel::bvh::{leaf_word, Aabb, Bvh, Node8, MAX_LEAF, STACK};
 use crate::render::prepared::SceneEdges;
-use crate::render::raytrace::intersect::TriangleEdges;
+use crate::render::accel::intersect::TriangleEdges;
 use crate::scene::{PrimitiveId, Scene, Triangle};
 use glam::{UVec3, Vec3, Vec3A};
 use rayon::prelude::*;

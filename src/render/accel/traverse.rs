@@ -3,10 +3,10 @@
 //! the leaf loop with its tie rule. Written once so both traversals find the
 //! same hits; `#[inline(always)]` because they are the hot loops.
 
-use super::intersect::{intersect_sphere, intersect_triangle, intersect_triangles_lanes, TriangleEdges, TriangleLanes};
+use crate::render::accel::intersect::{intersect_sphere, intersect_triangle, intersect_triangles_lanes, TriangleEdges, TriangleLanes};
 use crate::math::lanes::{self, mask_bits, transpose8, V3};
 use crate::math::Ray;
-use crate::render::pixel_record::{PrimitiveTest, Recorder};
+use crate::render::inspect::pixel_record::{PrimitiveTest, Recorder};
 use crate::scene::{PrimitiveId, PrimitiveKind, Sphere};
 use fearless_simd::{f32x8, mask32x8, Simd, SimdBase, SimdFrom};
 use glam::{BVec4A, Vec3, Vec3A, Vec4};
@@ -283,7 +283,7 @@ pub fn test_triangle_leaf<S: Simd>(simd: S, prims: &[(TriangleEdges, PrimitiveId
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::pixel_record::NoRecord;
+    use crate::render::inspect::pixel_record::NoRecord;
 
     #[test]
     fn slab_test_by_hand() {
@@ -328,7 +328,7 @@ mod tests {
 
     #[test]
     fn leaf_ties_go_to_the_lower_id_and_any_stops_at_the_first_hit() {
-        use crate::render::raytrace::intersect::TriangleEdges;
+        use crate::render::accel::intersect::TriangleEdges;
         use crate::scene::Triangle;
         // The same triangle twice, listed with the higher id first, and a sphere behind it.
         let v = [Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, -1.0, 0.0), Vec3::new(0.0, 1.0, 0.0)];

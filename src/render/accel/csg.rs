@@ -474,8 +474,9 @@ pub fn surface_hit(scene: &Scene, index: u32, b: Boundary, ray: &Ray) -> Surface
 /// Settings under which CSG objects cannot be drawn, as one sentence: shadow
 /// maps and shadow volumes are built from triangles and spheres only, and the
 /// wireframe and shadow-map views draw those only.
-pub fn check(scene: &Scene, settings: &super::RenderSettings) -> Result<(), String> {
-    use super::{debug::View, ShadowMode};
+pub fn check(scene: &Scene, settings: &crate::render::RenderSettings) -> Result<(), String> {
+    use crate::render::inspect::debug::View;
+    use crate::render::ShadowMode;
     if scene.csgs.is_empty() {
         return Ok(());
     }

@@ -3,9 +3,9 @@
 //! code path with a recorder.
 
 use crate::math::Vec3;
-use crate::render::raytrace::intersect::Miss;
-use crate::render::csg::SurfaceRef;
-use crate::render::pixel_record::{CsgABufferRecord, FragmentRecord, LightSample, PixelTrace, RayRecord};
+use crate::render::accel::intersect::Miss;
+use crate::render::accel::csg::SurfaceRef;
+use crate::render::inspect::pixel_record::{CsgABufferRecord, FragmentRecord, LightSample, PixelTrace, RayRecord};
 use crate::render::PixelReplay;
 use crate::scene::{PrimitiveKind, Scene, SurfaceHit};
 use serde_json::{json, Value};
@@ -94,15 +94,15 @@ fn ray_json(scene: &Scene, t: &PixelTrace, r: &RayRecord) -> Value {
             })
             .collect();
         out["csg"]["text"] = json!(a.lines());
-    } else if let Some(e) = r.closest.as_ref().and_then(|h| crate::render::csg::explain_hit(scene, h, &r.ray, r.t_max)) {
+    } else if let Some(e) = r.closest.as_ref().and_then(|h| crate::render::accel::csg::explain_hit(scene, h, &r.ray, r.t_max)) {
         out["csg"] = csg_json(&e);
     }
     out
 }
 
 /// A CSG hit's intervals: each operand's, the combined ones, the winner.
-fn csg_json(e: &crate::render::csg::Explanation) -> Value {
-    let list = |l: &[crate::render::csg::Interval]| -> Vec<Value> { l.iter().map(|iv| json!([iv.enter.t, iv.exit.t])).collect() };
+fn csg_json(e: &crate::render::accel::csg::Explanation) -> Value {
+    let list = |l: &[crate::render::accel::csg::Interval]| -> Vec<Value> { l.iter().map(|iv| json!([iv.enter.t, iv.exit.t])).collect() };
     json!({
         "op": e.op.name(),
         "operands": e.leaves.iter().map(|l| json!({"operand": l.path, "kind": l.kind, "intervals": list(&l.intervals)})).collect::<Vec<_>>(),
@@ -258,7 +258,7 @@ pub fn to_text(renderer: &str, scene: &Scene, x: u32, y: u32, replay: &PixelRepl
                         for line in a.lines() {
                             let _ = writeln!(s, "{indent}    {line}");
                         }
-                    } else if let Some(e) = crate::render::csg::explain_hit(scene, h, &r.ray, r.t_max) {
+                    } else if let Some(e) = crate::render::accel::csg::explain_hit(scene, h, &r.ray, r.t_max) {
                         let _ = writeln!(s, "{indent}  csg intervals along the ray (t from its origin):");
                         for line in e.lines() {
                             let _ = writeln!(s, "{indent}    {line}");

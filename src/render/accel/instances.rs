@@ -12,11 +12,11 @@
 //! carried into a copy's space is off by rounding, and a grown box can only
 //! make a traversal test more triangles, never miss one.
 
-use super::bvh::{leaf_range, Bvh, LEAF_BIT};
-use super::intersect::TriangleEdges;
-use super::traverse::{test_leaf, BestHit, PreparedRay, SLAB_WIDEN};
+use crate::render::accel::bvh::{leaf_range, Bvh, LEAF_BIT};
+use crate::render::accel::intersect::TriangleEdges;
+use crate::render::accel::traverse::{test_leaf, BestHit, PreparedRay, SLAB_WIDEN};
 use crate::math::Ray;
-use crate::render::pixel_record::Recorder;
+use crate::render::inspect::pixel_record::Recorder;
 use crate::scene::instanced::InstanceLayer;
 use crate::scene::{PrimitiveId, Scene, Triangle};
 use glam::{Mat4, Vec3};

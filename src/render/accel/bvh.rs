@@ -21,14 +21,14 @@
 //! many dependent node loads per ray, which is what an incoherent ray's
 //! walk waits on.
 
-use super::intersect::TriangleEdges;
-use super::traverse::{slab_test8, test_leaf, test_triangle_leaf, BestHit, ChildOrder, PreparedRay};
+use crate::render::accel::intersect::TriangleEdges;
+use crate::render::accel::traverse::{slab_test8, test_leaf, test_triangle_leaf, BestHit, ChildOrder, PreparedRay};
 use crate::math::lanes::{mask_bits, simd_level, V3};
 use crate::math::prefetch::{prefetch, prefetch_lines};
 use fearless_simd::{f32x8, Simd, SimdBase};
 use crate::math::Ray;
 use fearless_simd::dispatch;
-use crate::render::pixel_record::{NoRecord, Recorder};
+use crate::render::inspect::pixel_record::{NoRecord, Recorder};
 use crate::render::{BatchHit, Occluder, PreparedScene, RayCounts, SceneQuery};
 use crate::scene::hit_lanes::TriangleHitInput;
 use crate::scene::{PrimitiveId, PrimitiveKind, SurfaceHit};
@@ -116,7 +116,7 @@ pub struct Bvh {
     leaves: usize,
     depth: u32,
     /// True when a traversal may need more than `STACK` entries.
-    pub(super) deep: bool,
+    pub(crate) deep: bool,
 }
 
 #[inline(always)]
@@ -339,7 +339,7 @@ impl Stack for Vec<(u32, f32)> {
 
 /// Closest-hit and shadow queries through the scene's BVH.
 pub struct BvhQuery<'a> {
-    pub(super) prepared: &'a PreparedScene,
+    pub(crate) prepared: &'a PreparedScene,
     /// Whether every query is one walk of the flat BVH: no instances, no
     /// CSG objects, some primitives (`closest_for_batch_at`, `occluder_at`
     /// ask this per ray).
@@ -387,7 +387,7 @@ impl<'a> BvhQuery<'a> {
     pub(super) fn batch_hit(&self, best: &BestHit, ray: &Ray) -> BatchHit {
         match best.id.kind() {
             PrimitiveKind::Triangle => BatchHit::Triangle(TriangleHitInput::new(best.id.index(), best.bary, best.t, ray.dir)),
-            _ => BatchHit::Record(self.prepared.scene.primitive_hit(best.id, best.t, best.bary.0, best.bary.1, ray)),
+            _ => BatchHit::Record(crate::render::accel::surface::primitive_hit(&self.prepared.scene, best.id, best.t, best.bary.0, best.bary.1, ray)),
         }
     }
 
@@ -578,12 +578,12 @@ impl SceneQuery for BvhQuery<'_> {
         // CSG objects are kept out of the hierarchy and tested after it.
         if !scene.csgs.is_empty() {
             let limit = best.as_ref().map_or(t_max, |b| b.t);
-            if let Some(h) = crate::render::csg::closest_in_scene(scene, ray, limit, inside, counts) {
+            if let Some(h) = crate::render::accel::csg::closest_in_scene(scene, ray, limit, inside, counts) {
                 return Some(h);
             }
         }
         let best = best?;
-        Some(scene.primitive_hit(best.id, best.t, best.bary.0, best.bary.1, ray))
+        Some(crate::render::accel::surface::primitive_hit(&scene, best.id, best.t, best.bary.0, best.bary.1, ray))
     }
 
     // Inlined into the pool's bounce loop, its only caller in frames: the
@@ -616,7 +616,7 @@ impl SceneQuery for BvhQuery<'_> {
         match self.traverse::<true, R>(ray, t_max, false, counts, rec) {
             Some(best) => Some(Occluder::new(best.id, best.t)),
             None if self.prepared.scene.csgs.is_empty() => None,
-            None => crate::render::csg::occluder_in_scene(&self.prepared.scene, ray, t_max, counts),
+            None => crate::render::accel::csg::occluder_in_scene(&self.prepared.scene, ray, t_max, counts),
         }
     }
 
@@ -634,9 +634,9 @@ impl SceneQuery for BvhQuery<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::raytrace::brute::BruteQuery;
-    use crate::render::raytrace::intersect::intersect_triangle;
-    use crate::render::pixel_record::NoRecord;
+    use crate::render::accel::brute::BruteQuery;
+    use crate::render::accel::intersect::intersect_triangle;
+    use crate::render::inspect::pixel_record::NoRecord;
     use crate::scene::{builtin, Scene, Sphere, Triangle};
     use proptest::prelude::*;
     use glam::Vec3A;

@@ -2,10 +2,10 @@
 //! tested against every primitive, in scene order. It stays in the program as
 //! the thing every faster method is checked against.
 
-use super::intersect::{intersect_sphere, intersect_triangle};
-use super::{cast_pass, cast_pixel};
+use crate::render::accel::intersect::{intersect_sphere, intersect_triangle};
+use crate::render::raytrace::{cast_pass, cast_pixel};
 use crate::math::{Radiance, Ray};
-use crate::render::pixel_record::{PixelTrace, PrimitiveTest, Recorder};
+use crate::render::inspect::pixel_record::{PixelTrace, PrimitiveTest, Recorder};
 use crate::render::{Occluder, PassJob, PreparedScene, RayCounts, Renderer, SceneQuery};
 use crate::scene::{PrimitiveId, PrimitiveKind, SurfaceHit};
 
@@ -65,10 +65,10 @@ impl SceneQuery for BruteQuery<'_> {
             }
         }
         // CSG objects after every primitive, as they come in id order.
-        if let Some(h) = crate::render::csg::closest_in_scene(&prepared.scene, ray, best_t, inside, counts) {
+        if let Some(h) = crate::render::accel::csg::closest_in_scene(&prepared.scene, ray, best_t, inside, counts) {
             return Some(h);
         }
-        best.map(|(id, b1, b2)| prepared.scene.primitive_hit(id, best_t, b1, b2, ray))
+        best.map(|(id, b1, b2)| crate::render::accel::surface::primitive_hit(&prepared.scene, id, best_t, b1, b2, ray))
     }
 
     fn occluder<R: Recorder>(&self, ray: &Ray, t_max: f32, counts: &mut RayCounts, rec: &mut R) -> Option<Occluder> {
@@ -93,6 +93,6 @@ impl SceneQuery for BruteQuery<'_> {
                 return Some(Occluder { kind: PrimitiveKind::Sphere, index: i as u32, t });
             }
         }
-        crate::render::csg::occluder_in_scene(&prepared.scene, ray, t_max, counts)
+        crate::render::accel::csg::occluder_in_scene(&prepared.scene, ray, t_max, counts)
     }
 }

@@ -58,10 +58,10 @@
 //! the pixel's count as a stencil masks them). Every secondary hit (mirror,
 //! glass, indirect bounces) has no stencil and casts shadow rays instead.
 
-use super::pixel_record::Recorder;
-use super::raytrace::bvh::Bvh;
-use super::raytrace::intersect::{intersect_triangle, TriangleEdges};
-use super::{Occluder, PreparedScene, RayCounts, RenderSettings, SceneQuery};
+use crate::render::inspect::pixel_record::Recorder;
+use crate::render::accel::bvh::Bvh;
+use crate::render::accel::intersect::{intersect_triangle, TriangleEdges};
+use crate::render::{Occluder, PreparedScene, RayCounts, RenderSettings, SceneQuery};
 use crate::math::{Ray, Vec2, Vec3};
 use crate::named::named_enum;
 use crate::scene::{Light, Scene, Sphere, SurfaceHit, Triangle};

@@ -176,7 +176,7 @@ fn build_range<T>(pairs: &mut [(Vec3, T)], axes: &mut [u8], _depth: u32) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::sampling::SampleRng;
+    use crate::render::transport::sampling::SampleRng;
 
     fn brute(points: &[Vec3], at: Vec3, k: usize, max2: f32) -> Vec<f32> {
         let mut d: Vec<f32> = points.iter().map(|p| (*p - at).length_squared()).filter(|d| *d <= max2).collect();

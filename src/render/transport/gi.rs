@@ -3,61 +3,15 @@
 //! parts of `shade()`, so the ray casters and the rasterizers get them alike;
 //! their random numbers come from the sample's own stream (`SampleRng`).
 
-use super::bsdf_sampling::sample_bsdf;
-use super::photon_map::PhotonMap;
-use super::pixel_record::{Bounce, Recorder};
-use super::sampling::{cosine_hemisphere, from_local, luminance, SampleRng};
-use super::{RayCounts, SceneQuery};
+use crate::render::transport::bsdf_sampling::sample_bsdf;
+use crate::render::transport::photon_map::PhotonMap;
+use crate::render::inspect::pixel_record::{Bounce, Recorder};
+use crate::render::transport::sampling::{cosine_hemisphere, from_local, luminance, SampleRng};
+use crate::render::{RayCounts, SceneQuery};
 use crate::math::{Radiance, Vec3};
-use crate::named::named_enum;
 use crate::scene::SurfaceHit;
 
-named_enum! {
-    /// How light that has bounced off other surfaces is accounted for.
-    #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-    pub enum GiMode ("gi mode") {
-        /// Direct light plus the scene's constant ambient term.
-        #[default]
-        None = "none",
-        /// The ambient term weighted by the unoccluded part of the hemisphere.
-        Ao = "ao",
-        /// Indirect light estimated from photons shot from the lights.
-        Photons = "photons",
-        /// Unidirectional path tracing with next-event estimation.
-        Path = "path",
-    }
-}
-
-/// The knobs of the indirect-light modes.
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-#[serde(default)]
-pub struct GiSettings {
-    pub mode: GiMode,
-    /// Path tracing: indirect bounces; `None` = as many as Russian roulette
-    /// lets live (up to `MAX_BOUNCES`).
-    pub bounces: Option<u32>,
-    /// Ambient occlusion: hemisphere rays per sample, and how far they look.
-    pub ao_samples: u32,
-    pub ao_distance: f32,
-    /// Photon mapping: photons shot, and neighbours per density estimate.
-    pub photons: u32,
-    pub photon_k: u32,
-    /// Photon mapping: rays gathered at the first hit (0: read the map there).
-    pub final_gather: u32,
-    /// Every random number depends on (pixel, sample index, seed) only.
-    pub seed: u64,
-}
-
-impl Default for GiSettings {
-    fn default() -> Self {
-        GiSettings { mode: GiMode::None, bounces: None, ao_samples: 16, ao_distance: 1.0, photons: 200_000, photon_k: 64, final_gather: 0, seed: 0 }
-    }
-}
-
-/// Unbounded paths still stop here, so recursion depth stays bounded; the
-/// throughput left after this many bounces off anything but a perfect
-/// mirror is far below what a pixel can show.
-pub const MAX_BOUNCES: u32 = 100;
+pub use crate::render::gi_settings::{GiMode, GiSettings, MAX_BOUNCES};
 
 /// Russian roulette decides on the bounce from this depth on (0 = the eye
 /// ray's surface): from the fifth surface a path reaches, as Mitsuba's
@@ -65,13 +19,6 @@ pub const MAX_BOUNCES: u32 = 100;
 /// surfaces from 1), so that both render the same estimator and their
 /// times at equal samples compare like with like.
 const ROULETTE_DEPTH: u32 = 4;
-
-impl GiSettings {
-    /// The deepest ray a path may cast (0 = eye ray), for `Path`.
-    pub fn max_path_depth(&self) -> u32 {
-        self.bounces.map_or(MAX_BOUNCES, |b| b.min(MAX_BOUNCES))
-    }
-}
 
 /// What a sample carries down its path: its random numbers, the product of
 /// the weights so far (for Russian roulette), and the photon map to read.
@@ -177,8 +124,8 @@ pub fn choose_lobe(a: Vec3, b: Vec3, rng: &mut SampleRng) -> (bool, f32) {
 mod tests {
     use super::*;
     use crate::render::PreparedScene;
-    use crate::render::pixel_record::NoRecord;
-    use crate::render::raytrace::bvh::BvhQuery;
+    use crate::render::inspect::pixel_record::NoRecord;
+    use crate::render::accel::bvh::BvhQuery;
     use crate::scene::{PrimitiveKind, Scene, Triangle};
     use crate::math::Vec2;
 

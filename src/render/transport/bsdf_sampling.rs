@@ -3,9 +3,9 @@
 //! vector, chosen between in proportion to their albedo. `bsdf()` itself
 //! stays the one definition of the reflectance.
 
-use super::sampling::{blinn_phong_half, blinn_phong_pdf, cosine_hemisphere, cosine_hemisphere_lanes, cosine_hemisphere_pdf, cosine_hemisphere_pdf_lanes, from_local, from_local_lanes, luminance, reflect};
+use crate::render::transport::sampling::{blinn_phong_half, blinn_phong_pdf, cosine_hemisphere, cosine_hemisphere_lanes, cosine_hemisphere_pdf, cosine_hemisphere_pdf_lanes, from_local, from_local_lanes, luminance, reflect};
 use crate::math::lanes::{Lane, V3};
-use super::shade::bsdf;
+use crate::render::transport::bsdf::bsdf;
 use crate::math::{Vec2, Vec3};
 use crate::scene::Material;
 
@@ -97,7 +97,7 @@ pub fn cosine_lobe<L: Lane>(n: V3<L>, ux: L, uy: L) -> (V3<L>, L, L::Mask) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::sampling::SampleRng;
+    use crate::render::transport::sampling::SampleRng;
 
     /// The Monte Carlo estimate of the directional albedo `∫ f cos dw`.
     fn albedo_estimate(m: &Material, w_o: Vec3, n: usize) -> Vec3 {

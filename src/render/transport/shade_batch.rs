@@ -3,17 +3,20 @@
 //! samples. Direct light runs eight lanes wide (`lighting::direct_light` on
 //! `f32x8`, at the best SIMD level the CPU has), or sixteen for two batches
 //! lit by direct light alone (`shade_batch_pair`). Frames hand path-traced
-//! samples on to a `path_batch::PathPool` (`start_paths`); everything else that
+//! samples on to a `path_batch::PathPool` (`path_batch::start_paths`); everything else that
 //! follows rays one sample at a time (ambient occlusion, photon gathers,
 //! mirrors and glass) is `shade()`'s own one-sample code, called per lane in
 //! the same order. So each lane's value is bit for bit the value `shade()`
 //! gives that sample alone, which is what pixel replays run.
 
-use super::lighting::{self, IncidenceLanes, LightVisibility, SurfaceLanes};
-use super::pixel_record::NoRecord;
-use super::shade::{self, Incidence, Shading};
-use super::path_batch::PathPool;
-use super::{debug::View, gi::{GiMode, PathState}, Interpolation, PassJob, RayCounts, SceneQuery, ShadowMode};
+use crate::render::transport::lighting;
+use crate::render::transport::lighting::{IncidenceLanes, LightVisibility, SurfaceLanes};
+use crate::render::inspect::pixel_record::NoRecord;
+use crate::render::transport::shade;
+use crate::render::transport::shade::{Incidence, Shading};
+use crate::render::inspect::debug::View;
+use crate::render::transport::gi::{GiMode, PathState};
+use crate::render::{Interpolation, PassJob, RayCounts, SceneQuery, ShadowMode};
 use crate::math::lanes::{mask_bits, mask_from_bits, simd_level, Lane, V3};
 use crate::math::{Radiance, Ray, Vec2, Vec3};
 use crate::scene::hit_lanes::{EyeSamples, Floats, HitLanes, TriangleHitInput};
@@ -36,7 +39,7 @@ pub fn batchable(job: &PassJob) -> bool {
 /// shading that `batchable` takes, or a debug view that colours only what
 /// is hit (`debug::miss_color`), which then colours each batch's records.
 pub fn resolved_in_batches(job: &PassJob) -> bool {
-    batchable(job) || crate::render::debug::miss_color(job.settings.view).is_some()
+    batchable(job) || crate::render::inspect::debug::miss_color(job.settings.view).is_some()
 }
 
 /// The interpolation a batch of `job`'s samples is built with: the
@@ -48,25 +51,25 @@ pub fn build_interpolation(job: &PassJob) -> Interpolation {
 
 /// Up to eight samples that see a surface, with where their results go.
 pub struct Batch {
-    len: usize,
+    pub(crate) len: usize,
     /// The surfaces as `shade()` is handed them (flat shading's normal
     /// applied), in lanes.
-    hits: HitLanes,
+    pub(crate) hits: HitLanes,
     /// Unit directions towards the eye, in lanes.
-    w_o: [Floats; 3],
-    pixels: [u32; LANES],
+    pub(crate) w_o: [Floats; 3],
+    pub(crate) pixels: [u32; LANES],
     /// Each lane's sample index among its pixel's (its pass): with the
     /// pixel, the key of its random numbers.
-    samples: [u32; LANES],
+    pub(crate) samples: [u32; LANES],
     /// The caller's index for each lane's result.
     pub slots: [usize; LANES],
     /// Eye samples pushed but not built yet, and their lanes.
-    pending: EyeSamples,
+    pub(crate) pending: EyeSamples,
     pending_lanes: [usize; LANES],
     /// Ray casters' triangle hits pushed but not built yet, and their lanes.
     pending_rays: [TriangleHitInput; LANES],
     pending_ray_lanes: [usize; LANES],
-    pending_ray_count: usize,
+    pub(crate) pending_ray_count: usize,
 }
 
 impl Default for Batch {
@@ -359,21 +362,6 @@ pub fn shade_batch<Q: SceneQuery>(job: &PassJob, query: &Q, batch: &Batch, block
     out
 }
 
-/// `shade_batch` with `--gi path`, the paths not followed yet: the batch's
-/// samples go into `pool`, lane k's radiance meant for `slots[k]` of what
-/// `PathPool::follow_into` writes, with those of other batches. (Frames
-/// take this way; `shade_batch` itself follows each lane's path alone, by
-/// `shade()`'s recursion, to the same bits.)
-#[allow(clippy::too_many_arguments)]
-pub fn start_paths<'p, Q: SceneQuery>(job: &PassJob<'p>, query: &Q, batch: &Batch, blocked: Option<&[u8]>, slots: &[usize], counts: &mut RayCounts, pool: &mut PathPool<'p>) {
-    assert_eq!(slots.len(), batch.len);
-    assert!(batch.pending.len == 0 && batch.pending_ray_count == 0, "start_paths on a batch with hits not built (`build_pending`)");
-    let settings = job.settings;
-    let paths = pool.start(batch.len, |i| PathState::new(batch.pixels[i], batch.samples[i], settings.spp, &settings.gi, job.photons));
-    let (albedo, direct) = direct_in_lanes(job, query, &batch.hits, &batch.w_o, batch.len, paths, &IN_ORDER, blocked, counts);
-    pool.add(&batch.hits, &batch.w_o, slots, &albedo, &direct);
-}
-
 /// Lane i's path is path i.
 pub const IN_ORDER: [usize; LANES] = [0, 1, 2, 3, 4, 5, 6, 7];
 
@@ -481,7 +469,7 @@ fn direct_light8<S: Simd, Q: SceneQuery>(simd: S, job: &PassJob, geometry: &Geom
 pub fn colour_batches(job: &PassJob, batches: &mut [Batch], mut put: impl FnMut(&Batch, usize, Radiance)) {
     for batch in batches.iter_mut() {
         for j in 0..batch.len() {
-            put(batch, j, super::debug::surface_color(job.settings.view, job.view, &batch.hit(j)));
+            put(batch, j, crate::render::inspect::debug::surface_color(job.settings.view, job.view, &batch.hit(j)));
         }
         batch.clear();
     }
@@ -810,8 +798,8 @@ impl ShadowRays {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::pixel_record::NoRecord;
-    use crate::render::raytrace::bvh::BvhQuery;
+    use crate::render::inspect::pixel_record::NoRecord;
+    use crate::render::accel::bvh::BvhQuery;
     use crate::render::{PreparedScene, RenderSettings};
     use crate::scene::builtin;
     use std::sync::atomic::AtomicBool;
@@ -928,7 +916,8 @@ mod tests {
     /// glass, textures, ambient occlusion) are refused, not shaded wrong.
     #[test]
     fn batch_pairs_equal_one_sample_shading() {
-        use crate::render::raytrace::packet::{shadow_packets, Packet};
+        use crate::render::accel::packet::Packet;
+use crate::render::transport::shadow_packets::shadow_packets;
         let (mut paired, mut refused) = (0, 0);
         let mut pk = Packet::new();
         for_each_shading_case(|name, job, query| {

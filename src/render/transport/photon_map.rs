@@ -5,13 +5,13 @@
 //! estimated from the k nearest photons. The map is built once per scene,
 //! lights, materials and photon settings, and cached on the prepared scene.
 
-use super::gi::GiSettings;
-use super::kd_tree::{KdTree, Neighbour};
-use super::pixel_record::NoRecord;
-use super::raytrace::bvh::BvhQuery;
-use super::sampling::{cosine_hemisphere, from_local, luminance, tangents, uniform_disk, uniform_sphere, SampleRng};
-use super::shade::{bsdf, refraction};
-use super::{PreparedScene, RayCounts, SceneQuery};
+use crate::render::gi_settings::GiSettings;
+use crate::render::transport::kd_tree::{KdTree, Neighbour};
+use crate::render::inspect::pixel_record::NoRecord;
+use crate::render::accel::bvh::BvhQuery;
+use crate::render::transport::sampling::{cosine_hemisphere, from_local, luminance, tangents, uniform_disk, uniform_sphere, SampleRng};
+use crate::render::transport::bsdf::{bsdf, refraction};
+use crate::render::{PreparedScene, RayCounts, SceneQuery};
 use crate::math::{Radiance, Ray, Vec3};
 use crate::scene::{Light, Material, Scene, SurfaceHit};
 use rayon::prelude::*;

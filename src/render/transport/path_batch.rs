@@ -20,14 +20,16 @@
 //! whose delta lobes add a second branch, or its last permitted bounce,
 //! finishes in `shade()`'s own code from there.
 
-use super::bsdf_sampling::cosine_lobe;
-use super::gi::{self, GiMode, PathState};
-use super::pixel_record::NoRecord;
-use super::shade::{self, Shading};
-use super::shade_batch::{direct_in_lanes, shadow_rays_of, LANES};
-use super::raytrace::packet::{Packet, HYBRID_ALONE, PACKET_RAYS};
-use super::{BatchHit, PassJob, RayCounts, SceneQuery, ShadowMode};
-use super::sampling::{luminance, StreamLanes};
+use crate::render::transport::bsdf_sampling::cosine_lobe;
+use crate::render::transport::gi;
+use crate::render::transport::gi::{GiMode, PathState};
+use crate::render::inspect::pixel_record::NoRecord;
+use crate::render::transport::shade;
+use crate::render::transport::shade::Shading;
+use crate::render::transport::shade_batch::{direct_in_lanes, shadow_rays_of, Batch, IN_ORDER, LANES};
+use crate::render::accel::packet::{Packet, HYBRID_ALONE, PACKET_RAYS};
+use crate::render::{BatchHit, PassJob, RayCounts, SceneQuery, ShadowMode};
+use crate::render::transport::sampling::{luminance, StreamLanes};
 use crate::math::lanes::{mask_bits, simd_level, Lane, V3};
 use crate::math::{Radiance, Ray, Vec3};
 use fearless_simd::{dispatch, f32x8, Simd, SimdFrom};
@@ -37,6 +39,21 @@ use crate::scene::hit_lanes::{Floats, HitLanes, TriangleHitInput};
 #[inline]
 pub fn takes(job: &PassJob) -> bool {
     job.settings.gi.mode == GiMode::Path
+}
+
+/// `shade_batch` with `--gi path`, the paths not followed yet: the batch's
+/// samples go into `pool`, lane k's radiance meant for `slots[k]` of what
+/// `PathPool::follow_into` writes, with those of other batches. (Frames
+/// take this way; `shade_batch` itself follows each lane's path alone, by
+/// `shade()`'s recursion, to the same bits.)
+#[allow(clippy::too_many_arguments)]
+pub fn start_paths<'p, Q: SceneQuery>(job: &PassJob<'p>, query: &Q, batch: &Batch, blocked: Option<&[u8]>, slots: &[usize], counts: &mut RayCounts, pool: &mut PathPool<'p>) {
+    assert_eq!(slots.len(), batch.len);
+    assert!(batch.pending.len == 0 && batch.pending_ray_count == 0, "start_paths on a batch with hits not built (`build_pending`)");
+    let settings = job.settings;
+    let paths = pool.start(batch.len, |i| PathState::new(batch.pixels[i], batch.samples[i], settings.spp, &settings.gi, job.photons));
+    let (albedo, direct) = direct_in_lanes(job, query, &batch.hits, &batch.w_o, batch.len, paths, &IN_ORDER, blocked, counts);
+    pool.add(&batch.hits, &batch.w_o, slots, &albedo, &direct);
 }
 
 /// One bounce a path took, kept until the radiance found beyond it is
@@ -511,7 +528,7 @@ impl Group {
         if normal_maps {
             for k in 0..self.len {
                 let mut h = self.hits.get(k);
-                super::normal_map::apply(scene, job.settings.texture_filter, &mut h);
+                crate::render::transport::normal_map::apply(scene, job.settings.texture_filter, &mut h);
                 self.hits.set(k, &h);
             }
         }

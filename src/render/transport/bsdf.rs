@@ -1,0 +1,79 @@
+//! The surfaces' scattering: the BSDF one sample evaluates (Lambertian plus
+//! normalized Blinn-Phong, CGPP listing 15.19, written once over lanes in
+//! `lighting`) and the delta lobes of mirrors and glass (Fresnel by Schlick's
+//! approximation, refraction by Snell's law).
+
+use crate::math::Vec3;
+use crate::render::transport::lighting;
+use crate::render::transport::lighting::SurfaceLanes;
+use crate::scene::{Material, SurfaceHit};
+
+/// The BSDF of CGPP listing 15.19 for one sample (`lighting::bsdf`, one lane
+/// wide): Lambertian plus normalized Blinn-Phong,
+/// `f = k_L / pi + k_G N(s) max(0, n.h)^s` (`N` is
+/// `lighting::blinn_phong_normalization`).
+#[inline]
+pub fn bsdf(material: &Material, albedo: Vec3, n: Vec3, w_i: Vec3, w_o: Vec3) -> Vec3 {
+    let surface = surface_lane(material, albedo, Vec3::ZERO, n, w_o);
+    lighting::bsdf(&surface, w_i.into()).into()
+}
+
+/// One sample's surface as the lane-generic lighting code reads it.
+#[inline(always)]
+pub(crate) fn surface_lane(material: &Material, albedo: Vec3, position: Vec3, n: Vec3, w_o: Vec3) -> SurfaceLanes<f32> {
+    SurfaceLanes {
+        position: position.into(),
+        normal: n.into(),
+        w_o: w_o.into(),
+        albedo: albedo.into(),
+        glossy: material.glossy.into(),
+        sharpness: material.sharpness,
+    }
+}
+
+/// The Fresnel reflectance (Schlick's approximation) at a dielectric seen
+/// from `w_o`, and the refracted direction unless the light is totally
+/// reflected. Entering when the front side faces us (spheres flip
+/// `back_face` inside).
+#[inline]
+pub fn refraction(hit: &SurfaceHit, material: &Material, w_o: Vec3) -> (f32, Option<Vec3>) {
+    let n = hit.geometric_normal;
+    let cos_o = w_o.dot(n).clamp(-1.0, 1.0);
+    let (eta_i, eta_t) = if hit.back_face { (material.ior, 1.0) } else { (1.0, material.ior) };
+    let eta = eta_i / eta_t;
+    let sin2_t = eta * eta * (1.0 - cos_o * cos_o).max(0.0);
+    let r0 = ((eta_i - eta_t) / (eta_i + eta_t)).powi(2);
+    let fresnel = if sin2_t >= 1.0 { 1.0 } else { r0 + (1.0 - r0) * (1.0 - cos_o.abs()).powi(5) };
+    let refracted = (sin2_t < 1.0).then(|| {
+        let cos_t = (1.0 - sin2_t).sqrt();
+        (-w_o * eta + n * (eta * cos_o - cos_t)).normalize()
+    });
+    (fresnel, refracted)
+}
+
+/// The two delta lobes of a surface seen from `w_o`: mirror reflection
+/// (the material's mirror weight plus the Fresnel-reflected part of its
+/// transmission) and refraction (the rest of the transmission, unless the
+/// light is totally reflected).
+pub(crate) struct DeltaLobes {
+    pub reflect_dir: Vec3,
+    pub reflect_weight: Vec3,
+    /// Direction and weight.
+    pub refract: Option<(Vec3, Vec3)>,
+}
+
+impl DeltaLobes {
+    #[inline]
+    pub fn at(hit: &SurfaceHit, material: &Material, w_o: Vec3) -> DeltaLobes {
+        let n = hit.geometric_normal;
+        let cos_o = w_o.dot(n).clamp(-1.0, 1.0);
+        let mut reflect_weight = material.mirror;
+        let mut refract = None;
+        if material.transmission != Vec3::ZERO {
+            let (fresnel, dir) = refraction(hit, material, w_o);
+            reflect_weight += material.transmission * fresnel;
+            refract = dir.map(|d| (d, material.transmission * (1.0 - fresnel)));
+        }
+        DeltaLobes { reflect_dir: (2.0 * cos_o * n - w_o).normalize(), reflect_weight, refract }
+    }
+}

@@ -1,0 +1,19 @@
+//! Hits to radiance: everything that lights a surface the renderers found.
+//! `shade` is the one shading entry for a single sample and `shade_batch` the
+//! same over eight lanes; `lighting` evaluates lights; `gi` holds the
+//! indirect-light modes, `path_batch` the path pool, `photon_map` photons
+//! and `bsdf_sampling` the BSDFs' importance sampling; `sampling` is the
+//! sampler whose numbers are a pure function of (pixel, sample, seed).
+
+pub mod bsdf;
+pub mod bsdf_sampling;
+pub mod gi;
+pub mod kd_tree;
+pub mod lighting;
+pub mod normal_map;
+pub mod path_batch;
+pub mod photon_map;
+pub mod sampling;
+pub mod shade;
+pub mod shade_batch;
+pub mod shadow_packets;
