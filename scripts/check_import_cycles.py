@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Fail if the crate's own module files import each other in a cycle.
+"""Fail if the crate's own module files import each other in a cycle, or upwards.
 
 Reads every `.rs` file under `src/`, collects the paths it names through
 `crate::` and `super::` (in `use` items and inline paths alike), resolves each
@@ -13,7 +13,11 @@ and any module naming another subtree. Test modules (`#[cfg(test)] mod tests { .
 a test may read any module. `main.rs` is the binary's root and is not part of
 the library's module tree.
 
-Exit status 0 when the graph is acyclic; 1 with every cycle listed otherwise.
+It also checks the layers (`FORBIDDEN` below): imports run downwards only,
+so a lower layer naming a higher one is reported even where no cycle forms.
+
+Exit status 0 when the graph is acyclic and keeps the layers; 1 with every
+cycle and every crossing listed otherwise.
 Run it from anywhere: `python3 scripts/check_import_cycles.py [SRC_DIR]`.
 """
 import os
@@ -168,9 +172,48 @@ for v in sorted(graph):
         visit(v)
 
 name = lambda m: "::".join(m) or "crate"
-if not sccs:
-    print(f"no import cycles among {len(files)} module files")
+
+# Layers: a module under the first prefix may not name one under the second.
+# Imports run downwards: app/cli over chart/gallery over render over scene
+# over math; inside render, accel finds hits and knows nothing of shading.
+FORBIDDEN = [
+    (("scene",), ("render",)),
+    (("math",), ("scene",)),
+    (("math",), ("render",)),
+    (("render",), ("app",)),
+    (("render",), ("cli",)),
+    (("render",), ("chart",)),
+    (("render",), ("gallery",)),
+    (("chart",), ("app",)),
+    (("gallery",), ("app",)),
+    (("render", "accel"), ("render", "transport")),
+    (("render", "accel"), ("render", "shadow")),
+    (("render", "accel"), ("render", "raytrace")),
+    (("render", "accel"), ("render", "raster")),
+    (("render", "accel"), ("render", "frame")),
+    (("render", "accel"), ("render", "opengl")),
+    (("render", "transport"), ("render", "raytrace")),
+    (("render", "transport"), ("render", "raster")),
+    (("render", "transport"), ("render", "frame")),
+]
+under = lambda m, prefix: tuple(m[: len(prefix)]) == prefix
+broken = sorted(
+    (name(a), name(b))
+    for a in graph
+    for b in graph[a]
+    for hi, lo in FORBIDDEN
+    if under(a, hi) and under(b, lo)
+)
+if broken:
+    print(f"{len(broken)} import(s) against the layers:")
+    for a, b in broken:
+        print(f"- {a} -> {b}")
+
+if not sccs and not broken:
+    print(f"no import cycles and no import against the layers among {len(files)} module files")
     sys.exit(0)
+if not sccs:
+    sys.exit(1)
 print(f"{len(sccs)} import cycle(s) among {len(files)} module files:")
 for c in sccs:
     print(f"- {len(c)} files: " + ", ".join(name(m) for m in c))

@@ -476,7 +476,7 @@ impl WorkerLoop {
                     pool.install(|| guarded(|| render::replay_pixel(renderer, prepared_ref, &settings, r.x, r.y))).and_then(|x| x)
                 };
                 let result = render::renderer_by_name(&r.renderer).and_then(|renderer| run(renderer.as_ref()));
-                reference = diff.then(|| run(&render::accel::brute::BruteForce));
+                reference = diff.then(|| run(&render::raytrace::brute_renderer::BruteForce));
                 // The frame in flight goes on with its own values.
                 if let Some(f) = &self.frame {
                     f.req.params.apply(&mut prepared.scene);

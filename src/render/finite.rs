@@ -95,7 +95,7 @@ mod tests {
 #[cfg(test)]
 mod renderer_tests {
     use crate::math::Radiance;
-    use crate::render::accel::brute::BruteForce;
+    use crate::render::raytrace::brute_renderer::BruteForce;
     use crate::render::raytrace::bvh_renderer::BvhRayTracer;
     use crate::math::Vec3;
     use crate::render::{raster, PassJob, PreparedScene, RenderSettings, Renderer, ShadowMode};

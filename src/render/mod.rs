@@ -418,7 +418,7 @@ pub trait Renderer: Sync + Send {
 
 /// Every registered renderer, reference first.
 pub fn renderers() -> Vec<Box<dyn Renderer>> {
-    let mut all: Vec<Box<dyn Renderer>> = vec![Box::new(accel::brute::BruteForce), Box::new(raytrace::bvh_renderer::BvhRayTracer)];
+    let mut all: Vec<Box<dyn Renderer>> = vec![Box::new(raytrace::brute_renderer::BruteForce), Box::new(raytrace::bvh_renderer::BvhRayTracer)];
     all.extend(raster::renderers());
     all.push(Box::new(opengl::OpenGl));
     all

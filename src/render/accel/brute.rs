@@ -3,36 +3,10 @@
 //! the thing every faster method is checked against.
 
 use crate::render::accel::intersect::{intersect_sphere, intersect_triangle};
-use crate::render::raytrace::{cast_pass, cast_pixel};
-use crate::math::{Radiance, Ray};
-use crate::render::inspect::pixel_record::{PixelTrace, PrimitiveTest, Recorder};
-use crate::render::{Occluder, PassJob, PreparedScene, RayCounts, Renderer, SceneQuery};
+use crate::math::Ray;
+use crate::render::inspect::pixel_record::{PrimitiveTest, Recorder};
+use crate::render::{Occluder, PreparedScene, RayCounts, SceneQuery};
 use crate::scene::{PrimitiveId, PrimitiveKind, SurfaceHit};
-
-pub struct BruteForce;
-
-impl Renderer for BruteForce {
-    fn name(&self) -> &'static str {
-        "raytrace:brute"
-    }
-
-    fn description(&self) -> &'static str {
-        "the reference ray caster: every pixel tests every primitive in scene order (CGPP 15.4)"
-    }
-
-    fn render_pass(&self, job: &PassJob, out: &mut [Radiance]) -> RayCounts {
-        cast_pass(job, &BruteQuery(job.prepared), out)
-    }
-
-    /// `cast_pass` checks each row as it finishes it.
-    fn admits_its_samples(&self) -> bool {
-        true
-    }
-
-    fn trace_pixel(&self, job: &PassJob, x: u32, y: u32, rec: &mut PixelTrace) -> Option<Radiance> {
-        Some(cast_pixel(job, &BruteQuery(job.prepared), x, y, &mut RayCounts::default(), rec))
-    }
-}
 
 /// Closest-hit and shadow queries by testing every primitive.
 pub struct BruteQuery<'a>(pub &'a PreparedScene);

@@ -11,5 +11,6 @@ pub mod csg;
 pub mod instances;
 pub mod intersect;
 pub mod packet;
+pub mod scene_edges;
 pub mod surface;
 pub mod traverse;

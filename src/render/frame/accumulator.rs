@@ -9,7 +9,7 @@ use crate::math::Radiance;
 use crate::render::transport::sampling::luminance;
 use crate::render::inspect::debug;
 use crate::render::inspect::debug::View;
-use crate::render::accel::brute::BruteForce;
+use crate::render::raytrace::brute_renderer::BruteForce;
 use crate::render::inspect::wireframe;
 use crate::render::inspect::wireframe::LineAlgorithm;
 use crate::render::finite::admit_all;

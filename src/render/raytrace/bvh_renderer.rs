@@ -75,7 +75,7 @@ impl Renderer for BvhRayTracer {
 mod tests {
     use super::*;
     use crate::render::inspect::debug::View;
-    use crate::render::accel::brute::BruteForce;
+    use crate::render::raytrace::brute_renderer::BruteForce;
     use crate::render::{render_frame, Interpolation, PreparedScene, RenderSettings, ShadowMode};
     use crate::scene::builtin;
     use std::sync::atomic::AtomicBool;

@@ -4,6 +4,7 @@
 //! checked against it); this module drives them pass by pass: one ray per
 //! pixel (`cast_pass`) and the BVH renderer (`bvh_renderer`).
 
+pub mod brute_renderer;
 pub mod bvh_renderer;
 pub mod packet_tiles;
 

@@ -77,3 +77,11 @@ impl DeltaLobes {
         DeltaLobes { reflect_dir: (2.0 * cos_o * n - w_o).normalize(), reflect_weight, refract }
     }
 }
+
+/// The mirror direction of `w_o` about the normal `n`: `2 (w_o.n) n - w_o`
+/// (photons' bounces; `DeltaLobes` clamps the cosine first, as shading has
+/// always done, so its bits stay its own).
+#[inline]
+pub fn mirror_direction(n: Vec3, w_o: Vec3) -> Vec3 {
+    (2.0 * w_o.dot(n) * n - w_o).normalize()
+}

@@ -10,7 +10,7 @@ use crate::render::transport::kd_tree::{KdTree, Neighbour};
 use crate::render::inspect::pixel_record::NoRecord;
 use crate::render::accel::bvh::BvhQuery;
 use crate::render::transport::sampling::{cosine_hemisphere, from_local, luminance, tangents, uniform_disk, uniform_sphere, SampleRng};
-use crate::render::transport::bsdf::{bsdf, refraction};
+use crate::render::transport::bsdf::{bsdf, mirror_direction, refraction};
 use crate::render::{PreparedScene, RayCounts, SceneQuery};
 use crate::math::{Radiance, Ray, Vec3};
 use crate::scene::{Light, Material, Scene, SurfaceHit};
@@ -217,8 +217,7 @@ fn trace_photon(scene: &Scene, query: &BvhQuery, mut ray: Ray, mut power: Vec3, 
             ray = hit.spawn_ray_front(dir, bump);
             inside = false;
         } else if u < p_d + p_m {
-            let n = hit.geometric_normal;
-            let dir = (2.0 * w_o.dot(n) * n - w_o).normalize();
+            let dir = mirror_direction(hit.geometric_normal, w_o);
             power *= material.mirror / p_m;
             ray = hit.spawn_ray_front(dir, bump);
             inside = false;
@@ -231,9 +230,7 @@ fn trace_photon(scene: &Scene, query: &BvhQuery, mut ray: Ray, mut power: Vec3, 
                     inside = true;
                 }
                 _ => {
-                    let n = hit.geometric_normal;
-                    let dir = (2.0 * w_o.dot(n) * n - w_o).normalize();
-                    ray = hit.spawn_ray_front(dir, bump);
+                    ray = hit.spawn_ray_front(mirror_direction(hit.geometric_normal, w_o), bump);
                     inside = false;
                 }
             }

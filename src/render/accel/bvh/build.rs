@@ -10,7 +10,7 @@
 //! partition it.
 
 use crate::render::accel::bvh::{leaf_word, Aabb, Bvh, Node8, MAX_LEAF, STACK};
-use crate::render::prepared::SceneEdges;
+use crate::render::accel::scene_edges::SceneEdges;
 use crate::render::accel::intersect::TriangleEdges;
 use crate::scene::{PrimitiveId, Scene, Triangle};
 use glam::{UVec3, Vec3, Vec3A};
