@@ -8,7 +8,7 @@ use super::photon_map::PhotonMap;
 use super::pixel_record::{Bounce, Recorder};
 use super::sampling::{cosine_hemisphere, from_local, luminance, SampleRng};
 use super::{RayCounts, SceneQuery};
-use crate::math::{Radiance, Vec3};
+use crate::math::Vec3;
 use crate::named::named_enum;
 use crate::scene::SurfaceHit;
 
@@ -152,11 +152,6 @@ pub fn sample_bounce<R: Recorder>(
     }
     let (scale, _) = survival?;
     Some((s.w_i, s.weight * scale))
-}
-
-/// Radiance from the photon map at a diffuse point seen from `w_o`.
-pub fn photon_estimate(photons: &PhotonMap, hit: &SurfaceHit, material: &crate::scene::Material, albedo: Vec3, w_o: Vec3, k: u32) -> Radiance {
-    photons.radiance(hit, material, albedo, w_o, k as usize)
 }
 
 /// Choose between two delta lobes with weights `a` and `b` in proportion to
