@@ -9,7 +9,7 @@
 //! world-space triangle of any index with the very arithmetic flattening
 //! uses, so a copy renders as its flattened triangles would.
 
-use super::file::Placement;
+use super::placement::Placement;
 use super::Triangle;
 use std::sync::Arc;
 
