@@ -443,16 +443,7 @@ fn add_object(
     }
     let two_sided = o.two_sided.unwrap_or(false);
     let placement = placement(o, where_)?;
-    let explicit_material = match &o.material {
-        Some(name) => Some(
-            scene
-                .materials
-                .iter()
-                .position(|m| &m.name == name)
-                .ok_or(format!("{where_}: material \"{name}\" is not defined in [materials]"))? as u32,
-        ),
-        None => None,
-    };
+    let explicit_material = material_index(scene, o.material.as_deref(), || where_.to_string())?;
     let first = scene.triangles.len();
     let kind = o.kind.as_str();
     let only = |allowed: &[&str]| -> Result<(), String> {
@@ -704,16 +695,7 @@ fn copies(
         let placement = placement_of(d.translate, d.rotate_deg, d.scale.as_ref(), "").map_err(|_| {
             placement_of(d.translate, d.rotate_deg, d.scale.as_ref(), &here()).err().unwrap_or_default()
         })?;
-        let material = match &d.material {
-            Some(name) => Some(
-                scene
-                    .materials
-                    .iter()
-                    .position(|m| &m.name == name)
-                    .ok_or_else(|| format!("{}: material \"{name}\" is not defined in [materials]", here()))? as u32,
-            ),
-            None => object_material,
-        };
+        let material = material_index(scene, d.material.as_deref(), here)?.or(object_material);
         out.push(MeshCopy { placement: Some(placement), material, index: Some(k as u32) });
     }
     Ok(out)
@@ -748,16 +730,7 @@ fn csg_node(
     parts: &mut CsgParts,
 ) -> Result<super::csg::CsgNode, String> {
     use super::csg::{CsgNode, CsgOp, MAX_DEPTH};
-    let material = match &o.material {
-        Some(name) => Some(
-            scene
-                .materials
-                .iter()
-                .position(|m| &m.name == name)
-                .ok_or(format!("{where_}: material \"{name}\" is not defined in [materials]"))? as u32,
-        ),
-        None => inherited,
-    };
+    let material = material_index(scene, o.material.as_deref(), || where_.to_string())?.or(inherited);
     if depth >= MAX_DEPTH {
         return Err(format!("{where_}: csg operations are nested more than {MAX_DEPTH} deep"));
     }
@@ -808,6 +781,17 @@ fn csg_node(
     let a = operand("a", &o.a, scene, meshes, parts)?;
     let b = operand("b", &o.b, scene, meshes, parts)?;
     Ok(CsgNode::Op { op, a: Box::new(a), b: Box::new(b) })
+}
+
+/// The index of the material called `name` in `[materials]`, `None` when no
+/// name is given. `where_` names the place for the message when no material
+/// has that name (made only then).
+fn material_index(scene: &Scene, name: Option<&str>, where_: impl FnOnce() -> String) -> Result<Option<u32>, String> {
+    let Some(name) = name else { return Ok(None) };
+    match scene.materials.iter().position(|m| m.name == name) {
+        Some(index) => Ok(Some(index as u32)),
+        None => Err(format!("{}: material \"{name}\" is not defined in [materials]", where_())),
+    }
 }
 
 fn placement(o: &ObjectDesc, where_: &str) -> Result<Placement, String> {
