@@ -13,6 +13,7 @@ pub mod finite;
 pub mod frame;
 pub mod gi;
 pub mod kd_tree;
+pub mod keyed_cache;
 pub mod layer_support;
 pub mod lighting;
 pub mod normal_map;

@@ -135,10 +135,4 @@ impl PreparedScene {
             prepared_bytes: self.edges.memory_bytes(),
         }
     }
-
-    /// The photon map for the scene's current lights and materials and the
-    /// photon settings `gi`, from the cache or built now.
-    pub fn photon_map(&self, gi: &super::gi::GiSettings, bump: f32) -> std::sync::Arc<super::photon_map::PhotonMap> {
-        self.photon_cache.get(self, gi, bump)
-    }
 }
