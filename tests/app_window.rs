@@ -20,6 +20,8 @@ fn run_windowed(args: &[&str]) -> Option<std::process::Output> {
         let mut c = Command::new("xvfb-run");
         c.args(["-a", "-s", "-screen 0 1280x800x24", exe]);
         c
+    } else if std::env::var("PINHOLE_REQUIRE_GL").is_ok_and(|v| v == "1") {
+        panic!("PINHOLE_REQUIRE_GL=1 but there is no DISPLAY and no xvfb-run to open a window");
     } else {
         eprintln!("note: app_window skipped: no DISPLAY and no xvfb-run (apt-get install xvfb libgl1-mesa-dri)");
         return None;

@@ -441,7 +441,7 @@ fn grove_copies_out_of_view_cost_the_ray_tracer_the_log_of_their_count() {
 /// for smooth and flat normals, mirrored copies included.
 #[test]
 fn copies_placed_corner_by_corner_are_the_triangles_placed_one_by_one() {
-    use pinhole::scene::file::Placement;
+    use pinhole::scene::placement::Placement;
     use pinhole::scene::obj::{load_obj, MtlTextures, NormalMode};
     use glam::Vec3;
     let d = dir();

@@ -11,7 +11,9 @@
 //! force's pixels exactly (tested with the BVH), in a fraction of the time.
 //!
 //! Without a usable OpenGL driver the tests print why and pass: the
-//! renderer then refuses with one sentence, which is checked instead.
+//! renderer then refuses with one sentence, which is checked instead. With
+//! `PINHOLE_REQUIRE_GL=1` (as CI runs them) a missing driver fails them
+//! instead (see `driver`).
 
 use pinhole::math::{Radiance, Vec3};
 use pinhole::render::{render_frame, renderer_by_name, Interpolation, PreparedScene, RenderSettings, Renderer, ShadowMode};
@@ -44,10 +46,18 @@ fn close(a: Vec3, b: Vec3) -> bool {
     d.x <= 1e-3 * m.x + 1e-6 && d.y <= 1e-3 * m.y + 1e-6 && d.z <= 1e-3 * m.z + 1e-6
 }
 
-/// The driver, or `None` after printing why the test is skipped.
+/// Set to `1` where a driver must exist (CI installs Mesa): a test that
+/// would skip for want of one fails instead.
+const REQUIRE_GL: &str = "PINHOLE_REQUIRE_GL";
+
+/// The driver, or `None` after printing why the test is skipped. Every test
+/// that needs GL starts here. Panics instead of skipping when
+/// `PINHOLE_REQUIRE_GL=1`, so that a machine meant to run these tests
+/// cannot pass them without running them.
 fn driver() -> Option<String> {
     match pinhole::render::opengl::driver() {
         Ok(d) => Some(d),
+        Err(e) if std::env::var(REQUIRE_GL).is_ok_and(|v| v == "1") => panic!("{REQUIRE_GL}=1 but there is no OpenGL driver: {e}"),
         Err(e) => {
             eprintln!("skipped: {e}");
             None

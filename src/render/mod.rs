@@ -11,6 +11,7 @@ pub mod finite;
 pub mod frame;
 pub mod gi_settings;
 pub mod inspect;
+pub mod keyed_cache;
 pub mod layer_support;
 pub mod opengl;
 pub mod prepared;

@@ -92,10 +92,4 @@ impl PreparedScene {
             prepared_bytes: self.edges.memory_bytes(),
         }
     }
-
-    /// The photon map for the scene's current lights and materials and the
-    /// photon settings `gi`, from the cache or built now.
-    pub fn photon_map(&self, gi: &crate::render::transport::gi::GiSettings, bump: f32) -> std::sync::Arc<crate::render::transport::photon_map::PhotonMap> {
-        self.photon_cache.get(self, gi, bump)
-    }
 }

@@ -96,17 +96,6 @@ impl Csg {
         let center = (self.lo + self.hi) * 0.5;
         Sphere { center, radius: ((self.hi - self.lo) * 0.5).length().max(1e-6), material: 0, object: self.object }
     }
-
-    /// Number of leaves (operands that are solids), in the order `leaf_name` numbers them.
-    pub fn leaf_count(&self) -> usize {
-        fn count(n: &CsgNode) -> usize {
-            match n {
-                CsgNode::Op { a, b, .. } => count(a) + count(b),
-                _ => 1,
-            }
-        }
-        count(&self.root)
-    }
 }
 
 /// Whether the triangles form a closed surface: every edge, by its end

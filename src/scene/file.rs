@@ -6,6 +6,7 @@ use crate::scene::mesh_cache::MeshCache;
 use crate::scene::obj::{self, NormalMode};
 use crate::scene::texture::{load_texture_as, Encoding, Wrap};
 use crate::scene::instanced::{InstanceLayer, LayerInstance};
+use crate::scene::placement::Placement;
 use crate::scene::{Camera, Fov, InstanceInfo, Light, Material, ObjectInfo, RenderDefaults, Scene, Sphere, Triangle};
 use crate::input::{MAX_COORDINATE, MAX_LIGHT, MAX_VALUE};
 use crate::math::{Vec2, Vec3};
@@ -442,16 +443,7 @@ fn add_object(
     }
     let two_sided = o.two_sided.unwrap_or(false);
     let placement = placement(o, where_)?;
-    let explicit_material = match &o.material {
-        Some(name) => Some(
-            scene
-                .materials
-                .iter()
-                .position(|m| &m.name == name)
-                .ok_or(format!("{where_}: material \"{name}\" is not defined in [materials]"))? as u32,
-        ),
-        None => None,
-    };
+    let explicit_material = material_index(scene, o.material.as_deref(), || where_.to_string())?;
     let first = scene.triangles.len();
     let kind = o.kind.as_str();
     let only = |allowed: &[&str]| -> Result<(), String> {
@@ -703,16 +695,7 @@ fn copies(
         let placement = placement_of(d.translate, d.rotate_deg, d.scale.as_ref(), "").map_err(|_| {
             placement_of(d.translate, d.rotate_deg, d.scale.as_ref(), &here()).err().unwrap_or_default()
         })?;
-        let material = match &d.material {
-            Some(name) => Some(
-                scene
-                    .materials
-                    .iter()
-                    .position(|m| &m.name == name)
-                    .ok_or_else(|| format!("{}: material \"{name}\" is not defined in [materials]", here()))? as u32,
-            ),
-            None => object_material,
-        };
+        let material = material_index(scene, d.material.as_deref(), here)?.or(object_material);
         out.push(MeshCopy { placement: Some(placement), material, index: Some(k as u32) });
     }
     Ok(out)
@@ -747,16 +730,7 @@ fn csg_node(
     parts: &mut CsgParts,
 ) -> Result<crate::scene::csg::CsgNode, String> {
     use crate::scene::csg::{CsgNode, CsgOp, MAX_DEPTH};
-    let material = match &o.material {
-        Some(name) => Some(
-            scene
-                .materials
-                .iter()
-                .position(|m| &m.name == name)
-                .ok_or(format!("{where_}: material \"{name}\" is not defined in [materials]"))? as u32,
-        ),
-        None => inherited,
-    };
+    let material = material_index(scene, o.material.as_deref(), || where_.to_string())?.or(inherited);
     if depth >= MAX_DEPTH {
         return Err(format!("{where_}: csg operations are nested more than {MAX_DEPTH} deep"));
     }
@@ -809,94 +783,14 @@ fn csg_node(
     Ok(CsgNode::Op { op, a: Box::new(a), b: Box::new(b) })
 }
 
-/// Object placement: scale, then rotate about X, Y, Z, then translate.
-#[derive(Clone, Debug)]
-pub struct Placement {
-    matrix: glam::Mat4,
-    normal_matrix: glam::Mat3,
-    uniform_scale: Option<f32>,
-    identity: bool,
-    /// The matrix mirrors (negative determinant).
-    flips: bool,
-}
-
-impl Placement {
-    pub fn new(translate: Vec3, rotate_deg: Vec3, scale: Vec3) -> Placement {
-        let rot = glam::Quat::from_rotation_z(rotate_deg.z.to_radians())
-            * glam::Quat::from_rotation_y(rotate_deg.y.to_radians())
-            * glam::Quat::from_rotation_x(rotate_deg.x.to_radians());
-        let matrix = glam::Mat4::from_scale_rotation_translation(scale, rot, translate);
-        let normal_matrix = glam::Mat3::from_mat4(matrix).inverse().transpose();
-        let uniform_scale = (scale.x == scale.y && scale.y == scale.z).then_some(scale.x);
-        let identity = translate == Vec3::ZERO && rotate_deg == Vec3::ZERO && scale == Vec3::ONE;
-        let flips = matrix.determinant() < 0.0;
-        Placement { matrix, normal_matrix, uniform_scale, identity, flips }
-    }
-
-    /// The 4x4 matrix of the placement.
-    pub fn matrix(&self) -> glam::Mat4 {
-        self.matrix
-    }
-
-    /// The vertices `apply` gives, alone (the normals left out).
-    #[inline]
-    pub fn apply_vertices(&self, v: [Vec3; 3]) -> [Vec3; 3] {
-        if self.identity {
-            return v;
-        }
-        let mut w = v.map(|p| self.matrix.transform_point3(p));
-        if self.flips {
-            w.swap(1, 2);
-        }
-        w
-    }
-
-    /// The triangle placed: vertices by the matrix, normals by its inverse
-    /// transpose, corners reordered when the placement mirrors.
-    /// One corner's position and normal placed as `apply` places them (a
-    /// flat triangle's normal aside, which `apply` makes anew).
-    #[inline]
-    pub fn apply_corner(&self, p: Vec3, n: Vec3) -> (Vec3, Vec3) {
-        if self.identity {
-            return (p, n);
-        }
-        (self.matrix.transform_point3(p), (self.normal_matrix * n).normalize_or_zero())
-    }
-
-    /// Whether the placement mirrors, so that `apply` reverses windings.
-    pub fn flips(&self) -> bool {
-        !self.identity && self.flips
-    }
-
-    pub fn apply(&self, mut t: Triangle) -> Triangle {
-        if self.identity {
-            return t;
-        }
-        // A mirroring scale flips the winding; swap two corners to keep fronts in front.
-        let flips = self.flips;
-        let flat = t.is_flat();
-        for k in 0..3 {
-            t.v[k] = self.matrix.transform_point3(t.v[k]);
-            t.n[k] = (self.normal_matrix * t.n[k]).normalize_or_zero();
-        }
-        if flips {
-            t.v.swap(1, 2);
-            t.n.swap(1, 2);
-            t.uv.swap(1, 2);
-        }
-        // A flat triangle stays flat: its normal is the placed triangle's own
-        // (equal to the transformed one up to rounding).
-        if flat {
-            t.n = [t.geometric_normal(); 3];
-        }
-        t
-    }
-
-    fn apply_sphere(&self, center: Vec3, radius: f32) -> Result<(Vec3, f32), String> {
-        match self.uniform_scale {
-            Some(s) => Ok((self.matrix.transform_point3(center), radius * s.abs())),
-            None => Err("a sphere's scale must be one number (non-uniform scale would not keep it a sphere)".into()),
-        }
+/// The index of the material called `name` in `[materials]`, `None` when no
+/// name is given. `where_` names the place for the message when no material
+/// has that name (made only then).
+fn material_index(scene: &Scene, name: Option<&str>, where_: impl FnOnce() -> String) -> Result<Option<u32>, String> {
+    let Some(name) = name else { return Ok(None) };
+    match scene.materials.iter().position(|m| m.name == name) {
+        Some(index) => Ok(Some(index as u32)),
+        None => Err(format!("{}: material \"{name}\" is not defined in [materials]", where_())),
     }
 }
 

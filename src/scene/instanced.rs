@@ -9,7 +9,7 @@
 //! world-space triangle of any index with the very arithmetic flattening
 //! uses, so a copy renders as its flattened triangles would.
 
-use crate::scene::file::Placement;
+use crate::scene::placement::Placement;
 use crate::scene::Triangle;
 use std::sync::Arc;
 

@@ -15,6 +15,7 @@ pub mod load;
 pub mod mesh_cache;
 pub mod material;
 pub mod obj;
+pub mod placement;
 pub mod recentre;
 pub mod tangents;
 pub mod texture;

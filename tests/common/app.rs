@@ -24,3 +24,19 @@ pub fn new_harness(scene: Scene) -> Harness<'static, PinholeApp> {
         .with_size([1280.0, 800.0])
         .build_ui_state(|ui: &mut egui::Ui, app: &mut PinholeApp| app.ui(ui), app)
 }
+
+/// Whether an OpenGL driver exists; prints why a test is skipped when none
+/// does. With `PINHOLE_REQUIRE_GL=1` (CI installs Mesa and sets it) a
+/// missing driver panics instead, so such a machine cannot pass a GL test
+/// without running it.
+#[allow(dead_code)] // not every viewer test draws with GL
+pub fn have_gl() -> bool {
+    match pinhole::render::opengl::driver() {
+        Ok(_) => true,
+        Err(e) if std::env::var("PINHOLE_REQUIRE_GL").is_ok_and(|v| v == "1") => panic!("PINHOLE_REQUIRE_GL=1 but there is no OpenGL driver: {e}"),
+        Err(e) => {
+            eprintln!("skipped: {e}");
+            false
+        }
+    }
+}

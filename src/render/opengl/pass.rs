@@ -83,37 +83,11 @@ struct Target {
     surfaces: Vec<glow::Texture>,
 }
 
-pub(super) unsafe fn compile(gl: &glow::Context, vertex: &str, fragment: &str) -> Result<glow::Program, String> {
-    unsafe {
-        let program = gl.create_program()?;
-        let mut shaders = Vec::new();
-        for (kind, source) in [(glow::VERTEX_SHADER, vertex), (glow::FRAGMENT_SHADER, fragment)] {
-            let shader = gl.create_shader(kind)?;
-            gl.shader_source(shader, source);
-            gl.compile_shader(shader);
-            if !gl.get_shader_compile_status(shader) {
-                return Err(format!("a shader did not compile: {}", gl.get_shader_info_log(shader)));
-            }
-            gl.attach_shader(program, shader);
-            shaders.push(shader);
-        }
-        gl.link_program(program);
-        if !gl.get_program_link_status(program) {
-            return Err(format!("a program did not link: {}", gl.get_program_info_log(program)));
-        }
-        for s in shaders {
-            gl.detach_shader(program, s);
-            gl.delete_shader(s);
-        }
-        Ok(program)
-    }
-}
-
 impl State {
     unsafe fn new(gl: &glow::Context) -> Result<State, String> {
         unsafe {
-            let background = compile(gl, shaders::BACKGROUND_VERTEX, &shaders::background_fragment())?;
-            let maps = crate::render::opengl::shadow_pass::ShadowPass::new(gl)?;
+            let background = shaders::compile(gl, shaders::BACKGROUND_VERTEX, &shaders::background_fragment())?;
+            let maps = super::shadow_pass::ShadowPass::new(gl)?;
             let vertex_array = gl.create_vertex_array()?;
             let vertex_buffer = gl.create_buffer()?;
             gl.bind_vertex_array(Some(vertex_array));
@@ -139,7 +113,7 @@ impl State {
             let cube_buffer = gl.create_buffer()?;
             gl.bind_vertex_array(Some(cube_array));
             gl.bind_buffer(glow::ARRAY_BUFFER, Some(cube_buffer));
-            gl.buffer_data_u8_slice(glow::ARRAY_BUFFER, bytes(&scene_data::cube_corners()), glow::STATIC_DRAW);
+            gl.buffer_data_u8_slice(glow::ARRAY_BUFFER, bytemuck::cast_slice(&scene_data::cube_corners()), glow::STATIC_DRAW);
             gl.enable_vertex_attrib_array(0);
             gl.vertex_attrib_pointer_f32(0, 3, glow::FLOAT, false, 12, 0);
             gl.bind_vertex_array(None);
@@ -174,10 +148,10 @@ impl State {
         unsafe {
             let fragment = shaders::triangle_fragment(defines);
             let p = Programs {
-                triangles: compile(gl, &shaders::triangle_vertex(defines), &fragment)?,
-                spheres: compile(gl, shaders::SPHERE_VERTEX, &shaders::sphere_fragment(defines))?,
-                copies: compile(gl, &shaders::triangle_vertex(&format!("{defines}#define INSTANCED 1\n")), &fragment)?,
-                csg: compile(gl, shaders::CSG_VERTEX, &shaders::csg_fragment(defines))?,
+                triangles: shaders::compile(gl, &shaders::triangle_vertex(defines), &fragment)?,
+                spheres: shaders::compile(gl, shaders::SPHERE_VERTEX, &shaders::sphere_fragment(defines))?,
+                copies: shaders::compile(gl, &shaders::triangle_vertex(&format!("{defines}#define INSTANCED 1\n")), &fragment)?,
+                csg: shaders::compile(gl, shaders::CSG_VERTEX, &shaders::csg_fragment(defines))?,
             };
             self.programs.push((defines.to_string(), p));
             Ok(p)
@@ -195,7 +169,7 @@ impl State {
         let g = scene_data::layer_geometry(layer);
         unsafe {
             gl.bind_buffer(glow::ARRAY_BUFFER, Some(self.layer_buffer));
-            gl.buffer_data_u8_slice(glow::ARRAY_BUFFER, bytes(&g.vertices), glow::STATIC_DRAW);
+            gl.buffer_data_u8_slice(glow::ARRAY_BUFFER, bytemuck::cast_slice(&g.vertices), glow::STATIC_DRAW);
         }
         self.layer = Some((layer.clone(), g.meshes.clone()));
         g.meshes
@@ -278,18 +252,13 @@ impl State {
         let g = scene_data::geometry(scene);
         unsafe {
             gl.bind_buffer(glow::ARRAY_BUFFER, Some(self.vertex_buffer));
-            gl.buffer_data_u8_slice(glow::ARRAY_BUFFER, bytes(&g.vertices), glow::STATIC_DRAW);
+            gl.buffer_data_u8_slice(glow::ARRAY_BUFFER, bytemuck::cast_slice(&g.vertices), glow::STATIC_DRAW);
             gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(self.sphere_buffer));
             let spheres = if g.spheres.is_empty() { vec![0.0; 8] } else { g.spheres };
-            gl.buffer_data_u8_slice(glow::SHADER_STORAGE_BUFFER, bytes(&spheres), glow::STATIC_DRAW);
+            gl.buffer_data_u8_slice(glow::SHADER_STORAGE_BUFFER, bytemuck::cast_slice(&spheres), glow::STATIC_DRAW);
         }
         self.uploaded = Some((key, g.runs, scene.spheres.len()));
     }
-}
-
-pub(super) fn bytes(v: &[f32]) -> &[u8] {
-    // SAFETY: f32 has no padding and u8 has alignment 1.
-    unsafe { std::slice::from_raw_parts(v.as_ptr().cast::<u8>(), std::mem::size_of_val(v)) }
 }
 
 /// Sets the uniforms both programs share.
@@ -382,9 +351,9 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Opt
             Vec::new()
         };
         gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(state.material_buffer));
-        gl.buffer_data_u8_slice(glow::SHADER_STORAGE_BUFFER, bytes(&scene_data::materials(scene)), glow::DYNAMIC_DRAW);
+        gl.buffer_data_u8_slice(glow::SHADER_STORAGE_BUFFER, bytemuck::cast_slice(&scene_data::materials(scene)), glow::DYNAMIC_DRAW);
         gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(state.light_buffer));
-        gl.buffer_data_u8_slice(glow::SHADER_STORAGE_BUFFER, bytes(&scene_data::lights(scene, &first_faces)), glow::DYNAMIC_DRAW);
+        gl.buffer_data_u8_slice(glow::SHADER_STORAGE_BUFFER, bytemuck::cast_slice(&scene_data::lights(scene, &first_faces)), glow::DYNAMIC_DRAW);
         gl.bind_buffer_base(glow::SHADER_STORAGE_BUFFER, 0, Some(state.material_buffer));
         gl.bind_buffer_base(glow::SHADER_STORAGE_BUFFER, 1, Some(state.light_buffer));
         gl.bind_buffer_base(glow::SHADER_STORAGE_BUFFER, 2, Some(state.sphere_buffer));
@@ -517,7 +486,7 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Opt
             rows.len() as i32,
             glow::RGBA,
             glow::FLOAT,
-            glow::PixelPackData::Slice(Some(bytes_mut(&mut pixels))),
+            glow::PixelPackData::Slice(Some(bytemuck::cast_slice_mut(&mut pixels))),
         );
         let surfaces = views.then(|| crate::render::opengl::views::Readback::read(gl, first_gl_row, width, rows.len() as u32));
         if views {
@@ -574,7 +543,7 @@ unsafe fn draw_csgs(gl: &glow::Context, state: &mut State, program: glow::Progra
         if state.csg_uploaded.as_ref() != Some(&data) {
             for (buffer, floats) in state.csg_buffers.iter().zip([&data.objects, &data.nodes, &data.spheres, &data.triangles]) {
                 gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(*buffer));
-                gl.buffer_data_u8_slice(glow::SHADER_STORAGE_BUFFER, bytes(floats), glow::STATIC_DRAW);
+                gl.buffer_data_u8_slice(glow::SHADER_STORAGE_BUFFER, bytemuck::cast_slice(floats), glow::STATIC_DRAW);
             }
             state.csg_uploaded = Some(data);
         }
@@ -630,7 +599,7 @@ unsafe fn draw_copies(
             return;
         }
         gl.bind_buffer(glow::ARRAY_BUFFER, Some(state.instance_buffer));
-        gl.buffer_data_u8_slice(glow::ARRAY_BUFFER, bytes(&floats), glow::STREAM_DRAW);
+        gl.buffer_data_u8_slice(glow::ARRAY_BUFFER, bytemuck::cast_slice(&floats), glow::STREAM_DRAW);
         gl.use_program(Some(program));
         uniforms(gl, program, job, environment);
         if mapped {
@@ -653,9 +622,4 @@ unsafe fn draw_copies(
         }
         gl.front_face(if y_down { glow::CW } else { glow::CCW });
     }
-}
-
-pub(super) fn bytes_mut(v: &mut [f32]) -> &mut [u8] {
-    // SAFETY: every bit pattern is a valid f32 and u8 has alignment 1.
-    unsafe { std::slice::from_raw_parts_mut(v.as_mut_ptr().cast::<u8>(), std::mem::size_of_val(v)) }
 }

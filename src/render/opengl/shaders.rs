@@ -1,6 +1,37 @@
 //! The GLSL programs: `shade()` of the CPU renderers (`render::transport::lighting`)
 //! written again for the fragment shader, a triangle program and an exact
-//! sphere program (a bounding cube whose fragments intersect the sphere).
+//! sphere program (a bounding cube whose fragments intersect the sphere),
+//! and their compilation into GL programs (`compile`).
+
+use glow::HasContext;
+
+/// The program linked from a vertex and a fragment shader's sources; the
+/// shaders are let go once linked.
+pub(super) unsafe fn compile(gl: &glow::Context, vertex: &str, fragment: &str) -> Result<glow::Program, String> {
+    unsafe {
+        let program = gl.create_program()?;
+        let mut shaders = Vec::new();
+        for (kind, source) in [(glow::VERTEX_SHADER, vertex), (glow::FRAGMENT_SHADER, fragment)] {
+            let shader = gl.create_shader(kind)?;
+            gl.shader_source(shader, source);
+            gl.compile_shader(shader);
+            if !gl.get_shader_compile_status(shader) {
+                return Err(format!("a shader did not compile: {}", gl.get_shader_info_log(shader)));
+            }
+            gl.attach_shader(program, shader);
+            shaders.push(shader);
+        }
+        gl.link_program(program);
+        if !gl.get_program_link_status(program) {
+            return Err(format!("a program did not link: {}", gl.get_program_info_log(program)));
+        }
+        for s in shaders {
+            gl.detach_shader(program, s);
+            gl.delete_shader(s);
+        }
+        Ok(program)
+    }
+}
 
 /// What both fragment shaders share: the eye ray through this fragment's
 /// sample position, computed as `CameraView::eye_ray` computes it, and the

@@ -7,8 +7,7 @@
 //! away from the light, as the CPU maps draw them. The fragment shaders look
 //! the maps up as `ShadowMaps::occluder` does (`shaders`, `shadowed`).
 
-use crate::render::opengl::pass::{bytes, compile};
-use crate::render::opengl::shaders;
+use crate::render::opengl::shaders::{self, compile};
 use crate::render::shadow::map::light_views;
 use crate::render::RenderSettings;
 use crate::scene::{CameraView, Light, Scene};
@@ -96,7 +95,7 @@ impl ShadowPass {
                 data.resize(20, 0.0);
             }
             gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(self.face_buffer));
-            gl.buffer_data_u8_slice(glow::SHADER_STORAGE_BUFFER, bytes(&data), glow::DYNAMIC_DRAW);
+            gl.buffer_data_u8_slice(glow::SHADER_STORAGE_BUFFER, bytemuck::cast_slice(&data), glow::DYNAMIC_DRAW);
 
             gl.bind_framebuffer(glow::FRAMEBUFFER, Some(self.framebuffer));
             gl.framebuffer_renderbuffer(glow::FRAMEBUFFER, glow::DEPTH_ATTACHMENT, glow::RENDERBUFFER, Some(depth));

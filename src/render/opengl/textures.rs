@@ -89,7 +89,7 @@ impl Textures {
                 return Err(format!("the scene's textures take {} MB, more than the driver's {} MB storage buffers", texels.len() * 4 >> 20, max >> 20));
             }
             gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(self.texels));
-            gl.buffer_data_u8_slice(glow::SHADER_STORAGE_BUFFER, crate::render::opengl::pass::bytes(&texels), glow::STATIC_DRAW);
+            gl.buffer_data_u8_slice(glow::SHADER_STORAGE_BUFFER, bytemuck::cast_slice(&texels), glow::STATIC_DRAW);
             gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(self.levels));
             let level_bytes = std::slice::from_raw_parts(levels.as_ptr().cast::<u8>(), std::mem::size_of_val(levels.as_slice()));
             gl.buffer_data_u8_slice(glow::SHADER_STORAGE_BUFFER, level_bytes, glow::STATIC_DRAW);

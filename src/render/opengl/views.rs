@@ -43,7 +43,7 @@ impl Readback {
                     rows as i32,
                     glow::RGBA,
                     glow::FLOAT,
-                    glow::PixelPackData::Slice(Some(crate::render::opengl::pass::bytes_mut(&mut buf))),
+                    glow::PixelPackData::Slice(Some(bytemuck::cast_slice_mut(&mut buf))),
                 );
                 floats.push(buf);
             }

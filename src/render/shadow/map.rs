@@ -49,14 +49,13 @@ use crate::render::raster::rect::{sample_span, PixelRect};
 use crate::render::raster::setup::{bin_rows, ScreenTri};
 use crate::render::raster::subpixel::snap_offset;
 use crate::render::raster::sphere::sphere_bounds;
+use crate::render::keyed_cache::{KeyedCache, ThreadCopy};
 use crate::render::inspect::pixel_record::Recorder;
 use crate::render::{Occluder, PassJob, PreparedScene, RayCounts, RenderSettings, SceneQuery};
 use crate::math::{Radiance, Ray, Vec2, Vec3};
 use crate::scene::{Camera, CameraView, Fov, Light, PrimitiveId, Scene, Sphere, SurfaceHit, Triangle};
 use rayon::prelude::*;
-use std::cell::RefCell;
-use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 use std::time::Instant;
 
 /// Texels per side of each map (per cube face for point lights).
@@ -638,34 +637,15 @@ fn sphere_entry(o: Vec3, d: Vec3, c: Vec3, radius: f32, ortho: bool) -> Option<f
     (t > 0.0).then_some(t)
 }
 
-/// The last shadow maps built for a `PreparedScene`, keyed by `shadow_map_size`
-/// and the lights. `id` tells one prepared scene's cache from another's.
-pub struct ShadowMapCache {
-    id: u64,
-    slot: Mutex<Option<Arc<ShadowMaps>>>,
-}
+/// The last shadow maps built for a `PreparedScene`, keyed by
+/// `shadow_map_size` (clamped) and the lights.
+pub type ShadowMapCache = KeyedCache<(u32, Vec<Light>), ShadowMaps>;
 
-impl Default for ShadowMapCache {
-    fn default() -> Self {
-        static NEXT: AtomicU64 = AtomicU64::new(1);
-        ShadowMapCache { id: NEXT.fetch_add(1, Ordering::Relaxed), slot: Mutex::new(None) }
-    }
-}
-
-impl ShadowMapCache {
-    /// The maps for `scene` at `size`, built now unless the cached ones match.
-    /// See `ShadowMaps::build` for `parallel`.
-    pub fn get(&self, scene: &Scene, size: u32, parallel: bool) -> Arc<ShadowMaps> {
-        let mut slot = self.slot.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some(m) = slot.as_ref() {
-            if m.matches(scene, size) {
-                return m.clone();
-            }
-        }
-        let m = Arc::new(ShadowMaps::build(scene, size, parallel));
-        *slot = Some(m.clone());
-        m
-    }
+/// The maps for `prepared` at `size`, built now unless the cached ones match.
+/// See `ShadowMaps::build` for `parallel`.
+fn cached_maps(prepared: &PreparedScene, size: u32, parallel: bool) -> Arc<ShadowMaps> {
+    let key = (size.clamp(1, MAX_SIZE), prepared.scene.lights.clone());
+    prepared.shadow_cache.get(key, |_| ShadowMaps::build(&prepared.scene, size, parallel))
 }
 
 impl PreparedScene {
@@ -673,13 +653,13 @@ impl PreparedScene {
     /// built now in parallel. Call it outside a parallel pass (before the
     /// frame); inside one, `with_maps` builds on the calling thread instead.
     pub fn shadow_maps(&self, size: u32) -> Arc<ShadowMaps> {
-        self.shadow_cache.get(&self.scene, size, true)
+        cached_maps(self, size, true)
     }
 }
 
 thread_local! {
     /// The maps this thread used last, so samples find them without a lock.
-    static CURRENT: RefCell<Option<(u64, Arc<ShadowMaps>)>> = const { RefCell::new(None) };
+    static CURRENT: ThreadCopy<ShadowMaps> = const { ThreadCopy::new() };
 }
 
 /// Runs `f` with the shadow maps for `prepared` and `settings`: from this
@@ -687,21 +667,8 @@ thread_local! {
 /// sample), else from the cache, built serially if missing.
 pub fn with_maps<T>(prepared: &PreparedScene, settings: &RenderSettings, f: impl FnOnce(&ShadowMaps) -> T) -> T {
     let size = settings.shadow_map_size;
-    let cache = &prepared.shadow_cache;
-    CURRENT.with(|cell| {
-        if let Ok(current) = cell.try_borrow() {
-            if let Some((id, maps)) = current.as_ref() {
-                if *id == cache.id && maps.matches(&prepared.scene, size) {
-                    return f(maps);
-                }
-            }
-        }
-        let maps = cache.get(&prepared.scene, size, false);
-        if let Ok(mut current) = cell.try_borrow_mut() {
-            *current = Some((cache.id, maps.clone()));
-        }
-        f(&maps)
-    })
+    let fits = |maps: &ShadowMaps| maps.matches(&prepared.scene, size);
+    CURRENT.with(|copy| copy.with(prepared.shadow_cache.id(), fits, || cached_maps(prepared, size, false), f))
 }
 
 /// A scene query that also answers shadow visibility from maps: `shade()`

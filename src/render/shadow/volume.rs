@@ -58,6 +58,7 @@
 //! the pixel's count as a stencil masks them). Every secondary hit (mirror,
 //! glass, indirect bounces) has no stencil and casts shadow rays instead.
 
+use crate::render::keyed_cache::{KeyedCache, ThreadCopy};
 use crate::render::inspect::pixel_record::Recorder;
 use crate::render::accel::bvh::Bvh;
 use crate::render::accel::intersect::{intersect_triangle, TriangleEdges};
@@ -65,9 +66,7 @@ use crate::render::{Occluder, PreparedScene, RayCounts, RenderSettings, SceneQue
 use crate::math::{Ray, Vec2, Vec3};
 use crate::named::named_enum;
 use crate::scene::{Light, Scene, Sphere, SurfaceHit, Triangle};
-use std::cell::RefCell;
-use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 use std::time::Instant;
 
 named_enum! {
@@ -329,63 +328,26 @@ fn volume_of_casters(casters: &[[Vec3; 3]], ex: &Extrude) -> Vec<[Vec3; 3]> {
 }
 
 /// The last shadow volumes built for a `PreparedScene`, keyed by the lights.
-pub struct ShadowVolumeCache {
-    id: u64,
-    slot: Mutex<Option<Arc<ShadowVolumes>>>,
-}
-
-impl Default for ShadowVolumeCache {
-    fn default() -> Self {
-        static NEXT: AtomicU64 = AtomicU64::new(1);
-        ShadowVolumeCache { id: NEXT.fetch_add(1, Ordering::Relaxed), slot: Mutex::new(None) }
-    }
-}
-
-impl ShadowVolumeCache {
-    pub fn get(&self, scene: &Scene) -> Arc<ShadowVolumes> {
-        let mut slot = self.slot.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some(v) = slot.as_ref() {
-            if v.matches(scene) {
-                return v.clone();
-            }
-        }
-        let v = Arc::new(ShadowVolumes::build(scene));
-        *slot = Some(v.clone());
-        v
-    }
-}
+pub type ShadowVolumeCache = KeyedCache<Vec<Light>, ShadowVolumes>;
 
 impl PreparedScene {
     /// The scene's shadow volumes, from the cache or built now. A frame
     /// builds them before its passes (`frame::build_shadow_volumes`).
     pub fn shadow_volumes(&self) -> Arc<ShadowVolumes> {
-        self.volume_cache.get(&self.scene)
+        self.volume_cache.get(self.scene.lights.clone(), |_| ShadowVolumes::build(&self.scene))
     }
 }
 
 thread_local! {
     /// The volumes this thread used last, so samples find them without a lock.
-    static CURRENT: RefCell<Option<(u64, Arc<ShadowVolumes>)>> = const { RefCell::new(None) };
+    static CURRENT: ThreadCopy<ShadowVolumes> = const { ThreadCopy::new() };
 }
 
 /// Runs `f` with the shadow volumes of `prepared`: this thread's last ones
 /// when they still match, else from the cache.
 pub fn with_volumes<T>(prepared: &PreparedScene, f: impl FnOnce(&ShadowVolumes) -> T) -> T {
-    let cache = &prepared.volume_cache;
-    CURRENT.with(|cell| {
-        if let Ok(current) = cell.try_borrow() {
-            if let Some((id, v)) = current.as_ref() {
-                if *id == cache.id && v.matches(&prepared.scene) {
-                    return f(v);
-                }
-            }
-        }
-        let v = cache.get(&prepared.scene);
-        if let Ok(mut current) = cell.try_borrow_mut() {
-            *current = Some((cache.id, v.clone()));
-        }
-        f(&v)
-    })
+    let fits = |v: &ShadowVolumes| v.matches(&prepared.scene);
+    CURRENT.with(|copy| copy.with(prepared.volume_cache.id(), fits, || prepared.shadow_volumes(), f))
 }
 
 /// A scene query whose light visibility for the primary surface comes from

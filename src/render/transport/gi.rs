@@ -8,7 +8,7 @@ use crate::render::transport::photon_map::PhotonMap;
 use crate::render::inspect::pixel_record::{Bounce, Recorder};
 use crate::render::transport::sampling::{cosine_hemisphere, from_local, luminance, SampleRng};
 use crate::render::{RayCounts, SceneQuery};
-use crate::math::{Radiance, Vec3};
+use crate::math::Vec3;
 use crate::scene::SurfaceHit;
 
 pub use crate::render::gi_settings::{GiMode, GiSettings, MAX_BOUNCES};
@@ -99,11 +99,6 @@ pub fn sample_bounce<R: Recorder>(
     }
     let (scale, _) = survival?;
     Some((s.w_i, s.weight * scale))
-}
-
-/// Radiance from the photon map at a diffuse point seen from `w_o`.
-pub fn photon_estimate(photons: &PhotonMap, hit: &SurfaceHit, material: &crate::scene::Material, albedo: Vec3, w_o: Vec3, k: u32) -> Radiance {
-    photons.radiance(hit, material, albedo, w_o, k as usize)
 }
 
 /// Choose between two delta lobes with weights `a` and `b` in proportion to

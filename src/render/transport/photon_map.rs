@@ -12,12 +12,13 @@ use crate::render::accel::bvh::BvhQuery;
 use crate::render::transport::sampling::{cosine_hemisphere, from_local, luminance, tangents, uniform_disk, uniform_sphere, SampleRng};
 use crate::render::transport::bsdf::{bsdf, mirror_direction, refraction};
 use crate::render::{PreparedScene, RayCounts, SceneQuery};
+use crate::render::keyed_cache::KeyedCache;
 use crate::math::{Radiance, Ray, Vec3};
 use crate::scene::{Light, Material, Scene, SurfaceHit};
 use rayon::prelude::*;
 use std::cell::RefCell;
 use std::f32::consts::PI;
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 /// One stored photon.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -44,12 +45,11 @@ pub struct PhotonMap {
     pub shot: u32,
     /// No photon farther than this (squared) enters an estimate.
     max_radius2: f32,
-    /// What the map was built from, to know when it must be rebuilt.
-    key: MapKey,
 }
 
+/// What a photon map is built from: when any of it changes, the map must be rebuilt.
 #[derive(Clone, Debug, PartialEq)]
-struct MapKey {
+pub struct MapKey {
     lights: Vec<Light>,
     /// Per material: the terms photons read (textures are never edited).
     materials: Vec<[f32; 13]>,
@@ -68,24 +68,14 @@ impl MapKey {
     }
 }
 
-/// The last map built for a prepared scene.
-#[derive(Default)]
-pub struct PhotonMapCache(Mutex<Option<Arc<PhotonMap>>>);
+/// The last map built for a prepared scene, keyed by what it was built from.
+pub type PhotonMapCache = KeyedCache<MapKey, PhotonMap>;
 
-impl PhotonMapCache {
-    /// The map for the scene as it is now, built (in parallel) if the cached
-    /// one was made from other lights, materials or settings.
-    pub fn get(&self, prepared: &PreparedScene, gi: &GiSettings, bump: f32) -> Arc<PhotonMap> {
-        let key = MapKey::of(&prepared.scene, gi, bump);
-        let mut cached = self.0.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some(map) = cached.as_ref() {
-            if map.key == key {
-                return map.clone();
-            }
-        }
-        let map = Arc::new(PhotonMap::build(prepared, gi, bump, key));
-        *cached = Some(map.clone());
-        map
+impl PreparedScene {
+    /// The photon map for the scene's current lights and materials and the
+    /// photon settings `gi`, from the cache or built now (in parallel).
+    pub fn photon_map(&self, gi: &GiSettings, bump: f32) -> Arc<PhotonMap> {
+        self.photon_cache.get(MapKey::of(&self.scene, gi, bump), |_| PhotonMap::build(self, gi, bump))
     }
 }
 
@@ -94,7 +84,7 @@ thread_local! {
 }
 
 impl PhotonMap {
-    fn build(prepared: &PreparedScene, gi: &GiSettings, bump: f32, key: MapKey) -> PhotonMap {
+    fn build(prepared: &PreparedScene, gi: &GiSettings, bump: f32) -> PhotonMap {
         let scene = &prepared.scene;
         let query = BvhQuery::new(prepared);
         let (center, radius) = match scene.bounds() {
@@ -149,7 +139,7 @@ impl PhotonMap {
         // The estimate's radius is capped at a tenth of the scene: beyond it,
         // a sparse map would smear light across whole walls.
         let max_radius2 = (0.1 * radius) * (0.1 * radius);
-        PhotonMap { tree, shot, max_radius2, key }
+        PhotonMap { tree, shot, max_radius2 }
     }
 
     /// Photons stored.
