@@ -66,7 +66,18 @@ impl Default for ViewerSettings {
 /// release's files (other fields are ignored when reading this).
 #[derive(serde::Deserialize)]
 struct SavedLayout {
-    render: Option<serde::de::IgnoredAny>,
+    #[serde(default)]
+    render: Present,
+}
+
+/// Whether a field was there, whatever its value.
+#[derive(Default)]
+struct Present(bool);
+
+impl<'de> serde::Deserialize<'de> for Present {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Present, D::Error> {
+        serde::de::IgnoredAny::deserialize(d).map(|_| Present(true))
+    }
 }
 
 impl ViewerSettings {
@@ -118,7 +129,7 @@ impl ViewerSettings {
     pub fn load(storage: Option<&dyn eframe::Storage>) -> Option<ViewerSettings> {
         let storage = storage?;
         let mut settings: ViewerSettings = eframe::get_value(storage, STORAGE_KEY)?;
-        if eframe::get_value::<SavedLayout>(storage, STORAGE_KEY)?.render.is_none() {
+        if !eframe::get_value::<SavedLayout>(storage, STORAGE_KEY)?.render.0 {
             // The same text read as a `RenderSettings`: it takes the knobs
             // it has a field for and ignores the rest.
             settings.render = eframe::get_value(storage, STORAGE_KEY)?;
