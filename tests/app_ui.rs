@@ -436,8 +436,18 @@ fn opengl_in_the_viewer_draws_what_render_frame_draws() {
     let mut h = harness(small_scene("teapot"));
     h.state_mut().settings.renderer = "opengl".into();
     settle(&mut h);
-    let error = h.state().with_output(|o| o.error.clone()).unwrap_or_default();
-    assert!(error.contains("--shadows none"), "shadow rays are refused in one sentence: {error:?}");
+    // Shadow rays (the default) are drawn as shadow maps, and the status bar says so.
+    let (error, notices) = h.state().with_output(|o| (o.error.clone(), o.notices.clone()));
+    assert_eq!(error, None);
+    let notice = "opengl cannot trace shadow rays; drawing shadow maps instead (--shadows map)";
+    assert_eq!(notices, vec![notice.to_string()]);
+    h.get_by_label(notice);
+    let substituted = shown(h.state());
+    h.state_mut().settings.render.shadows = pinhole::render::ShadowMode::Map;
+    settle(&mut h);
+    assert_eq!(shown(h.state()), substituted, "the image is the shadow maps'");
+    assert_eq!(substituted, reference(h.state()));
+    assert!(h.state().with_output(|o| o.notices.is_empty()), "asked for maps, nothing is substituted");
     h.state_mut().settings.render.shadows = pinhole::render::ShadowMode::None;
     settle(&mut h);
     let img = shown(h.state());
