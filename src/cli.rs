@@ -6,13 +6,16 @@ use crate::render;
 use crate::render::inspect::debug::View;
 use crate::render::{PreparedScene, RayCounts, RenderSettings, ShadowMode};
 use crate::scene::Scene;
-use clap::{Args, Parser, Subcommand};
+use clap::{Parser, Subcommand};
 use serde_json::json;
 use std::fmt::Write as _;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::Instant;
+
+mod render_opts;
+use render_opts::RenderOpts;
 
 #[derive(Parser)]
 #[command(name = "pinhole", version, about = "Watch a CPU ray tracer and a CPU rasterizer render the same scene.")]
@@ -117,113 +120,6 @@ enum Command {
     List,
 }
 
-#[derive(Args, Clone)]
-struct RenderOpts {
-    /// raytrace | rasterize, or a variant (see `pinhole list`).
-    #[arg(long, default_value = "raytrace")]
-    renderer: String,
-    #[arg(long)]
-    width: Option<u32>,
-    #[arg(long)]
-    height: Option<u32>,
-    /// Samples per pixel (stratified; 1 = the pixel centre).
-    #[arg(long, default_value_t = 1)]
-    spp: u32,
-    /// shaded | barycentric | raydir | depth | zbuffer | normal | id | uv | cost | diff | shadowmap | wireframe (see `pinhole list`)
-    #[arg(long, default_value = "shaded")]
-    view: String,
-    /// ray | map | volume | none (default: ray; none for the opengl renderer, which cannot cast rays)
-    #[arg(long)]
-    shadows: Option<String>,
-    /// Rasterizers: interpolate attributes affinely in screen space (no 1/z correction).
-    #[arg(long)]
-    affine: bool,
-    /// flat | gouraud | phong: how shading varies across a triangle.
-    #[arg(long, default_value = "phong")]
-    interpolation: String,
-    /// Worker threads (default: all cores).
-    #[arg(long)]
-    threads: Option<usize>,
-    /// Shadow-ray start offset along the ray (CGPP's rayBumpEpsilon).
-    #[arg(long, value_name = "EPS")]
-    bump: Option<f32>,
-    /// --shadows map: texels per side of each shadow map (per cube face for point lights).
-    #[arg(long = "shadow-map-size", value_name = "N")]
-    shadow_map_size: Option<u32>,
-    /// --shadows map: depth bias in texels, slope-scaled (too small: acne; too large: peter-panning).
-    #[arg(long = "shadow-bias", value_name = "B")]
-    shadow_bias: Option<f32>,
-    /// --shadows volume: count the volume faces in front of the visible
-    /// surface (zpass, wrong with the eye inside a shadow) or behind it (zfail).
-    #[arg(long = "shadow-volume", value_name = "zpass|zfail", default_value = "zfail")]
-    shadow_volume: String,
-    /// Rasterizers: coverage samples per pixel with one shade per pixel per
-    /// primitive: 1 (off), 2, 4 or 8. Ray casters ignore it (use --spp).
-    #[arg(long, default_value_t = 1, value_name = "N")]
-    msaa: u32,
-    /// Rasterizers: depth pass first, then one shade per pixel (false: forward shading).
-    #[arg(long = "early-depth", value_name = "BOOL", default_value_t = true, action = clap::ArgAction::Set)]
-    early_depth: bool,
-    /// Rasterizers: forward shading, every fragment that passes the depth test
-    /// is shaded (the same as --early-depth false).
-    #[arg(long)]
-    forward: bool,
-    /// Indirect light: none | ao | photons | path.
-    #[arg(long, default_value = "none")]
-    gi: String,
-    /// --gi path: indirect bounces, a number or `inf` (Mitsuba's max_depth = N + 2).
-    #[arg(long, default_value = "inf", value_name = "N|inf")]
-    bounces: String,
-    /// --gi ao: hemisphere rays per sample.
-    #[arg(long = "ao-samples", value_name = "N")]
-    ao_samples: Option<u32>,
-    /// --gi ao: how far the hemisphere rays look for occluders.
-    #[arg(long = "ao-distance", value_name = "D")]
-    ao_distance: Option<f32>,
-    /// --gi photons: photons shot from the lights.
-    #[arg(long, value_name = "N")]
-    photons: Option<u32>,
-    /// --gi photons: nearest photons per density estimate.
-    #[arg(long = "photon-k", value_name = "K")]
-    photon_k: Option<u32>,
-    /// --gi photons: rays gathered at the first hit (0: read the map there).
-    #[arg(long = "final-gather", value_name = "N")]
-    final_gather: Option<u32>,
-    /// Stochastic methods: the image depends on (scene, settings, seed) only.
-    #[arg(long, default_value_t = 0)]
-    seed: u64,
-    /// Adaptive sampling: pixels stop taking samples (of at most --spp) once
-    /// their estimated relative error is below TARGET (e.g. 0.05).
-    #[arg(long, value_name = "TARGET")]
-    adaptive: Option<f32>,
-    /// Sub-sampling: trace every N-th pixel in x and y (1, 2, 4, 8, 16) and
-    /// interpolate the pixels between.
-    #[arg(long, default_value_t = 1, value_name = "N")]
-    subsample: u32,
-    /// --subsample: also trace in full each grid cell whose corners differ in
-    /// contrast ((max - min) / (max + min), per channel) by more than C.
-    #[arg(long = "subsample-contrast", value_name = "C")]
-    subsample_contrast: Option<f32>,
-    /// Rasterizers: what the depth buffer stores: f32 | unorm24 | unorm16 | reversed.
-    #[arg(long = "depth-buffer", default_value = "f32", value_name = "FORMAT")]
-    depth_buffer: String,
-    /// --view wireframe: the line algorithm, float (DDA) | integer (Bresenham).
-    #[arg(long, default_value = "float")]
-    lines: String,
-    /// How textures are read: nearest | bilinear | trilinear (mipmapped).
-    #[arg(long = "texture-filter", default_value = "trilinear", value_name = "FILTER")]
-    texture_filter: String,
-    /// What mirrors reflect: ray (traced) | env (the environment in the reflected direction, no ray).
-    #[arg(long, default_value = "ray", value_name = "ray|env")]
-    reflections: String,
-    /// Rasterizers: clip triangles at the near plane only, or at every plane of the view volume.
-    #[arg(long, default_value = "near", value_name = "near|frustum")]
-    clip: String,
-    /// Rasterizers: cull copies made by `instances` by their bounding spheres (same image either way).
-    #[arg(long = "cull-instances", value_name = "BOOL", default_value_t = true, action = clap::ArgAction::Set)]
-    cull_instances: bool,
-}
-
 /// What is left to do once the command line ran: the viewer is not part of
 /// the core, so opening it is the caller's job.
 #[derive(Clone, Debug, PartialEq)]
@@ -281,19 +177,9 @@ const MAX_THREADS: usize = 256;
 
 fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
     let renderer = render::renderer_by_name(&opts.renderer)?;
-    let view = View::parse(&opts.view)?;
-    let shadows = match &opts.shadows {
-        Some(name) => ShadowMode::parse(name)?,
-        None if renderer.name() == "opengl" => ShadowMode::None,
-        None => ShadowMode::Ray,
-    };
-    let interpolation = render::Interpolation::parse(&opts.interpolation)?;
-    let texture_filter = crate::scene::texture::TextureFilter::parse(&opts.texture_filter).map_err(|e| format!("--texture-filter: {e}"))?;
-    let reflections = render::Reflections::parse(&opts.reflections).map_err(|e| format!("--reflections: {e}"))?;
-    let shadow_volume = render::shadow::volume::VolumeMode::parse(&opts.shadow_volume).map_err(|e| format!("--shadow-volume: {e}"))?;
-    if opts.spp == 0 || opts.spp > 65536 {
-        return Err(format!("--spp {} is not between 1 and 65536", opts.spp));
-    }
+    // The options are checked before the scene loads (which can take seconds)
+    // and written over the scene's settings once it has.
+    opts.write_into(&mut RenderSettings::default())?;
     let mut threads = opts.threads.unwrap_or(0);
     if opts.threads == Some(0) {
         return Err("--threads must be at least 1".into());
@@ -313,121 +199,15 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
         eprintln!("warning: {w}");
     }
     let mut settings = RenderSettings::for_scene(&scene);
-    for (flag, v) in [("--width", opts.width), ("--height", opts.height)] {
-        if let Some(v) = v {
-            if !(1..=16384).contains(&v) {
-                return Err(format!("{flag} {v} is not between 1 and 16384"));
-            }
-        }
+    opts.write_into(&mut settings)?;
+    let admitted = render::admit::admit(renderer.as_ref(), &scene, &settings)?;
+    // Said before the renderer loads its driver, which may fail.
+    for notice in &admitted.notices {
+        eprintln!("note: {notice}");
     }
-    settings.width = opts.width.unwrap_or(settings.width);
-    settings.height = opts.height.unwrap_or(settings.height);
-    crate::input::check_image_size(settings.width, settings.height).map_err(|e| format!("the image size {e}"))?;
-    settings.spp = opts.spp;
-    settings.view = view;
-    settings.shadows = shadows;
-    settings.shadow_volume = shadow_volume;
-    settings.interpolation = interpolation;
-    settings.texture_filter = texture_filter;
-    settings.reflections = reflections;
-    settings.clip = render::raster::clip::ClipMode::parse(&opts.clip).map_err(|e| format!("--clip: {e}"))?;
-    settings.cull_instances = opts.cull_instances;
-    settings.affine = opts.affine;
-    if let Some(b) = opts.bump {
-        if !(b.is_finite() && b >= 0.0) {
-            return Err(format!("--bump {b} must be a finite number >= 0"));
-        }
-        settings.shadow_bump = b;
-    }
-    if let Some(n) = opts.shadow_map_size {
-        if !(1..=render::shadow::map::MAX_SIZE).contains(&n) {
-            return Err(format!("--shadow-map-size {n} is not between 1 and {}", render::shadow::map::MAX_SIZE));
-        }
-        settings.shadow_map_size = n;
-    }
-    if let Some(b) = opts.shadow_bias {
-        if !(b.is_finite() && b >= 0.0) {
-            return Err(format!("--shadow-bias {b} must be a finite number of texels >= 0"));
-        }
-        settings.shadow_map_bias = b;
-    }
-    if !render::raster::msaa::COUNTS.contains(&opts.msaa) {
-        return Err(format!("--msaa {} is not one of 1, 2, 4, 8", opts.msaa));
-    }
-    settings.msaa = opts.msaa;
-    settings.early_depth = opts.early_depth && !opts.forward;
-    settings.gi = gi_settings(opts)?;
-    settings.depth_buffer = render::raster::depth_format::DepthFormat::parse(&opts.depth_buffer).map_err(|e| format!("--depth-buffer: {e}"))?;
-    settings.lines = render::inspect::wireframe::LineAlgorithm::parse(&opts.lines).map_err(|e| format!("--lines: {e}"))?;
-    if let Some(t) = opts.adaptive {
-        if !(t > 0.0 && t.is_finite()) {
-            return Err(format!("--adaptive {t} must be a relative error > 0 (e.g. 0.05)"));
-        }
-        settings.adaptive = Some(t);
-    }
-    if !render::frame::subsample::STEPS.contains(&opts.subsample) {
-        return Err(format!("--subsample {} is not one of 1, 2, 4, 8, 16", opts.subsample));
-    }
-    settings.subsample.step = opts.subsample;
-    if let Some(c) = opts.subsample_contrast {
-        if !(c >= 0.0 && c.is_finite()) {
-            return Err(format!("--subsample-contrast {c} must be a contrast >= 0 (e.g. 0.3)"));
-        }
-        if opts.subsample == 1 {
-            return Err("--subsample-contrast refines a sub-sampled frame: give --subsample 2, 4, 8 or 16 too".into());
-        }
-        settings.subsample.contrast = Some(c);
-    }
-    if settings.shadows == ShadowMode::Map {
-        render::shadow::map::check_memory(&scene, settings.shadow_map_size)?;
-    }
-    render::layer_support::check(renderer.name(), &scene, &settings)?;
-    renderer.check(&scene, &settings)?;
+    renderer.ready(&admitted.settings)?;
     let prepared = pool.install(|| PreparedScene::new(scene));
-    Ok(Loaded { prepared, settings, renderer, pool, load_ms })
-}
-
-/// The indirect-light options, checked.
-fn gi_settings(opts: &RenderOpts) -> Result<render::transport::gi::GiSettings, String> {
-    let mut gi = render::transport::gi::GiSettings { mode: render::transport::gi::GiMode::parse(&opts.gi)?, seed: opts.seed, ..Default::default() };
-    gi.bounces = match opts.bounces.as_str() {
-        "inf" => None,
-        n => match n.parse::<u32>() {
-            Ok(b) if b <= render::transport::gi::MAX_BOUNCES => Some(b),
-            _ => return Err(format!("--bounces {n} is neither inf nor a number from 0 to {}", render::transport::gi::MAX_BOUNCES)),
-        },
-    };
-    if let Some(n) = opts.ao_samples {
-        if !(1..=4096).contains(&n) {
-            return Err(format!("--ao-samples {n} is not between 1 and 4096"));
-        }
-        gi.ao_samples = n;
-    }
-    if let Some(d) = opts.ao_distance {
-        if !(d > 0.0) || d.is_nan() {
-            return Err(format!("--ao-distance {d} must be a number > 0 (inf allowed)"));
-        }
-        gi.ao_distance = d;
-    }
-    if let Some(n) = opts.photons {
-        if !(1..=50_000_000).contains(&n) {
-            return Err(format!("--photons {n} is not between 1 and 50000000"));
-        }
-        gi.photons = n;
-    }
-    if let Some(k) = opts.photon_k {
-        if !(1..=4096).contains(&k) {
-            return Err(format!("--photon-k {k} is not between 1 and 4096"));
-        }
-        gi.photon_k = k;
-    }
-    if let Some(n) = opts.final_gather {
-        if n > 4096 {
-            return Err(format!("--final-gather {n} is more than 4096"));
-        }
-        gi.final_gather = n;
-    }
-    Ok(gi)
+    Ok(Loaded { prepared, settings: admitted.settings, renderer, pool, load_ms })
 }
 
 fn stats_json(l: &Loaded, render_ms: f64, counts: &RayCounts, spp: u32) -> serde_json::Value {
@@ -728,7 +508,7 @@ fn cmd_chart(scene_arg: &str, output: &Path, renderers: &str, spp_list: &str, re
         }
     };
     let points = l.pool.install(|| {
-        crate::chart::spp_sweep::sweep(&l.prepared, &l.settings, &names, &spps, &reference_pixels, 3, |r, spp| eprintln!("measuring {r} at {spp} spp"))
+        crate::chart::spp_sweep::sweep(&l.prepared, &l.settings, &names, &spps, &reference_pixels, 3, |r, spp| eprintln!("measuring {r} at {spp} spp"), |n| eprintln!("note: {n}"))
     })?;
     let title = format!("{}: error against time, {w}x{h}, {} threads", l.prepared.scene.name, l.pool.current_num_threads());
     let png = crate::chart::plot::draw_spp_png(&points, &title, 900, 600)?;

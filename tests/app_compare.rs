@@ -61,7 +61,7 @@ fn the_compare_window_plots_every_configuration_and_a_click_applies_one() {
     let current = h.state().settings.clone();
     let (target, pos) = points
         .iter()
-        .filter(|(c, _)| c.renderer != current.renderer || c.settings.spp != current.spp || c.settings.gi != current.gi)
+        .filter(|(c, _)| c.renderer != current.renderer || c.settings.spp != current.render.spp || c.settings.gi != current.render.gi)
         .map(|(c, m)| (c.clone(), screen(m)))
         .find(|(_, p)| points.iter().filter(|(_, m)| screen(m).distance(*p) < 25.0).count() == 1)
         .expect("an isolated point");
@@ -139,12 +139,12 @@ fn the_wipe_shows_two_renderers_and_measures_their_difference() {
     {
         let app = h.state_mut();
         app.split.b.renderer = "rasterize:fixed".into();
-        app.split.b.shadows = pinhole::render::ShadowMode::None;
+        app.split.b.render.shadows = pinhole::render::ShadowMode::None;
     }
     settle(&mut h);
     let app = h.state();
     let (w, hgt) = app.image_size();
-    let b_settings = app.split.b_settings(&app.settings, &app.scene, w, hgt);
+    let b_settings = app.split.b_settings(&app.settings, w, hgt);
     let (_, _, b_image) = app.split.b_linear().expect("B rendered");
     assert_eq!(b_image, rendered(app, "rasterize:fixed", &b_settings), "B is the rasterizer's image");
     let a_image = app.with_output(|o| o.linear.clone());
@@ -173,8 +173,8 @@ fn the_wipe_shows_two_renderers_and_measures_their_difference() {
     settle(&mut h);
     let app = h.state();
     assert_eq!(app.settings.renderer, "rasterize:fixed");
-    assert_eq!(app.settings.shadows, pinhole::render::ShadowMode::None);
-    assert_eq!(app.split.b.shadows, pinhole::render::ShadowMode::Ray);
+    assert_eq!(app.settings.render.shadows, pinhole::render::ShadowMode::None);
+    assert_eq!(app.split.b.render.shadows, pinhole::render::ShadowMode::Ray);
     assert_eq!(app.with_output(|o| o.linear.clone()), b_image, "A now shows what B showed");
 
     // The difference view and closing.
@@ -194,7 +194,7 @@ fn the_viewer_shows_a_sub_sampled_frame() {
     let mut h = new_harness(small_scene("spheres"));
     settle(&mut h);
     let full = h.state().with_output(|o| o.linear.clone());
-    h.state_mut().settings.subsample = pinhole::render::frame::Subsample { step: 4, contrast: None };
+    h.state_mut().settings.render.subsample = pinhole::render::frame::Subsample { step: 4, contrast: None };
     settle(&mut h);
     let app = h.state();
     let settings = app.effective_settings();

@@ -3,7 +3,7 @@
 //! explanation; "apply cure" switches to the cure. The image shown is
 //! checked against `render_frame` of the case's own scene and settings.
 
-use egui_kittest::kittest::Queryable;
+use egui_kittest::kittest::{NodeT, Queryable};
 use egui_kittest::Harness;
 use pinhole::app::PinholeApp;
 use pinhole::math::Radiance;
@@ -84,4 +84,32 @@ fn a_case_whose_cure_moves_the_scene_opens_the_moved_scene() {
     h.get_by_label("leave").click();
     settle(&mut h);
     assert!(h.state().gallery.is_none());
+}
+
+/// Whether the radio button labelled `label` is the selected one.
+fn radio_selected(h: &Harness<'static, PinholeApp>, label: &str) -> bool {
+    h.get_by_label(label).accesskit_node().toggled() == Some(eframe::egui::accesskit::Toggled::True)
+}
+
+#[test]
+fn the_shading_panel_shows_the_shadow_setting_a_gallery_case_renders_with() {
+    let mut h = new_harness(small_scene("one-triangle"));
+    settle(&mut h);
+    assert!(radio_selected(&h, "ray") && !radio_selected(&h, "volume"), "ray shadows before the case");
+    open_case(&mut h, "zpass-eye-in-shadow");
+    // The case renders z-pass shadow volumes ...
+    let s = h.state().effective_settings();
+    assert_eq!((s.shadows, s.shadow_volume), (ShadowMode::Volume, render::shadow::volume::VolumeMode::ZPass));
+    // ... and the Shading panel says so.
+    assert!(radio_selected(&h, "volume"), "the shadows radio shows volume");
+    assert!(!radio_selected(&h, "ray"));
+    assert!(radio_selected(&h, "zpass") && !radio_selected(&h, "zfail"), "the volume count shows zpass");
+    // The cure shows z-fail there; leaving gives the user's ray shadows back.
+    h.get_by_label("apply cure").click();
+    settle(&mut h);
+    assert!(radio_selected(&h, "volume") && radio_selected(&h, "zfail"));
+    h.get_by_label("leave").click();
+    settle(&mut h);
+    assert!(radio_selected(&h, "ray") && !radio_selected(&h, "volume"));
+    assert_eq!(h.state().effective_settings().shadows, ShadowMode::Ray);
 }

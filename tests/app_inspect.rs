@@ -169,7 +169,7 @@ fn debug_views_show_their_legends() {
     }
     h.get_by_label("cost").click();
     settle(&mut h);
-    assert_eq!(h.state().settings.view, View::Cost);
+    assert_eq!(h.state().settings.render.view, View::Cost);
     assert!(has_label(&h, "cost: work per pixel"));
     assert!(has_label(&h, "log scale up to 1024"));
 
@@ -177,13 +177,13 @@ fn debug_views_show_their_legends() {
     let next = View::ALL[(View::ALL.iter().position(|v| *v == View::Cost).unwrap() + 1) % View::ALL.len()];
     h.key_press(egui::Key::V);
     settle(&mut h);
-    assert_eq!(h.state().settings.view, next);
+    assert_eq!(h.state().settings.render.view, next);
 
-    h.state_mut().settings.view = View::Depth;
+    h.state_mut().settings.render.view = View::Depth;
     settle(&mut h);
     assert!(has_label(&h, "depth: distance along the eye ray"));
     assert!(has_label(&h, "near = 0.100"), "near/far mapping shown");
-    h.state_mut().settings.view = View::Id;
+    h.state_mut().settings.render.view = View::Id;
     settle(&mut h);
     let name = h.state().scene.objects[0].name.clone();
     assert!(has_label(&h, &format!("0: {name}")), "id legend names the objects");
@@ -192,7 +192,7 @@ fn debug_views_show_their_legends() {
 #[test]
 fn hovering_and_the_selected_pixel_give_exact_cost_numbers() {
     let mut h = harness(small_scene("one-triangle"));
-    h.state_mut().settings.view = View::Cost;
+    h.state_mut().settings.render.view = View::Cost;
     settle(&mut h);
     let pos = pixel_pos(h.state(), 80, 50);
     click(&mut h, pos);
@@ -243,7 +243,7 @@ fn zooming_in_keeps_the_pixel_under_the_cursor_and_picks_pixels_exactly() {
 #[test]
 fn diff_view_counts_pixels_that_differ_from_brute_force() {
     let mut h = harness(small_scene("one-triangle"));
-    h.state_mut().settings.view = View::parse("diff").unwrap();
+    h.state_mut().settings.render.view = View::parse("diff").unwrap();
     settle(&mut h);
     // raytrace:bvh agrees with brute force: no differing pixel.
     assert_eq!(h.state().with_output(|o| o.differing_pixels), Some(0));

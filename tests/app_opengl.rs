@@ -38,7 +38,7 @@ fn opengl_in_the_viewer_matches_the_cli_and_reads_back_a_clicked_pixel() {
     let mut h = new_harness(small_scene("teapot"));
     settle(&mut h);
     h.state_mut().settings.renderer = "opengl".into();
-    h.state_mut().settings.shadows = pinhole::render::ShadowMode::None;
+    h.state_mut().settings.render.shadows = pinhole::render::ShadowMode::None;
     settle(&mut h);
     let (img, w, hgt) = h.state().with_output(|o| {
         assert!(o.complete && o.error.is_none(), "frame not complete: {:?}", o.error);

@@ -161,7 +161,7 @@ fn ctrl_s_exports_png_as_displayed_and_linear_exr() {
     let dir = std::env::temp_dir().join(format!("pinhole-app-export-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     // A debug view is exported as displayed, too.
-    h.state_mut().settings.view = render::inspect::debug::View::Barycentric;
+    h.state_mut().settings.render.view = render::inspect::debug::View::Barycentric;
     settle(&mut h);
     h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::S);
     h.step();
@@ -262,7 +262,7 @@ fn orbit_drag_moves_the_eye_around_the_target() {
 #[test]
 fn samples_accumulate_and_exposure_is_display_only() {
     let mut h = harness(small_scene("one-triangle"));
-    h.state_mut().settings.spp = 4;
+    h.state_mut().settings.render.spp = 4;
     settle(&mut h);
     let app = h.state();
     assert_eq!(app.with_output(|o| (o.passes, o.spp)), (4, 4));
@@ -283,7 +283,7 @@ fn shadow_map_mode_never_crashes_the_viewer() {
     let mut h = harness(small_scene("triangle-ground"));
     h.get_by_label("map").click();
     settle(&mut h);
-    assert_eq!(h.state().settings.shadows, render::ShadowMode::Map);
+    assert_eq!(h.state().settings.render.shadows, render::ShadowMode::Map);
     let status = pinhole::app::panels::status::status_text(h.state());
     assert!(status.contains("done") || status.contains("error"), "{status}");
     // And back to ray shadows renders normally.
@@ -302,13 +302,13 @@ fn shadow_maps_over_the_memory_limit_are_an_error_not_a_crash() {
     let mut h = harness(scene);
     {
         let app = h.state_mut();
-        app.settings.shadows = render::ShadowMode::Map;
-        app.settings.per_scene.shadow_map_size = 4096;
+        app.settings.render.shadows = render::ShadowMode::Map;
+        app.settings.render.shadow_map_size = 4096;
     }
     settle(&mut h);
     let error = h.state().with_output(|o| o.error.clone()).expect("an error");
     assert!(error.contains("shadow maps") && error.contains("MiB"), "{error}");
-    h.state_mut().settings.per_scene.shadow_map_size = 64;
+    h.state_mut().settings.render.shadow_map_size = 64;
     settle(&mut h);
     assert!(h.state().with_output(|o| o.error.is_none() && o.complete));
 }
@@ -318,7 +318,7 @@ fn settings_persist_between_runs() {
     use pinhole::app::settings_store::MemoryStorage as Mem;
     let mut app = PinholeApp::new_for_test(small_scene("one-triangle"));
     app.settings.renderer = "raytrace:brute".into();
-    app.settings.spp = 9;
+    app.settings.render.spp = 9;
     app.settings.gamma = false;
     app.settings.panels.materials = true;
     let mut mem = Mem::default();
@@ -327,7 +327,7 @@ fn settings_persist_between_runs() {
     let again = PinholeApp::new(small_scene("spheres"), "spheres".into(), Some(&p));
     assert_eq!(p.scene.as_deref(), Some("one-triangle"));
     assert_eq!(again.settings.renderer, "raytrace:brute");
-    assert_eq!(again.settings.spp, 9);
+    assert_eq!(again.settings.render.spp, 9);
     assert!(!again.settings.gamma && again.settings.panels.materials);
 }
 
@@ -384,20 +384,20 @@ fn rasterizer_knobs_in_the_shading_panel_reach_the_pixels() {
     // checker (screen-space interpolation), and MSAA 4x changes edge pixels.
     let mut h = harness(small_scene("teapot"));
     h.state_mut().settings.renderer = "rasterize".into();
-    h.state_mut().settings.view = pinhole::render::inspect::debug::View::Uv;
+    h.state_mut().settings.render.view = pinhole::render::inspect::debug::View::Uv;
     h.state_mut().settings.panels.shading = true;
     settle(&mut h);
     let before = shown(h.state());
     h.get_by_label("affine uv").click();
     settle(&mut h);
-    assert!(h.state().settings.per_scene.affine);
+    assert!(h.state().settings.render.affine);
     let affine = shown(h.state());
     assert_eq!(affine, reference(h.state()), "the viewer shows what render_frame gives");
     let changed = before.iter().zip(&affine).filter(|(a, b)| a != b).count();
     assert!(changed > before.len() / 20, "affine uv changed only {changed} pixels");
     h.get_by_label("4x").click();
     settle(&mut h);
-    assert_eq!(h.state().settings.per_scene.msaa, 4);
+    assert_eq!(h.state().settings.render.msaa, 4);
     assert_eq!(shown(h.state()), reference(h.state()));
 }
 
@@ -409,14 +409,14 @@ fn indirect_light_selector_reaches_the_pixels() {
     // the noise left once two passes are in.
     let mut h = harness(small_scene("cornell-gi"));
     h.state_mut().settings.panels.shading = true;
-    h.state_mut().settings.spp = 4;
+    h.state_mut().settings.render.spp = 4;
     settle(&mut h);
     let direct = shown(h.state());
     h.get_by_label("indirect light").click();
     h.run();
     h.get_by_label("path").click();
     settle(&mut h);
-    assert_eq!(h.state().settings.gi.mode, pinhole::render::transport::gi::GiMode::Path);
+    assert_eq!(h.state().settings.render.gi.mode, pinhole::render::transport::gi::GiMode::Path);
     let path = shown(h.state());
     assert_eq!(path, reference(h.state()), "the viewer shows what render_frame gives");
     let mean = |img: &[pinhole::math::Radiance]| img.iter().map(|c| c.x + c.y + c.z).sum::<f32>() / img.len() as f32;
@@ -435,9 +435,19 @@ fn opengl_in_the_viewer_draws_what_render_frame_draws() {
     let mut h = harness(small_scene("teapot"));
     h.state_mut().settings.renderer = "opengl".into();
     settle(&mut h);
-    let error = h.state().with_output(|o| o.error.clone()).unwrap_or_default();
-    assert!(error.contains("--shadows none"), "shadow rays are refused in one sentence: {error:?}");
-    h.state_mut().settings.shadows = pinhole::render::ShadowMode::None;
+    // Shadow rays (the default) are drawn as shadow maps, and the status bar says so.
+    let (error, notices) = h.state().with_output(|o| (o.error.clone(), o.notices.clone()));
+    assert_eq!(error, None);
+    let notice = "opengl cannot trace shadow rays; drawing shadow maps instead (--shadows map)";
+    assert_eq!(notices, vec![notice.to_string()]);
+    h.get_by_label(notice);
+    let substituted = shown(h.state());
+    h.state_mut().settings.render.shadows = pinhole::render::ShadowMode::Map;
+    settle(&mut h);
+    assert_eq!(shown(h.state()), substituted, "the image is the shadow maps'");
+    assert_eq!(substituted, reference(h.state()));
+    assert!(h.state().with_output(|o| o.notices.is_empty()), "asked for maps, nothing is substituted");
+    h.state_mut().settings.render.shadows = pinhole::render::ShadowMode::None;
     settle(&mut h);
     let img = shown(h.state());
     assert_eq!(img, reference(h.state()));

@@ -135,3 +135,28 @@ fn failed_standard_output_is_an_error_not_a_panic() {
     assert!(out.status.success(), "{err}");
     assert!(err.is_empty(), "a closed pipe printed: {err}");
 }
+
+/// opengl casts no shadow rays: asked for them (the default), it draws
+/// shadow maps and says so on stderr, before it loads its driver (so the
+/// notice is there with or without one).
+#[test]
+fn opengl_says_it_draws_shadow_maps_for_shadow_rays() {
+    let png = tmp("gl.png");
+    let stats = tmp("gl.json");
+    let out = pinhole(&["render", "spheres", "--renderer", "opengl", "--width", "80", "--height", "50", "-o", png.to_str().unwrap(), "--stats", stats.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("note: opengl cannot trace shadow rays; drawing shadow maps instead (--shadows map)"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    if out.status.success() {
+        let j: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+        assert_eq!(j["shadows"], "map", "the statistics say what was drawn");
+    } else {
+        assert!(err.contains("no usable OpenGL driver"), "the only way this fails: {err}");
+    }
+    // Asked for what it draws, it says nothing.
+    let out = pinhole(&["render", "spheres", "--renderer", "opengl", "--shadows", "none", "--width", "80", "--height", "50", "-o", png.to_str().unwrap()]);
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("note:"), "{}", String::from_utf8_lossy(&out.stderr));
+    // Other renderers trace the rays asked for, without a note.
+    let out = pinhole(&["render", "spheres", "--width", "80", "--height", "50", "-o", png.to_str().unwrap()]);
+    assert!(out.status.success() && out.stderr.is_empty(), "{}", String::from_utf8_lossy(&out.stderr));
+}

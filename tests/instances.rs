@@ -302,12 +302,12 @@ fn the_two_level_layer_renders_what_flattening_renders() {
     settings.clip = ClipMode::Frustum;
     assert_eq!(bits(&base.pixels), bits(&frame("rasterize", &pl, &settings).pixels));
     // What cannot draw the layer says so.
-    let e = render::layer_support::check("raytrace:brute", &pl.scene, &RenderSettings::for_scene(&pl.scene)).unwrap_err();
+    let e = render::layer_support::check(render::renderer_by_name("raytrace:brute").unwrap().as_ref(), &pl.scene, &RenderSettings::for_scene(&pl.scene)).unwrap_err();
     assert!(e.contains("raytrace:brute") && e.contains("copies"), "{e}");
     let mut volume = RenderSettings::for_scene(&pl.scene);
     volume.shadows = render::ShadowMode::Volume;
-    assert!(render::layer_support::check("rasterize", &pl.scene, &volume).is_err());
-    assert!(render::layer_support::check("rasterize", &pf.scene, &volume).is_ok());
+    assert!(render::layer_support::check(render::renderer_by_name("rasterize").unwrap().as_ref(), &pl.scene, &volume).is_err());
+    assert!(render::layer_support::check(render::renderer_by_name("rasterize").unwrap().as_ref(), &pf.scene, &volume).is_ok());
 }
 
 /// Shadow maps over the two-level layer: each light face draws the copies
@@ -332,8 +332,8 @@ fn shadow_maps_draw_the_two_level_layer_as_flattening_does() {
         let mut settings = RenderSettings::for_scene(&flat.scene);
         settings.shadows = render::ShadowMode::Map;
         settings.shadow_map_size = 256;
-        assert!(render::layer_support::check("rasterize", &layered.scene, &settings).is_ok());
-        assert!(render::layer_support::check("opengl", &layered.scene, &settings).is_err(), "opengl's maps do not draw copies");
+        assert!(render::layer_support::check(render::renderer_by_name("rasterize").unwrap().as_ref(), &layered.scene, &settings).is_ok());
+        assert!(render::layer_support::check(render::renderer_by_name("opengl").unwrap().as_ref(), &layered.scene, &settings).is_err(), "opengl's maps do not draw copies");
         for renderer in ["raytrace", "rasterize", "rasterize:tiled"] {
             let (a, b) = (frame(renderer, &flat, &settings), frame(renderer, &layered, &settings));
             assert_eq!(bits(&a.pixels), bits(&b.pixels), "{renderer}: shadow maps over the layer differ from flattening");

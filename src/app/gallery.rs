@@ -1,18 +1,22 @@
 //! The stress gallery in the viewer: a case opened from the Gallery menu
-//! shows its scene with the failing setting applied, its one-line
+//! shows its scene with the failing setting applied (to the settings the
+//! panels show), its one-line
 //! explanation in a bar under the menu, and a button that applies the cure
 //! (and one that brings the failure back).
 
 use eframe::egui;
 use crate::app::PinholeApp;
 use crate::gallery::{self, GalleryCase, Setting};
+use crate::app::settings_store::ViewerSettings;
 use crate::render::RenderSettings;
 
-/// The case on show and which of its settings.
-#[derive(Clone, Copy)]
+/// The case on show, which of its settings, and the user's own renderer
+/// and knobs from before it opened (given back when it closes).
+#[derive(Clone)]
 pub struct GalleryView {
     pub case: GalleryCase,
     pub cured: bool,
+    own: (String, RenderSettings),
 }
 
 impl GalleryView {
@@ -23,46 +27,63 @@ impl GalleryView {
 
 impl PinholeApp {
     /// Opens gallery case `name` with its failing setting (`cured`: its cure):
-    /// its scene (transformed when the setting says so), its renderer, its
-    /// knobs on top of the user's (`apply_gallery`).
+    /// its scene (transformed when the setting says so), its renderer, and
+    /// its knobs written over the user's, where the panels show them.
     pub fn open_gallery_case(&mut self, name: &str, cured: bool) {
-        let view = match gallery::case_by_name(name) {
-            Ok(case) => GalleryView { case, cured },
+        let case = match gallery::case_by_name(name) {
+            Ok(case) => case,
             Err(e) => {
                 self.error_bar = Some(e);
                 return;
             }
         };
-        let setting = view.setting();
-        let scene = match gallery::measure::scene_and_settings(&view.case, setting) {
+        let setting = if cured { &case.cured } else { &case.failing };
+        let scene = match gallery::measure::scene_and_settings(&case, setting) {
             Ok((scene, _)) => scene,
             Err(e) => {
                 self.error_bar = Some(e);
                 return;
             }
         };
-        match crate::render::renderer_by_name(setting.renderer) {
-            Ok(r) => self.settings.renderer = r.name().to_string(),
+        let renderer = match crate::render::renderer_by_name(setting.renderer) {
+            Ok(r) => r.name().to_string(),
             Err(e) => {
                 self.error_bar = Some(e);
                 return;
             }
-        }
-        self.install_scene(scene, view.case.scene.to_string());
-        self.gallery = Some(view);
+        };
+        // Another setting of a case on show starts from the user's own knobs too.
+        let own = self.gallery.take().map_or_else(|| (self.settings.renderer.clone(), self.settings.render.clone()), |g| g.own);
+        self.settings.render = own.1.clone();
+        self.install_scene(scene, case.scene.to_string());
+        self.settings.renderer = renderer;
+        (setting.apply)(&mut self.settings.render);
+        self.gallery = Some(GalleryView { case, cured, own });
     }
 
-    /// The knobs of the gallery setting on show, if any, applied over `settings`.
-    pub fn apply_gallery(&self, settings: &mut RenderSettings) {
-        if let Some(g) = &self.gallery {
-            (g.setting().apply)(settings);
+    /// Closes the case on show, if any, giving the user's own renderer and
+    /// knobs back (those that go with a scene at their defaults).
+    pub fn leave_gallery(&mut self) {
+        if let Some(g) = self.gallery.take() {
+            (self.settings.renderer, self.settings.render) = g.own;
+            self.settings.reset_scene_knobs();
         }
+    }
+
+    /// The settings to save between runs: those in force, but the user's
+    /// own renderer and knobs while a gallery case is on show.
+    pub fn own_settings(&self) -> ViewerSettings {
+        let mut s = self.settings.clone();
+        if let Some(g) = &self.gallery {
+            (s.renderer, s.render) = g.own.clone();
+        }
+        s
     }
 }
 
 /// The bar under the menu while a gallery case is on show.
 pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
-    let Some(g) = app.gallery else { return };
+    let Some(g) = app.gallery.clone() else { return };
     let mut switch = None;
     let mut close = false;
     egui::Panel::top("gallery-bar").show(ui, |ui| {
@@ -89,6 +110,6 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
         app.open_gallery_case(g.case.name, cured);
     }
     if close {
-        app.gallery = None;
+        app.leave_gallery();
     }
 }

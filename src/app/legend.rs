@@ -82,7 +82,7 @@ fn num(v: f32) -> String {
 
 /// Draws the legend of the current view in the corner of `viewport` (nothing for shaded).
 pub fn show(app: &PinholeApp, ctx: &egui::Context, viewport: Rect) {
-    let view = app.settings.view.name();
+    let view = app.settings.render.view.name();
     let Some(title) = title(view) else { return };
     let s = app.effective_settings();
     let camera = app.params.camera.view(s.width, s.height);

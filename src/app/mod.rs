@@ -159,94 +159,50 @@ fn screenshot_frame(app: &mut PinholeApp, ctx: &egui::Context) {
     });
 }
 
-/// For scripts (screenshots, benchmarks): `PINHOLE_RENDERER=NAME` picks the
-/// renderer, `PINHOLE_VIEW=NAME` the debug view, `PINHOLE_PANELS=camera,lights,
-/// materials,shading` (or `none`) which side-panel sections are open (the
-/// inspector shows whenever a pixel is selected),
-/// `PINHOLE_GAMMA=off` turns the sRGB encoding off, `PINHOLE_GI` and
-/// `PINHOLE_SPP` set the indirect light and the samples per pixel,
-/// `PINHOLE_COMPARE=on` opens the Compare window measuring,
-/// `PINHOLE_SPLIT=RENDERER` shows the view against RENDERER side by side,
-/// `PINHOLE_GALLERY=CASE` opens a stress-gallery case.
-fn apply_env_overrides(app: &mut PinholeApp) {
-    if let Ok(name) = std::env::var("PINHOLE_RENDERER") {
-        match crate::render::renderer_by_name(&name) {
-            Ok(r) => app.settings.renderer = r.name().to_string(),
-            Err(e) => eprintln!("pinhole: PINHOLE_RENDERER: {e}"),
-        }
+/// Applies the environment's overrides for scripts and tests
+/// (`env_overrides`, where each is documented) to the viewer.
+fn apply_env_overrides(app: &mut PinholeApp, env: &crate::env_overrides::ViewerOverrides) {
+    if let Some(name) = env.renderer {
+        app.settings.renderer = name.to_string();
     }
-    // PINHOLE_SPLIT=RENDERER shows the live view against RENDERER (A|B wipe);
     // B keeps the settings as they are here, before the overrides below.
-    if let Ok(name) = std::env::var("PINHOLE_SPLIT") {
-        match crate::render::renderer_by_name(&name) {
-            Ok(r) => {
-                let mut b = app.settings.clone();
-                b.renderer = r.name().to_string();
-                app.split.set_b(b);
-            }
-            Err(e) => eprintln!("pinhole: PINHOLE_SPLIT: {e}"),
-        }
+    if let Some(name) = env.split {
+        let mut b = app.settings.clone();
+        b.renderer = name.to_string();
+        app.split.set_b(b);
     }
-    if let Ok(v) = std::env::var("PINHOLE_VIEW") {
-        match crate::render::inspect::debug::View::parse(&v) {
-            Ok(v) => app.settings.view = v,
-            Err(e) => eprintln!("pinhole: PINHOLE_VIEW: {e}"),
-        }
+    if let Some(v) = env.view {
+        app.settings.render.view = v;
     }
-    if let Ok(g) = std::env::var("PINHOLE_GAMMA") {
-        app.settings.gamma = !matches!(g.as_str(), "0" | "off" | "false");
+    if let Some(g) = env.gamma {
+        app.settings.gamma = g;
     }
-    // PINHOLE_GI=MODE picks the indirect light, PINHOLE_SPP=N the samples.
-    if let Ok(m) = std::env::var("PINHOLE_GI") {
-        match crate::render::transport::gi::GiMode::parse(&m) {
-            Ok(m) => app.settings.gi.mode = m,
-            Err(e) => eprintln!("pinhole: PINHOLE_GI: {e}"),
-        }
+    if let Some(m) = env.gi {
+        app.settings.render.gi.mode = m;
     }
-    if let Ok(n) = std::env::var("PINHOLE_SPP") {
-        match n.parse::<u32>() {
-            Ok(n) if (1..=4096).contains(&n) => app.settings.spp = n,
-            _ => eprintln!("pinhole: PINHOLE_SPP: expected 1 to 4096, got \"{n}\""),
-        }
+    if let Some(n) = env.spp {
+        app.settings.render.spp = n;
     }
-    // PINHOLE_SELECT=X,Y selects a pixel for the inspector; PINHOLE_ZOOM=Z
-    // magnifies the image (about the selected pixel, if any);
-    // PINHOLE_VERTICES=on draws the vertex overlay.
-    if let Ok(sel) = std::env::var("PINHOLE_SELECT") {
-        let xy: Vec<i64> = sel.split(',').filter_map(|v| v.trim().parse().ok()).collect();
-        match xy[..] {
-            [x, y] => app.select_pixel(x, y),
-            _ => eprintln!("pinhole: PINHOLE_SELECT: expected X,Y, got \"{sel}\""),
-        }
+    if let Some((x, y)) = env.select {
+        app.select_pixel(x, y);
     }
-    if let Ok(z) = std::env::var("PINHOLE_ZOOM") {
-        match z.parse::<f32>() {
-            Ok(z) => {
-                app.inspect.zoom = z.clamp(1.0, inspect::MAX_ZOOM);
-                app.inspect.center_on_selection = true;
-            }
-            Err(_) => eprintln!("pinhole: PINHOLE_ZOOM: expected a number, got \"{z}\""),
-        }
+    if let Some(z) = env.zoom {
+        app.inspect.zoom = z.clamp(1.0, inspect::MAX_ZOOM);
+        app.inspect.center_on_selection = true;
     }
-    // PINHOLE_GALLERY=CASE opens a stress-gallery case at its failing setting.
-    if let Ok(name) = std::env::var("PINHOLE_GALLERY") {
-        app.open_gallery_case(&name, false);
+    if let Some(name) = &env.gallery {
+        app.open_gallery_case(name, false);
     }
-    // PINHOLE_COMPARE=on opens the Compare window and starts measuring.
-    if std::env::var("PINHOLE_COMPARE").is_ok_and(|v| !matches!(v.as_str(), "0" | "off" | "false")) {
+    if env.compare {
         app.compare.open = true;
         app.start_compare();
     }
-    if let Ok(v) = std::env::var("PINHOLE_VERTICES") {
-        app.inspect.vertices = !matches!(v.as_str(), "0" | "off" | "false");
+    if let Some(v) = env.vertices {
+        app.inspect.vertices = v;
     }
-    if let Ok(list) = std::env::var("PINHOLE_PANELS") {
-        let has = |n: &str| list.split(',').any(|p| p.trim() == n);
-        app.settings.panels.side = list.trim() != "none";
-        app.settings.panels.camera = has("camera");
-        app.settings.panels.lights = has("lights");
-        app.settings.panels.materials = has("materials");
-        app.settings.panels.shading = has("shading");
+    if let Some(p) = env.panels {
+        let panels = &mut app.settings.panels;
+        (panels.side, panels.camera, panels.lights, panels.materials, panels.shading) = (p.side, p.camera, p.lights, p.materials, p.shading);
     }
 }
 
@@ -265,7 +221,7 @@ impl eframe::App for EframeApp {
 
     fn save(&mut self, storage: &mut dyn eframe::Storage) {
         if self.0.persist {
-            self.0.settings.save(storage);
+            self.0.own_settings().save(storage);
         }
     }
 }
@@ -282,7 +238,8 @@ pub fn run(scene: Option<String>, screenshot: Option<PathBuf>) -> Result<(), Str
         None => None,
     };
     let shot_result = Arc::new(Mutex::new(None));
-    let bench = std::env::var("PINHOLE_BENCH_UI").ok().and_then(|s| UiBench::parse(&s));
+    let env = crate::env_overrides::ViewerOverrides::from_env();
+    let bench = env.bench_ui.as_deref().and_then(UiBench::parse);
     let batch = screenshot.is_some() || bench.is_some();
 
     // In --screenshot mode the window fits the image 1:1 beside the side panel.
@@ -337,11 +294,11 @@ pub fn run(scene: Option<String>, screenshot: Option<PathBuf>) -> Result<(), Str
             if batch {
                 app.settings.res_scale = 1.0;
             }
-            apply_env_overrides(&mut app);
+            apply_env_overrides(&mut app, &env);
             app.screenshot = shot_state;
             app.bench = bench;
             if let Some(n) = app.bench.as_ref().and_then(|b| b.spp) {
-                app.settings.spp = n;
+                app.settings.render.spp = n;
             }
             Ok(Box::new(EframeApp(app)))
         }),

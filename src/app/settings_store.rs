@@ -1,20 +1,17 @@
 //! What the viewer remembers between runs (eframe storage): one struct,
 //! `ViewerSettings`, that the viewer edits live and saves and loads whole.
+//! Its render knobs are a `RenderSettings`, the very value the worker
+//! renders with (at the viewer's image size), so the panels show the
+//! settings in force.
 
-use crate::render::inspect::debug::View;
-use crate::render::raster::depth_format::DepthFormat;
-use crate::render::inspect::wireframe::LineAlgorithm;
-use crate::render::shadow::volume::VolumeMode;
-use crate::render::shadow::map as shadow_map;
-use crate::render::{Interpolation, RenderSettings, ShadowMode};
-use crate::scene::Scene;
+use crate::render::RenderSettings;
 
 pub const STORAGE_KEY: &str = "pinhole";
 
 /// The user's choices that outlive a scene: renderer, render knobs, display
 /// and panels. `#[serde(default)]`: settings saved by an older version load,
-/// missing values taking their defaults. The knobs marked `skip` are not
-/// remembered between runs and go back to their defaults with a new scene.
+/// missing values taking their defaults; `load` also reads the last
+/// release's layout, whose render knobs stood beside the others.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default)]
 pub struct ViewerSettings {
@@ -23,51 +20,15 @@ pub struct ViewerSettings {
     /// Saved as an option, as older versions saved it; empty: the default.
     #[serde(with = "saved_as_option")]
     pub renderer: String,
-    pub spp: u32,
-    pub shadows: ShadowMode,
-    /// `--shadows volume`: z-pass or z-fail counting.
-    pub shadow_volume: VolumeMode,
-    pub shadow_bump: f32,
-    pub max_depth: u32,
-    pub view: View,
-    pub interpolation: Interpolation,
-    /// Indirect light and its knobs.
-    pub gi: crate::render::transport::gi::GiSettings,
-    /// How textures are read.
-    pub texture_filter: crate::scene::texture::TextureFilter,
-    /// Traced reflections or environment lookups.
-    pub reflections: crate::render::Reflections,
-    /// Sub-sampling: a grid traced, the rest interpolated.
-    pub subsample: crate::render::frame::Subsample,
+    /// Every render knob. The image size is the scene's times `res_scale`
+    /// (`PinholeApp::effective_settings`); the knobs `reset_scene_knobs`
+    /// names go back to their defaults with every scene.
+    pub render: RenderSettings,
     /// Image size over the scene's size.
     pub res_scale: f32,
     /// Encode the image as sRGB for display.
     pub gamma: bool,
     pub panels: Panels,
-    #[serde(skip)]
-    pub per_scene: SceneKnobs,
-}
-
-/// Render knobs that go back to their defaults with every scene.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SceneKnobs {
-    pub shadow_map_size: u32,
-    pub shadow_map_bias: f32,
-    pub msaa: u32,
-    pub early_depth: bool,
-    pub affine: bool,
-    /// What the depth buffer stores (rasterizers with one).
-    pub depth_buffer: DepthFormat,
-    /// The wireframe view's line algorithm.
-    pub lines: LineAlgorithm,
-    /// The planes rasterizers clip at (the same image either way).
-    pub clip: crate::render::raster::clip::ClipMode,
-}
-
-impl Default for SceneKnobs {
-    fn default() -> Self {
-        SceneKnobs { shadow_map_size: shadow_map::DEFAULT_SIZE, shadow_map_bias: shadow_map::DEFAULT_BIAS, msaa: 1, early_depth: true, affine: false, depth_buffer: DepthFormat::F32, lines: LineAlgorithm::Float, clip: Default::default() }
-    }
 }
 
 /// Which side-panel sections are open.
@@ -92,22 +53,30 @@ impl Default for ViewerSettings {
         ViewerSettings {
             scene: None,
             renderer: crate::render::DEFAULT_RAYTRACE.to_string(),
-            spp: 1,
-            shadows: ShadowMode::Ray,
-            shadow_volume: VolumeMode::ZFail,
-            shadow_bump: 1e-4,
-            max_depth: 4,
-            view: View::Shaded,
-            interpolation: Interpolation::Phong,
-            gi: Default::default(),
-            texture_filter: Default::default(),
-            reflections: Default::default(),
-            subsample: Default::default(),
+            render: RenderSettings::default(),
             res_scale: 1.0,
             gamma: true,
             panels: Panels::default(),
-            per_scene: SceneKnobs::default(),
         }
+    }
+}
+
+/// The one field that tells a saved file's layout: present since the render
+/// knobs became a `RenderSettings` of their own, absent in the last
+/// release's files (other fields are ignored when reading this).
+#[derive(serde::Deserialize)]
+struct SavedLayout {
+    #[serde(default)]
+    render: Present,
+}
+
+/// Whether a field was there, whatever its value.
+#[derive(Default)]
+struct Present(bool);
+
+impl<'de> serde::Deserialize<'de> for Present {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Present, D::Error> {
+        serde::de::IgnoredAny::deserialize(d).map(|_| Present(true))
     }
 }
 
@@ -118,77 +87,54 @@ impl ViewerSettings {
         if !renderer_names.contains(&self.renderer.as_str()) {
             self.renderer = crate::render::DEFAULT_RAYTRACE.to_string();
         }
-        self.spp = self.spp.clamp(1, 1024);
+        self.render.spp = self.render.spp.clamp(1, 1024);
         self.res_scale = self.res_scale.clamp(0.1, 2.0);
         self
     }
 
-    /// The settings to render `scene` with at `width` x `height`: the scene's
-    /// values with these knobs.
-    pub fn render_settings(&self, scene: &Scene, width: u32, height: u32) -> RenderSettings {
-        let k = &self.per_scene;
-        RenderSettings {
-            width,
-            height,
-            spp: self.spp,
-            shadows: self.shadows,
-            shadow_volume: self.shadow_volume,
-            shadow_bump: self.shadow_bump,
-            max_depth: self.max_depth,
-            view: self.view,
-            interpolation: self.interpolation,
-            gi: self.gi.clone(),
-            texture_filter: self.texture_filter,
-            reflections: self.reflections,
-            subsample: self.subsample,
-            shadow_map_size: k.shadow_map_size,
-            shadow_map_bias: k.shadow_map_bias,
-            msaa: k.msaa,
-            early_depth: k.early_depth,
-            affine: k.affine,
-            depth_buffer: k.depth_buffer,
-            lines: k.lines,
-            clip: k.clip,
-            ..RenderSettings::for_scene(scene)
-        }
+    /// The knobs that suit one scene (shadow-map size and bias, the
+    /// rasterizers' and debugging knobs) back at their defaults: they go
+    /// with the scene, not with the user.
+    pub fn reset_scene_knobs(&mut self) {
+        let d = RenderSettings::default();
+        let r = &mut self.render;
+        (r.shadow_map_size, r.shadow_map_bias, r.shadow_map_slope_bias) = (d.shadow_map_size, d.shadow_map_bias, d.shadow_map_slope_bias);
+        (r.msaa, r.early_depth, r.affine, r.depth_buffer, r.lines, r.clip) = (d.msaa, d.early_depth, d.affine, d.depth_buffer, d.lines, d.clip);
+        (r.near_clip, r.terminator_lift, r.cull_instances, r.adaptive) = (d.near_clip, d.terminator_lift, d.cull_instances, d.adaptive);
     }
 
-    /// Takes the renderer and every render knob of `settings` (a configuration
-    /// measured elsewhere), keeping the image size, the view and the display.
+    /// The render settings at `width` x `height`: these knobs, that size.
+    pub fn render_settings(&self, width: u32, height: u32) -> RenderSettings {
+        RenderSettings { width, height, ..self.render.clone() }
+    }
+
+    /// Takes `renderer` and every render knob of `settings` (a configuration
+    /// measured elsewhere), keeping the view and the display.
     pub fn apply_configuration(&mut self, renderer: &str, settings: &RenderSettings) {
         self.renderer = renderer.to_string();
-        self.spp = settings.spp;
-        self.shadows = settings.shadows;
-        self.shadow_volume = settings.shadow_volume;
-        self.shadow_bump = settings.shadow_bump;
-        self.max_depth = settings.max_depth;
-        self.interpolation = settings.interpolation;
-        self.gi = settings.gi.clone();
-        self.texture_filter = settings.texture_filter;
-        self.reflections = settings.reflections;
-        self.subsample = settings.subsample;
-        self.per_scene = SceneKnobs {
-            shadow_map_size: settings.shadow_map_size,
-            shadow_map_bias: settings.shadow_map_bias,
-            msaa: settings.msaa,
-            early_depth: settings.early_depth,
-            affine: settings.affine,
-            depth_buffer: settings.depth_buffer,
-            lines: settings.lines,
-            clip: settings.clip,
-        };
+        self.render = RenderSettings { view: self.render.view, ..settings.clone() };
     }
 
     /// Takes `other`'s renderer and render knobs, keeping this one's view,
     /// display, panels and scene.
     pub fn take_configuration(&mut self, other: &ViewerSettings) {
-        let keep = (self.scene.take(), self.view, self.res_scale, self.gamma, self.panels);
+        let keep = (self.scene.take(), self.render.view, self.res_scale, self.gamma, self.panels);
         *self = other.clone();
-        (self.scene, self.view, self.res_scale, self.gamma, self.panels) = keep;
+        (self.scene, self.render.view, self.res_scale, self.gamma, self.panels) = keep;
     }
 
+    /// The settings saved in `storage`, in this layout or the last release's
+    /// (its render knobs beside the others, no `render`). `None`: nothing
+    /// saved, or nothing readable.
     pub fn load(storage: Option<&dyn eframe::Storage>) -> Option<ViewerSettings> {
-        storage.and_then(|s| eframe::get_value(s, STORAGE_KEY))
+        let storage = storage?;
+        let mut settings: ViewerSettings = eframe::get_value(storage, STORAGE_KEY)?;
+        if !eframe::get_value::<SavedLayout>(storage, STORAGE_KEY)?.render.0 {
+            // The same text read as a `RenderSettings`: it takes the knobs
+            // it has a field for and ignores the rest.
+            settings.render = eframe::get_value(storage, STORAGE_KEY)?;
+        }
+        Some(settings)
     }
 
     pub fn save(&self, storage: &mut dyn eframe::Storage) {
@@ -231,6 +177,7 @@ impl eframe::Storage for MemoryStorage {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::render::ShadowMode;
 
     type Mem = MemoryStorage;
 
@@ -243,8 +190,8 @@ mod tests {
         let s = ViewerSettings::load(Some(&mem)).unwrap();
         assert_eq!(s.scene.as_deref(), Some("spheres"));
         assert_eq!(s.renderer, "raytrace:brute");
-        assert_eq!((s.spp, s.shadows, s.gamma), (9, ShadowMode::Map, false));
-        assert_eq!(s.max_depth, 4);
+        assert_eq!((s.render.spp, s.render.shadows, s.gamma), (9, ShadowMode::Map, false));
+        assert_eq!(s.render.max_depth, 4);
         s.save(&mut mem);
         assert_eq!(ViewerSettings::load(Some(&mem)), Some(s));
     }
@@ -252,7 +199,7 @@ mod tests {
     #[test]
     fn render_settings_match_the_scene_defaults() {
         let scene = crate::scene::builtin::load_builtin("spheres").unwrap().unwrap();
-        let s = ViewerSettings::default().render_settings(&scene, scene.render.width, scene.render.height);
+        let s = ViewerSettings::default().render_settings(scene.render.width, scene.render.height);
         assert_eq!(s, RenderSettings::for_scene(&scene));
     }
 }

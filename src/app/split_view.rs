@@ -91,15 +91,13 @@ impl SplitView {
     }
 
     /// The label of B's configuration.
-    pub fn b_label(&self, a: &ViewerSettings, scene: &crate::scene::Scene) -> String {
-        crate::chart::describe(&self.b.renderer, &self.b_settings(a, scene, 1, 1))
+    pub fn b_label(&self, a: &ViewerSettings) -> String {
+        crate::chart::describe(&self.b.renderer, &self.b_settings(a, 1, 1))
     }
 
     /// B's render settings: its knobs, with A's view and image size.
-    pub fn b_settings(&self, a: &ViewerSettings, scene: &crate::scene::Scene, width: u32, height: u32) -> crate::render::RenderSettings {
-        let mut s = self.b.render_settings(scene, width, height);
-        s.view = a.view;
-        s
+    pub fn b_settings(&self, a: &ViewerSettings, width: u32, height: u32) -> crate::render::RenderSettings {
+        crate::render::RenderSettings { view: a.render.view, ..self.b.render_settings(width, height) }
     }
 
     /// Asks B's worker for the image that goes with A's request `a` when
@@ -108,12 +106,8 @@ impl SplitView {
         if !self.enabled {
             return;
         }
+        let settings = self.b_settings(a_settings, a.settings.width, a.settings.height);
         let worker = self.worker.get_or_insert_with(|| Worker::start(repaint));
-        let settings = {
-            let mut s = self.b.render_settings(scene, a.settings.width, a.settings.height);
-            s.view = a_settings.view;
-            s
-        };
         if let Some(l) = &self.last_sent {
             if l.scene_id == scene_id && l.renderer == self.b.renderer && l.settings == settings && l.gamma == a.gamma && l.params.same_as(&a.params) && l.interactive == a.interactive {
                 return;
@@ -258,13 +252,14 @@ mod tests {
 
     #[test]
     fn swapping_exchanges_the_configurations() {
-        let mut a = ViewerSettings { renderer: "raytrace:bvh".into(), spp: 4, ..Default::default() };
+        let mut a = ViewerSettings { renderer: "raytrace:bvh".into(), ..Default::default() };
+        a.render.spp = 4;
         let mut split = SplitView::default();
         split.toggle(&a);
         split.b.renderer = "rasterize:fixed".into();
-        split.b.spp = 1;
+        split.b.render.spp = 1;
         split.swap(&mut a);
-        assert_eq!((a.renderer.as_str(), a.spp), ("rasterize:fixed", 1));
-        assert_eq!((split.b.renderer.as_str(), split.b.spp), ("raytrace:bvh", 4));
+        assert_eq!((a.renderer.as_str(), a.render.spp), ("rasterize:fixed", 1));
+        assert_eq!((split.b.renderer.as_str(), split.b.render.spp), ("raytrace:bvh", 4));
     }
 }

@@ -7,7 +7,7 @@ use eframe::egui;
 use crate::app::export::ExportDialog;
 use crate::app::open_dialog::OpenDialog;
 use crate::app::panels::Requests;
-use crate::app::settings_store::{SceneKnobs, ViewerSettings};
+use crate::app::settings_store::ViewerSettings;
 use crate::app::worker::{Output, Request, SceneParams, Worker};
 use crate::render::{self, RenderSettings};
 use crate::scene::{builtin, Camera, Scene};
@@ -28,8 +28,10 @@ pub struct PinholeApp {
     pub params: SceneParams,
     /// The camera the scene file gave, for "reset".
     pub initial_camera: Camera,
-    /// Renderer, render knobs, display and panels as the user set them;
-    /// saved whole between runs. `effective_settings()` renders with them.
+    /// Renderer, render knobs, display and panels in force (a gallery case's
+    /// or an applied configuration's knobs included); saved between runs
+    /// (`own_settings`). The panels edit them, `effective_settings()`
+    /// renders with them.
     pub settings: ViewerSettings,
     pub renderer_names: Vec<&'static str>,
     pub worker: Worker,
@@ -134,7 +136,7 @@ impl PinholeApp {
         self.scene_id += 1;
         self.params = SceneParams::of(&scene);
         self.initial_camera = scene.camera.clone();
-        self.settings.per_scene = SceneKnobs::default();
+        self.settings.reset_scene_knobs();
         self.settings.scene = Some(arg.clone());
         self.message = (!scene.warnings.is_empty()).then(|| scene.warnings.join("; "));
         let path = PathBuf::from(&arg);
@@ -187,7 +189,7 @@ impl PinholeApp {
         match result {
             Ok(scene) => {
                 // Another scene (or the file reloaded): the gallery case is over.
-                self.gallery = None;
+                self.leave_gallery();
                 self.install_scene(scene, arg)
             }
             Err(e) => self.error_bar = Some(e),
@@ -226,13 +228,11 @@ impl PinholeApp {
         }
     }
 
-    /// The settings the worker renders with: the scene's, with the user's
-    /// knobs (and a gallery case's over them), at the scaled resolution.
+    /// The settings the worker renders with: the knobs the panels show, at
+    /// the scaled resolution.
     pub fn effective_settings(&self) -> RenderSettings {
         let (width, height) = self.image_size();
-        let mut settings = self.settings.render_settings(&self.scene, width, height);
-        self.apply_gallery(&mut settings);
-        settings
+        self.settings.render_settings(width, height)
     }
 
     /// The image size: the scene's, times the resolution scale.
@@ -377,6 +377,8 @@ impl PinholeApp {
         }
         if let Some(c) = req.apply {
             self.settings.apply_configuration(&c.renderer, &c.settings);
+            // The configuration replaces a gallery case's knobs: they are the user's now.
+            self.gallery = None;
             self.message = Some(format!("applied {}", c.label));
         }
         if let Some(c) = req.set_b {
@@ -403,7 +405,7 @@ impl PinholeApp {
                 ctx.request_repaint();
             }
         });
-        self.compare.start(scene, self.settings.gi.seed, None, repaint);
+        self.compare.start(scene, self.settings.render.gi.seed, None, repaint);
     }
 
     /// Copies a newly published image into the texture.
@@ -473,8 +475,8 @@ impl PinholeApp {
         if let Some(step) = ctx.input(|i| i.key_pressed(Key::V).then_some(if i.modifiers.shift { -1 } else { 1 })) {
             use crate::render::inspect::debug::View;
             let n = View::ALL.len() as i64;
-            let at = View::ALL.iter().position(|v| *v == self.settings.view).unwrap_or(0) as i64;
-            self.settings.view = View::ALL[(at + step).rem_euclid(n) as usize];
+            let at = View::ALL.iter().position(|v| *v == self.settings.render.view).unwrap_or(0) as i64;
+            self.settings.render.view = View::ALL[(at + step).rem_euclid(n) as usize];
         }
         // Arrows move the selected pixel (shift: by 10), Esc clears it.
         if let Some((x, y)) = self.inspect.selected {
@@ -535,7 +537,7 @@ impl PinholeApp {
         requests |= crate::app::panels::menu::show(ui, &mut self.settings, &self.renderer_names, &mut self.inspect, &self.scene.name);
         if self.split.enabled {
             let a_label = crate::chart::describe(&self.settings.renderer, &self.effective_settings());
-            let b_label = self.split.b_label(&self.settings, &self.scene);
+            let b_label = self.split.b_label(&self.settings);
             let r = crate::app::panels::split_bar::show(ui, &mut self.split, &a_label, &b_label);
             if r.swap {
                 self.split.swap(&mut self.settings);

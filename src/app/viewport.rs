@@ -265,7 +265,7 @@ fn hover_readout(app: &PinholeApp, painter: &egui::Painter, avail: Rect, view: &
     let Some((x, y)) = app.inspect.hover else { return };
     let exposure = app.params.render.exposure;
     let Some(v) = app.with_output(|o| (x < o.width && y < o.height && o.linear.len() == (o.width * o.height) as usize).then(|| o.linear[(x + y * o.width) as usize])) else { return };
-    let meaning = crate::app::inspect::value_text(app.settings.view.name(), v, view, &app.scene);
+    let meaning = crate::app::inspect::value_text(app.settings.render.view.name(), v, view, &app.scene);
     let d = crate::image_io::display_pixel(v, exposure, app.settings.gamma);
     let text = if meaning.starts_with("linear") {
         format!("({x}, {y})  {meaning}  -> {d:?}")

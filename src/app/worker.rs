@@ -156,8 +156,12 @@ pub struct Output {
     /// The worker has nothing to do.
     pub idle: bool,
     pub stats: Stats,
-    /// What the renderer reported when it failed (a panic message).
+    /// What the renderer reported when it failed (a panic message), or why
+    /// it refused the request (`render::admit`).
     pub error: Option<String>,
+    /// What the renderer draws otherwise than asked, one sentence each
+    /// (`render::admit`), for the request last started.
+    pub notices: Vec<String>,
     /// Diff view, once complete: pixels that differ from `raytrace:brute`.
     pub differing_pixels: Option<u64>,
 }
@@ -198,6 +202,7 @@ impl Worker {
                 idle: true,
                 stats: Stats::default(),
                 error: None,
+                notices: Vec::new(),
                 differing_pixels: None,
             }),
             changed: Condvar::new(),
@@ -278,6 +283,8 @@ impl Drop for Worker {
 struct Frame {
     req: Request,
     renderer: Box<dyn Renderer>,
+    /// What the renderer draws: `req.settings` as `render::admit` admitted them.
+    settings: RenderSettings,
     frame: Accumulator,
     started: Instant,
     /// The coarse preview is still to come, before the passes.
@@ -425,19 +432,20 @@ impl WorkerLoop {
                 return;
             }
         };
-        let settings = RenderSettings { width: req.settings.width.max(1), height: req.settings.height.max(1), ..req.settings.clone() };
+        let asked = RenderSettings { width: req.settings.width.max(1), height: req.settings.height.max(1), ..req.settings.clone() };
+        // The gate the command line asks too: what the renderer cannot draw
+        // (or input made too big to allocate) is refused in one sentence.
+        let admitted = render::admit::admit(renderer.as_ref(), &prepared.scene, &asked);
+        let admitted = admitted.and_then(|a| renderer.ready(&a.settings).map(|()| a));
+        let render::admit::Admitted { settings, notices } = match admitted {
+            Ok(a) => a,
+            Err(e) => {
+                self.fail(&req, e);
+                return;
+            }
+        };
+        self.shared.output.lock().unwrap().notices = notices;
         let (width, height) = (settings.width, settings.height);
-        // What input can make too big is refused here, as on the command
-        // line, rather than aborting the viewer when it is allocated.
-        let maps = settings.shadows == render::ShadowMode::Map || settings.view == View::Shadowmap;
-        let too_big = crate::input::check_image_size(width, height)
-            .and_then(|_| if maps { render::shadow::map::check_memory(&prepared.scene, settings.shadow_map_size) } else { Ok(()) });
-        let too_big = too_big.and_then(|_| render::layer_support::check(renderer.name(), &prepared.scene, &settings));
-        let too_big = too_big.and_then(|_| renderer.check(&prepared.scene, &settings));
-        if let Err(e) = too_big {
-            self.fail(&req, e);
-            return;
-        }
         if self.timed != (req.renderer.clone(), req.scene_id) {
             // Another renderer or scene: old timings mean nothing.
             self.timed = (req.renderer.clone(), req.scene_id);
@@ -449,6 +457,7 @@ impl WorkerLoop {
         self.frame = Some(Frame {
             renderer,
             frame: Accumulator::new(&settings),
+            settings,
             started: now,
             preview_pending: (req.interactive || slow) && width >= 8 && height >= 8,
             pass_started: now,
@@ -472,8 +481,10 @@ impl WorkerLoop {
                 let settings = if diff { RenderSettings { view: View::Shaded, ..r.settings.clone() } } else { r.settings.clone() };
                 let pool = &self.pool;
                 let prepared_ref = &*prepared;
+                // The pixel as the frame drew it: with the settings the gate admitted.
                 let run = |renderer: &dyn Renderer| {
-                    pool.install(|| guarded(|| render::replay_pixel(renderer, prepared_ref, &settings, r.x, r.y))).and_then(|x| x)
+                    let admitted = render::admit::admit(renderer, &prepared_ref.scene, &settings)?;
+                    pool.install(|| guarded(|| render::replay_pixel(renderer, prepared_ref, &admitted.settings, r.x, r.y))).and_then(|x| x)
                 };
                 let result = render::renderer_by_name(&r.renderer).and_then(|renderer| run(renderer.as_ref()));
                 reference = diff.then(|| run(&render::raytrace::brute_renderer::BruteForce));
@@ -493,6 +504,7 @@ impl WorkerLoop {
     fn fail(&mut self, req: &Request, message: String) {
         let mut out = self.shared.output.lock().unwrap();
         out.error = Some(message);
+        out.notices.clear();
         out.generation = req.generation;
         out.complete = true;
         out.version += 1;
@@ -518,8 +530,8 @@ impl WorkerLoop {
             let div = self.preview_div;
             let (pw, ph) = ((width / div).max(1), (height / div).max(1));
             // One sample at 1/div of the resolution, shaded for the diff view.
-            let view = if f.req.settings.view == View::Diff { View::Shaded } else { f.req.settings.view };
-            let settings = RenderSettings { width: pw, height: ph, spp: 1, view, ..f.req.settings.clone() };
+            let view = if f.settings.view == View::Diff { View::Shaded } else { f.settings.view };
+            let settings = RenderSettings { width: pw, height: ph, spp: 1, view, ..f.settings.clone() };
             let mut preview = Accumulator::new(&settings);
             // The preview is not cancelled: it is cheap by construction (its
             // size adapts), and while the camera moves every frame cancels the
@@ -572,9 +584,9 @@ impl WorkerLoop {
 
         // A sub-sampled frame is rendered whole: which cells are traced in
         // full depends on the grid around them.
-        if f.req.settings.subsample.is_on() && f.req.settings.view == View::Shaded {
+        if f.settings.subsample.is_on() && f.settings.view == View::Shaded {
             let renderer = f.renderer.as_ref();
-            let settings = &f.req.settings;
+            let settings = &f.settings;
             let result = self.pool.install(|| guarded(|| render::frame::subsample::render_subsampled(renderer, prepared, settings, cancel, None)));
             match result {
                 Ok(Some(frame)) => self.publish_whole(f, frame),
@@ -688,7 +700,7 @@ impl WorkerLoop {
         out.rgb8 = rgb8;
         out.generation = f.req.generation;
         out.scene_id = f.req.scene_id;
-        out.spp = f.req.settings.spp.max(1);
+        out.spp = f.settings.spp.max(1);
         out.passes = out.spp;
         out.preview = false;
         out.complete = true;

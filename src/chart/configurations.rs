@@ -101,10 +101,13 @@ pub fn describe(renderer: &str, s: &RenderSettings) -> String {
     out.join(" ")
 }
 
-/// Whether `config`'s renderer draws `scene` with its settings (its
-/// `Renderer::check` passes).
+/// Whether `config`'s renderer draws `scene` with exactly its settings
+/// (`render::admit` accepts them with nothing substituted: a substitute
+/// would be measured under a label that does not say what was drawn).
 pub fn accepted(scene: &Scene, config: &Configuration) -> bool {
-    crate::render::renderer_by_name(&config.renderer).is_ok_and(|r| r.check(scene, &config.settings).is_ok())
+    crate::render::renderer_by_name(&config.renderer)
+        .and_then(|r| crate::render::admit::admit(r.as_ref(), scene, &config.settings))
+        .is_ok_and(|a| a.notices.is_empty())
 }
 
 /// What every swept configuration starts from: the scene's defaults, the
@@ -154,9 +157,9 @@ pub fn method_configurations(scene: &Scene, base: &RenderSettings) -> Vec<Config
     let casts_shadows = !scene.lights.is_empty() && scene.triangles.len() + scene.spheres.len() > 1;
     if casts_shadows {
         add("shadows", raster, with(&|s| s.shadows = ShadowMode::None));
-        // Sizes whose maps for all the scene's lights would not fit in memory are left out.
-        let fits = |size| crate::render::shadow::map::check_memory(scene, size).is_ok();
-        for size in [256, 1024, 2048].into_iter().filter(|&n| fits(n)) {
+        // Sizes whose maps for all the scene's lights would not fit in
+        // memory are refused by `accepted` and left out below.
+        for size in [256, 1024, 2048] {
             add("shadows", raster, with(&|s| {
                 s.shadows = ShadowMode::Map;
                 s.shadow_map_size = size;
@@ -168,7 +171,7 @@ pub fn method_configurations(scene: &Scene, base: &RenderSettings) -> Vec<Config
                 s.shadow_volume = mode;
             }));
         }
-        for bias in [0.1, 8.0].into_iter().filter(|_| fits(shadow_map::DEFAULT_SIZE)) {
+        for bias in [0.1, 8.0] {
             add("shadows", raster, with(&|s| {
                 s.shadows = ShadowMode::Map;
                 s.shadow_map_bias = bias;
@@ -235,8 +238,8 @@ pub fn method_configurations(scene: &Scene, base: &RenderSettings) -> Vec<Config
         s.spp = 16;
     }));
     // What the scene cannot be drawn with (CSG objects under the painter or
-    // shadow maps, the copies' two-level layer under shadow maps...) is not
-    // measured: its image would be refused, not wrong.
+    // shadow maps, the copies' two-level layer under shadow maps, maps too
+    // big for memory...) is not measured: its image would be refused, not wrong.
     out.retain(|c| accepted(scene, c));
     out
 }

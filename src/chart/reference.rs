@@ -123,7 +123,7 @@ pub fn load_reference(
 /// platform's cache folder (`$XDG_CACHE_HOME/pinhole`, `~/.cache/pinhole`).
 pub fn default_cache_dir() -> Option<PathBuf> {
     let env = |k: &str| std::env::var_os(k).filter(|v| !v.is_empty()).map(PathBuf::from);
-    env("PINHOLE_CACHE_DIR")
+    crate::env_overrides::cache_dir()
         .or_else(|| env("XDG_CACHE_HOME").map(|d| d.join("pinhole")))
         .or_else(|| env("HOME").map(|d| d.join(".cache").join("pinhole")))
 }

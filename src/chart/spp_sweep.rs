@@ -19,7 +19,8 @@ pub struct SweepPoint {
 }
 
 /// Renders each renderer at each spp (`repeats` timed frames, best kept) and
-/// measures it against `reference`. `progress` is called before each frame.
+/// measures it against `reference`. `progress` is called before each frame,
+/// `notice` with what a renderer draws otherwise than asked (`render::admit`).
 pub fn sweep(
     prepared: &PreparedScene,
     base: &RenderSettings,
@@ -28,6 +29,7 @@ pub fn sweep(
     reference: &[Radiance],
     repeats: u32,
     mut progress: impl FnMut(&str, u32),
+    mut notice: impl FnMut(&str),
 ) -> Result<Vec<SweepPoint>, String> {
     let cancel = AtomicBool::new(false);
     let mut points = Vec::new();
@@ -35,7 +37,10 @@ pub fn sweep(
         let r = render::renderer_by_name(name)?;
         for &spp in spps {
             progress(r.name(), spp);
-            let settings = RenderSettings { spp, ..base.clone() };
+            let admitted = render::admit::admit(r.as_ref(), &prepared.scene, &RenderSettings { spp, ..base.clone() })?;
+            admitted.notices.iter().for_each(|n| notice(n));
+            r.ready(&admitted.settings)?;
+            let settings = admitted.settings;
             let mut best = f64::INFINITY;
             let mut image = Vec::new();
             for _ in 0..repeats.max(1) {

@@ -43,8 +43,14 @@ pub fn render_setting(case: &GalleryCase, setting: &Setting) -> Result<(Vec<Radi
         (settings.width, settings.height) = (w, h);
     }
     let renderer = render::renderer_by_name(setting.renderer)?;
+    let admitted = render::admit::admit(renderer.as_ref(), &scene, &settings).map_err(|e| format!("gallery case {}: \"{}\": {e}", case.name, setting.description))?;
+    // A case shows what its settings draw: a substitute would show something else.
+    if let Some(n) = admitted.notices.first() {
+        return Err(format!("gallery case {}: \"{}\": {n}", case.name, setting.description));
+    }
+    renderer.ready(&admitted.settings)?;
     let prepared = PreparedScene::new(scene);
-    let frame = render::render_frame(renderer.as_ref(), &prepared, &settings, &AtomicBool::new(false), None).ok_or("the render was cancelled")?;
+    let frame = render::render_frame(renderer.as_ref(), &prepared, &admitted.settings, &AtomicBool::new(false), None).ok_or("the render was cancelled")?;
     Ok((frame.pixels, settings.width, settings.height))
 }
 

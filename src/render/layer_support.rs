@@ -1,15 +1,27 @@
 //! What can draw a scene whose copies live in the two-level instance layer
-//! (`scene::instanced`): the BVH ray tracer, the rasterizers and `opengl`
-//! (its copies instanced in GL), with ray or no shadows, and the CPU
-//! renderers with shadow maps too. The rest read `Scene::triangles` alone, so they refuse
-//! such a scene with one sentence instead of drawing it without its copies.
+//! (`scene::instanced`). Each renderer says how much of the layer it draws
+//! (`Renderer::instance_layer`): a renderer that reads `Scene::triangles`
+//! alone refuses such a scene with one sentence instead of drawing it
+//! without its copies. Shadow volumes and the wireframe and shadow-map views
+//! are built from `Scene::triangles`, so every renderer refuses them here.
 
 use crate::render::inspect::debug::View;
-use crate::render::{RenderSettings, ShadowMode};
+use crate::render::{RenderSettings, Renderer, ShadowMode};
 use crate::scene::Scene;
 
-/// `Ok` when `renderer` (by name) with `settings` draws every copy of `scene`.
-pub fn check(renderer: &str, scene: &Scene, settings: &RenderSettings) -> Result<(), String> {
+/// How much of the instance layer a renderer draws.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LayerSupport {
+    /// Nothing: it reads `Scene::triangles` alone.
+    Nothing,
+    /// The copies, with ray or no shadows, but not into shadow maps of its own.
+    WithoutShadowMaps,
+    /// The copies, with the CPU shadow maps too (each copy culled whole per light face).
+    Everything,
+}
+
+/// `Ok` when `renderer` with `settings` draws every copy of `scene`.
+pub fn check(renderer: &dyn Renderer, scene: &Scene, settings: &RenderSettings) -> Result<(), String> {
     if scene.layer.is_none() {
         return Ok(());
     }
@@ -20,15 +32,13 @@ pub fn check(renderer: &str, scene: &Scene, settings: &RenderSettings) -> Result
             crate::scene::file::FLATTEN_LIMIT
         ))
     };
-    match renderer {
-        "raytrace:brute" => return why(renderer),
-        _ => {}
+    match renderer.instance_layer() {
+        LayerSupport::Nothing => return why(renderer.name()),
+        LayerSupport::WithoutShadowMaps if settings.shadows == ShadowMode::Map => return why(&format!("{}'s --shadows map", renderer.name())),
+        LayerSupport::WithoutShadowMaps | LayerSupport::Everything => {}
     }
-    match settings.shadows {
-        // The CPU maps draw the copies (each culled whole per light face).
-        ShadowMode::Map if renderer == "opengl" => return why("opengl's --shadows map"),
-        ShadowMode::Volume => return why("--shadows volume"),
-        ShadowMode::None | ShadowMode::Ray | ShadowMode::Map => {}
+    if settings.shadows == ShadowMode::Volume {
+        return why("--shadows volume");
     }
     match settings.view {
         View::Wireframe => why("--view wireframe"),

@@ -6,6 +6,7 @@
 //! `resolve_sample`, which shades it (or draws a debug view).
 
 pub mod accel;
+pub mod admit;
 pub mod differentials;
 pub mod finite;
 pub mod frame;
@@ -70,9 +71,13 @@ named_enum! {
     }
 }
 
-/// Per-render knobs. Scene-level values (background, ambient, exposure) stay
-/// in `Scene::render`.
+/// Per-render knobs: the one struct every front end (command line, viewer,
+/// chart, gallery) fills and renders with. Scene-level values (background,
+/// ambient, exposure) stay in `Scene::render`. `#[serde(default)]`: a value
+/// saved without a field loads with that field's default (`Default` below,
+/// the one place defaults are written).
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
 pub struct RenderSettings {
     pub width: u32,
     pub height: u32,
@@ -82,54 +87,42 @@ pub struct RenderSettings {
     /// CGPP's `rayBumpEpsilon`: how far shadow and secondary rays start off the surface.
     pub shadow_bump: f32,
     /// `--shadows map`: texels per side of each shadow map (per cube face for a point light).
-    #[serde(default = "shadow::map::default_size")]
     pub shadow_map_size: u32,
     /// `--shadows map`: depth bias in texels of the map, slope-scaled: a point is
     /// shadowed when it lies farther from the light than the stored depth by more
     /// than `bias * texel size * (1 + tan theta)` (see `shadow_map`).
-    #[serde(default = "shadow::map::default_bias")]
     pub shadow_map_bias: f32,
     /// `--shadows volume`: count the volume faces in front of the visible
     /// surface (z-pass) or behind it (z-fail).
-    #[serde(default)]
     pub shadow_volume: shadow::volume::VolumeMode,
     /// Maximum depth of mirror and refraction rays.
     pub max_depth: u32,
     pub view: inspect::debug::View,
-    #[serde(default)]
     pub interpolation: Interpolation,
     /// Rasterizers: resolve visibility first, then shade once per pixel
     /// (CGPP 15.8.3); false = forward shading of every fragment that passes
     /// the depth test when it arrives. Ray casters ignore it.
-    #[serde(default = "default_true")]
     pub early_depth: bool,
     /// Rasterizers: coverage samples per pixel (1 = off; 2, 4 or 8 at the
     /// D3D standard positions), one shade per pixel per primitive. Ray
     /// casters ignore it (they antialias with `spp`).
-    #[serde(default = "default_one")]
     pub msaa: u32,
     /// Rasterizers with 2D weights: interpolate attributes affinely in screen
     /// space instead of perspective-correctly, to show the difference (the uv
     /// checker bends). Ray casters and the 3D-ray variants ignore it.
-    #[serde(default)]
     pub affine: bool,
     /// Indirect light and its knobs.
-    #[serde(default)]
     pub gi: transport::gi::GiSettings,
     /// Adaptive sampling: after a few passes, only pixels whose estimated
     /// relative error is above this keep taking samples (up to `spp`).
-    #[serde(default)]
     pub adaptive: Option<f32>,
     /// Sub-sampling: trace a grid of pixels and interpolate the rest
     /// (`frame::subsample`); the shaded view of whole frames only.
-    #[serde(default)]
     pub subsample: frame::Subsample,
     /// Rasterizers with a depth buffer: what it stores (`raster::depth_format`).
     /// The ray casters, naive, bbox and the painter ignore it.
-    #[serde(default)]
     pub depth_buffer: raster::depth_format::DepthFormat,
     /// The wireframe view: the line algorithm (float DDA or integer Bresenham).
-    #[serde(default)]
     pub lines: inspect::wireframe::LineAlgorithm,
     /// Rasterizers: cut triangles at the near plane (CGPP 15.6.3). A debug
     /// knob to show why: false drops every triangle that reaches nearer than
@@ -138,49 +131,36 @@ pub struct RenderSettings {
     /// and walls that pass beside the camera lose their nearest triangles.
     /// Ray casters and `rasterize:naive` ignore it (they test eye rays,
     /// which start on the near plane).
-    #[serde(default = "default_true")]
     pub near_clip: bool,
     /// `--shadows map`: scale the bias with the slope of the surface to the
     /// light (see `shadow_map`); false: a constant `shadow_map_bias` texels,
     /// which at grazing light is too little (acne). A debug knob.
-    #[serde(default = "default_true")]
     pub shadow_map_slope_bias: bool,
     /// Shadow rays from smooth-normal triangles facing away from the light
     /// leave from the surface the normals imply (`transport::shade::shadow_origin`,
     /// against the shadow terminator); false: from the hit point, as the book
     /// does, to show the speckles. A debug knob.
-    #[serde(default = "default_true")]
     pub terminator_lift: bool,
     /// How textures and normal maps are read.
-    #[serde(default)]
     pub texture_filter: crate::scene::texture::TextureFilter,
     /// Traced reflections or environment lookups.
-    #[serde(default)]
     pub reflections: Reflections,
     /// Rasterizers: clip at the near plane only, or at every plane of the
     /// view volume (`raster::clip`). The same image either way.
-    #[serde(default)]
     pub clip: raster::clip::ClipMode,
     /// Rasterizers and shadow maps: skip copies made by `instances` whose
     /// bounding sphere is outside the view volume (`raster::cull`). The same
     /// image either way; a knob to measure and test that.
-    #[serde(default = "default_true")]
     pub cull_instances: bool,
 }
 
-fn default_true() -> bool {
-    true
-}
-
-fn default_one() -> u32 {
-    1
-}
-
-impl RenderSettings {
-    pub fn for_scene(scene: &crate::scene::Scene) -> RenderSettings {
+impl Default for RenderSettings {
+    /// Every knob's default, at the default scene size.
+    fn default() -> RenderSettings {
+        let size = crate::scene::RenderDefaults::default();
         RenderSettings {
-            width: scene.render.width,
-            height: scene.render.height,
+            width: size.width,
+            height: size.height,
             spp: 1,
             shadows: ShadowMode::Ray,
             shadow_bump: 1e-4,
@@ -206,6 +186,13 @@ impl RenderSettings {
             clip: raster::clip::ClipMode::Near,
             cull_instances: true,
         }
+    }
+}
+
+impl RenderSettings {
+    /// The defaults at `scene`'s image size.
+    pub fn for_scene(scene: &crate::scene::Scene) -> RenderSettings {
+        RenderSettings { width: scene.render.width, height: scene.render.height, ..RenderSettings::default() }
     }
 }
 
@@ -403,10 +390,32 @@ pub trait Renderer: Sync + Send {
     }
 
     /// Whether this renderer can draw `scene` with `settings`: one sentence
-    /// saying why not (an option it does not support, no driver). Checked
-    /// before a frame starts.
+    /// saying why not (an option it does not support). Asked by
+    /// `admit::admit`, with no driver loaded.
     fn check(&self, scene: &crate::scene::Scene, settings: &RenderSettings) -> Result<(), String> {
         accel::csg::check(scene, settings)
+    }
+
+    /// What this renderer draws instead of `settings` when `check` refuses
+    /// them but it can draw something close: candidates, best first, each
+    /// with the sentence that says what changed. `admit::admit` takes the
+    /// first that passes. None (the default): it draws `settings` or refuses.
+    fn substitutes(&self, _settings: &RenderSettings) -> Vec<admit::Substitute> {
+        Vec::new()
+    }
+
+    /// How much of the two-level instance layer (`scene::instanced`) this
+    /// renderer draws; `layer_support::check` refuses the rest. None by
+    /// default: a renderer that reads `Scene::triangles` alone.
+    fn instance_layer(&self) -> layer_support::LayerSupport {
+        layer_support::LayerSupport::Nothing
+    }
+
+    /// Readies what this renderer needs from outside the process (a
+    /// driver) for `settings`, once they are admitted and before a frame
+    /// starts: one sentence when it cannot.
+    fn ready(&self, _settings: &RenderSettings) -> Result<(), String> {
+        Ok(())
     }
 
     /// Replays pixel `(x, y)` of this pass through the same code path with a

@@ -3,7 +3,7 @@
 //! it places. The scene file's objects and the instance layer's copies are
 //! placed with the same arithmetic.
 
-use super::Triangle;
+use crate::scene::Triangle;
 use crate::math::Vec3;
 
 /// Object placement: scale, then rotate about X, Y, Z, then translate.

@@ -45,7 +45,7 @@ pub fn show(ui: &mut egui::Ui, settings: &mut ViewerSettings, renderer_names: &[
                 ui.checkbox(&mut settings.panels.side, "Side panel");
                 ui.separator();
                 for v in View::ALL {
-                    ui.radio_value(&mut settings.view, v, v.name());
+                    ui.radio_value(&mut settings.render.view, v, v.name());
                 }
             });
             if ui.button("Compare").on_hover_text("C: error against time of every method, against a reference").clicked() {
@@ -61,7 +61,7 @@ pub fn show(ui: &mut egui::Ui, settings: &mut ViewerSettings, renderer_names: &[
             });
             ui.separator();
             renderer_combo(ui, &mut settings.renderer, renderer_names);
-            view_combo(ui, &mut settings.view);
+            view_combo(ui, &mut settings.render.view);
             ui.separator();
             zoom_controls(ui, inspect);
             ui.checkbox(&mut inspect.vertices, "vertices")

@@ -15,12 +15,13 @@ use crate::render::{Interpolation, Reflections, ShadowMode};
 use crate::scene::texture::TextureFilter;
 use crate::scene::RenderDefaults;
 
-/// `settings`: the render knobs and gamma; `look`: the scene's ambient,
-/// background and exposure.
+/// `settings`: the render knobs in force (the worker renders with these) and
+/// gamma; `look`: the scene's ambient, background and exposure.
 pub fn show(ui: &mut egui::Ui, settings: &mut ViewerSettings, look: &mut RenderDefaults) {
     let mut open = settings.panels.shading;
+    let gamma = &mut settings.gamma;
     section(ui, "Shading", &mut open, |ui| {
-        let s = &mut *settings;
+        let s = &mut settings.render;
         ui.horizontal(|ui| {
             ui.label("shadows");
             for m in ShadowMode::ALL {
@@ -35,11 +36,11 @@ pub fn show(ui: &mut egui::Ui, settings: &mut ViewerSettings, look: &mut RenderD
             // CGPP 15.6.5's knobs: too little bias shows acne, too much peter-panning.
             ui.horizontal(|ui| {
                 let l = ui.label("map size");
-                ui.add(egui::Slider::new(&mut s.per_scene.shadow_map_size, 16..=4096).logarithmic(true)).labelled_by(l.id);
+                ui.add(egui::Slider::new(&mut s.shadow_map_size, 16..=4096).logarithmic(true)).labelled_by(l.id);
             });
             ui.horizontal(|ui| {
                 let l = ui.label("map bias (texels)");
-                ui.add(egui::Slider::new(&mut s.per_scene.shadow_map_bias, 0.0..=32.0)).labelled_by(l.id);
+                ui.add(egui::Slider::new(&mut s.shadow_map_bias, 0.0..=32.0)).labelled_by(l.id);
             });
         }
         if s.shadows == ShadowMode::Volume {
@@ -67,7 +68,7 @@ pub fn show(ui: &mut egui::Ui, settings: &mut ViewerSettings, look: &mut RenderD
             let l = ui.label("exposure");
             ui.add(egui::Slider::new(&mut r.exposure, 0.01..=100.0).logarithmic(true)).labelled_by(l.id);
         });
-        ui.checkbox(&mut s.gamma, "gamma (sRGB encode)");
+        ui.checkbox(gamma, "gamma (sRGB encode)");
         ui.horizontal(|ui| {
             ui.label("interpolation");
             for m in Interpolation::ALL {
@@ -87,7 +88,6 @@ pub fn show(ui: &mut egui::Ui, settings: &mut ViewerSettings, look: &mut RenderD
         });
         subsample_controls(ui, &mut s.subsample);
         // Rasterizer-only knobs; the ray casters ignore them.
-        let s = &mut s.per_scene;
         ui.horizontal(|ui| {
             ui.label("rasterizer: MSAA");
             for n in [1u32, 2, 4, 8] {

@@ -1,5 +1,6 @@
 //! The status bar: renderer, resolution, samples so far, time per frame,
-//! rays or fragments per second, triangles, and UI frames per second.
+//! rays or fragments per second, triangles, and UI frames per second; and
+//! under it, what the renderer draws otherwise than asked.
 
 use eframe::egui;
 use crate::app::PinholeApp;
@@ -7,6 +8,7 @@ use crate::app::PinholeApp;
 pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
     let text = status_text(app);
     let fps = app.ui_fps();
+    let notices = app.with_output(|o| o.notices.clone());
     egui::Panel::bottom("status-bar").show(ui, |ui| {
         ui.horizontal(|ui| {
             ui.label(text);
@@ -17,6 +19,10 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
                 ui.label(m);
             }
         });
+        // What the renderer draws otherwise than the panels ask (`render::admit`).
+        for n in &notices {
+            ui.colored_label(egui::Color32::from_rgb(230, 180, 60), n);
+        }
     });
 }
 

@@ -20,6 +20,8 @@ use crate::math::Radiance;
 use crate::render::inspect::debug;
 use crate::render::transport::gi;
 use crate::render::{Interpolation, PassJob, RayCounts, Reflections, RenderSettings, Renderer, ShadowMode};
+use crate::render::admit::Substitute;
+use crate::render::layer_support::LayerSupport;
 use crate::render::inspect::pixel_record::{GlReadback, PixelTrace};
 use crate::scene::Scene;
 
@@ -77,7 +79,32 @@ impl Renderer for OpenGl {
         if let Some(m) = csg_materials.filter_map(|m| scene.materials.get(m as usize)).find(|m| m.texture.is_some() || m.normal_map.is_some()) {
             return Err(format!("the opengl renderer draws csg objects without textures only (material \"{}\")", m.name));
         }
-        unsupported(scene, settings)?;
+        unsupported(scene, settings)
+    }
+
+    /// Shadow rays it cannot cast: shadow maps in the shaded view, else no shadows.
+    fn substitutes(&self, settings: &RenderSettings) -> Vec<Substitute> {
+        if settings.shadows != ShadowMode::Ray {
+            return Vec::new();
+        }
+        let with = |shadows, notice: String| Substitute { settings: RenderSettings { shadows, ..settings.clone() }, notice };
+        if settings.view != debug::View::Shaded {
+            let notice = format!("opengl cannot trace shadow rays, which the {} view does not show; drawing no shadows (--shadows none)", settings.view.name());
+            return vec![with(ShadowMode::None, notice)];
+        }
+        vec![
+            with(ShadowMode::Map, "opengl cannot trace shadow rays; drawing shadow maps instead (--shadows map)".into()),
+            with(ShadowMode::None, "opengl cannot trace shadow rays, and shadow maps cannot draw this scene; drawing no shadows instead (--shadows none)".into()),
+        ]
+    }
+
+    /// The copies are instanced in GL; its shadow pass draws `Scene::triangles` only.
+    fn instance_layer(&self) -> LayerSupport {
+        LayerSupport::WithoutShadowMaps
+    }
+
+    /// The driver, and as many multisamples as `--msaa` asks for.
+    fn ready(&self, settings: &RenderSettings) -> Result<(), String> {
         let max_samples = max_samples()?;
         if settings.msaa > 1 && settings.msaa as i32 > max_samples {
             return Err(format!("the opengl renderer's driver offers at most {max_samples} samples per pixel, not --msaa {}", settings.msaa));
@@ -89,7 +116,7 @@ impl Renderer for OpenGl {
         match with_gl(|g| pass::render(g, job, out, None)) {
             Ok(Ok((counts, _))) => counts,
             Ok(Err(e)) | Err(e) => {
-                // `check` refuses what cannot be drawn before a frame starts;
+                // `check` and `ready` refuse what cannot be drawn before a frame starts;
                 // a failure here leaves the rows black rather than stale.
                 eprintln!("warning: opengl: {e}");
                 out.fill(Radiance::ZERO);

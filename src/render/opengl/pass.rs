@@ -87,7 +87,7 @@ impl State {
     unsafe fn new(gl: &glow::Context) -> Result<State, String> {
         unsafe {
             let background = shaders::compile(gl, shaders::BACKGROUND_VERTEX, &shaders::background_fragment())?;
-            let maps = super::shadow_pass::ShadowPass::new(gl)?;
+            let maps = crate::render::opengl::shadow_pass::ShadowPass::new(gl)?;
             let vertex_array = gl.create_vertex_array()?;
             let vertex_buffer = gl.create_buffer()?;
             gl.bind_vertex_array(Some(vertex_array));

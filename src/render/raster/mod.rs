@@ -86,6 +86,11 @@ impl Renderer for Rasterizer {
         self.method.description()
     }
 
+    /// The copies, each set up whole (and culled whole); shadow maps draw them too.
+    fn instance_layer(&self) -> crate::render::layer_support::LayerSupport {
+        crate::render::layer_support::LayerSupport::Everything
+    }
+
     fn render_pass(&self, job: &PassJob, out: &mut [Radiance]) -> RayCounts {
         pass::render(self.method, job, out)
     }

@@ -20,6 +20,11 @@ impl Renderer for BvhRayTracer {
         "ray casting through a SAH bounding volume hierarchy: same pixels as the reference, far fewer tests"
     }
 
+    /// The copies, by the two-level BVH; shadow maps draw them too.
+    fn instance_layer(&self) -> crate::render::layer_support::LayerSupport {
+        crate::render::layer_support::LayerSupport::Everything
+    }
+
     fn render_pass(&self, job: &PassJob, out: &mut [Radiance]) -> RayCounts {
         if job.prepared.instances.is_some() {
             // Packets walk the one BVH; the two-level layer takes rays one at a time.

@@ -94,13 +94,6 @@ pub fn check_memory(scene: &Scene, size: u32) -> Result<(), String> {
     Ok(())
 }
 
-pub fn default_size() -> u32 {
-    DEFAULT_SIZE
-}
-
-pub fn default_bias() -> f32 {
-    DEFAULT_BIAS
-}
 
 /// Rows of a map rasterized together (bands run in parallel).
 const BAND: u32 = 32;

@@ -1,0 +1,246 @@
+//! The options every rendering subcommand takes (`render`, `bench`,
+//! `pixel`, `chart`), and how they are written into `RenderSettings`, the
+//! one settings struct: clap reads them as given, `write_into` checks each
+//! and sets its field. Their defaults are `RenderSettings::default()`'s,
+//! shown by `--help`.
+
+use crate::render::{self, RenderSettings};
+use clap::Args;
+
+/// The defaults the options show and start from.
+fn defaults() -> RenderSettings {
+    RenderSettings::default()
+}
+
+/// `--bounces` as written: a number, or `inf` for no limit.
+fn bounces_name(bounces: Option<u32>) -> String {
+    bounces.map_or("inf".to_string(), |b| b.to_string())
+}
+
+#[derive(Args, Clone)]
+pub struct RenderOpts {
+    /// raytrace | rasterize, or a variant (see `pinhole list`).
+    #[arg(long, default_value = "raytrace")]
+    pub renderer: String,
+    #[arg(long)]
+    pub width: Option<u32>,
+    #[arg(long)]
+    pub height: Option<u32>,
+    /// Samples per pixel (stratified; 1 = the pixel centre).
+    #[arg(long, default_value_t = defaults().spp)]
+    pub spp: u32,
+    /// shaded | barycentric | raydir | depth | zbuffer | normal | id | uv | cost | diff | shadowmap | wireframe (see `pinhole list`)
+    #[arg(long, default_value_t = defaults().view.name().to_string())]
+    pub view: String,
+    /// ray | map | volume | none (opengl, which casts no rays, draws ray shadows as maps)
+    #[arg(long, default_value_t = defaults().shadows.name().to_string())]
+    pub shadows: String,
+    /// Rasterizers: interpolate attributes affinely in screen space (no 1/z correction).
+    #[arg(long)]
+    pub affine: bool,
+    /// flat | gouraud | phong: how shading varies across a triangle.
+    #[arg(long, default_value_t = defaults().interpolation.name().to_string())]
+    pub interpolation: String,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Shadow-ray start offset along the ray (CGPP's rayBumpEpsilon).
+    #[arg(long, value_name = "EPS")]
+    pub bump: Option<f32>,
+    /// --shadows map: texels per side of each shadow map (per cube face for point lights).
+    #[arg(long = "shadow-map-size", value_name = "N")]
+    pub shadow_map_size: Option<u32>,
+    /// --shadows map: depth bias in texels, slope-scaled (too small: acne; too large: peter-panning).
+    #[arg(long = "shadow-bias", value_name = "B")]
+    pub shadow_bias: Option<f32>,
+    /// --shadows volume: count the volume faces in front of the visible
+    /// surface (zpass, wrong with the eye inside a shadow) or behind it (zfail).
+    #[arg(long = "shadow-volume", value_name = "zpass|zfail", default_value_t = defaults().shadow_volume.name().to_string())]
+    pub shadow_volume: String,
+    /// Rasterizers: coverage samples per pixel with one shade per pixel per
+    /// primitive: 1 (off), 2, 4 or 8. Ray casters ignore it (use --spp).
+    #[arg(long, default_value_t = defaults().msaa, value_name = "N")]
+    pub msaa: u32,
+    /// Rasterizers: depth pass first, then one shade per pixel (false: forward shading).
+    #[arg(long = "early-depth", value_name = "BOOL", default_value_t = defaults().early_depth, action = clap::ArgAction::Set)]
+    pub early_depth: bool,
+    /// Rasterizers: forward shading, every fragment that passes the depth test
+    /// is shaded (the same as --early-depth false).
+    #[arg(long)]
+    pub forward: bool,
+    /// Indirect light: none | ao | photons | path.
+    #[arg(long, default_value_t = defaults().gi.mode.name().to_string())]
+    pub gi: String,
+    /// --gi path: indirect bounces, a number or `inf` (Mitsuba's max_depth = N + 2).
+    #[arg(long, default_value_t = bounces_name(defaults().gi.bounces), value_name = "N|inf")]
+    pub bounces: String,
+    /// --gi ao: hemisphere rays per sample.
+    #[arg(long = "ao-samples", value_name = "N")]
+    pub ao_samples: Option<u32>,
+    /// --gi ao: how far the hemisphere rays look for occluders.
+    #[arg(long = "ao-distance", value_name = "D")]
+    pub ao_distance: Option<f32>,
+    /// --gi photons: photons shot from the lights.
+    #[arg(long, value_name = "N")]
+    pub photons: Option<u32>,
+    /// --gi photons: nearest photons per density estimate.
+    #[arg(long = "photon-k", value_name = "K")]
+    pub photon_k: Option<u32>,
+    /// --gi photons: rays gathered at the first hit (0: read the map there).
+    #[arg(long = "final-gather", value_name = "N")]
+    pub final_gather: Option<u32>,
+    /// Stochastic methods: the image depends on (scene, settings, seed) only.
+    #[arg(long, default_value_t = defaults().gi.seed)]
+    pub seed: u64,
+    /// Adaptive sampling: pixels stop taking samples (of at most --spp) once
+    /// their estimated relative error is below TARGET (e.g. 0.05).
+    #[arg(long, value_name = "TARGET")]
+    pub adaptive: Option<f32>,
+    /// Sub-sampling: trace every N-th pixel in x and y (1, 2, 4, 8, 16) and
+    /// interpolate the pixels between.
+    #[arg(long, default_value_t = defaults().subsample.step, value_name = "N")]
+    pub subsample: u32,
+    /// --subsample: also trace in full each grid cell whose corners differ in
+    /// contrast ((max - min) / (max + min), per channel) by more than C.
+    #[arg(long = "subsample-contrast", value_name = "C")]
+    pub subsample_contrast: Option<f32>,
+    /// Rasterizers: what the depth buffer stores: f32 | unorm24 | unorm16 | reversed.
+    #[arg(long = "depth-buffer", default_value_t = defaults().depth_buffer.name().to_string(), value_name = "FORMAT")]
+    pub depth_buffer: String,
+    /// --view wireframe: the line algorithm, float (DDA) | integer (Bresenham).
+    #[arg(long, default_value_t = defaults().lines.name().to_string())]
+    pub lines: String,
+    /// How textures are read: nearest | bilinear | trilinear (mipmapped).
+    #[arg(long = "texture-filter", default_value_t = defaults().texture_filter.name().to_string(), value_name = "FILTER")]
+    pub texture_filter: String,
+    /// What mirrors reflect: ray (traced) | env (the environment in the reflected direction, no ray).
+    #[arg(long, default_value_t = defaults().reflections.name().to_string(), value_name = "ray|env")]
+    pub reflections: String,
+    /// Rasterizers: clip triangles at the near plane only, or at every plane of the view volume.
+    #[arg(long, default_value_t = defaults().clip.name().to_string(), value_name = "near|frustum")]
+    pub clip: String,
+    /// Rasterizers: cull copies made by `instances` by their bounding spheres (same image either way).
+    #[arg(long = "cull-instances", value_name = "BOOL", default_value_t = defaults().cull_instances, action = clap::ArgAction::Set)]
+    pub cull_instances: bool,
+}
+
+impl RenderOpts {
+    /// Writes every option into `settings`, each checked: the error is one
+    /// sentence naming the option. The image size only where `--width` or
+    /// `--height` is given (else it stays the scene's).
+    pub fn write_into(&self, settings: &mut RenderSettings) -> Result<(), String> {
+        let s = settings;
+        s.view = render::inspect::debug::View::parse(&self.view)?;
+        s.shadows = render::ShadowMode::parse(&self.shadows)?;
+        s.interpolation = render::Interpolation::parse(&self.interpolation)?;
+        s.texture_filter = crate::scene::texture::TextureFilter::parse(&self.texture_filter).map_err(|e| format!("--texture-filter: {e}"))?;
+        s.reflections = render::Reflections::parse(&self.reflections).map_err(|e| format!("--reflections: {e}"))?;
+        s.shadow_volume = render::shadow::volume::VolumeMode::parse(&self.shadow_volume).map_err(|e| format!("--shadow-volume: {e}"))?;
+        if self.spp == 0 || self.spp > 65536 {
+            return Err(format!("--spp {} is not between 1 and 65536", self.spp));
+        }
+        s.spp = self.spp;
+        for (flag, v) in [("--width", self.width), ("--height", self.height)] {
+            if let Some(v) = v {
+                if !(1..=16384).contains(&v) {
+                    return Err(format!("{flag} {v} is not between 1 and 16384"));
+                }
+            }
+        }
+        s.width = self.width.unwrap_or(s.width);
+        s.height = self.height.unwrap_or(s.height);
+        s.clip = render::raster::clip::ClipMode::parse(&self.clip).map_err(|e| format!("--clip: {e}"))?;
+        s.cull_instances = self.cull_instances;
+        s.affine = self.affine;
+        if let Some(b) = self.bump {
+            if !(b.is_finite() && b >= 0.0) {
+                return Err(format!("--bump {b} must be a finite number >= 0"));
+            }
+            s.shadow_bump = b;
+        }
+        if let Some(n) = self.shadow_map_size {
+            if !(1..=render::shadow::map::MAX_SIZE).contains(&n) {
+                return Err(format!("--shadow-map-size {n} is not between 1 and {}", render::shadow::map::MAX_SIZE));
+            }
+            s.shadow_map_size = n;
+        }
+        if let Some(b) = self.shadow_bias {
+            if !(b.is_finite() && b >= 0.0) {
+                return Err(format!("--shadow-bias {b} must be a finite number of texels >= 0"));
+            }
+            s.shadow_map_bias = b;
+        }
+        if !render::raster::msaa::COUNTS.contains(&self.msaa) {
+            return Err(format!("--msaa {} is not one of 1, 2, 4, 8", self.msaa));
+        }
+        s.msaa = self.msaa;
+        s.early_depth = self.early_depth && !self.forward;
+        self.write_gi(&mut s.gi)?;
+        s.depth_buffer = render::raster::depth_format::DepthFormat::parse(&self.depth_buffer).map_err(|e| format!("--depth-buffer: {e}"))?;
+        s.lines = render::inspect::wireframe::LineAlgorithm::parse(&self.lines).map_err(|e| format!("--lines: {e}"))?;
+        if let Some(t) = self.adaptive {
+            if !(t > 0.0 && t.is_finite()) {
+                return Err(format!("--adaptive {t} must be a relative error > 0 (e.g. 0.05)"));
+            }
+            s.adaptive = Some(t);
+        }
+        if !render::frame::subsample::STEPS.contains(&self.subsample) {
+            return Err(format!("--subsample {} is not one of 1, 2, 4, 8, 16", self.subsample));
+        }
+        s.subsample.step = self.subsample;
+        if let Some(c) = self.subsample_contrast {
+            if !(c >= 0.0 && c.is_finite()) {
+                return Err(format!("--subsample-contrast {c} must be a contrast >= 0 (e.g. 0.3)"));
+            }
+            if self.subsample == 1 {
+                return Err("--subsample-contrast refines a sub-sampled frame: give --subsample 2, 4, 8 or 16 too".into());
+            }
+            s.subsample.contrast = Some(c);
+        }
+        Ok(())
+    }
+
+    /// The indirect-light options, checked, written into `gi`.
+    fn write_gi(&self, gi: &mut render::transport::gi::GiSettings) -> Result<(), String> {
+        gi.mode = render::transport::gi::GiMode::parse(&self.gi)?;
+        gi.seed = self.seed;
+        gi.bounces = match self.bounces.as_str() {
+            "inf" => None,
+            n => match n.parse::<u32>() {
+                Ok(b) if b <= render::transport::gi::MAX_BOUNCES => Some(b),
+                _ => return Err(format!("--bounces {n} is neither inf nor a number from 0 to {}", render::transport::gi::MAX_BOUNCES)),
+            },
+        };
+        if let Some(n) = self.ao_samples {
+            if !(1..=4096).contains(&n) {
+                return Err(format!("--ao-samples {n} is not between 1 and 4096"));
+            }
+            gi.ao_samples = n;
+        }
+        if let Some(d) = self.ao_distance {
+            if !(d > 0.0) || d.is_nan() {
+                return Err(format!("--ao-distance {d} must be a number > 0 (inf allowed)"));
+            }
+            gi.ao_distance = d;
+        }
+        if let Some(n) = self.photons {
+            if !(1..=50_000_000).contains(&n) {
+                return Err(format!("--photons {n} is not between 1 and 50000000"));
+            }
+            gi.photons = n;
+        }
+        if let Some(k) = self.photon_k {
+            if !(1..=4096).contains(&k) {
+                return Err(format!("--photon-k {k} is not between 1 and 4096"));
+            }
+            gi.photon_k = k;
+        }
+        if let Some(n) = self.final_gather {
+            if n > 4096 {
+                return Err(format!("--final-gather {n} is more than 4096"));
+            }
+            gi.final_gather = n;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,126 @@
+//! The admission gate: can this renderer draw this scene with these
+//! settings? Every front end (the command line, the viewer's worker, chart
+//! and gallery) asks here before a frame starts, so they all give the same
+//! answer: the settings the renderer will really use, with one sentence for
+//! each thing it draws otherwise than asked, or a refusal in one sentence.
+//!
+//! What a renderer can do is its own answer (`Renderer::check`,
+//! `Renderer::substitutes`, `Renderer::instance_layer`); what no renderer
+//! can afford (an image or shadow maps too big for memory) is checked here.
+
+use crate::render::inspect::debug::View;
+use crate::render::{layer_support, RenderSettings, Renderer, ShadowMode};
+use crate::render::shadow::map as shadow_map;
+use crate::scene::Scene;
+
+/// Settings a renderer accepted.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Admitted {
+    /// What the renderer will draw with: the settings asked for, or what it
+    /// substituted for them.
+    pub settings: RenderSettings,
+    /// One sentence per substitution, saying what changed and why.
+    pub notices: Vec<String>,
+}
+
+/// Settings a renderer can draw in place of ones it cannot, and the
+/// sentence that says so.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Substitute {
+    pub settings: RenderSettings,
+    pub notice: String,
+}
+
+/// Whether `renderer` draws `scene` with `settings`: `Ok` with the settings
+/// it will use (`settings` themselves, or the first of its substitutes that
+/// it draws), `Err` with why not. Loads no driver (`Renderer::ready` does).
+pub fn admit(renderer: &dyn Renderer, scene: &Scene, settings: &RenderSettings) -> Result<Admitted, String> {
+    let mut refusal = match check(renderer, scene, settings) {
+        Ok(()) => return Ok(Admitted { settings: settings.clone(), notices: Vec::new() }),
+        Err(e) => e,
+    };
+    for s in renderer.substitutes(settings) {
+        match check(renderer, scene, &s.settings) {
+            Ok(()) => return Ok(Admitted { settings: s.settings, notices: vec![s.notice] }),
+            // The most lenient substitute's refusal names what really stands in the way.
+            Err(e) => refusal = e,
+        }
+    }
+    Err(refusal)
+}
+
+/// Every reason `renderer` cannot draw `scene` with exactly `settings`.
+fn check(renderer: &dyn Renderer, scene: &Scene, settings: &RenderSettings) -> Result<(), String> {
+    crate::input::check_image_size(settings.width, settings.height).map_err(|e| format!("the image size {e}"))?;
+    // Refused before anything is allocated, rather than aborting when it is.
+    if settings.shadows == ShadowMode::Map || settings.view == View::Shadowmap {
+        shadow_map::check_memory(scene, settings.shadow_map_size)?;
+    }
+    layer_support::check(renderer, scene, settings)?;
+    renderer.check(scene, settings)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::renderer_by_name;
+
+    fn scene(name: &str) -> Scene {
+        crate::scene::builtin::load_builtin(name).unwrap().unwrap()
+    }
+
+    #[test]
+    fn settings_a_renderer_draws_pass_through_unchanged() {
+        let sc = scene("spheres");
+        let settings = RenderSettings { spp: 4, shadows: ShadowMode::Map, shadow_map_size: 256, msaa: 4, ..RenderSettings::for_scene(&sc) };
+        for name in ["raytrace:brute", "raytrace:bvh", "rasterize"] {
+            let a = admit(renderer_by_name(name).unwrap().as_ref(), &sc, &settings).unwrap();
+            assert_eq!(a, Admitted { settings: settings.clone(), notices: Vec::new() }, "{name}");
+        }
+    }
+
+    #[test]
+    fn opengl_draws_shadow_maps_for_shadow_rays_and_says_so() {
+        let sc = scene("spheres");
+        let asked = RenderSettings::for_scene(&sc);
+        assert_eq!(asked.shadows, ShadowMode::Ray, "rays are the default");
+        let a = admit(renderer_by_name("opengl").unwrap().as_ref(), &sc, &asked).unwrap();
+        assert_eq!(a.settings, RenderSettings { shadows: ShadowMode::Map, ..asked.clone() }, "only the shadows change");
+        assert_eq!(a.notices, vec!["opengl cannot trace shadow rays; drawing shadow maps instead (--shadows map)".to_string()]);
+        // Asked for what it draws, nothing is substituted.
+        let none = RenderSettings { shadows: ShadowMode::None, ..asked };
+        assert_eq!(admit(renderer_by_name("opengl").unwrap().as_ref(), &sc, &none).unwrap().notices, Vec::<String>::new());
+    }
+
+    #[test]
+    fn opengl_draws_no_shadows_where_its_maps_cannot_draw_the_scene() {
+        // Shadow maps are built from triangles and spheres, not CSG objects.
+        let sc = scene("csg");
+        let asked = RenderSettings::for_scene(&sc);
+        let a = admit(renderer_by_name("opengl").unwrap().as_ref(), &sc, &asked).unwrap();
+        assert_eq!(a.settings.shadows, ShadowMode::None);
+        assert_eq!(a.notices.len(), 1);
+        assert!(a.notices[0].contains("--shadows none") && !a.notices[0].contains('\n'), "{:?}", a.notices);
+    }
+
+    #[test]
+    fn a_refusal_is_one_sentence_naming_what_stands_in_the_way() {
+        // CSG objects under shadow volumes: no renderer substitutes.
+        let sc = scene("csg");
+        let s = RenderSettings { shadows: ShadowMode::Volume, ..RenderSettings::for_scene(&sc) };
+        let e = admit(renderer_by_name("rasterize").unwrap().as_ref(), &sc, &s).unwrap_err();
+        assert!(e.starts_with("--shadows volume cannot include csg objects") && !e.contains('\n'), "{e}");
+        // The shadow-map view needs the maps in memory whatever the shadows: six
+        // point lights at 4096 texels per face take 4.5 GiB.
+        let mut big = scene("spheres");
+        big.lights = vec![big.lights[0].clone(); 6];
+        let s = RenderSettings { view: View::Shadowmap, shadow_map_size: shadow_map::MAX_SIZE, ..RenderSettings::for_scene(&big) };
+        assert_eq!(s.shadows, ShadowMode::Ray);
+        let e = admit(renderer_by_name("raytrace").unwrap().as_ref(), &big, &s).unwrap_err();
+        assert!(e.starts_with("shadow maps of 6 lights") && !e.contains('\n'), "{e}");
+        // An image too big for memory.
+        let s = RenderSettings { width: 100_000, ..RenderSettings::for_scene(&big) };
+        let e = admit(renderer_by_name("raytrace").unwrap().as_ref(), &big, &s).unwrap_err();
+        assert!(e.starts_with("the image size 100000x"), "{e}");
+    }
+}
