@@ -285,13 +285,13 @@ pub trait SceneQuery: Sync {
         None
     }
     /// Shadow maps to look light visibility up in (`--shadows map`);
-    /// `resolve_sample` wraps the query in a `shadow::map::MapQuery` that has them.
+    /// `resolve_sample` wraps the query in a `shadow::ApproximateShadows` that has them.
     fn shadow_maps(&self) -> Option<&shadow::map::ShadowMaps> {
         None
     }
     /// The shadow volume count of light `light` at the primary surface
     /// (`--shadows volume`, nonzero = shadow); `resolve_sample` wraps the
-    /// query in a `shadow::volume::VolumeQuery` that has the counts.
+    /// query in a `shadow::ApproximateShadows` that has the counts.
     fn volume_count(&self, _light: usize) -> Option<i32> {
         None
     }
@@ -498,7 +498,7 @@ pub fn resolve_sample<Q: SceneQuery, R: Recorder>(
     }
     if job.settings.shadows == ShadowMode::Map && job.settings.view == inspect::debug::View::Shaded && hit.is_some() {
         return shadow::map::with_maps(job.prepared, job.settings, |maps| {
-            resolve_with(job, &shadow::map::MapQuery { inner: query, maps }, ray, hit, pixel, counts, rec)
+            resolve_with(job, &shadow::ApproximateShadows { inner: query, maps: Some(maps), volume_counts: None }, ray, hit, pixel, counts, rec)
         });
     }
     if job.settings.shadows == ShadowMode::Volume && job.settings.view == inspect::debug::View::Shaded {
@@ -524,7 +524,7 @@ pub fn resolve_counted<Q: SceneQuery, R: Recorder>(
     counts: &mut RayCounts,
     rec: &mut R,
 ) -> Radiance {
-    resolve_with(job, &shadow::volume::VolumeQuery { inner: query, counts: volume }, ray, hit, pixel, counts, rec)
+    resolve_with(job, &shadow::ApproximateShadows { inner: query, maps: None, volume_counts: Some(volume) }, ray, hit, pixel, counts, rec)
 }
 
 #[inline]

@@ -4,7 +4,7 @@
 //! crossing to that light's count: z-pass counts faces in front of the
 //! visible surface, z-fail the faces behind it, against the split depth
 //! `shadow_volume::split_depth`. Nonzero counts are shadow; `shade()` reads
-//! them through `shadow_volume::VolumeQuery`.
+//! them through `shadow::ApproximateShadows`.
 //!
 //! Depths are compared as the ray casters compare them: the face's plane
 //! intersected with the pixel's eye ray gives its ray parameter, the visible

@@ -51,7 +51,7 @@ use crate::render::raster::subpixel::snap_offset;
 use crate::render::raster::sphere::sphere_bounds;
 use crate::render::keyed_cache::{KeyedCache, ThreadCopy};
 use crate::render::inspect::pixel_record::Recorder;
-use crate::render::{Occluder, PassJob, PreparedScene, RayCounts, RenderSettings, SceneQuery};
+use crate::render::{Occluder, PassJob, PreparedScene, RenderSettings};
 use crate::math::{Radiance, Ray, Vec2, Vec3};
 use crate::scene::{Camera, CameraView, Fov, Light, PrimitiveId, Scene, Sphere, SurfaceHit, Triangle};
 use rayon::prelude::*;
@@ -662,30 +662,6 @@ pub fn with_maps<T>(prepared: &PreparedScene, settings: &RenderSettings, f: impl
     let size = settings.shadow_map_size;
     let fits = |maps: &ShadowMaps| maps.matches(&prepared.scene, size);
     CURRENT.with(|copy| copy.with(prepared.shadow_cache.id(), fits, || cached_maps(prepared, size, false), f))
-}
-
-/// A scene query that also answers shadow visibility from maps: `shade()`
-/// asks `shadow_maps()` when `settings.shadows == ShadowMode::Map`.
-pub struct MapQuery<'a, Q> {
-    pub inner: &'a Q,
-    pub maps: &'a ShadowMaps,
-}
-
-impl<Q: SceneQuery> SceneQuery for MapQuery<'_, Q> {
-    #[inline]
-    fn closest<R: Recorder>(&self, ray: &Ray, t_max: f32, inside: bool, counts: &mut RayCounts, rec: &mut R) -> Option<SurfaceHit> {
-        self.inner.closest(ray, t_max, inside, counts, rec)
-    }
-
-    #[inline]
-    fn occluder<R: Recorder>(&self, ray: &Ray, t_max: f32, counts: &mut RayCounts, rec: &mut R) -> Option<Occluder> {
-        self.inner.occluder(ray, t_max, counts, rec)
-    }
-
-    #[inline]
-    fn shadow_maps(&self) -> Option<&ShadowMaps> {
-        Some(self.maps)
-    }
 }
 
 /// The `shadowmap` view's value for the sample whose eye ray is `ray`: the

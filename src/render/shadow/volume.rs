@@ -53,19 +53,18 @@
 //! faces into a per-pixel stencil count after their depth pass
 //! (`raster::stencil`); the ray casters count crossings along the eye ray
 //! through a BVH over the volume faces (`ShadowVolumes::count`). Either way
-//! the counts reach `shade()` through `VolumeQuery`, which answers the
+//! the counts reach `shade()` through `shadow::ApproximateShadows`, which answers the
 //! primary surface only (`depth == 0`, with Gouraud its vertices, masked by
 //! the pixel's count as a stencil masks them). Every secondary hit (mirror,
 //! glass, indirect bounces) has no stencil and casts shadow rays instead.
 
 use crate::render::keyed_cache::{KeyedCache, ThreadCopy};
-use crate::render::inspect::pixel_record::Recorder;
 use crate::render::accel::bvh::Bvh;
 use crate::render::accel::intersect::{intersect_triangle, TriangleEdges};
-use crate::render::{Occluder, PreparedScene, RayCounts, RenderSettings, SceneQuery};
+use crate::render::{PreparedScene, RenderSettings};
 use crate::math::{Ray, Vec2, Vec3};
 use crate::named::named_enum;
-use crate::scene::{Light, Scene, Sphere, SurfaceHit, Triangle};
+use crate::scene::{Light, Scene, Sphere, Triangle};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -348,32 +347,6 @@ thread_local! {
 pub fn with_volumes<T>(prepared: &PreparedScene, f: impl FnOnce(&ShadowVolumes) -> T) -> T {
     let fits = |v: &ShadowVolumes| v.matches(&prepared.scene);
     CURRENT.with(|copy| copy.with(prepared.volume_cache.id(), fits, || prepared.shadow_volumes(), f))
-}
-
-/// A scene query whose light visibility for the primary surface comes from
-/// per-light volume counts (a stencil): `shade()` asks `volume_count()` at
-/// depth 0 with `ShadowMode::Volume`, and casts shadow rays elsewhere.
-pub struct VolumeQuery<'a, Q> {
-    pub inner: &'a Q,
-    /// One count per light, in scene order.
-    pub counts: &'a [i32],
-}
-
-impl<Q: SceneQuery> SceneQuery for VolumeQuery<'_, Q> {
-    #[inline]
-    fn closest<R: Recorder>(&self, ray: &Ray, t_max: f32, inside: bool, counts: &mut RayCounts, rec: &mut R) -> Option<SurfaceHit> {
-        self.inner.closest(ray, t_max, inside, counts, rec)
-    }
-
-    #[inline]
-    fn occluder<R: Recorder>(&self, ray: &Ray, t_max: f32, counts: &mut RayCounts, rec: &mut R) -> Option<Occluder> {
-        self.inner.occluder(ray, t_max, counts, rec)
-    }
-
-    #[inline]
-    fn volume_count(&self, light: usize) -> Option<i32> {
-        self.counts.get(light).copied()
-    }
 }
 
 /// The ray casters' counts for the sample whose eye ray `ray` hits at `t_hit`.
