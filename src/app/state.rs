@@ -564,6 +564,7 @@ impl PinholeApp {
         crate::app::gallery::show(self, ui);
         crate::app::panels::status::show(self, ui);
         if self.settings.panels.side {
+            let (admitted, notices) = self.with_output(|o| (o.admitted.clone(), o.notices.clone()));
             egui::Panel::left("side-panel").default_size(300.0).resizable(true).show(ui, |ui| {
                 egui::ScrollArea::vertical().show(ui, |ui| {
                     let (width, height) = (self.scene.render.width, self.scene.render.height);
@@ -571,7 +572,8 @@ impl PinholeApp {
                     requests |= crate::app::panels::camera::show(ui, &mut panels.camera, &mut self.params.camera, &mut self.settings.res_scale, (width, height));
                     crate::app::panels::lights::show(ui, &mut panels.lights, &mut self.params.lights, &self.params.camera, &self.scene);
                     crate::app::panels::materials::show(ui, &mut panels.materials, &mut self.params.materials);
-                    crate::app::panels::shading::show(ui, &mut self.settings, &mut self.params.render);
+                    let in_force = crate::app::panels::shading::InForce { admitted: admitted.as_ref(), notices: &notices };
+                    crate::app::panels::shading::show(ui, &mut self.settings, &mut self.params.render, in_force);
                 });
             });
         }
