@@ -26,20 +26,20 @@ fn shading_panel_shows_the_shadow_maps_opengl_draws_for_shadow_rays() {
     }
     let mut h = new_harness(small_scene("teapot"));
     settle(&mut h);
-    assert_eq!(h.state().settings.render.shadows, ShadowMode::Ray, "the scene asks for shadow rays");
+    assert_eq!(h.state().settings().render.shadows, ShadowMode::Ray, "the scene asks for shadow rays");
     assert!(h.query_by_label_contains("in force:").is_none(), "the ray tracer draws what is asked");
 
-    h.state_mut().settings.renderer = "opengl".into();
+    h.state_mut().settings_mut().renderer = "opengl".into();
     settle(&mut h);
     let notices = h.state().with_output(|o| o.notices.clone());
     assert_eq!(notices.len(), 1, "{notices:?}");
     assert!(notices[0].contains("shadow maps"), "{notices:?}");
     // The panel still asks for rays, and says what is drawn instead.
-    assert_eq!(h.state().settings.render.shadows, ShadowMode::Ray);
+    assert_eq!(h.state().settings().render.shadows, ShadowMode::Ray);
     h.get_by_label(&format!("in force: map — {}", notices[0]));
 
     // Asking for maps: nothing substituted, no line.
-    h.state_mut().settings.render.shadows = ShadowMode::Map;
+    h.state_mut().settings_mut().render.shadows = ShadowMode::Map;
     settle(&mut h);
     assert!(h.query_by_label_contains("in force:").is_none(), "maps are drawn as asked");
 }
