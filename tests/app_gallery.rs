@@ -30,10 +30,10 @@ fn settle(h: &mut Harness<'static, PinholeApp>) {
 
 /// What `pinhole render` gives for the app's scene, settings and renderer.
 fn reference(app: &PinholeApp) -> Vec<Radiance> {
-    let mut scene = (*app.scene).clone();
-    app.params.apply(&mut scene);
+    let mut scene = (*app.scene()).clone();
+    app.params().apply(&mut scene);
     let prepared = PreparedScene::new(scene);
-    let renderer = render::renderer_by_name(&app.settings.renderer).unwrap();
+    let renderer = render::renderer_by_name(&app.settings().renderer).unwrap();
     render::render_frame(renderer.as_ref(), &prepared, &app.effective_settings(), &AtomicBool::new(false), None).unwrap().pixels
 }
 
@@ -52,11 +52,11 @@ fn the_gallery_menu_opens_a_case_with_its_failing_setting_then_its_cure() {
     open_case(&mut h, "shadow-acne");
     {
         let app = h.state();
-        assert_eq!(app.scene.name, "stress-shadow");
-        assert_eq!(app.settings.renderer, "rasterize:fixed", "the case's renderer, by its full name");
+        assert_eq!(app.scene().name, "stress-shadow");
+        assert_eq!(app.settings().renderer, "rasterize:fixed", "the case's renderer, by its full name");
         let s = app.effective_settings();
         assert_eq!((s.shadows, s.shadow_map_bias), (ShadowMode::Map, 0.0), "the failing setting is applied");
-        assert_eq!(app.gallery.as_ref().map(|g| g.cured), Some(false));
+        assert_eq!(app.gallery().map(|g| g.cured), Some(false));
         let shown = app.with_output(|o| o.linear.clone());
         assert_eq!(shown, reference(app), "the image is the failing setting's");
     }
@@ -67,7 +67,7 @@ fn the_gallery_menu_opens_a_case_with_its_failing_setting_then_its_cure() {
     let app = h.state();
     let s = app.effective_settings();
     assert_eq!((s.shadows, s.shadow_map_bias), (ShadowMode::Map, render::shadow::map::DEFAULT_BIAS));
-    assert_eq!(app.gallery.as_ref().map(|g| g.cured), Some(true));
+    assert_eq!(app.gallery().map(|g| g.cured), Some(true));
     assert_eq!(app.with_output(|o| o.linear.clone()), reference(app));
 }
 
@@ -76,14 +76,14 @@ fn a_case_whose_cure_moves_the_scene_opens_the_moved_scene() {
     let mut h = new_harness(small_scene("one-triangle"));
     settle(&mut h);
     open_case(&mut h, "far-from-origin");
-    assert_eq!(h.state().scene.camera.eye, pinhole::math::Vec3::splat(100_000.0) + pinhole::math::Vec3::new(0.0, 2.5, 5.0));
+    assert_eq!(h.state().scene().camera.eye, pinhole::math::Vec3::splat(100_000.0) + pinhole::math::Vec3::new(0.0, 2.5, 5.0));
     h.get_by_label("apply cure").click();
     settle(&mut h);
-    assert_eq!(h.state().scene.camera.eye, pinhole::math::Vec3::ZERO, "re-centred at the camera");
+    assert_eq!(h.state().scene().camera.eye, pinhole::math::Vec3::ZERO, "re-centred at the camera");
     // Leaving the case gives the user's own knobs back.
     h.get_by_label("leave").click();
     settle(&mut h);
-    assert!(h.state().gallery.is_none());
+    assert!(h.state().gallery().is_none());
 }
 
 /// Whether the radio button labelled `label` is the selected one.

@@ -37,14 +37,14 @@ fn opengl_in_the_viewer_matches_the_cli_and_reads_back_a_clicked_pixel() {
     }
     let mut h = new_harness(small_scene("teapot"));
     settle(&mut h);
-    h.state_mut().settings.renderer = "opengl".into();
-    h.state_mut().settings.render.shadows = pinhole::render::ShadowMode::None;
+    h.state_mut().settings_mut().renderer = "opengl".into();
+    h.state_mut().settings_mut().render.shadows = pinhole::render::ShadowMode::None;
     settle(&mut h);
     let (img, w, hgt) = h.state().with_output(|o| {
         assert!(o.complete && o.error.is_none(), "frame not complete: {:?}", o.error);
         (o.linear.clone(), o.width, o.height)
     });
-    let background = h.state().scene.render.background;
+    let background = h.state().scene().render.background;
     assert!(img.iter().filter(|p| **p != background).count() > img.len() / 10, "the teapot is drawn");
 
     // The same scene through the command line.
@@ -68,11 +68,11 @@ fn opengl_in_the_viewer_matches_the_cli_and_reads_back_a_clicked_pixel() {
     std::fs::remove_dir_all(&dir).ok();
 
     // Click the middle of the image: the inspector shows GL's readback.
-    let rect = h.state().viewport_rect.unwrap();
+    let rect = h.state().viewport_rect().unwrap();
     let (x, y) = (w / 2, hgt / 2 + 5);
     let pos = rect.min + egui::vec2(x as f32 + 0.5, y as f32 + 0.5) * (rect.width() / w as f32);
     click(&mut h, pos);
-    assert_eq!(h.state().inspect.selected, Some((x, y)));
+    assert_eq!(h.state().inspect().selected, Some((x, y)));
     h.step();
     assert!(h.state_mut().wait_inspector(WAIT), "the readback did not arrive");
     h.step();

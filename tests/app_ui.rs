@@ -33,10 +33,10 @@ fn settle(h: &mut Harness<'static, PinholeApp>) {
 
 /// What `pinhole render` computes for the app's current scene, settings and renderer.
 fn reference(app: &PinholeApp) -> Vec<Radiance> {
-    let mut scene = (*app.scene).clone();
-    app.params.apply(&mut scene);
+    let mut scene = (*app.scene()).clone();
+    app.params().apply(&mut scene);
     let prepared = PreparedScene::new(scene);
-    let renderer = render::renderer_by_name(&app.settings.renderer).unwrap();
+    let renderer = render::renderer_by_name(&app.settings().renderer).unwrap();
     let settings = app.effective_settings();
     render::render_frame(renderer.as_ref(), &prepared, &settings, &AtomicBool::new(false), None)
         .unwrap()
@@ -60,31 +60,31 @@ fn first_frame_matches_the_reference_renderer() {
     let app = h.state();
     assert_eq!(app.with_output(|o| (o.width, o.height)), (160, 100));
     assert_eq!(shown(app), reference(app));
-    let status = pinhole::app::panels::status::status_text(app);
+    let status = app.status_line();
     assert!(status.contains("160x100") && status.contains("1/1 spp") && status.contains("1 triangles"), "{status}");
 }
 
 #[test]
 fn renderer_combo_and_number_keys_switch_renderer_in_place() {
     let mut h = harness(small_scene("one-triangle"));
-    let names = h.state().renderer_names.clone();
-    let target = *names.iter().find(|n| **n != h.state().settings.renderer).expect("at least two renderers");
-    let camera = h.state().params.camera.clone();
+    let names = h.state().renderer_names().to_vec();
+    let target = *names.iter().find(|n| **n != h.state().settings().renderer).expect("at least two renderers");
+    let camera = h.state().params().camera.clone();
     h.get_by_label("Renderer").click();
     h.step();
     h.step();
     h.get_by_label(target).click();
     settle(&mut h);
     let app = h.state();
-    assert_eq!(app.settings.renderer, target);
-    assert_eq!(app.params.camera, camera, "the camera stays when the renderer changes");
+    assert_eq!(app.settings().renderer, target);
+    assert_eq!(app.params().camera, camera, "the camera stays when the renderer changes");
     assert_eq!(shown(app), reference(app), "{target} image differs from render_frame");
-    assert!(pinhole::app::panels::status::status_text(app).starts_with(target));
+    assert!(app.status_line().starts_with(target));
 
     // Key 1 picks the first renderer.
     h.key_press(egui::Key::Num1);
     settle(&mut h);
-    assert_eq!(h.state().settings.renderer, names[0]);
+    assert_eq!(h.state().settings().renderer, names[0]);
 }
 
 #[test]
@@ -98,7 +98,7 @@ fn editing_a_material_colour_rerenders_with_it() {
     h.get_by_label("green k_L R").set_value_accesskit(0.8);
     settle(&mut h);
     let app = h.state();
-    let green = app.params.materials.iter().find(|m| m.name == "green").unwrap();
+    let green = app.params().materials.iter().find(|m| m.name == "green").unwrap();
     assert_eq!(green.lambertian, Vec3::new(0.8, 0.8, 0.0));
     let after = pixel(app, 80, 60);
     assert!(after.x > 1e-4 && after.x > 0.5 * after.y, "red appears where the triangle is lit: {after}");
@@ -115,15 +115,15 @@ fn moving_a_light_in_the_panel_and_by_its_marker() {
     h.get_by_label("L0 position y").set_value_accesskit(0.0);
     settle(&mut h);
     let app = h.state();
-    assert_eq!(app.params.lights[0], Light::Point { position: Vec3::new(1.0, 0.0, -1.0), power: Vec3::splat(10.0) });
+    assert_eq!(app.params().lights[0], Light::Point { position: Vec3::new(1.0, 0.0, -1.0), power: Vec3::splat(10.0) });
     let after = shown(app);
     assert_ne!(before, after);
     assert_eq!(after, reference(app));
 
     // Drag its marker 30 points left: the light moves left in the view plane at its depth.
     let settings = app.effective_settings();
-    let view = app.params.camera.view(settings.width, settings.height);
-    let rect = app.viewport_rect.unwrap();
+    let view = app.params().camera.view(settings.width, settings.height);
+    let rect = app.viewport_rect().unwrap();
     let (p, depth) = view.project(Vec3::new(1.0, 0.0, -1.0)).unwrap();
     let scale = rect.width() / settings.width as f32;
     let start = rect.min + egui::vec2(p.x, p.y) * scale;
@@ -136,7 +136,7 @@ fn moving_a_light_in_the_panel_and_by_its_marker() {
     h.drop_at(start + egui::vec2(-30.0, 0.0));
     settle(&mut h);
     let app = h.state();
-    let Light::Point { position, .. } = app.params.lights[0] else { panic!("not a point light") };
+    let Light::Point { position, .. } = app.params().lights[0] else { panic!("not a point light") };
     assert!(position.x < 1.0 - 1e-3, "light did not move left: {position}");
     assert!((view.view_depth(position) - depth).abs() < 1e-3, "depth kept");
     assert_eq!(shown(app), reference(app));
@@ -147,12 +147,12 @@ fn adding_and_removing_lights() {
     let mut h = harness(small_scene("one-triangle"));
     h.get_by_label("+ directional").click();
     settle(&mut h);
-    assert!(matches!(h.state().params.lights[1], Light::Directional { .. }));
+    assert!(matches!(h.state().params().lights[1], Light::Directional { .. }));
     assert_eq!(shown(h.state()), reference(h.state()));
     h.get_all_by_label("remove").next().unwrap().click();
     settle(&mut h);
-    assert_eq!(h.state().params.lights.len(), 1);
-    assert!(matches!(h.state().params.lights[0], Light::Directional { .. }));
+    assert_eq!(h.state().params().lights.len(), 1);
+    assert!(matches!(h.state().params().lights[0], Light::Directional { .. }));
 }
 
 #[test]
@@ -161,12 +161,12 @@ fn ctrl_s_exports_png_as_displayed_and_linear_exr() {
     let dir = std::env::temp_dir().join(format!("pinhole-app-export-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     // A debug view is exported as displayed, too.
-    h.state_mut().settings.render.view = render::inspect::debug::View::Barycentric;
+    h.state_mut().settings_mut().render.view = render::inspect::debug::View::Barycentric;
     settle(&mut h);
     h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::S);
     h.step();
     h.step();
-    let suggested = h.state().export.path.clone();
+    let suggested = h.state().export_path().to_string();
     assert!(suggested.contains("one-triangle-raytrace_"), "{suggested}");
     let base = dir.join("shot");
     h.get_by_label("file").set_text_value_accesskit(&base.with_extension("png").to_string_lossy());
@@ -177,7 +177,7 @@ fn ctrl_s_exports_png_as_displayed_and_linear_exr() {
     let png = image::open(base.with_extension("png")).unwrap().to_rgb8();
     let displayed = h.state().with_output(|o| o.rgb8.clone());
     assert_eq!(png.as_raw(), &displayed);
-    assert!(h.state().message.as_deref().unwrap_or("").contains("saved"));
+    assert!(h.state().message().unwrap_or("").contains("saved"));
 
     h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::S);
     h.step();
@@ -204,16 +204,16 @@ fn a_broken_file_shows_its_error_and_the_scene_stays_then_reloads_on_change() {
     h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::O);
     h.step();
     h.step();
-    assert!(h.state().open_dialog.open);
+    assert!(h.state().open_dialog_is_open());
     h.get_by_label("path").set_text_value_accesskit(&path.to_string_lossy());
     h.step();
     h.get_by_label("Open").click();
     h.step();
     assert!(h.state_mut().wait_loaded(WAIT));
     h.step();
-    let err = h.state().error_bar.clone().expect("an error bar");
+    let err = h.state().error_bar().map(str::to_string).expect("an error bar");
     assert!(err.contains("mine.toml"), "{err}");
-    assert_eq!(h.state().scene.name, "one-triangle", "the previous scene stays");
+    assert_eq!(h.state().scene().name, "one-triangle", "the previous scene stays");
     assert!(h.query_by_label_contains("mine.toml").is_some(), "the error is on screen");
 
     // Fix the file: the viewer notices and reloads it.
@@ -221,13 +221,13 @@ fn a_broken_file_shows_its_error_and_the_scene_stays_then_reloads_on_change() {
     h.state_mut().open(path.to_string_lossy().into_owned());
     assert!(h.state_mut().wait_loaded(WAIT));
     settle(&mut h);
-    assert!(h.state().error_bar.is_none());
-    assert_eq!(h.state().scene.name, "mine");
+    assert!(h.state().error_bar().is_none());
+    assert_eq!(h.state().scene().name, "mine");
     assert_eq!(pixel(h.state(), 0, 0), Vec3::new(0.5, 0.0, 0.0));
     std::thread::sleep(Duration::from_millis(1100));
     std::fs::write(&path, good.replace("[0.5, 0.0, 0.0]", "[0.0, 0.25, 0.0]")).unwrap();
     let start = std::time::Instant::now();
-    while h.state().params.render.background.y != 0.25 && start.elapsed() < Duration::from_secs(10) {
+    while h.state().params().render.background.y != 0.25 && start.elapsed() < Duration::from_secs(10) {
         std::thread::sleep(Duration::from_millis(100));
         h.step();
         h.state_mut().wait_loaded(WAIT);
@@ -240,15 +240,15 @@ fn a_broken_file_shows_its_error_and_the_scene_stays_then_reloads_on_change() {
 #[test]
 fn orbit_drag_moves_the_eye_around_the_target() {
     let mut h = harness(small_scene("teapot"));
-    let before = h.state().params.camera.clone();
-    let c = h.state().viewport_rect.unwrap().center();
+    let before = h.state().params().camera.clone();
+    let c = h.state().viewport_rect().unwrap().center();
     h.drag_at(c);
     h.step();
     h.hover_at(c + egui::vec2(40.0, 10.0));
     h.step();
     h.drop_at(c + egui::vec2(40.0, 10.0));
     settle(&mut h);
-    let cam = &h.state().params.camera;
+    let cam = &h.state().params().camera;
     assert_eq!(cam.target, before.target);
     assert!((cam.eye - before.eye).length() > 1e-3);
     assert!(((cam.eye - cam.target).length() - (before.eye - before.target).length()).abs() < 1e-3);
@@ -256,13 +256,13 @@ fn orbit_drag_moves_the_eye_around_the_target() {
     // F frames everything; Home resets.
     h.key_press(egui::Key::Home);
     settle(&mut h);
-    assert_eq!(h.state().params.camera, before);
+    assert_eq!(h.state().params().camera, before);
 }
 
 #[test]
 fn samples_accumulate_and_exposure_is_display_only() {
     let mut h = harness(small_scene("one-triangle"));
-    h.state_mut().settings.render.spp = 4;
+    h.state_mut().settings_mut().render.spp = 4;
     settle(&mut h);
     let app = h.state();
     assert_eq!(app.with_output(|o| (o.passes, o.spp)), (4, 4));
@@ -272,7 +272,7 @@ fn samples_accumulate_and_exposure_is_display_only() {
     let max = lin.iter().zip(&refr).map(|(a, b)| (*a - *b).abs().max_element()).fold(0.0, f32::max);
     assert!(max < 1e-5, "4 spp differs from render_frame by {max}");
     let rgb_before = app.with_output(|o| o.rgb8.clone());
-    h.state_mut().params.render.exposure = 4.0;
+    h.state_mut().params_mut().render.exposure = 4.0;
     settle(&mut h);
     assert_eq!(shown(h.state()), lin, "exposure does not re-render");
     assert_ne!(h.state().with_output(|o| o.rgb8.clone()), rgb_before);
@@ -283,8 +283,8 @@ fn shadow_map_mode_never_crashes_the_viewer() {
     let mut h = harness(small_scene("triangle-ground"));
     h.get_by_label("map").click();
     settle(&mut h);
-    assert_eq!(h.state().settings.render.shadows, render::ShadowMode::Map);
-    let status = pinhole::app::panels::status::status_text(h.state());
+    assert_eq!(h.state().settings().render.shadows, render::ShadowMode::Map);
+    let status = h.state().status_line();
     assert!(status.contains("done") || status.contains("error"), "{status}");
     // And back to ray shadows renders normally.
     h.get_by_label("ray").click();
@@ -302,13 +302,13 @@ fn shadow_maps_over_the_memory_limit_are_an_error_not_a_crash() {
     let mut h = harness(scene);
     {
         let app = h.state_mut();
-        app.settings.render.shadows = render::ShadowMode::Map;
-        app.settings.render.shadow_map_size = 4096;
+        app.settings_mut().render.shadows = render::ShadowMode::Map;
+        app.settings_mut().render.shadow_map_size = 4096;
     }
     settle(&mut h);
     let error = h.state().with_output(|o| o.error.clone()).expect("an error");
     assert!(error.contains("shadow maps") && error.contains("MiB"), "{error}");
-    h.state_mut().settings.render.shadow_map_size = 64;
+    h.state_mut().settings_mut().render.shadow_map_size = 64;
     settle(&mut h);
     assert!(h.state().with_output(|o| o.error.is_none() && o.complete));
 }
@@ -317,18 +317,18 @@ fn shadow_maps_over_the_memory_limit_are_an_error_not_a_crash() {
 fn settings_persist_between_runs() {
     use pinhole::app::settings_store::MemoryStorage as Mem;
     let mut app = PinholeApp::new_for_test(small_scene("one-triangle"));
-    app.settings.renderer = "raytrace:brute".into();
-    app.settings.render.spp = 9;
-    app.settings.gamma = false;
-    app.settings.panels.materials = true;
+    app.settings_mut().renderer = "raytrace:brute".into();
+    app.settings_mut().render.spp = 9;
+    app.settings_mut().gamma = false;
+    app.settings_mut().panels.materials = true;
     let mut mem = Mem::default();
-    app.settings.save(&mut mem);
+    app.settings().save(&mut mem);
     let p = pinhole::app::settings_store::ViewerSettings::load(Some(&mem)).unwrap();
     let again = PinholeApp::new(small_scene("spheres"), "spheres".into(), Some(&p));
     assert_eq!(p.scene.as_deref(), Some("one-triangle"));
-    assert_eq!(again.settings.renderer, "raytrace:brute");
-    assert_eq!(again.settings.render.spp, 9);
-    assert!(!again.settings.gamma && again.settings.panels.materials);
+    assert_eq!(again.settings().renderer, "raytrace:brute");
+    assert_eq!(again.settings().render.spp, 9);
+    assert!(!again.settings().gamma && again.settings().panels.materials);
 }
 
 #[test]
@@ -371,9 +371,9 @@ fn dropping_an_obj_on_the_window_opens_it_framed() {
     assert!(h.state_mut().wait_loaded(WAIT));
     settle(&mut h);
     let app = h.state();
-    assert_eq!(app.scene.name, "tri");
-    assert_eq!(app.scene.triangles.len(), 1);
-    assert!(app.error_bar.is_none());
+    assert_eq!(app.scene().name, "tri");
+    assert_eq!(app.scene().triangles.len(), 1);
+    assert!(app.error_bar().is_none());
     assert_eq!(shown(app), reference(app));
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -383,21 +383,21 @@ fn rasterizer_knobs_in_the_shading_panel_reach_the_pixels() {
     // The teapot's ground quad under the uv view: ticking "affine uv" bends the
     // checker (screen-space interpolation), and MSAA 4x changes edge pixels.
     let mut h = harness(small_scene("teapot"));
-    h.state_mut().settings.renderer = "rasterize".into();
-    h.state_mut().settings.render.view = pinhole::render::inspect::debug::View::Uv;
-    h.state_mut().settings.panels.shading = true;
+    h.state_mut().settings_mut().renderer = "rasterize".into();
+    h.state_mut().settings_mut().render.view = pinhole::render::inspect::debug::View::Uv;
+    h.state_mut().settings_mut().panels.shading = true;
     settle(&mut h);
     let before = shown(h.state());
     h.get_by_label("affine uv").click();
     settle(&mut h);
-    assert!(h.state().settings.render.affine);
+    assert!(h.state().settings().render.affine);
     let affine = shown(h.state());
     assert_eq!(affine, reference(h.state()), "the viewer shows what render_frame gives");
     let changed = before.iter().zip(&affine).filter(|(a, b)| a != b).count();
     assert!(changed > before.len() / 20, "affine uv changed only {changed} pixels");
     h.get_by_label("4x").click();
     settle(&mut h);
-    assert_eq!(h.state().settings.render.msaa, 4);
+    assert_eq!(h.state().settings().render.msaa, 4);
     assert_eq!(shown(h.state()), reference(h.state()));
 }
 
@@ -408,20 +408,20 @@ fn indirect_light_selector_reaches_the_pixels() {
     // render_frame gives for the same settings, and the status bar reports
     // the noise left once two passes are in.
     let mut h = harness(small_scene("cornell-gi"));
-    h.state_mut().settings.panels.shading = true;
-    h.state_mut().settings.render.spp = 4;
+    h.state_mut().settings_mut().panels.shading = true;
+    h.state_mut().settings_mut().render.spp = 4;
     settle(&mut h);
     let direct = shown(h.state());
     h.get_by_label("indirect light").click();
     h.run();
     h.get_by_label("path").click();
     settle(&mut h);
-    assert_eq!(h.state().settings.render.gi.mode, pinhole::render::transport::gi::GiMode::Path);
+    assert_eq!(h.state().settings().render.gi.mode, pinhole::render::transport::gi::GiMode::Path);
     let path = shown(h.state());
     assert_eq!(path, reference(h.state()), "the viewer shows what render_frame gives");
     let mean = |img: &[pinhole::math::Radiance]| img.iter().map(|c| c.x + c.y + c.z).sum::<f32>() / img.len() as f32;
     assert!(mean(&path) > 1.3 * mean(&direct), "bounced light adds nothing: {} vs {}", mean(&path), mean(&direct));
-    let status = pinhole::app::panels::status::status_text(h.state());
+    let status = h.state().status_line();
     assert!(status.contains("noise ≈"), "{status}");
 }
 
@@ -433,7 +433,7 @@ fn opengl_in_the_viewer_draws_what_render_frame_draws() {
         return;
     }
     let mut h = harness(small_scene("teapot"));
-    h.state_mut().settings.renderer = "opengl".into();
+    h.state_mut().settings_mut().renderer = "opengl".into();
     settle(&mut h);
     // Shadow rays (the default) are drawn as shadow maps, and the status bar says so.
     let (error, notices) = h.state().with_output(|o| (o.error.clone(), o.notices.clone()));
@@ -442,15 +442,15 @@ fn opengl_in_the_viewer_draws_what_render_frame_draws() {
     assert_eq!(notices, vec![notice.to_string()]);
     h.get_by_label(notice);
     let substituted = shown(h.state());
-    h.state_mut().settings.render.shadows = pinhole::render::ShadowMode::Map;
+    h.state_mut().settings_mut().render.shadows = pinhole::render::ShadowMode::Map;
     settle(&mut h);
     assert_eq!(shown(h.state()), substituted, "the image is the shadow maps'");
     assert_eq!(substituted, reference(h.state()));
     assert!(h.state().with_output(|o| o.notices.is_empty()), "asked for maps, nothing is substituted");
-    h.state_mut().settings.render.shadows = pinhole::render::ShadowMode::None;
+    h.state_mut().settings_mut().render.shadows = pinhole::render::ShadowMode::None;
     settle(&mut h);
     let img = shown(h.state());
     assert_eq!(img, reference(h.state()));
-    let background = h.state().scene.render.background;
+    let background = h.state().scene().render.background;
     assert!(img.iter().filter(|p| **p != background).count() > img.len() / 10, "the teapot is drawn");
 }

@@ -3,14 +3,14 @@
 //! renderer and time; files are written atomically.
 
 use eframe::egui;
-use crate::app::PinholeApp;
+use crate::app::worker::Output;
 use crate::image_io;
 use std::path::{Path, PathBuf};
 
 #[derive(Default)]
 pub struct ExportDialog {
     pub open: bool,
-    /// Path without extension... no: the full path, its extension picks the format.
+    /// The full path; its extension picks the format.
     pub path: String,
     pub last_error: Option<String>,
 }
@@ -21,6 +21,22 @@ impl ExportDialog {
         self.path = dir.join(format!("{}.png", suggested_stem(scene, renderer, std::time::SystemTime::now()))).to_string_lossy().into_owned();
         self.last_error = None;
         self.open = true;
+    }
+
+    /// Takes the outcome of a save the window asked for: closes the window
+    /// and returns the note for the status bar, or keeps it open with the error.
+    pub fn finish(&mut self, result: Result<String, String>) -> Option<String> {
+        match result {
+            Ok(note) => {
+                self.last_error = None;
+                self.open = false;
+                Some(note)
+            }
+            Err(e) => {
+                self.last_error = Some(e);
+                None
+            }
+        }
     }
 }
 
@@ -53,37 +69,37 @@ fn civil_from_days(z: i64) -> (i64, u32, u32) {
     (yoe + era * 400 + i64::from(m <= 2), m, d)
 }
 
-/// Writes the image on show: `.png` as displayed (exposure, gamma setting,
-/// debug view), `.exr` linear. Returns a note for the status bar.
-pub fn export(app: &PinholeApp, path: &Path) -> Result<String, String> {
+/// Writes `o`, the image on show: `.png` as displayed (exposure, gamma
+/// setting, debug view), `.exr` linear. Returns a note for the status bar.
+pub fn export(o: &Output, path: &Path) -> Result<String, String> {
     let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).unwrap_or_default();
-    app.with_output(|o| {
-        if o.width == 0 {
-            return Err("nothing rendered yet".to_string());
-        }
-        match ext.as_str() {
-            "png" => image_io::write_atomic(path, &image_io::encode_png(o.width, o.height, &o.rgb8)?)?,
-            "exr" => image_io::save_image(path, o.width, o.height, &o.linear, 1.0)?,
-            _ => return Err(format!("{}: choose a .png or .exr name", path.display())),
-        }
-        Ok(format!("saved {} ({}/{} spp)", path.display(), o.passes, o.spp))
-    })
+    if o.width == 0 {
+        return Err("nothing rendered yet".to_string());
+    }
+    match ext.as_str() {
+        "png" => image_io::write_atomic(path, &image_io::encode_png(o.width, o.height, &o.rgb8)?)?,
+        "exr" => image_io::save_image(path, o.width, o.height, &o.linear, 1.0)?,
+        _ => return Err(format!("{}: choose a .png or .exr name", path.display())),
+    }
+    Ok(format!("saved {} ({}/{} spp)", path.display(), o.passes, o.spp))
 }
 
-/// The export window: path (suggested), PNG or EXR, Save.
-pub fn show_dialog(app: &mut PinholeApp, ctx: &egui::Context) {
-    if !app.export.open {
-        return;
+/// The export window: path (suggested), PNG or EXR, Save. Edits the
+/// dialog's own path; returns the file a Save button asks to write (the
+/// viewer writes it and hands the outcome to `ExportDialog::finish`).
+pub fn show_dialog(ctx: &egui::Context, dialog: &mut ExportDialog) -> Option<PathBuf> {
+    if !dialog.open {
+        return None;
     }
     let mut open = true;
     let mut save = None;
     egui::Window::new("Export image").open(&mut open).collapsible(false).show(ctx, |ui| {
         ui.horizontal(|ui| {
             let l = ui.label("file");
-            ui.add(egui::TextEdit::singleline(&mut app.export.path).desired_width(380.0)).labelled_by(l.id);
+            ui.add(egui::TextEdit::singleline(&mut dialog.path).desired_width(380.0)).labelled_by(l.id);
         });
         ui.horizontal(|ui| {
-            let p = PathBuf::from(&app.export.path);
+            let p = PathBuf::from(&dialog.path);
             if ui.button("Save PNG (as displayed)").clicked() {
                 save = Some(p.with_extension("png"));
             }
@@ -91,21 +107,12 @@ pub fn show_dialog(app: &mut PinholeApp, ctx: &egui::Context) {
                 save = Some(p.with_extension("exr"));
             }
         });
-        if let Some(e) = &app.export.last_error {
+        if let Some(e) = &dialog.last_error {
             ui.colored_label(egui::Color32::LIGHT_RED, e);
         }
     });
-    if let Some(path) = save {
-        match export(app, &path) {
-            Ok(note) => {
-                app.message = Some(note);
-                app.export.last_error = None;
-                open = false;
-            }
-            Err(e) => app.export.last_error = Some(e),
-        }
-    }
-    app.export.open &= open;
+    dialog.open &= open;
+    save
 }
 
 #[cfg(test)]

@@ -81,11 +81,20 @@ impl PinholeApp {
     }
 }
 
-/// The bar under the menu while a gallery case is on show.
-pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
-    let Some(g) = app.gallery.clone() else { return };
-    let mut switch = None;
-    let mut close = false;
+/// What the gallery bar asks of the viewer.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BarRequests {
+    /// Show this case again, cured (`true`) or failing.
+    pub show: Option<(&'static str, bool)>,
+    /// Close the case, back to the user's own settings.
+    pub leave: bool,
+}
+
+/// The bar under the menu while a gallery case is on show; it reads the
+/// case and edits nothing.
+pub fn show(ui: &mut egui::Ui, view: Option<&GalleryView>) -> BarRequests {
+    let mut requests = BarRequests::default();
+    let Some(g) = view else { return requests };
     egui::Panel::top("gallery-bar").show(ui, |ui| {
         ui.horizontal_wrapped(|ui| {
             ui.strong(format!("Gallery: {}", g.case.name));
@@ -95,21 +104,16 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
             ui.colored_label(color, format!("{what}: {} {}", g.setting().renderer, g.setting().description));
             if g.cured {
                 if ui.button("show failure").clicked() {
-                    switch = Some(false);
+                    requests.show = Some((g.case.name, false));
                 }
             } else if ui.button("apply cure").clicked() {
-                switch = Some(true);
+                requests.show = Some((g.case.name, true));
             }
             if ui.button("leave").on_hover_text("back to your own settings on this scene").clicked() {
-                close = true;
+                requests.leave = true;
             }
         });
         ui.label(g.case.explanation);
     });
-    if let Some(cured) = switch {
-        app.open_gallery_case(g.case.name, cured);
-    }
-    if close {
-        app.leave_gallery();
-    }
+    requests
 }

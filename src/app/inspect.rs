@@ -74,6 +74,13 @@ impl Inspect {
         self.selected.is_some() && self.current(generation).is_none()
     }
 
+    /// Selects pixel `(x, y)`, clamped into a `width` x `height` image.
+    pub fn select(&mut self, x: i64, y: i64, width: u32, height: u32) {
+        let x = x.clamp(0, width as i64 - 1) as u32;
+        let y = y.clamp(0, height as i64 - 1) as u32;
+        self.selected = Some((x, y));
+    }
+
     pub fn clear(&mut self) {
         self.selected = None;
         self.replay = None;
@@ -97,9 +104,7 @@ impl PinholeApp {
     /// Selects pixel `(x, y)` of the image on show (clamped into it).
     pub fn select_pixel(&mut self, x: i64, y: i64) {
         let s = self.effective_settings();
-        let x = x.clamp(0, s.width as i64 - 1) as u32;
-        let y = y.clamp(0, s.height as i64 - 1) as u32;
-        self.inspect.selected = Some((x, y));
+        self.inspect.select(x, y, s.width, s.height);
     }
 
     /// Takes the worker's answer and asks for the replay of the selection

@@ -5,7 +5,8 @@
 //! plain legend (their name) without a change here.
 
 use crate::render::inspect::debug::{cost_of_t, depth_distance, t_of_cost, zbuffer_depth};
-use crate::app::PinholeApp;
+use crate::app::viewport::Viewed;
+use crate::scene::Camera;
 use crate::math::Vec3;
 use crate::render::inspect::debug::{cost_color, id_color, mip_color, COST_SCALE, MIP_SCALE};
 use eframe::egui;
@@ -80,12 +81,14 @@ fn num(v: f32) -> String {
     }
 }
 
-/// Draws the legend of the current view in the corner of `viewport` (nothing for shaded).
-pub fn show(app: &PinholeApp, ctx: &egui::Context, viewport: Rect) {
-    let view = app.settings.render.view.name();
+/// Draws the legend of the current view in the corner of `viewport`
+/// (nothing for shaded): `viewed` is the frame on show, `hover` the pixel
+/// under the cursor, `camera` the camera as edited.
+pub fn show(viewed: &Viewed, hover: Option<(u32, u32)>, camera: &Camera, ctx: &egui::Context, viewport: Rect) {
+    let s = viewed.settings;
+    let view = s.view.name();
     let Some(title) = title(view) else { return };
-    let s = app.effective_settings();
-    let camera = app.params.camera.view(s.width, s.height);
+    let camera = camera.view(s.width, s.height);
     egui::Area::new(egui::Id::unique("view-legend"))
         .order(egui::Order::Foreground)
         .pivot(egui::Align2::RIGHT_TOP)
@@ -113,7 +116,7 @@ pub fn show(app: &PinholeApp, ctx: &egui::Context, viewport: Rect) {
                         small(ui, "ticks: view depth z; no hit: black");
                     }
                     "cost" => {
-                        let what = if app.settings.renderer.starts_with("raytrace") {
+                        let what = if viewed.renderer.starts_with("raytrace") {
                             "BVH nodes visited + primitives tested by the eye ray"
                         } else {
                             "the renderer's work for the pixel's samples"
@@ -127,15 +130,15 @@ pub fn show(app: &PinholeApp, ctx: &egui::Context, viewport: Rect) {
                         }
                         ticks.push((1.0, format!("{COST_SCALE:.0}")));
                         bar(ui, |t| cost_color(cost_of_t(t)), &ticks);
-                        if let Some((x, y)) = app.inspect.hover {
-                            let v = app.with_output(|o| (x < o.width && y < o.height).then(|| o.linear[(x + y * o.width) as usize]));
+                        if let Some((x, y)) = hover {
+                            let v = viewed.with_output(|o| (x < o.width && y < o.height).then(|| o.linear[(x + y * o.width) as usize]));
                             if let Some(v) = v {
-                                small(ui, &format!("under the cursor: {}", crate::app::inspect::value_text("cost", v, &camera, &app.scene)));
+                                small(ui, &format!("under the cursor: {}", crate::app::inspect::value_text("cost", v, &camera, viewed.scene)));
                             }
                         }
                     }
                     "id" => {
-                        let objects = &app.scene.objects;
+                        let objects = &viewed.scene.objects;
                         egui::Grid::new("id-legend").num_columns(2).spacing([6.0, 2.0]).show(ui, |ui| {
                             for (i, o) in objects.iter().enumerate().take(MAX_IDS) {
                                 let (r, _) = ui.allocate_exact_size(egui::vec2(14.0, 14.0), egui::Sense::hover());
@@ -161,7 +164,7 @@ pub fn show(app: &PinholeApp, ctx: &egui::Context, viewport: Rect) {
                     "uv" => small(ui, "an 8 × 8 checker in (u, v): straight in perspective-correct interpolation, bent in affine"),
                     "diff" => {
                         small(ui, "red: brighter, blue: darker than the reference (10% of its mean = full scale); equal pixels dimmed grey");
-                        match app.with_output(|o| o.differing_pixels.filter(|_| o.complete)) {
+                        match viewed.with_output(|o| o.differing_pixels.filter(|_| o.complete)) {
                             Some(n) => {
                                 ui.label(format!("differing pixels: {n}"));
                             }

@@ -4,6 +4,7 @@
 //! and `viewport` draw it.
 
 use eframe::egui;
+mod access;
 pub mod compare_lab;
 pub mod export;
 pub mod gallery;

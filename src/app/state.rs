@@ -1,6 +1,8 @@
 //! The viewer's state and its frame: what is loaded, what is edited, what
-//! was last asked of the worker. The menu and side-panel sections edit their
-//! slice of it and return `Requests`, applied once per frame (`apply`); at the
+//! was last asked of the worker. Every part of the window (menu, side
+//! panels, gallery bar, status bar, inspector, viewport, export dialog) gets
+//! the slice it reads and edits, and returns what it asks beyond that; this
+//! file applies those requests (`apply` for the panels' `Requests`). At the
 //! end of each frame a change becomes a render request.
 
 use eframe::egui;
@@ -20,58 +22,58 @@ use std::time::{Duration, Instant, SystemTime};
 /// window and the egui_kittest harness run the same code.
 pub struct PinholeApp {
     /// The scene as loaded (its geometry is what the worker renders).
-    pub scene: Arc<Scene>,
+    pub(crate) scene: Arc<Scene>,
     /// How to load it again (built-in name or path).
-    pub scene_arg: String,
-    pub scene_id: u64,
+    pub(crate) scene_arg: String,
+    pub(crate) scene_id: u64,
     /// Camera, lights, materials and `[render]` values as edited.
-    pub params: SceneParams,
+    pub(crate) params: SceneParams,
     /// The camera the scene file gave, for "reset".
-    pub initial_camera: Camera,
-    /// Renderer, render knobs, display and panels in force (a gallery case's
-    /// or an applied configuration's knobs included); saved between runs
-    /// (`own_settings`). The panels edit them, `effective_settings()`
-    /// renders with them.
-    pub settings: ViewerSettings,
-    pub renderer_names: Vec<&'static str>,
-    pub worker: Worker,
+    pub(crate) initial_camera: Camera,
+    /// The persisted state: renderer, render knobs, display, panels and the
+    /// last scene, in force (a gallery case's or an applied configuration's
+    /// knobs included). `own_settings()` is what is saved between runs: this
+    /// struct whole, the user's own knobs in place of a gallery case's. The
+    /// panels edit it, `effective_settings()` renders with it.
+    pub(crate) settings: ViewerSettings,
+    pub(crate) renderer_names: Vec<&'static str>,
+    pub(crate) worker: Worker,
     /// The last request sent (generation counts every request).
-    pub generation: u64,
+    pub(crate) generation: u64,
     last_sent: Option<Request>,
     /// The camera moved this frame (orbit, pan, fly...): ask for a preview.
-    pub camera_moving: bool,
-    pub texture: Option<egui::TextureHandle>,
-    pub shown_version: u64,
+    pub(crate) camera_moving: bool,
+    pub(crate) texture: Option<egui::TextureHandle>,
+    pub(crate) shown_version: u64,
     /// A problem to show in the red bar (the previous scene stays).
-    pub error_bar: Option<String>,
+    pub(crate) error_bar: Option<String>,
     /// A passing note in the status bar (e.g. "saved x.png").
-    pub message: Option<String>,
+    pub(crate) message: Option<String>,
     loader: Option<Receiver<(String, Result<Scene, String>)>>,
     watch: Option<(PathBuf, Option<SystemTime>)>,
     last_watch_check: Instant,
-    pub open_dialog: OpenDialog,
-    pub export: ExportDialog,
-    pub screenshot: Option<crate::app::ScreenshotState>,
+    pub(crate) open_dialog: OpenDialog,
+    pub(crate) export: ExportDialog,
+    pub(crate) screenshot: Option<crate::app::ScreenshotState>,
     /// Where the image was drawn last frame, in points, and its size in pixels.
-    pub viewport_rect: Option<egui::Rect>,
-    /// Index of the light being dragged in the viewport.
-    pub dragging_light: Option<usize>,
-    pub viewport_focused: bool,
+    pub(crate) viewport_rect: Option<egui::Rect>,
+    /// The viewport's focus and the light it drags.
+    pub(crate) viewport: crate::app::viewport::ViewportState,
     /// Timestamps of recent UI frames, for the fps read-out.
     frame_times: std::collections::VecDeque<Instant>,
     repaint_ctx: Arc<Mutex<Option<egui::Context>>>,
     /// Whether `save()` writes eframe storage (off for tests and screenshots).
-    pub persist: bool,
+    pub(crate) persist: bool,
     /// `PINHOLE_BENCH_UI`: orbit continuously for this long, print fps, quit.
-    pub bench: Option<crate::app::UiBench>,
+    pub(crate) bench: Option<crate::app::UiBench>,
     /// Selected pixel and its replay, zoom, overlays (visual debugging).
-    pub inspect: crate::app::inspect::Inspect,
+    pub(crate) inspect: crate::app::inspect::Inspect,
     /// The Compare window's measurements.
-    pub compare: crate::app::compare_lab::CompareLab,
+    pub(crate) compare: crate::app::compare_lab::CompareLab,
     /// A second configuration shown beside the live one (A|B).
-    pub split: crate::app::split_view::SplitView,
+    pub(crate) split: crate::app::split_view::SplitView,
     /// The stress-gallery case on show, whose setting overrides the knobs.
-    pub gallery: Option<crate::app::gallery::GalleryView>,
+    pub(crate) gallery: Option<crate::app::gallery::GalleryView>,
 }
 
 impl PinholeApp {
@@ -110,8 +112,7 @@ impl PinholeApp {
             export: ExportDialog::default(),
             screenshot: None,
             viewport_rect: None,
-            dragging_light: None,
-            viewport_focused: false,
+            viewport: Default::default(),
             frame_times: Default::default(),
             repaint_ctx,
             persist: false,
@@ -526,7 +527,7 @@ impl PinholeApp {
             let report = b.done && !b.reported;
             b.reported |= b.done;
             if report {
-                println!("ui-bench: {}", crate::app::panels::status::status_text(self));
+                println!("ui-bench: {}", self.status_line());
             }
             ctx.request_repaint();
         }
@@ -561,9 +562,22 @@ impl PinholeApp {
                     });
                 });
         }
-        crate::app::gallery::show(self, ui);
-        crate::app::panels::status::show(self, ui);
+        let bar = crate::app::gallery::show(ui, self.gallery.as_ref());
+        if let Some((name, cured)) = bar.show {
+            self.open_gallery_case(name, cured);
+        }
+        if bar.leave {
+            self.leave_gallery();
+        }
+        let status = crate::app::panels::status::Status {
+            line: self.status_line(),
+            ui_fps: self.ui_fps(),
+            message: self.message.as_deref(),
+            notices: self.with_output(|o| o.notices.clone()),
+        };
+        crate::app::panels::status::show(ui, status);
         if self.settings.panels.side {
+            let (admitted, notices) = self.with_output(|o| (o.admitted.clone(), o.notices.clone()));
             egui::Panel::left("side-panel").default_size(300.0).resizable(true).show(ui, |ui| {
                 egui::ScrollArea::vertical().show(ui, |ui| {
                     let (width, height) = (self.scene.render.width, self.scene.render.height);
@@ -571,19 +585,64 @@ impl PinholeApp {
                     requests |= crate::app::panels::camera::show(ui, &mut panels.camera, &mut self.params.camera, &mut self.settings.res_scale, (width, height));
                     crate::app::panels::lights::show(ui, &mut panels.lights, &mut self.params.lights, &self.params.camera, &self.scene);
                     crate::app::panels::materials::show(ui, &mut panels.materials, &mut self.params.materials);
-                    crate::app::panels::shading::show(ui, &mut self.settings, &mut self.params.render);
+                    let in_force = crate::app::panels::shading::InForce { admitted: admitted.as_ref(), notices: &notices };
+                    crate::app::panels::shading::show(ui, &mut self.settings, &mut self.params.render, in_force);
                 });
             });
         }
-        crate::app::panels::inspector::show(self, ui);
-        egui::CentralPanel::default().frame(egui::Frame::new().fill(egui::Color32::from_gray(24))).show(ui, |ui| {
-            crate::app::viewport::show(self, ui);
-        });
+        if let Some((x, y)) = self.inspect.selected {
+            let generation = self.generation;
+            let frame_pixel = self.with_output(|o| {
+                (o.complete && o.error.is_none() && o.generation == generation && x < o.width && y < o.height)
+                    .then(|| o.linear[(x + y * o.width) as usize])
+            });
+            let viewed = crate::app::panels::inspector::Viewed {
+                generation,
+                scene: &self.scene,
+                lights: &self.params.lights,
+                materials: &self.params.materials,
+                renderer: &self.settings.renderer,
+                exposure: self.params.render.exposure,
+                gamma: self.settings.gamma,
+                frame_pixel,
+            };
+            crate::app::panels::inspector::show(ui, &mut self.inspect, &viewed);
+        }
+        let settings = self.effective_settings();
+        let viewed = crate::app::viewport::Viewed {
+            settings: &settings,
+            renderer: &self.settings.renderer,
+            exposure: self.params.render.exposure,
+            gamma: self.settings.gamma,
+            scene: &self.scene,
+            scene_id: self.scene_id,
+            generation: self.generation,
+            texture: self.texture.as_ref(),
+            output: &self.worker.shared.output,
+        };
+        let edited = crate::app::viewport::Edited {
+            camera: &mut self.params.camera,
+            lights: &mut self.params.lights,
+            inspect: &mut self.inspect,
+            split: &mut self.split,
+            state: &mut self.viewport,
+        };
+        let shown = egui::CentralPanel::default()
+            .frame(egui::Frame::new().fill(egui::Color32::from_gray(24)))
+            .show(ui, |ui| crate::app::viewport::show(ui, &viewed, edited))
+            .inner;
+        self.camera_moving |= shown.camera_moved;
+        self.viewport_rect = shown.image_rect.or(self.viewport_rect);
         self.apply(requests, &ctx);
         if let Some(path) = self.open_dialog.show(&ctx) {
             self.open(path);
         }
-        crate::app::export::show_dialog(self, &ctx);
+        if let Some(path) = crate::app::export::show_dialog(&ctx, &mut self.export) {
+            let result = self.with_output(|o| crate::app::export::export(o, &path));
+            if let Some(note) = self.export.finish(result) {
+                self.message = Some(note);
+            }
+        }
         self.compare_window(&ctx);
 
         self.sync_worker();

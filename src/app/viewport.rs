@@ -5,17 +5,75 @@
 
 use eframe::egui;
 use crate::scene::camera::control as cc;
+use crate::app::inspect::Inspect;
 use crate::app::overlay::{self, ImageMap};
-use crate::app::PinholeApp;
+use crate::app::split_view::SplitView;
+use crate::app::worker::Output;
 use crate::math::{Vec2, Vec3};
-use crate::scene::Light;
+use crate::render::RenderSettings;
+use crate::scene::{Camera, Light, Scene};
 use egui::{Color32, Pos2, Rect, Sense, Stroke};
+use std::sync::Mutex;
 
-pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
+/// What the viewport reads: the frame on show and what it was drawn from.
+pub struct Viewed<'a> {
+    /// The settings the worker renders with, at the image's size.
+    pub settings: &'a RenderSettings,
+    pub renderer: &'a str,
+    pub exposure: f32,
+    pub gamma: bool,
+    pub scene: &'a Scene,
+    pub scene_id: u64,
+    /// The last render request sent: a replay for it is current.
+    pub generation: u64,
+    pub texture: Option<&'a egui::TextureHandle>,
+    /// The worker's latest output (pixel values under the cursor, counts).
+    pub output: &'a Mutex<Output>,
+}
+
+/// What the viewport edits: the camera and lights (dragged), the
+/// inspection (selection, zoom, hover), configuration B's divider and
+/// region, and its own focus and drag.
+pub struct Edited<'a> {
+    pub camera: &'a mut Camera,
+    pub lights: &'a mut [Light],
+    pub inspect: &'a mut Inspect,
+    pub split: &'a mut SplitView,
+    pub state: &'a mut ViewportState,
+}
+
+/// The viewport's own state between frames.
+#[derive(Clone, Debug, Default)]
+pub struct ViewportState {
+    /// Index of the light being dragged.
+    pub dragging_light: Option<usize>,
+    /// Clicked last: the keyboard flies the camera.
+    pub focused: bool,
+}
+
+/// What the viewport asks of the viewer this frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ViewportRequests {
+    /// The camera was moved (orbit, pan, dolly, fly): render a quick preview.
+    pub camera_moved: bool,
+    /// Where the image was drawn, in points.
+    pub image_rect: Option<Rect>,
+}
+
+impl Viewed<'_> {
+    /// Runs `f` on the worker's latest output under its lock.
+    pub fn with_output<T>(&self, f: impl FnOnce(&Output) -> T) -> T {
+        f(&self.output.lock().unwrap())
+    }
+}
+
+pub fn show(ui: &mut egui::Ui, viewed: &Viewed, edited: Edited) -> ViewportRequests {
+    let Edited { camera, lights, inspect, split, state } = edited;
+    let mut requests = ViewportRequests::default();
     let avail = ui.available_rect_before_wrap();
     let response = ui.allocate_rect(avail, Sense::click_and_drag());
     let ppp = ui.ctx().pixels_per_point();
-    let settings = app.effective_settings();
+    let settings = viewed.settings;
     let (iw, ih) = (settings.width as f32, settings.height as f32);
 
     // Zoom: ctrl+wheel (or pinch) about the cursor; right drag pans the image.
@@ -23,11 +81,11 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
         let zoom = ui.input(|i| i.zoom_delta());
         if zoom != 1.0 {
             let anchor = response.hover_pos().map_or(egui::Vec2::ZERO, |p| p - avail.center());
-            app.inspect.zoom_about(app.inspect.zoom * zoom, anchor);
+            inspect.zoom_about(inspect.zoom * zoom, anchor);
         }
     }
-    if response.dragged_by(egui::PointerButton::Secondary) && app.inspect.zoom > 1.0 {
-        app.inspect.pan += response.drag_delta();
+    if response.dragged_by(egui::PointerButton::Secondary) && inspect.zoom > 1.0 {
+        inspect.pan += response.drag_delta();
     }
 
     // 1 image pixel = 1 screen pixel when it fits; otherwise scaled to fit;
@@ -37,24 +95,24 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
     if fit < 1.0 {
         size *= fit;
     }
-    size *= app.inspect.zoom;
-    if std::mem::take(&mut app.inspect.center_on_selection) {
-        if let Some((x, y)) = app.inspect.selected {
+    size *= inspect.zoom;
+    if std::mem::take(&mut inspect.center_on_selection) {
+        if let Some((x, y)) = inspect.selected {
             let (cx, cy) = (x as f32 + 0.5 - iw * 0.5, y as f32 + 0.5 - ih * 0.5);
-            app.inspect.pan = -egui::vec2(cx / iw * size.x, cy / ih * size.y);
+            inspect.pan = -egui::vec2(cx / iw * size.x, cy / ih * size.y);
         }
     }
-    let min = avail.center() + app.inspect.pan - size * 0.5;
+    let min = avail.center() + inspect.pan - size * 0.5;
     let min = Pos2::new((min.x * ppp).round() / ppp, (min.y * ppp).round() / ppp);
     let rect = Rect::from_min_size(min, size);
-    app.viewport_rect = Some(rect);
+    requests.image_rect = Some(rect);
     let painter = ui.painter_at(avail);
-    if let Some(t) = &app.texture {
+    if let Some(t) = viewed.texture {
         // The texture samples with nearest filtering: zoomed pixels stay square.
         painter.image(t.id(), rect, Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0)), Color32::WHITE);
     }
     let map = ImageMap { rect, width: iw, height: ih };
-    let split_drag = split_view(app, ui, &response, &painter, &map);
+    let split_drag = split_view(split, ui, &response, &painter, &map);
     overlay::pixel_grid(&painter, &map, avail);
 
     // Image pixel of a screen point and back.
@@ -62,10 +120,8 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
     let to_screen = |v: Vec2| map.to_screen(v);
     let px_per_point = iw / rect.width().max(1.0);
 
-    let view = app.params.camera.view(settings.width, settings.height);
-    let markers: Vec<(usize, Option<Pos2>)> = app
-        .params
-        .lights
+    let view = camera.view(settings.width, settings.height);
+    let markers: Vec<(usize, Option<Pos2>)> = lights
         .iter()
         .enumerate()
         .map(|(i, l)| match l {
@@ -77,23 +133,23 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
     // Clicking a pixel selects it for the inspector.
     if response.clicked() {
         if let Some((x, y)) = response.interact_pointer_pos().and_then(|p| map.pixel_at(p)) {
-            app.select_pixel(x as i64, y as i64);
+            inspect.select(x as i64, y as i64, settings.width, settings.height);
         }
     }
-    app.inspect.hover = response.hover_pos().and_then(|p| map.pixel_at(p));
+    inspect.hover = response.hover_pos().and_then(|p| map.pixel_at(p));
 
     // Focus: clicking the viewport gives it the keyboard (WASD/QE fly).
     if response.clicked() || response.drag_started() {
-        app.viewport_focused = true;
+        state.focused = true;
         ui.ctx().memory_mut(|m| m.surrender_focus(m.focused().unwrap_or(egui::Id::NULL)));
     } else if ui.input(|i| i.pointer.any_pressed()) && !response.hovered() {
-        app.viewport_focused = false;
+        state.focused = false;
     }
 
     // Dragging a point-light marker moves the light in the view plane.
     if response.drag_started_by(egui::PointerButton::Primary) && !split_drag {
         if let Some(p) = ui.input(|i| i.pointer.press_origin()) {
-            app.dragging_light = markers
+            state.dragging_light = markers
                 .iter()
                 .filter_map(|(i, m)| m.map(|m| (*i, m.distance(p))))
                 .filter(|(_, d)| *d < 10.0)
@@ -102,12 +158,12 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
         }
     }
     if response.drag_stopped() {
-        app.dragging_light = None;
+        state.dragging_light = None;
     }
     let delta = response.drag_delta() * px_per_point;
     let shift = ui.input(|i| i.modifiers.shift);
-    if let Some(i) = app.dragging_light {
-        if let (Some(p), Some(Light::Point { position, .. })) = (response.interact_pointer_pos(), app.params.lights.get_mut(i)) {
+    if let Some(i) = state.dragging_light {
+        if let (Some(p), Some(Light::Point { position, .. })) = (response.interact_pointer_pos(), lights.get_mut(i)) {
             let depth = view.view_depth(*position);
             if depth > view.near {
                 let q = to_px(p);
@@ -115,32 +171,32 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
             }
         }
     } else if delta != egui::Vec2::ZERO && !split_drag {
-        let cam = &mut app.params.camera;
+        let cam = &mut *camera;
         if response.dragged_by(egui::PointerButton::Middle) || (response.dragged_by(egui::PointerButton::Primary) && shift) {
             cc::pan(cam, delta.x, delta.y, settings.width, settings.height);
-            app.camera_moving = true;
+            requests.camera_moved = true;
         } else if response.dragged_by(egui::PointerButton::Primary) {
             cc::orbit(cam, delta.x, delta.y);
-            app.camera_moving = true;
+            requests.camera_moved = true;
         }
     }
     if response.hovered() && ui.input(|i| i.zoom_delta()) == 1.0 {
         let scroll = ui.input(|i| i.smooth_scroll_delta.y);
         if scroll != 0.0 {
-            cc::dolly(&mut app.params.camera, scroll / 50.0);
-            app.camera_moving = true;
+            cc::dolly(camera, scroll / 50.0);
+            requests.camera_moved = true;
         }
     }
-    if app.viewport_focused && !ui.ctx().egui_wants_keyboard_input() {
-        fly_keys(app, ui);
+    if state.focused && !ui.ctx().egui_wants_keyboard_input() {
+        requests.camera_moved |= fly_keys(camera, viewed.scene, ui);
     }
 
-    if app.inspect.vertices {
-        let verts = match &app.inspect.vertex_cache {
-            Some((id, v)) if *id == app.scene_id => v.clone(),
+    if inspect.vertices {
+        let verts = match &inspect.vertex_cache {
+            Some((id, v)) if *id == viewed.scene_id => v.clone(),
             _ => {
-                let v = std::sync::Arc::new(overlay::unique_vertices(&app.scene));
-                app.inspect.vertex_cache = Some((app.scene_id, v.clone()));
+                let v = std::sync::Arc::new(overlay::unique_vertices(viewed.scene));
+                inspect.vertex_cache = Some((viewed.scene_id, v.clone()));
                 v
             }
         };
@@ -154,12 +210,12 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
         painter.text(avail.left_top() + egui::vec2(6.0, 6.0), egui::Align2::LEFT_TOP, note, egui::FontId::monospace(11.0), Color32::from_rgb(255, 80, 200));
     }
     // The selected pixel's rays, then the pixel itself.
-    if let Some((x, y)) = app.inspect.selected {
-        if app.inspect.paths {
-            if let Some(Ok(replay)) = app.inspect.current(app.generation).map(|r| &r.result) {
+    if let Some((x, y)) = inspect.selected {
+        if inspect.paths {
+            if let Some(Ok(replay)) = inspect.current(viewed.generation).map(|r| &r.result) {
                 if let Some((_, trace, _)) = replay.samples.first() {
-                    let length = cc::scene_scale(app.scene.bounds());
-                    overlay::paths(&painter, &map, &view, trace, &app.params.lights, length);
+                    let length = cc::scene_scale(viewed.scene.bounds());
+                    overlay::paths(&painter, &map, &view, trace, lights, length);
                 }
             }
         }
@@ -169,14 +225,14 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
     // Light markers.
     for (i, m) in &markers {
         if let Some(p) = m {
-            let hot = app.dragging_light == Some(*i);
+            let hot = state.dragging_light == Some(*i);
             painter.circle(*p, if hot { 7.0 } else { 5.0 }, Color32::from_rgb(255, 220, 80), Stroke::new(1.5, Color32::BLACK));
             painter.text(*p + egui::vec2(8.0, -8.0), egui::Align2::LEFT_BOTTOM, format!("L{i}"), egui::FontId::monospace(12.0), Color32::YELLOW);
         }
     }
     // Directional lights: an arrow in the corner along the projected direction.
     let mut corner = rect.left_top() + egui::vec2(28.0, 28.0);
-    for (i, l) in app.params.lights.iter().enumerate() {
+    for (i, l) in lights.iter().enumerate() {
         if let Light::Directional { direction, .. } = l {
             let d = view.world_to_camera * direction.normalize_or(Vec3::NEG_Y);
             let v = egui::vec2(d.x, -d.y);
@@ -187,20 +243,20 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
             corner.y += 48.0;
         }
     }
-    if app.viewport_focused {
+    if state.focused {
         painter.rect_stroke(avail.shrink(1.0), 0.0, Stroke::new(1.0, Color32::from_rgb(80, 120, 200)), egui::StrokeKind::Inside);
     }
-    hover_readout(app, &painter, avail, &view);
-    crate::app::legend::show(app, ui.ctx(), avail);
+    hover_readout(viewed, inspect.hover, &painter, avail, &view);
+    crate::app::legend::show(viewed, inspect.hover, camera, ui.ctx(), avail);
+    requests
 }
 
 /// Configuration B over the image (right of the divider, or as the
 /// difference), the divider, B's label and the measured rectangle. Dragging
 /// the divider moves it; alt+drag measures a rectangle. Returns whether a
 /// drag of the primary button was taken here (so it does not orbit).
-fn split_view(app: &mut PinholeApp, ui: &egui::Ui, response: &egui::Response, painter: &egui::Painter, map: &ImageMap) -> bool {
+fn split_view(split: &mut SplitView, ui: &egui::Ui, response: &egui::Response, painter: &egui::Painter, map: &ImageMap) -> bool {
     use crate::app::split_view::SplitMode;
-    let split = &mut app.split;
     if !split.enabled {
         return false;
     }
@@ -261,12 +317,12 @@ fn split_view(app: &mut PinholeApp, ui: &egui::Ui, response: &egui::Response, pa
 
 /// The pixel under the cursor: coordinates, the value on show and what it
 /// means in this view, in the viewport's bottom-left corner.
-fn hover_readout(app: &PinholeApp, painter: &egui::Painter, avail: Rect, view: &crate::scene::CameraView) {
-    let Some((x, y)) = app.inspect.hover else { return };
-    let exposure = app.params.render.exposure;
-    let Some(v) = app.with_output(|o| (x < o.width && y < o.height && o.linear.len() == (o.width * o.height) as usize).then(|| o.linear[(x + y * o.width) as usize])) else { return };
-    let meaning = crate::app::inspect::value_text(app.settings.render.view.name(), v, view, &app.scene);
-    let d = crate::image_io::display_pixel(v, exposure, app.settings.gamma);
+fn hover_readout(viewed: &Viewed, hover: Option<(u32, u32)>, painter: &egui::Painter, avail: Rect, view: &crate::scene::CameraView) {
+    let Some((x, y)) = hover else { return };
+    let exposure = viewed.exposure;
+    let Some(v) = viewed.with_output(|o| (x < o.width && y < o.height && o.linear.len() == (o.width * o.height) as usize).then(|| o.linear[(x + y * o.width) as usize])) else { return };
+    let meaning = crate::app::inspect::value_text(viewed.settings.view.name(), v, view, viewed.scene);
+    let d = crate::image_io::display_pixel(v, exposure, viewed.gamma);
     let text = if meaning.starts_with("linear") {
         format!("({x}, {y})  {meaning}  -> {d:?}")
     } else {
@@ -278,18 +334,20 @@ fn hover_readout(app: &PinholeApp, painter: &egui::Painter, avail: Rect, view: &
     painter.galley(pos, galley, Color32::WHITE);
 }
 
-/// WASD/QE fly at a speed proportional to the scene's size.
-fn fly_keys(app: &mut PinholeApp, ui: &egui::Ui) {
+/// WASD/QE fly at a speed proportional to the scene's size; true when the
+/// camera moved.
+fn fly_keys(camera: &mut Camera, scene: &Scene, ui: &egui::Ui) -> bool {
     use egui::Key;
     let (dir, dt, fast) = ui.input(|i| {
         let k = |key: Key| if i.key_down(key) { 1.0 } else { 0.0 };
         let dir = Vec3::new(k(Key::D) - k(Key::A), k(Key::E) - k(Key::Q), k(Key::W) - k(Key::S));
         (dir, i.stable_dt.min(0.1), i.modifiers.shift)
     });
-    if dir != Vec3::ZERO {
-        let speed = cc::scene_scale(app.scene.bounds()) * if fast { 1.0 } else { 0.3 };
-        cc::fly(&mut app.params.camera, dir, speed * dt.max(1.0 / 60.0));
-        app.camera_moving = true;
-        ui.ctx().request_repaint();
+    if dir == Vec3::ZERO {
+        return false;
     }
+    let speed = cc::scene_scale(scene.bounds()) * if fast { 1.0 } else { 0.3 };
+    cc::fly(camera, dir, speed * dt.max(1.0 / 60.0));
+    ui.ctx().request_repaint();
+    true
 }

@@ -162,6 +162,9 @@ pub struct Output {
     /// What the renderer draws otherwise than asked, one sentence each
     /// (`render::admit`), for the request last started.
     pub notices: Vec<String>,
+    /// The settings the gate admitted for that request: those asked, or what
+    /// the renderer draws in their place (`None` after a refusal).
+    pub admitted: Option<RenderSettings>,
     /// Diff view, once complete: pixels that differ from `raytrace:brute`.
     pub differing_pixels: Option<u64>,
 }
@@ -203,6 +206,7 @@ impl Worker {
                 stats: Stats::default(),
                 error: None,
                 notices: Vec::new(),
+                admitted: None,
                 differing_pixels: None,
             }),
             changed: Condvar::new(),
@@ -444,7 +448,11 @@ impl WorkerLoop {
                 return;
             }
         };
-        self.shared.output.lock().unwrap().notices = notices;
+        {
+            let mut out = self.shared.output.lock().unwrap();
+            out.notices = notices;
+            out.admitted = Some(settings.clone());
+        }
         let (width, height) = (settings.width, settings.height);
         if self.timed != (req.renderer.clone(), req.scene_id) {
             // Another renderer or scene: old timings mean nothing.
@@ -505,6 +513,7 @@ impl WorkerLoop {
         let mut out = self.shared.output.lock().unwrap();
         out.error = Some(message);
         out.notices.clear();
+        out.admitted = None;
         out.generation = req.generation;
         out.complete = true;
         out.version += 1;

@@ -8,20 +8,38 @@
 //! displayed 8-bit value.
 
 use eframe::egui;
-use crate::app::inspect::{fmt3, kind_name, object_name};
-use crate::app::PinholeApp;
+use crate::app::inspect::{fmt3, kind_name, object_name, Inspect};
 use crate::math::Radiance;
 use crate::render::inspect::pixel_report::miss_reason;
 use crate::render::inspect::pixel_record::{CsgABufferRecord, FragmentRecord, GlReadback, LightSample, PixelTrace, RayRecord};
 use crate::render::PixelReplay;
-use crate::scene::{Light, Scene};
+use crate::scene::{Light, Material, Scene};
 use egui::{Color32, RichText};
 
 const DIM: Color32 = Color32::from_gray(150);
 
-/// The inspector as a right-hand panel, while a pixel is selected.
-pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
-    let Some((x, y)) = app.inspect.selected else { return };
+/// What the inspector reads beside its own state: the request the frame
+/// belongs to, the scene with the values being edited, and how the pixel
+/// is displayed.
+pub struct Viewed<'a> {
+    /// The last render request sent: a replay for it is current.
+    pub generation: u64,
+    pub scene: &'a Scene,
+    pub lights: &'a [Light],
+    pub materials: &'a [Material],
+    pub renderer: &'a str,
+    pub exposure: f32,
+    pub gamma: bool,
+    /// The frame's own value at the selected pixel, once the frame of
+    /// `generation` is complete.
+    pub frame_pixel: Option<Radiance>,
+}
+
+/// The inspector as a right-hand panel, while a pixel is selected. It edits
+/// only `inspect` (selection, zoom, drawn rays), so it asks nothing more of
+/// the viewer.
+pub fn show(ui: &mut egui::Ui, inspect: &mut Inspect, viewed: &Viewed) {
+    let Some((x, y)) = inspect.selected else { return };
     egui::Panel::right("inspector").default_size(420.0).size_range(300.0..=640.0).resizable(true).show(ui, |ui| {
         // Fill the panel's width (the panel takes the size of its content,
         // which would otherwise be the narrow "replaying…" of the first frame).
@@ -29,21 +47,20 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
         ui.horizontal(|ui| {
             ui.heading("Inspector");
             if ui.button("clear (Esc)").clicked() {
-                app.inspect.clear();
+                inspect.clear();
             }
             if ui.button("zoom to pixel").on_hover_text("magnify 16x around the selected pixel").clicked() {
-                app.inspect.zoom = app.inspect.zoom.max(16.0);
-                app.inspect.center_on_selection = true;
+                inspect.zoom = inspect.zoom.max(16.0);
+                inspect.center_on_selection = true;
             }
         });
         ui.horizontal(|ui| {
-            ui.checkbox(&mut app.inspect.paths, "draw rays");
+            ui.checkbox(&mut inspect.paths, "draw rays");
             ui.label(RichText::new("arrows move · shift+arrows by 10").small().color(DIM));
         });
         ui.label(RichText::new(format!("pixel ({x}, {y})")).strong());
-        let generation = app.generation;
-        let current = app.inspect.current(generation).is_some();
-        let Some(replay) = app.inspect.replay.as_ref().filter(|r| r.x == x && r.y == y) else {
+        let current = inspect.current(viewed.generation).is_some();
+        let Some(replay) = inspect.replay.as_ref().filter(|r| r.x == x && r.y == y) else {
             ui.horizontal(|ui| {
                 ui.spinner();
                 ui.label("replaying…");
@@ -52,14 +69,15 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
         };
         ui.label(RichText::new(format!("{} · replayed in {:.1} ms{}", replay.renderer, replay.ms, if current { "" } else { " · updating…" })).small().color(DIM));
         ui.separator();
-        let scene = scene_now(app);
+        let names = SceneNames { scene: viewed.scene, lights: viewed.lights, materials: viewed.materials.iter().map(|m| m.name.clone()).collect() };
         match &replay.result {
             Err(e) => {
                 ui.colored_label(Color32::LIGHT_RED, format!("cannot replay this pixel: {e}"));
             }
             Ok(r) => {
+                let reference = replay.reference.as_ref();
                 egui::ScrollArea::both().auto_shrink([false, false]).show(ui, |ui| {
-                    record(app, ui, &scene, r, x, y, current);
+                    record(viewed, reference, ui, &names, r, current);
                 });
             }
         }
@@ -67,17 +85,15 @@ pub fn show(app: &mut PinholeApp, ui: &mut egui::Ui) {
 }
 
 /// The scene with the values being edited (lights, materials) for names.
-fn scene_now(app: &PinholeApp) -> SceneNames<'_> {
-    SceneNames { scene: &app.scene, lights: &app.params.lights, materials: app.params.materials.iter().map(|m| m.name.clone()).collect() }
-}
-
 struct SceneNames<'a> {
     scene: &'a Scene,
     lights: &'a [Light],
     materials: Vec<String>,
 }
 
-fn record(app: &PinholeApp, ui: &mut egui::Ui, names: &SceneNames, r: &PixelReplay, x: u32, y: u32, current: bool) {
+/// The replayed samples, then the final value; in the diff view, both
+/// renderers' values (`reference`: the reference renderer's replay).
+fn record(viewed: &Viewed, reference: Option<&Result<PixelReplay, String>>, ui: &mut egui::Ui, names: &SceneNames, r: &PixelReplay, current: bool) {
     let many = r.samples.len() > 1;
     for (i, (offset, trace, value)) in r.samples.iter().enumerate() {
         if many {
@@ -90,9 +106,9 @@ fn record(app: &PinholeApp, ui: &mut egui::Ui, names: &SceneNames, r: &PixelRepl
         }
     }
     ui.separator();
-    if let Some(reference) = app.inspect.replay.as_ref().and_then(|r| r.reference.as_ref()) {
+    if let Some(reference) = reference {
         // Diff view: both renderers' shaded values; the frame shows their difference.
-        ui.label(RichText::new(format!("{} (shaded) {}", app.settings.renderer, fmt3(r.radiance))).monospace());
+        ui.label(RichText::new(format!("{} (shaded) {}", viewed.renderer, fmt3(r.radiance))).monospace());
         match reference {
             Ok(b) => {
                 ui.label(RichText::new(format!("raytrace:brute (shaded) {}", fmt3(b.radiance))).monospace());
@@ -108,7 +124,7 @@ fn record(app: &PinholeApp, ui: &mut egui::Ui, names: &SceneNames, r: &PixelRepl
         }
         return;
     }
-    final_value(app, ui, r.radiance, x, y, current);
+    final_value(viewed, ui, r.radiance, current);
 }
 
 /// The `opengl` renderer's record: what its render targets hold at the pixel.
@@ -419,13 +435,10 @@ pub fn final_radiance_text(r: Radiance) -> String {
     format!("final radiance ({:.6}, {:.6}, {:.6})", r.x, r.y, r.z)
 }
 
-fn final_value(app: &PinholeApp, ui: &mut egui::Ui, radiance: Radiance, x: u32, y: u32, current: bool) {
+fn final_value(viewed: &Viewed, ui: &mut egui::Ui, radiance: Radiance, current: bool) {
     ui.label(RichText::new(final_radiance_text(radiance)).strong().monospace());
     // The frame's own pixel: the same number, once the frame is complete.
-    let frame = app.with_output(|o| {
-        (o.complete && o.error.is_none() && o.generation == app.generation && x < o.width && y < o.height)
-            .then(|| o.linear[(x + y * o.width) as usize])
-    });
+    let frame = viewed.frame_pixel;
     match frame {
         Some(f) if current && f == radiance => {
             ui.label(RichText::new("= the frame's pixel, exactly").color(Color32::LIGHT_GREEN));
@@ -437,8 +450,8 @@ fn final_value(app: &PinholeApp, ui: &mut egui::Ui, radiance: Radiance, x: u32, 
             ui.label(RichText::new("the frame is still rendering").color(DIM));
         }
     }
-    let exposure = app.params.render.exposure;
-    let d = crate::image_io::display_pixel(radiance, exposure, app.settings.gamma);
+    let exposure = viewed.exposure;
+    let d = crate::image_io::display_pixel(radiance, exposure, viewed.gamma);
     ui.horizontal(|ui| {
         let (r, _) = ui.allocate_exact_size(egui::vec2(18.0, 18.0), egui::Sense::hover());
         ui.painter().rect_filled(r, 2.0, Color32::from_rgb(d[0], d[1], d[2]));
@@ -447,7 +460,7 @@ fn final_value(app: &PinholeApp, ui: &mut egui::Ui, radiance: Radiance, x: u32, 
             d[0],
             d[1],
             d[2],
-            if app.settings.gamma { "sRGB" } else { "no gamma" }
+            if viewed.gamma { "sRGB" } else { "no gamma" }
         ));
     });
 }

@@ -1,8 +1,9 @@
 //! The viewer's panels: the menu bar, the status bar and the side-panel
 //! sections (camera, lights, materials, shading) and the pixel inspector,
-//! one file each. The menu and the side-panel sections get only the values
-//! they edit; what they ask of the viewer beyond that comes back as
-//! `Requests`, which `PinholeApp::apply` carries out once per frame.
+//! one file each. Each gets only the values it reads and, mutably, those it
+//! edits; what the menu and the side-panel sections ask of the viewer beyond
+//! that comes back as `Requests`, which `PinholeApp::apply` carries out once
+//! per frame. The status bar and the inspector ask nothing more.
 
 use eframe::egui;
 pub mod camera;

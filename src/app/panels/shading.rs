@@ -11,13 +11,23 @@ use crate::render::raster::clip::ClipMode;
 use crate::render::raster::depth_format::DepthFormat;
 use crate::render::inspect::wireframe::LineAlgorithm;
 use crate::render::shadow::volume::VolumeMode;
-use crate::render::{Interpolation, Reflections, ShadowMode};
+use crate::render::{Interpolation, Reflections, RenderSettings, ShadowMode};
 use crate::scene::texture::TextureFilter;
 use crate::scene::RenderDefaults;
 
-/// `settings`: the render knobs in force (the worker renders with these) and
-/// gamma; `look`: the scene's ambient, background and exposure.
-pub fn show(ui: &mut egui::Ui, settings: &mut ViewerSettings, look: &mut RenderDefaults) {
+/// What the renderer draws with, as the admission gate (`render::admit`)
+/// let it: the settings admitted for the request last started, and the
+/// gate's sentences saying what it substituted.
+#[derive(Clone, Copy, Default)]
+pub struct InForce<'a> {
+    pub admitted: Option<&'a RenderSettings>,
+    pub notices: &'a [String],
+}
+
+/// `settings`: the render knobs asked for (the worker renders with these,
+/// through the gate) and gamma; `look`: the scene's ambient, background and
+/// exposure; `in_force`: what the gate admitted, shown where it differs.
+pub fn show(ui: &mut egui::Ui, settings: &mut ViewerSettings, look: &mut RenderDefaults, in_force: InForce) {
     let mut open = settings.panels.shading;
     let gamma = &mut settings.gamma;
     section(ui, "Shading", &mut open, |ui| {
@@ -28,6 +38,10 @@ pub fn show(ui: &mut egui::Ui, settings: &mut ViewerSettings, look: &mut RenderD
                 ui.radio_value(&mut s.shadows, m, m.name());
             }
         });
+        if let Some(admitted) = in_force.admitted.filter(|a| a.shadows != s.shadows) {
+            let line = format!("in force: {} — {}", admitted.shadows.name(), in_force.notices.join("; "));
+            ui.colored_label(egui::Color32::from_rgb(230, 180, 60), line);
+        }
         ui.horizontal(|ui| {
             let l = ui.label("ray bump ε");
             ui.add(egui::Slider::new(&mut s.shadow_bump, 1e-7..=1e-1).logarithmic(true)).labelled_by(l.id);
