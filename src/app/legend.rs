@@ -5,7 +5,7 @@
 //! plain legend (their name) without a change here.
 
 use crate::render::inspect::debug::{cost_of_t, depth_distance, t_of_cost, zbuffer_depth};
-use crate::app::viewport::Viewed;
+use crate::app::viewed::Viewed;
 use crate::scene::Camera;
 use crate::math::Vec3;
 use crate::render::inspect::debug::{cost_color, id_color, mip_color, COST_SCALE, MIP_SCALE};

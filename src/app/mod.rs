@@ -16,6 +16,7 @@ pub mod panels;
 pub mod settings_store;
 pub mod split_view;
 pub mod state;
+pub mod viewed;
 pub mod viewport;
 pub mod worker;
 

@@ -609,7 +609,7 @@ impl PinholeApp {
             crate::app::panels::inspector::show(ui, &mut self.inspect, &viewed);
         }
         let settings = self.effective_settings();
-        let viewed = crate::app::viewport::Viewed {
+        let viewed = crate::app::viewed::Viewed {
             settings: &settings,
             renderer: &self.settings.renderer,
             exposure: self.params.render.exposure,

@@ -8,28 +8,10 @@ use crate::scene::camera::control as cc;
 use crate::app::inspect::Inspect;
 use crate::app::overlay::{self, ImageMap};
 use crate::app::split_view::SplitView;
-use crate::app::worker::Output;
+use crate::app::viewed::Viewed;
 use crate::math::{Vec2, Vec3};
-use crate::render::RenderSettings;
 use crate::scene::{Camera, Light, Scene};
 use egui::{Color32, Pos2, Rect, Sense, Stroke};
-use std::sync::Mutex;
-
-/// What the viewport reads: the frame on show and what it was drawn from.
-pub struct Viewed<'a> {
-    /// The settings the worker renders with, at the image's size.
-    pub settings: &'a RenderSettings,
-    pub renderer: &'a str,
-    pub exposure: f32,
-    pub gamma: bool,
-    pub scene: &'a Scene,
-    pub scene_id: u64,
-    /// The last render request sent: a replay for it is current.
-    pub generation: u64,
-    pub texture: Option<&'a egui::TextureHandle>,
-    /// The worker's latest output (pixel values under the cursor, counts).
-    pub output: &'a Mutex<Output>,
-}
 
 /// What the viewport edits: the camera and lights (dragged), the
 /// inspection (selection, zoom, hover), configuration B's divider and
@@ -58,13 +40,6 @@ pub struct ViewportRequests {
     pub camera_moved: bool,
     /// Where the image was drawn, in points.
     pub image_rect: Option<Rect>,
-}
-
-impl Viewed<'_> {
-    /// Runs `f` on the worker's latest output under its lock.
-    pub fn with_output<T>(&self, f: impl FnOnce(&Output) -> T) -> T {
-        f(&self.output.lock().unwrap())
-    }
 }
 
 pub fn show(ui: &mut egui::Ui, viewed: &Viewed, edited: Edited) -> ViewportRequests {
