@@ -4,20 +4,11 @@
 //! where no OpenGL driver exists, unless `PINHOLE_REQUIRE_GL=1` asks for one.
 
 use egui_kittest::kittest::Queryable;
-use egui_kittest::Harness;
-use pinhole::app::PinholeApp;
 use pinhole::render::ShadowMode;
 
 #[path = "common/app.rs"]
 mod app_common;
-use app_common::{new_harness, small_scene, WAIT};
-
-fn settle(h: &mut Harness<'static, PinholeApp>) {
-    h.step();
-    assert!(h.state_mut().wait_idle(WAIT), "the worker did not finish");
-    h.step();
-    h.step();
-}
+use app_common::{new_harness, settle, small_scene};
 
 #[test]
 fn shading_panel_shows_the_shadow_maps_opengl_draws_for_shadow_rays() {

@@ -9,14 +9,7 @@ use std::time::{Duration, Instant};
 
 #[path = "common/app.rs"]
 mod app_common;
-use app_common::{new_harness, small_scene, WAIT};
-
-fn settle(h: &mut Harness<'static, PinholeApp>) {
-    h.step();
-    assert!(h.state_mut().wait_idle(WAIT), "the worker did not finish");
-    h.step();
-    h.step();
-}
+use app_common::{WAIT, new_harness, settle, small_scene};
 
 /// Steps the UI until the sweep has finished.
 fn wait_for_sweep(h: &mut Harness<'static, PinholeApp>) {

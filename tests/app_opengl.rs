@@ -12,14 +12,7 @@ use pinhole::app::PinholeApp;
 
 #[path = "common/app.rs"]
 mod app_common;
-use app_common::{new_harness, small_scene, WAIT};
-
-fn settle(h: &mut Harness<'static, PinholeApp>) {
-    h.step();
-    assert!(h.state_mut().wait_idle(WAIT), "the worker did not finish");
-    h.step();
-    h.step();
-}
+use app_common::{WAIT, new_harness, settle, small_scene};
 
 fn click(h: &mut Harness<'static, PinholeApp>, pos: egui::Pos2) {
     h.hover_at(pos);

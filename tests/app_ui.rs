@@ -14,7 +14,7 @@ use std::time::Duration;
 
 #[path = "common/app.rs"]
 mod app_common;
-use app_common::{new_harness, small_scene, WAIT};
+use app_common::{WAIT, new_harness, settle, small_scene};
 
 fn harness(scene: Scene) -> Harness<'static, PinholeApp> {
     let mut h = new_harness(scene);
@@ -24,13 +24,6 @@ fn harness(scene: Scene) -> Harness<'static, PinholeApp> {
 
 /// Runs frames until the worker finished what the UI asked, and one more
 /// frame so the texture shows it.
-fn settle(h: &mut Harness<'static, PinholeApp>) {
-    h.step();
-    assert!(h.state_mut().wait_idle(WAIT), "the worker did not finish");
-    h.step();
-    h.step();
-}
-
 /// What `pinhole render` computes for the app's current scene, settings and renderer.
 fn reference(app: &PinholeApp) -> Vec<Radiance> {
     let mut scene = (*app.scene()).clone();

@@ -40,3 +40,13 @@ pub fn have_gl() -> bool {
         }
     }
 }
+
+/// One frame, then waits for the worker to finish the render in flight and
+/// lets two more frames show its image and the panels that follow it.
+#[allow(dead_code)] // not every viewer test waits for a render
+pub fn settle(h: &mut Harness<'static, PinholeApp>) {
+    h.step();
+    assert!(h.state_mut().wait_idle(WAIT), "the worker did not finish");
+    h.step();
+    h.step();
+}
