@@ -152,7 +152,17 @@ pub struct RenderSettings {
     /// bounding sphere is outside the view volume (`raster::cull`). The same
     /// image either way; a knob to measure and test that.
     pub cull_instances: bool,
+    /// Area lights and the environment: shadow rays per light per shading
+    /// point, stratified over the emitter (`transport::sampled_light`).
+    pub light_samples: u32,
+    /// Area lights and the environment: combine light sampling with BSDF
+    /// sampling by multiple importance sampling (power heuristic); false:
+    /// light sampling alone.
+    pub mis: bool,
 }
+
+/// The most `RenderSettings::light_samples` a front end accepts.
+pub const MAX_LIGHT_SAMPLES: u32 = 4096;
 
 impl Default for RenderSettings {
     /// Every knob's default, at the default scene size.
@@ -185,6 +195,8 @@ impl Default for RenderSettings {
             reflections: Reflections::Ray,
             clip: raster::clip::ClipMode::Near,
             cull_instances: true,
+            light_samples: 1,
+            mis: true,
         }
     }
 }

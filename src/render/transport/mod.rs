@@ -13,6 +13,7 @@ pub mod lighting;
 pub mod normal_map;
 pub mod path_batch;
 pub mod photon_map;
+pub mod sampled_light;
 pub mod sampling;
 pub mod shade;
 pub mod shade_batch;

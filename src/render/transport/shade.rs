@@ -6,6 +6,8 @@ use crate::render::transport::bsdf::{surface_lane, DeltaLobes};
 use crate::render::transport::gi;
 use crate::render::transport::gi::{GiMode, PathState};
 use crate::render::transport::lighting;
+use crate::render::transport::sampled_light;
+use crate::render::transport::sampled_light::Arrival;
 use crate::render::transport::lighting::{IncidenceLanes, LightVisibility};
 use crate::render::inspect::pixel_record::{LightSample, Recorder};
 use crate::render::differentials::{self, RayDifferential};
@@ -80,13 +82,15 @@ pub fn ambient_term<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: imp
 /// frame without traced or mapped indirect light adds nothing to most
 /// surfaces, and its batches skip the call.
 #[inline(always)]
-pub fn adds_after_direct(settings: &RenderSettings, material: &Material) -> bool {
-    matches!(settings.gi.mode, GiMode::Path | GiMode::Photons) || material.has_secondary()
+pub fn adds_after_direct(scene: &Scene, settings: &RenderSettings, material: &Material) -> bool {
+    matches!(settings.gi.mode, GiMode::Path | GiMode::Photons) || material.has_secondary() || material.is_emissive() || scene.has_sampled_lights()
 }
 
-/// What `shade()` adds after direct light, in this order: traced or mapped
-/// indirect light, then mirror reflection and refraction. `l_o` is the
-/// ambient term plus direct light.
+/// What `shade()` adds after the point and directional lights, in this
+/// order: the surface's own emission, direct light from area lights and
+/// the environment, traced or mapped indirect light, then mirror
+/// reflection and refraction. `l_o` is the ambient term plus the point and
+/// directional lights' light.
 #[inline]
 pub fn after_direct<Q: SceneQuery, R: Recorder>(
     sh: &mut Shading<Q, R>,
@@ -98,6 +102,10 @@ pub fn after_direct<Q: SceneQuery, R: Recorder>(
     mut l_o: Radiance,
 ) -> Radiance {
     let Shading { settings, .. } = *sh;
+    if material.is_emissive() {
+        l_o += sampled_light::emitted_seen(sh, hit, w_o);
+    }
+    l_o += sampled_light::sampled_direct(sh, hit, material, albedo, w_o, depth);
     match settings.gi.mode {
         GiMode::Path if depth < settings.gi.max_path_depth() => {
             l_o += indirect_path(sh, hit, material, albedo, w_o, depth);
@@ -189,26 +197,30 @@ fn indirect_path<Q: SceneQuery, R: Recorder>(
     depth: u32,
 ) -> Radiance {
     let Shading { settings, .. } = *sh;
-    let Some((w_i, weight)) = gi::sample_bounce(material, albedo, hit, w_o, depth, sh.path, sh.rec) else {
+    let Some((w_i, weight, pdf)) = gi::sample_bounce(material, albedo, hit, w_o, depth, sh.path, sh.rec) else {
         return Vec3::ZERO;
     };
     let ray = hit.spawn_ray_front(w_i, settings.shadow_bump);
-    weight * follow(sh, &ray, depth, false, weight)
+    weight * follow(sh, &ray, depth, false, weight, Arrival::Bsdf { pdf, from: hit.position })
 }
 
 /// `radiance_along` with the path's throughput multiplied by `weight` for
-/// the rest of the path (Russian roulette reads it), restored afterwards.
+/// the rest of the path (Russian roulette reads it) and the ray chosen as
+/// `arrival` says, both restored afterwards.
 fn follow<Q: SceneQuery, R: Recorder>(
     sh: &mut Shading<Q, R>,
     ray: &Ray,
     depth: u32,
     inside: bool,
     weight: Vec3,
+    arrival: Arrival,
 ) -> Radiance {
-    let before = sh.path.throughput;
+    let (before, arrived) = (sh.path.throughput, sh.path.arrival);
     sh.path.throughput *= weight;
+    sh.path.arrival = arrival;
     let l = radiance_along(sh, ray, None, depth + 1, inside);
     sh.path.throughput = before;
+    sh.path.arrival = arrived;
     l
 }
 
@@ -234,7 +246,7 @@ fn indirect_photons<Q: SceneQuery, R: Recorder>(
             if let Some(s) = crate::render::transport::bsdf_sampling::sample_bsdf(material, albedo, hit.shading_normal, w_o, choice, u) {
                 if s.w_i.dot(hit.geometric_normal) > 0.0 {
                     let ray = hit.spawn_ray_front(s.w_i, settings.shadow_bump);
-                    sum += s.weight * follow(sh, &ray, depth, false, s.weight);
+                    sum += s.weight * follow(sh, &ray, depth, false, s.weight, Arrival::Gathered);
                 }
             }
         }
@@ -272,7 +284,7 @@ fn secondary_sampled<Q: SceneQuery, R: Recorder>(
         return Vec3::ZERO;
     };
     let weight = weight * survive;
-    weight * follow(sh, &ray, depth, inside, weight)
+    weight * follow(sh, &ray, depth, inside, weight, Arrival::Direct)
 }
 
 /// How one light arrives at a surface point: the first half of every light's
@@ -401,14 +413,19 @@ fn secondary<Q: SceneQuery, R: Recorder>(
     let Shading { settings, .. } = *sh;
     let DeltaLobes { reflect_dir, reflect_weight, refract } = DeltaLobes::at(hit, material, w_o);
     let mut result = Vec3::ZERO;
+    // Delta lobes: the light they find counts whole.
+    let arrived = std::mem::take(&mut sh.path.arrival);
     if let Some((dir, weight)) = refract {
         let ray = hit.spawn_ray_back(dir, settings.shadow_bump);
         let rd = differentials::refracted(hit);
+        sh.path.arrival = Arrival::Direct;
         result += weight * radiance_along(sh, &ray, Some(&rd), depth + 1, true);
     }
     if reflect_weight != Vec3::ZERO {
+        sh.path.arrival = Arrival::Direct;
         result += reflect_weight * reflection(sh, hit, reflect_dir, -w_o, depth);
     }
+    sh.path.arrival = arrived;
     result
 }
 
@@ -458,7 +475,7 @@ pub fn radiance_along<Q: SceneQuery, R: Recorder>(
     match &hit {
         Some(h) => shade(sh, h, -ray.dir, depth),
         None => {
-            let l = scene.miss_radiance(ray.dir);
+            let l = sampled_light::miss_seen(sh, ray.dir);
             sh.rec.shaded(depth, l);
             l
         }
