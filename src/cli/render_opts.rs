@@ -128,6 +128,12 @@ pub struct RenderOpts {
     /// Area lights and the environment: combine light and BSDF sampling (on) or sample the lights alone (off).
     #[arg(long, default_value = "on", value_name = "on|off")]
     pub mis: String,
+    /// --shadows map: none (hard) | pcf (percentage-closer) | pcss (percentage-closer soft).
+    #[arg(long = "shadow-filter", default_value_t = defaults().shadow_filter.name().to_string(), value_name = "none|pcf|pcss")]
+    pub shadow_filter: String,
+    /// --shadow-filter pcf: the filter's radius in shadow-map texels.
+    #[arg(long = "pcf-radius", default_value_t = defaults().pcf_radius, value_name = "R")]
+    pub pcf_radius: f32,
 }
 
 impl RenderOpts {
@@ -146,6 +152,11 @@ impl RenderOpts {
             return Err(format!("--light-samples {} is not between 1 and {}", self.light_samples, render::MAX_LIGHT_SAMPLES));
         }
         s.light_samples = self.light_samples;
+        s.shadow_filter = render::shadow::ShadowFilter::parse(&self.shadow_filter).map_err(|e| format!("--shadow-filter: {e}"))?;
+        if !(self.pcf_radius.is_finite() && (0.0..=64.0).contains(&self.pcf_radius)) {
+            return Err(format!("--pcf-radius {} is not a number from 0 to 64", self.pcf_radius));
+        }
+        s.pcf_radius = self.pcf_radius;
         s.mis = match self.mis.as_str() {
             "on" => true,
             "off" => false,

@@ -27,7 +27,7 @@ pub struct PathState<'a> {
     pub throughput: Vec3,
     pub photons: Option<&'a PhotonMap>,
     /// How the ray being followed was chosen (weights the light it finds).
-    pub arrival: crate::render::transport::sampled_light::Arrival,
+    pub arrival: crate::render::transport::arrival::Arrival,
 }
 
 impl<'a> PathState<'a> {

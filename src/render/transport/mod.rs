@@ -2,12 +2,15 @@
 //! `shade` is the one shading entry for a single sample and `shade_batch` the
 //! same over eight lanes; `lighting` evaluates lights; `gi` holds the
 //! indirect-light modes, `path_batch` the path pool, `photon_map` photons
-//! and `bsdf_sampling` the BSDFs' importance sampling; `sampling` is the
+//! and `bsdf_sampling` the BSDFs' importance sampling; `sampled_light` samples area
+//! lights and the environment; `sampling` is the
 //! sampler whose numbers are a pure function of (pixel, sample, seed).
 
+pub mod arrival;
 pub mod bsdf;
 pub mod bsdf_sampling;
 pub mod gi;
+pub mod incidence;
 pub mod kd_tree;
 pub mod lighting;
 pub mod normal_map;
@@ -17,4 +20,5 @@ pub mod sampled_light;
 pub mod sampling;
 pub mod shade;
 pub mod shade_batch;
+pub mod shading;
 pub mod shadow_packets;

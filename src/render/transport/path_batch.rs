@@ -25,7 +25,7 @@ use crate::render::transport::gi;
 use crate::render::transport::gi::{GiMode, PathState};
 use crate::render::inspect::pixel_record::NoRecord;
 use crate::render::transport::shade;
-use crate::render::transport::shade::Shading;
+use crate::render::transport::shading::Shading;
 use crate::render::transport::shade_batch::{direct_in_lanes, shadow_rays_of, Batch, IN_ORDER, LANES};
 use crate::render::accel::packet::{Packet, HYBRID_ALONE, PACKET_RAYS};
 use crate::render::{BatchHit, PassJob, RayCounts, SceneQuery, ShadowMode};

@@ -17,38 +17,12 @@ use crate::render::inspect::pixel_record::{Recorder, SampledLight, SampledLightK
 use crate::render::transport::bsdf::bsdf;
 use crate::render::transport::bsdf_sampling::{bsdf_pdf, sample_bsdf};
 use crate::render::transport::gi::GiMode;
-use crate::render::transport::shade::{Incidence, Shading};
+use crate::render::transport::arrival::{power_heuristic, Arrival};
+use crate::render::transport::incidence::Incidence;
+use crate::render::transport::shading::Shading;
 use crate::render::{SceneQuery, ShadowMode};
 use crate::scene::emitters::emitted;
 use crate::scene::{Material, SurfaceHit};
-
-/// How the ray that reached a surface (or missed everything) was chosen,
-/// which decides how much of the light it finds on an emitter counts.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub enum Arrival {
-    /// An eye ray, or a mirror's or glass's delta lobe: no light sample
-    /// could have found this light, so all of it counts.
-    #[default]
-    Direct,
-    /// A path's bounce sampled from the BSDF with density `pdf` at `from`:
-    /// the light found is weighted against light sampling.
-    Bsdf { pdf: f32, from: Vec3 },
-    /// A final-gather ray of photon mapping: light sampling at the surface
-    /// it left already counted direct light, so lights found count nothing.
-    Gathered,
-}
-
-/// The power heuristic (exponent 2): the weight of a sample drawn with
-/// density `a` by a strategy competing with one of density `b` (each
-/// density already multiplied by its strategy's sample count).
-#[inline]
-pub fn power_heuristic(a: f32, b: f32) -> f32 {
-    if a.is_infinite() {
-        return 1.0;
-    }
-    let (a2, b2) = (a * a, b * b);
-    if a2 + b2 > 0.0 { a2 / (a2 + b2) } else { 0.0 }
-}
 
 /// Whether the BSDF strategy of multiple importance sampling is taken at a
 /// surface at `depth`: with MIS on, unless a path ends here (its bounce is
@@ -115,9 +89,10 @@ pub fn sampled_direct<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &
     let mut l_o = Vec3::ZERO;
     let emitters = scene.emitters.clone();
     if !emitters.is_empty() {
-        // Volumes and maps know only hard shadows: each area light is
-        // shadowed from its centre, asked once per surface.
-        let mut centre_visible: Vec<Option<bool>> = Vec::new();
+        // Volumes give the hard shadow of each area light's centre, and maps
+        // (filtered or not) one visibility for the whole light: asked once
+        // per light and surface, and multiplying every sample of that light.
+        let mut whole_light: Vec<Option<f32>> = Vec::new();
         for k in 0..count {
             let u_choose = (k as f32 + sh.path.rng.next_f32()) / count as f32;
             let u = sh.path.rng.next_2d();
@@ -130,28 +105,27 @@ pub fn sampled_direct<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &
             if f == Vec3::ZERO {
                 continue;
             }
-            let visible = match settings.shadows {
-                ShadowMode::None => true,
-                ShadowMode::Ray => unblocked(sh, hit, s.w_i, s.distance),
+            let visibility = match settings.shadows {
+                ShadowMode::None => 1.0,
+                ShadowMode::Ray => unblocked(sh, hit, s.w_i, s.distance) as u8 as f32,
                 ShadowMode::Map | ShadowMode::Volume => {
                     let light = s.light as usize;
-                    if centre_visible.len() <= light {
-                        centre_visible.resize(light + 1, None);
+                    if whole_light.len() <= light {
+                        whole_light.resize(light + 1, None);
                     }
-                    match centre_visible[light] {
+                    match whole_light[light] {
                         Some(v) => v,
                         None => {
-                            let to = emitters.lights[light].centre - hit.position;
-                            let d = to.length();
-                            let v = d > 0.0 && unblocked(sh, hit, to / d, d);
-                            centre_visible[light] = Some(v);
+                            let v = light_visibility(sh, hit, light);
+                            whole_light[light] = Some(v);
                             v
                         }
                     }
                 }
             };
+            let visible = visibility > 0.0;
             let weight = if mis { power_heuristic(count as f32 * s.pdf, bsdf_pdf(material, albedo, n, w_o, s.w_i)) } else { 1.0 };
-            let contribution = if visible { s.radiance * f * (cos * weight / (s.pdf * count as f32)) } else { Vec3::ZERO };
+            let contribution = if visible { s.radiance * f * (cos * weight * visibility / (s.pdf * count as f32)) } else { Vec3::ZERO };
             l_o += contribution;
             if R::ENABLED {
                 sh.rec.sampled_light(SampledLight { kind: SampledLightKind::Area(s.light), point: Some(s.point), w_i: s.w_i, pdf: s.pdf, mis_weight: weight, visible, contribution });
@@ -220,6 +194,23 @@ fn bsdf_sampled<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &Surfac
         sh.rec.sampled_light(SampledLight { kind, point, w_i: s.w_i, pdf: s.pdf, mis_weight: weight, visible: radiance != Vec3::ZERO, contribution });
     }
     contribution
+}
+
+/// The fraction of area light `light` that `hit` sees, as the shadow
+/// approximations answer it: the light's shadow map (filtered as
+/// `RenderSettings::shadow_filter` says), or else one shadow ray to the
+/// light's centre (the hard shadow a volume or an unfiltered map of a point
+/// there gives).
+fn light_visibility<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &SurfaceHit, light: usize) -> f32 {
+    let Shading { scene, query, settings, .. } = *sh;
+    if settings.shadows == ShadowMode::Map {
+        if let Some(v) = query.shadow_maps().and_then(|maps| maps.area_light_visibility(scene, light, hit, settings)) {
+            return v;
+        }
+    }
+    let to = scene.emitters.lights[light].centre - hit.position;
+    let d = to.length();
+    (d > 0.0 && unblocked(sh, hit, to / d, d)) as u8 as f32
 }
 
 /// Whether nothing blocks the way from `hit` along unit `w_i` for

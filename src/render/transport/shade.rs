@@ -4,32 +4,22 @@
 
 use crate::render::transport::bsdf::{surface_lane, DeltaLobes};
 use crate::render::transport::gi;
-use crate::render::transport::gi::{GiMode, PathState};
+use crate::render::transport::gi::GiMode;
 use crate::render::transport::lighting;
 use crate::render::transport::sampled_light;
-use crate::render::transport::sampled_light::Arrival;
+use crate::render::transport::arrival::Arrival;
+use crate::render::transport::incidence::Incidence;
+use crate::render::transport::shading::Shading;
 use crate::render::transport::lighting::{IncidenceLanes, LightVisibility};
 use crate::render::inspect::pixel_record::{LightSample, Recorder};
 use crate::render::differentials::{self, RayDifferential};
-use crate::render::{RayCounts, Reflections, RenderSettings, SceneQuery, ShadowMode};
+use crate::render::{Reflections, RenderSettings, SceneQuery, ShadowMode};
 use crate::math::lanes::V3;
 use crate::math::{Radiance, Ray, Vec2, Vec3};
-use crate::scene::{Differentials, Light, Material, Scene, SurfaceHit};
+use crate::scene::{Differentials, Material, Scene, SurfaceHit};
 #[cfg(test)]
 use std::f32::consts::PI;
 
-/// What shading one sample reads and writes besides the surface: the scene
-/// and its query, the settings, the sample's path (random numbers,
-/// throughput, photon map), the counters and the recorder. Passed down
-/// whole through every step of `shade()` and the rays it follows.
-pub struct Shading<'a, 'p, Q, R> {
-    pub scene: &'a Scene,
-    pub query: &'a Q,
-    pub settings: &'a RenderSettings,
-    pub path: &'a mut PathState<'p>,
-    pub counts: &'a mut RayCounts,
-    pub rec: &'a mut R,
-}
 
 /// Outgoing radiance towards `w_o` (unit, pointing away from the surface) at `hit`.
 pub fn shade<Q: SceneQuery, R: Recorder>(
@@ -287,88 +277,6 @@ fn secondary_sampled<Q: SceneQuery, R: Recorder>(
     weight * follow(sh, &ray, depth, inside, weight, Arrival::Direct)
 }
 
-/// How one light arrives at a surface point: the first half of every light's
-/// term in `shade()`, before visibility and the BSDF.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Incidence {
-    /// Unit direction towards the light.
-    pub w_i: Vec3,
-    /// Distance to the light (infinite for directional lights).
-    pub distance: f32,
-    /// Incident radiance (point, CGPP 15.4.5: power / (4 pi d^2)) or
-    /// irradiance (directional), before visibility.
-    pub incident: Radiance,
-    /// `w_i . n` with the shading normal.
-    pub cos_theta: f32,
-}
-
-impl Incidence {
-    /// Light `light` at point `p` with unit shading normal `n`; `None` when
-    /// a point light sits exactly at `p` (it has no direction there and
-    /// contributes nothing).
-    #[inline]
-    pub fn of(light: &Light, p: Vec3, n: Vec3) -> Option<Incidence> {
-        let lane = lighting::incidence::<f32>(light, p.into(), n.into());
-        lane.exists.then(|| Incidence::from_lane(&lane))
-    }
-
-    /// One lane's incidence as this struct.
-    #[inline(always)]
-    pub fn from_lane(lane: &IncidenceLanes<f32>) -> Incidence {
-        Incidence { w_i: lane.w_i.into(), distance: lane.distance, incident: lane.incident.into(), cos_theta: lane.cos_theta }
-    }
-
-    /// Whether the light reaches the surface's lit side with some radiance:
-    /// only then can it contribute, and only then is a shadow ray cast.
-    #[inline]
-    pub fn illuminates(&self) -> bool {
-        !(self.cos_theta <= 0.0 || self.incident == Vec3::ZERO)
-    }
-
-    /// The shadow ray from `hit` towards the light, and its far end. It
-    /// leaves from `shadow_origin` and starts `bump` along the ray so it does
-    /// not hit P again (CGPP listing 15.20); it ends `bump` short of the light.
-    /// `lift`: `RenderSettings::terminator_lift`.
-    #[inline]
-    pub fn shadow_ray(&self, scene: &Scene, hit: &SurfaceHit, bump: f32, lift: bool) -> (Ray, f32) {
-        let leaving = SurfaceHit { position: shadow_origin(scene, hit, self.w_i, lift), ..*hit };
-        (leaving.spawn_ray_along(self.w_i, bump), self.distance - bump)
-    }
-}
-
-/// Where a shadow ray towards `w_i` leaves a surface point. Normally the hit
-/// point itself (the ray is then bumped along `w_i`, CGPP listing 15.20). But
-/// on a triangle with smooth vertex normals, where the shading normal faces
-/// the light while the flat facet faces away (the shadow terminator), a ray
-/// from the facet is blocked by the mesh's own neighbouring facets and leaves
-/// black speckles. There, following Hanika ("Hacking the shadow terminator",
-/// Ray Tracing Gems II, ch. 4), the origin is lifted onto the curved surface
-/// the vertex normals imply. Only there: elsewhere the lift would move the
-/// origin of a coarse, strongly bent triangle (the book's) far off its surface.
-/// Without `lift` (`RenderSettings::terminator_lift` off) always the hit point,
-/// to show the speckles it prevents.
-pub fn shadow_origin(scene: &Scene, hit: &SurfaceHit, w_i: Vec3, lift: bool) -> Vec3 {
-    if !lift || hit.kind != crate::scene::PrimitiveKind::Triangle || hit.geometric_normal.dot(w_i) > 0.0 {
-        return hit.position;
-    }
-    lifted_position(scene, hit)
-}
-
-/// The hit point lifted onto the surface implied by the vertex normals
-/// (Hanika's construction); the hit point itself on flat triangles.
-pub fn lifted_position(scene: &Scene, hit: &SurfaceHit) -> Vec3 {
-    let tri = &scene.triangle(hit.primitive);
-    let side = if hit.back_face { -1.0 } else { 1.0 };
-    let mut lifted = Vec3::ZERO;
-    for k in 0..3 {
-        let n = tri.n[k] * side;
-        let d = hit.position - tri.v[k];
-        // Keep only the part of P - v_k above the vertex's tangent plane.
-        let below = d.dot(n).min(0.0);
-        lifted += hit.barycentric[k] * (tri.v[k] + d - below * n);
-    }
-    if lifted.is_finite() { lifted } else { hit.position }
-}
 
 /// Gouraud shading: `shade()` at the triangle's three vertices (each seen
 /// from the eye), the results blended with the hit's barycentric weights.
