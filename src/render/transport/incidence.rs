@@ -88,3 +88,36 @@ pub fn lifted_position(scene: &Scene, hit: &SurfaceHit) -> Vec3 {
     }
     if lifted.is_finite() { lifted } else { hit.position }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shadow_origin_lifts_onto_the_smooth_surface() {
+        use crate::scene::{Triangle, PrimitiveKind};
+        use glam::Vec2;
+        let v = [Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0)];
+        // Normals leaning outwards, as on a convex dome: the implied surface bulges up (+z).
+        let n = [Vec3::new(-1.0, -1.0, 2.0).normalize(), Vec3::new(1.0, -0.2, 2.0).normalize(), Vec3::new(-0.2, 1.0, 2.0).normalize()];
+        let mut scene = Scene::default();
+        scene.triangles.push(Triangle { v, n, uv: [Vec2::ZERO; 3], material: 0, object: 0, two_sided: false });
+        let b = Vec3::splat(1.0 / 3.0);
+        let p = v[0] * b.x + v[1] * b.y + v[2] * b.z;
+        let hit = SurfaceHit {
+            position: p, geometric_normal: Vec3::Z, shading_normal: Vec3::Z, barycentric: b, uv: Vec2::ZERO, t: 1.0,
+            kind: PrimitiveKind::Triangle, primitive: 0, object: 0, material: 0, back_face: false, diff: crate::scene::Differentials::ZERO,
+        };
+        let lifted = lifted_position(&scene, &hit);
+        assert!(lifted.z > 0.05, "the origin must rise above the facet: {lifted}");
+        // At a vertex nothing moves; on a flat triangle nothing moves.
+        let at_vertex = SurfaceHit { position: v[1], barycentric: Vec3::new(0.0, 1.0, 0.0), ..hit };
+        assert!((lifted_position(&scene, &at_vertex) - v[1]).length() < 1e-6);
+        // Only towards a light behind the facet: otherwise the book's plain bump.
+        assert_eq!(shadow_origin(&scene, &hit, Vec3::Z, true), p);
+        assert_eq!(shadow_origin(&scene, &hit, Vec3::new(0.0, 0.6, -0.8), true), lifted);
+        assert_eq!(shadow_origin(&scene, &hit, Vec3::new(0.0, 0.6, -0.8), false), p, "no lift when it is turned off");
+        scene.triangles.set(0, Triangle { n: [Vec3::Z; 3], ..scene.triangles.at(0) });
+        assert!((lifted_position(&scene, &hit) - p).length() < 1e-7);
+    }
+}
