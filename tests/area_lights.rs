@@ -11,6 +11,7 @@ use pinhole::math::{Radiance, Vec3};
 use pinhole::metrics::compare;
 use pinhole::render::transport::gi::GiMode;
 use pinhole::render::{PreparedScene, RenderSettings, ShadowMode};
+use pinhole::named::Named;
 use pinhole::scene::file::parse_scene;
 use pinhole::scene::Scene;
 use std::f64::consts::PI;
@@ -429,4 +430,34 @@ fn a_million_emissive_triangles_stay_bounded() {
     let prepared = PreparedScene::new(scene);
     let img = render("raytrace", &prepared, &direct_settings(&prepared, 2, 4));
     assert!(all_finite(&img) && mean(&img).x > 0.0);
+}
+
+/// Soft shadows from shadow maps, against the ray-traced shadow of the
+/// panel on `soft-shadows`: a plain map (the centre's hard shadow) is
+/// farthest, PCF blurs every edge alike and comes closer, PCSS (a blocker
+/// search, then PCF as wide as the penumbra) closest. In both families.
+#[test]
+fn shadow_filters_approach_the_area_shadow_in_order() {
+    let mut scene = builtin("soft-shadows");
+    (scene.render.width, scene.render.height) = (160, 120);
+    let prepared = PreparedScene::new(scene);
+    let mut truth = direct_settings(&prepared, 16, 16);
+    truth.shadows = ShadowMode::Ray;
+    let truth_img = render("raytrace", &prepared, &truth);
+    use pinhole::render::shadow::ShadowFilter;
+    for renderer in ["raytrace", "rasterize"] {
+        let errors: Vec<f64> = [ShadowFilter::None, ShadowFilter::Pcf, ShadowFilter::Pcss]
+            .into_iter()
+            .map(|filter| {
+                let mut s = direct_settings(&prepared, 16, 16);
+                s.shadows = ShadowMode::Map;
+                s.shadow_filter = filter;
+                s.pcf_radius = 3.0;
+                let e = relative_rmse(&render(renderer, &prepared, &s), &truth_img);
+                eprintln!("{renderer} --shadows map --shadow-filter {}: rmse/mean {:.2}%", filter.name(), e * 100.0);
+                e
+            })
+            .collect();
+        assert!(errors[2] < errors[1] && errors[1] < errors[0], "{renderer}: none {}, pcf {}, pcss {}", errors[0], errors[1], errors[2]);
+    }
 }

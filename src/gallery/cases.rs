@@ -159,7 +159,7 @@ pub fn cases() -> Vec<GalleryCase> {
             knob: "spp",
             explanation: "each bump's highlight is smaller than a pixel: one sample per pixel hits it or misses it, and the field sparkles instead of glowing",
             failing: Setting::new("rasterize", "--spp 1", |s| s.spp = 1),
-            cured: Setting::new("rasterize", "--spp 64", |s| s.spp = 64),
+            cured: Setting::new("rasterize", "--spp 256", |s| s.spp = 256),
             truth: Setting::new("raytrace", "raytrace --spp 1024", |s| s.spp = 1024),
             threshold: 400,
             size: None,

@@ -11,6 +11,8 @@
 use crate::render::inspect::debug::View;
 use crate::render::{layer_support, RenderSettings, Renderer, ShadowMode};
 use crate::render::shadow::map as shadow_map;
+use crate::render::shadow::ShadowFilter;
+use crate::named::Named;
 use crate::scene::Scene;
 
 /// Settings a renderer accepted.
@@ -36,17 +38,44 @@ pub struct Substitute {
 /// it draws), `Err` with why not. Loads no driver (`Renderer::ready` does).
 pub fn admit(renderer: &dyn Renderer, scene: &Scene, settings: &RenderSettings) -> Result<Admitted, String> {
     let mut refusal = match check(renderer, scene, settings) {
-        Ok(()) => return Ok(Admitted { settings: settings.clone(), notices: Vec::new() }),
+        Ok(()) => return Ok(Admitted { settings: settings.clone(), notices: approximations(scene, settings) }),
         Err(e) => e,
     };
     for s in renderer.substitutes(settings) {
         match check(renderer, scene, &s.settings) {
-            Ok(()) => return Ok(Admitted { settings: s.settings, notices: vec![s.notice] }),
+            Ok(()) => {
+                let mut notices = vec![s.notice];
+                notices.extend(approximations(scene, &s.settings));
+                return Ok(Admitted { settings: s.settings, notices });
+            }
             // The most lenient substitute's refusal names what really stands in the way.
             Err(e) => refusal = e,
         }
     }
     Err(refusal)
+}
+
+/// What admitted settings draw otherwise than the light transport they
+/// approximate, and settings that have nothing to act on: one sentence
+/// each, so nothing is left out without a word.
+fn approximations(scene: &Scene, settings: &RenderSettings) -> Vec<String> {
+    let mut notes = Vec::new();
+    let area_lights = !scene.emitters.is_empty();
+    let sky = scene.environment.as_ref().is_some_and(|e| e.is_light());
+    let shaded = settings.view == View::Shaded;
+    if shaded && area_lights && settings.shadows == ShadowMode::Volume {
+        notes.push("--shadows volume gives each area light the hard shadow of its centre (a volume cannot be soft); --shadows ray, or map with --shadow-filter pcss, draws penumbrae".to_string());
+    }
+    if shaded && area_lights && settings.shadows == ShadowMode::Map && settings.shadow_filter == ShadowFilter::None {
+        notes.push("--shadows map without a filter gives each area light the hard shadow of its centre; --shadow-filter pcf or pcss softens it".to_string());
+    }
+    if shaded && sky && matches!(settings.shadows, ShadowMode::Map | ShadowMode::Volume) {
+        notes.push(format!("--shadows {} holds no shadows of the [environment]; its light samples cast shadow rays", settings.shadows.name()));
+    }
+    if settings.shadow_filter != ShadowFilter::None && (settings.shadows != ShadowMode::Map || !area_lights) {
+        notes.push(format!("--shadow-filter {} filters the shadow maps of area lights only, and this render has none; it changes nothing", settings.shadow_filter.name()));
+    }
+    notes
 }
 
 /// Every reason `renderer` cannot draw `scene` with exactly `settings`.
@@ -101,6 +130,25 @@ mod tests {
         assert_eq!(a.settings.shadows, ShadowMode::None);
         assert_eq!(a.notices.len(), 1);
         assert!(a.notices[0].contains("--shadows none") && !a.notices[0].contains('\n'), "{:?}", a.notices);
+    }
+
+    #[test]
+    fn approximations_of_area_light_shadows_are_said() {
+        let sc = scene("soft-shadows");
+        let asked = RenderSettings { shadows: ShadowMode::Volume, ..RenderSettings::for_scene(&sc) };
+        let a = admit(renderer_by_name("rasterize").unwrap().as_ref(), &sc, &asked).unwrap();
+        assert_eq!(a.settings, asked);
+        assert_eq!(a.notices.len(), 1, "{:?}", a.notices);
+        assert!(a.notices[0].contains("hard shadow of its centre"), "{:?}", a.notices);
+        // Filtered maps say nothing; a filter with ray shadows says it does nothing.
+        let pcss = RenderSettings { shadows: ShadowMode::Map, shadow_filter: ShadowFilter::Pcss, ..asked.clone() };
+        assert!(admit(renderer_by_name("rasterize").unwrap().as_ref(), &sc, &pcss).unwrap().notices.is_empty());
+        let idle = RenderSettings { shadows: ShadowMode::Ray, shadow_filter: ShadowFilter::Pcf, ..asked };
+        let notes = admit(renderer_by_name("raytrace").unwrap().as_ref(), &sc, &idle).unwrap().notices;
+        assert!(notes.len() == 1 && notes[0].contains("changes nothing"), "{notes:?}");
+        // OpenGL refuses lights it cannot sample, in one sentence.
+        let e = admit(renderer_by_name("opengl").unwrap().as_ref(), &sc, &RenderSettings::for_scene(&sc)).unwrap_err();
+        assert!(e.contains("area lights") && !e.contains('\n'), "{e}");
     }
 
     #[test]

@@ -171,6 +171,15 @@ fn unsupported(scene: &Scene, settings: &RenderSettings) -> Result<(), String> {
     if settings.interpolation == Interpolation::Gouraud {
         return refuse("supports --interpolation phong|flat only");
     }
+    // Its shaders sum point and directional lights; lights with extent are
+    // sampled by the CPU renderers' shared shading only.
+    if let Some(light) = scene.emitters.lights.first() {
+        let name = scene.objects.get(light.object as usize).map_or_else(|| format!("object {}", light.object), |o| o.name.clone());
+        return refuse(&format!("cannot sample area lights yet ({name} emits light); use raytrace or rasterize"));
+    }
+    if scene.environment.as_ref().is_some_and(|e| e.is_light()) {
+        return refuse("cannot light the scene with the [environment] yet; use raytrace or rasterize");
+    }
     if let Some(m) = scene.materials.iter().find(|m| m.transmission != crate::math::Vec3::ZERO) {
         return refuse(&format!("cannot trace glass rays (material \"{}\")", m.name));
     }

@@ -51,6 +51,7 @@ use crate::render::raster::subpixel::snap_offset;
 use crate::render::raster::sphere::sphere_bounds;
 use crate::render::keyed_cache::{KeyedCache, ThreadCopy};
 use crate::render::inspect::pixel_record::Recorder;
+use crate::render::shadow::ShadowFilter;
 use crate::render::{Occluder, PassJob, PreparedScene, RenderSettings};
 use crate::math::{Radiance, Ray, Vec2, Vec3};
 use crate::scene::{Camera, CameraView, Fov, Light, PrimitiveId, Scene, Sphere, SurfaceHit, Triangle};
@@ -74,7 +75,7 @@ pub const MAX_BYTES: u64 = 1 << 30;
 /// Memory the maps of every light of `scene` take at `size` texels per side:
 /// a depth and a primitive id per texel, six faces per point light.
 pub fn memory_bytes(scene: &Scene, size: u32) -> u64 {
-    let faces: u64 = scene.lights.iter().map(|l| if matches!(l, Light::Point { .. }) { 6 } else { 1 }).sum();
+    let faces: u64 = scene.lights.iter().map(|l| if matches!(l, Light::Point { .. }) { 6 } else { 1 }).sum::<u64>() + 6 * scene.emitters.lights.len() as u64;
     let texel = (std::mem::size_of::<f32>() + std::mem::size_of::<PrimitiveId>()) as u64;
     let side = size.clamp(1, MAX_SIZE) as u64;
     side * side * faces * texel
@@ -86,7 +87,7 @@ pub fn check_memory(scene: &Scene, size: u32) -> Result<(), String> {
     if bytes > MAX_BYTES {
         return Err(format!(
             "shadow maps of {} lights at {size}x{size} texels would take {} MiB, more than the limit of {} MiB; use a smaller --shadow-map-size",
-            scene.lights.len(),
+            scene.lights.len() + scene.emitters.lights.len(),
             bytes >> 20,
             MAX_BYTES >> 20
         ));
@@ -127,6 +128,11 @@ pub struct ShadowMaps {
     /// The lights they were built for (the cache key with `size`).
     pub lights: Vec<Light>,
     pub maps: Vec<LightMap>,
+    /// Per area light (`Scene::emitters.lights`): a cube map drawn from its
+    /// centre without its own surfaces, read by `area_light_visibility`.
+    pub area: Vec<LightMap>,
+    /// What `area` was built for: each area light's object and centre.
+    pub area_lights: Vec<(u32, Vec3)>,
     /// Time to build them all, milliseconds.
     pub build_ms: f64,
 }
@@ -149,23 +155,34 @@ impl ShadowMaps {
     pub fn build(scene: &Scene, size: u32, parallel: bool) -> ShadowMaps {
         let start = Instant::now();
         let size = size.clamp(1, MAX_SIZE);
-        let mut faces: Vec<(usize, Face)> = Vec::new();
+        // (map index, the object whose surfaces it leaves out, face): point
+        // and directional lights first, then the area lights.
+        let mut faces: Vec<(usize, Option<u32>, Face)> = Vec::new();
         for (li, light) in scene.lights.iter().enumerate() {
             for view in light_views(scene, light, size) {
                 let ortho = matches!(light, Light::Directional { .. });
-                faces.push((li, Face { view, ortho, depth: Vec::new(), id: Vec::new() }));
+                faces.push((li, None, Face { view, ortho, depth: Vec::new(), id: Vec::new() }));
             }
         }
-        let draw = |face: &mut Face| draw_face(scene, face, size, parallel);
-        if parallel {
-            faces.par_iter_mut().for_each(|(_, f)| draw(f));
-        } else {
-            faces.iter_mut().for_each(|(_, f)| draw(f));
+        let lights = scene.lights.len();
+        for (ai, area) in scene.emitters.lights.iter().enumerate() {
+            for view in cube_views(scene, area.centre, size) {
+                faces.push((lights + ai, Some(area.object), Face { view, ortho: false, depth: Vec::new(), id: Vec::new() }));
+            }
         }
-        let mut maps: Vec<LightMap> = scene.lights.iter().map(|_| LightMap { faces: Vec::new(), depth_range: (0.0, 0.0) }).collect();
-        for (li, face) in faces {
+        let draw = |skip: Option<u32>, face: &mut Face| draw_face(scene, face, size, parallel, skip);
+        if parallel {
+            faces.par_iter_mut().for_each(|(_, skip, f)| draw(*skip, f));
+        } else {
+            faces.iter_mut().for_each(|(_, skip, f)| draw(*skip, f));
+        }
+        let count = lights + scene.emitters.lights.len();
+        let mut maps: Vec<LightMap> = (0..count).map(|_| LightMap { faces: Vec::new(), depth_range: (0.0, 0.0) }).collect();
+        for (li, _, face) in faces {
             maps[li].faces.push(face);
         }
+        let area = maps.split_off(lights);
+        let mut maps = maps;
         for m in &mut maps {
             let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
             for d in m.faces.iter().flat_map(|f| f.depth.iter()).filter(|d| d.is_finite()) {
@@ -174,13 +191,13 @@ impl ShadowMaps {
             }
             m.depth_range = if lo <= hi { (lo, hi) } else { (0.0, 0.0) };
         }
-        ShadowMaps { size, lights: scene.lights.clone(), maps, build_ms: start.elapsed().as_secs_f64() * 1e3 }
+        ShadowMaps { size, lights: scene.lights.clone(), maps, area, area_lights: area_key(scene), build_ms: start.elapsed().as_secs_f64() * 1e3 }
     }
 
     /// True when these maps were built for `scene`'s lights at `size`.
     #[inline]
     pub fn matches(&self, scene: &Scene, size: u32) -> bool {
-        self.size == size.clamp(1, MAX_SIZE) && self.lights == scene.lights
+        self.size == size.clamp(1, MAX_SIZE) && self.lights == scene.lights && self.area_lights == area_key(scene)
     }
 
     /// The map's verdict for light `light` at `hit`: the primitive stored in
@@ -225,8 +242,48 @@ impl ShadowMaps {
     /// The fraction of area light `light` (`Scene::emitters.lights`) that
     /// `hit` sees according to the maps, filtered as `settings.shadow_filter`
     /// says; `None` where the maps hold no map of that light.
-    pub fn area_light_visibility(&self, _scene: &Scene, _light: usize, _hit: &SurfaceHit, _settings: &RenderSettings) -> Option<f32> {
-        None
+    pub fn area_light_visibility(&self, scene: &Scene, light: usize, hit: &SurfaceHit, settings: &RenderSettings) -> Option<f32> {
+        let map = self.area.get(light).filter(|m| m.faces.len() == 6)?;
+        let area = scene.emitters.lights.get(light)?;
+        let to_light = area.centre - hit.position;
+        let w_i = to_light.normalize_or_zero();
+        let p = crate::render::transport::incidence::shadow_origin(scene, hit, w_i, settings.terminator_lift);
+        let v = p - area.centre;
+        let dist = v.length();
+        if !(dist > 0.0) {
+            return Some(1.0);
+        }
+        let face = &map.faces[cube_face(v)];
+        let c = face.view.to_camera(p);
+        if !(c.z < 0.0) {
+            return Some(1.0);
+        }
+        let centre = face.view.project_camera(c);
+        let n = self.size as f32;
+        let texel_w = 2.0 * -c.z / n;
+        let cos = hit.geometric_normal.dot(w_i).abs().clamp(1e-6, 1.0);
+        let tan = if settings.shadow_map_slope_bias { ((1.0 - cos * cos).max(0.0).sqrt() / cos).min(MAX_SLOPE) } else { 0.0 };
+        let taps = Taps { face, size: self.size, centre, dist, texel_w, bias: settings.shadow_map_bias, tan };
+        Some(match settings.shadow_filter {
+            ShadowFilter::None => taps.lit_fraction(0.0),
+            ShadowFilter::Pcf => taps.lit_fraction(settings.pcf_radius),
+            ShadowFilter::Pcss => {
+                // The light as a disc of equal area (a square's half diagonal
+                // is sqrt(pi / 2) times that disc's radius).
+                let radius = area.radius * (2.0 / std::f32::consts::PI).sqrt();
+                // Blockers that can shade this point lie in the cone from it
+                // to the light; searched where that cone is at least a
+                // quarter of the way from the light (nearer blockers are
+                // rare), as an angle from the light and then in texels.
+                let near = 0.25 * dist;
+                let search = (radius * (dist - near) / (dist * near)).min(0.6) * n * 0.5;
+                let Some(blocker) = taps.mean_blocker_distance(search) else { return Some(1.0) };
+                // Similar triangles: the penumbra's half width at the point
+                // is radius (d - d_b) / d_b; seen from the light, over d.
+                let penumbra = radius * (dist - blocker) / (blocker * dist) * n * 0.5;
+                taps.lit_fraction(penumbra.min(n * 0.25))
+            }
+        })
     }
 
     /// The `shadowmap` view at image position `pos` of a `width` x `height`
@@ -272,6 +329,75 @@ impl ShadowMaps {
             (d / lo).ln() / (hi / lo).ln()
         };
         Vec3::splat(grey.clamp(0.0, 1.0))
+    }
+}
+
+/// Depth tests around one point's position in a face of an area light's
+/// cube map, for the filters.
+struct Taps<'a> {
+    face: &'a Face,
+    size: u32,
+    /// The point's position in the face, in texels, and its distance from the light.
+    centre: Vec2,
+    dist: f32,
+    /// World size of a texel at the point's depth; bias in texels; the
+    /// slope term tan(theta) of the bias (0 without slope scaling).
+    texel_w: f32,
+    bias: f32,
+    tan: f32,
+}
+
+/// Most taps per side of a filter or blocker search: wider kernels spread
+/// this many taps over their width instead of reading every texel.
+const MAX_TAPS_PER_SIDE: i32 = 9;
+
+impl Taps<'_> {
+    /// The texel `offset` texels from the point (clamped to the face), its
+    /// stored distance, and whether the point is lit there. The bias grows
+    /// with the offset by the slope: a tilted receiver's own depth changes
+    /// by `tan` texel widths per texel across the kernel.
+    #[inline]
+    fn test(&self, offset: Vec2) -> (f32, bool) {
+        let last = (self.size - 1) as f32;
+        let x = (self.centre.x + offset.x).clamp(0.0, last) as u32;
+        let y = (self.centre.y + offset.y).clamp(0.0, last) as u32;
+        let stored = self.face.depth[(x + y * self.size) as usize];
+        let tolerance = self.texel_w * (self.bias * (1.0 + self.tan) + offset.length() * self.tan);
+        (stored, !(self.dist - stored > tolerance))
+    }
+
+    /// Tap offsets covering a square of half width `radius` texels: every
+    /// texel while that is at most `MAX_TAPS_PER_SIDE` per side, else a
+    /// regular grid of that many.
+    fn offsets(radius: f32) -> impl Iterator<Item = Vec2> {
+        let k = (radius.max(0.0).ceil() as i32).min(MAX_TAPS_PER_SIDE / 2);
+        let step = if k > 0 { radius / k as f32 } else { 0.0 };
+        (-k..=k).flat_map(move |j| (-k..=k).map(move |i| Vec2::new(i as f32, j as f32) * step))
+    }
+
+    /// The fraction of taps within `radius` texels that see the light
+    /// (percentage-closer filtering; one tap at radius 0).
+    fn lit_fraction(&self, radius: f32) -> f32 {
+        let (mut lit, mut total) = (0u32, 0u32);
+        for o in Self::offsets(radius) {
+            lit += self.test(o).1 as u32;
+            total += 1;
+        }
+        lit as f32 / total as f32
+    }
+
+    /// The mean distance from the light of the blockers found within
+    /// `radius` texels; `None` when nothing there blocks the point.
+    fn mean_blocker_distance(&self, radius: f32) -> Option<f32> {
+        let (mut sum, mut count) = (0.0f32, 0u32);
+        for o in Self::offsets(radius) {
+            let (stored, lit) = self.test(o);
+            if !lit {
+                sum += stored;
+                count += 1;
+            }
+        }
+        (count > 0).then(|| sum / count as f32)
     }
 }
 
@@ -330,32 +456,7 @@ fn ortho_project(view: &CameraView, c: Vec3) -> Vec2 {
 pub fn light_views(scene: &Scene, light: &Light, size: u32) -> Vec<CameraView> {
     let Some((lo, hi)) = scene.bounds() else { return Vec::new() };
     match *light {
-        Light::Point { position, .. } => {
-            // Nothing nearer than this to the light is drawn (the near plane).
-            let far_corner = (0..8)
-                .map(|i| Vec3::new(if i & 1 == 0 { lo.x } else { hi.x }, if i & 2 == 0 { lo.y } else { hi.y }, if i & 4 == 0 { lo.z } else { hi.z }))
-                .map(|c| (c - position).length())
-                .fold(0.0f32, f32::max);
-            let near = (far_corner * 1e-6).max(1e-9);
-            let axes = [
-                (Vec3::X, Vec3::Y),
-                (Vec3::NEG_X, Vec3::Y),
-                (Vec3::Y, Vec3::Z),
-                (Vec3::NEG_Y, Vec3::NEG_Z),
-                (Vec3::Z, Vec3::Y),
-                (Vec3::NEG_Z, Vec3::Y),
-            ];
-            axes.iter()
-                .map(|&(forward, up)| {
-                    let cam = Camera { eye: position, target: position + forward, up, fov: Fov::Y(90.0), near, far: f32::MAX };
-                    let mut v = CameraView::new(&cam, size, size);
-                    // Exactly 90 degrees: faces meet edge to edge.
-                    v.half_x = 1.0;
-                    v.half_y = 1.0;
-                    v
-                })
-                .collect()
-        }
+        Light::Point { position, .. } => cube_views(scene, position, size),
         Light::Directional { direction, .. } => {
             let forward = direction.normalize_or(Vec3::NEG_Y);
             let up = if forward.y.abs() < 0.9 { Vec3::Y } else { Vec3::Z };
@@ -380,6 +481,36 @@ pub fn light_views(scene: &Scene, light: &Light, size: u32) -> Vec<CameraView> {
             vec![v]
         }
     }
+}
+
+/// The six 90-degree faces (+x, -x, +y, -y, +z, -z) of a cube map drawn from
+/// `position`: a point light's, or an area light's from its centre.
+pub fn cube_views(scene: &Scene, position: Vec3, size: u32) -> Vec<CameraView> {
+    let Some((lo, hi)) = scene.bounds() else { return Vec::new() };
+    // Nothing nearer than this to the light is drawn (the near plane).
+    let far_corner = (0..8)
+        .map(|i| Vec3::new(if i & 1 == 0 { lo.x } else { hi.x }, if i & 2 == 0 { lo.y } else { hi.y }, if i & 4 == 0 { lo.z } else { hi.z }))
+        .map(|c| (c - position).length())
+        .fold(0.0f32, f32::max);
+    let near = (far_corner * 1e-6).max(1e-9);
+    let axes = [
+        (Vec3::X, Vec3::Y),
+        (Vec3::NEG_X, Vec3::Y),
+        (Vec3::Y, Vec3::Z),
+        (Vec3::NEG_Y, Vec3::NEG_Z),
+        (Vec3::Z, Vec3::Y),
+        (Vec3::NEG_Z, Vec3::Y),
+    ];
+    axes.iter()
+        .map(|&(forward, up)| {
+            let cam = Camera { eye: position, target: position + forward, up, fov: Fov::Y(90.0), near, far: f32::MAX };
+            let mut v = CameraView::new(&cam, size, size);
+            // Exactly 90 degrees: faces meet edge to edge.
+            v.half_x = 1.0;
+            v.half_y = 1.0;
+            v
+        })
+        .collect()
 }
 
 /// The box a directional light's map must cover: that of every primitive
@@ -434,13 +565,18 @@ pub fn caster_bounds(scene: &Scene) -> Option<(Vec3, Vec3)> {
 }
 
 /// Rasterizes every triangle (in scene order) and then every sphere into one face.
-fn draw_face(scene: &Scene, face: &mut Face, size: u32, parallel: bool) {
+/// `skip`: an object whose surfaces are left out (an area light's own, which
+/// would otherwise hide the light from everything).
+fn draw_face(scene: &Scene, face: &mut Face, size: u32, parallel: bool, skip: Option<u32>) {
     let n = size as usize;
     face.depth = vec![f32::INFINITY; n * n];
     face.id = vec![PrimitiveId::NONE; n * n];
     let (view, ortho) = (&face.view.clone(), face.ortho);
     let mut tris = Vec::new();
     for (i, t) in scene.triangles.iter().enumerate() {
+        if skip.is_some_and(|o| o == t.object) {
+            continue;
+        }
         setup_face_triangle(view, ortho, &t, i as u32, size, &mut tris);
     }
     // The two-level layer's copies after them, in index order, each culled
@@ -477,6 +613,7 @@ fn draw_face(scene: &Scene, face: &mut Face, size: u32, parallel: bool) {
         .spheres
         .iter()
         .enumerate()
+        .filter(|(_, s)| !skip.is_some_and(|o| o == s.object))
         .filter_map(|(i, s)| sphere_rect(view, ortho, s, size).map(|r| (i as u32, s, r)))
         .collect();
     draw_pieces(face, &tris, &spheres, size, parallel);
@@ -639,12 +776,18 @@ fn sphere_entry(o: Vec3, d: Vec3, c: Vec3, radius: f32, ortho: bool) -> Option<f
 
 /// The last shadow maps built for a `PreparedScene`, keyed by
 /// `shadow_map_size` (clamped) and the lights.
-pub type ShadowMapCache = KeyedCache<(u32, Vec<Light>), ShadowMaps>;
+pub type ShadowMapCache = KeyedCache<(u32, Vec<Light>, Vec<(u32, Vec3)>), ShadowMaps>;
+
+/// What an area light's map depends on besides geometry: its object and
+/// centre (emission edits that make or unmake emitters change it).
+fn area_key(scene: &Scene) -> Vec<(u32, Vec3)> {
+    scene.emitters.lights.iter().map(|l| (l.object, l.centre)).collect()
+}
 
 /// The maps for `prepared` at `size`, built now unless the cached ones match.
 /// See `ShadowMaps::build` for `parallel`.
 fn cached_maps(prepared: &PreparedScene, size: u32, parallel: bool) -> Arc<ShadowMaps> {
-    let key = (size.clamp(1, MAX_SIZE), prepared.scene.lights.clone());
+    let key = (size.clamp(1, MAX_SIZE), prepared.scene.lights.clone(), area_key(&prepared.scene));
     prepared.shadow_cache.get(key, |_| ShadowMaps::build(&prepared.scene, size, parallel))
 }
 
