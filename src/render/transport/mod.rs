@@ -2,7 +2,8 @@
 //! `shade` is the one shading entry for a single sample and `shade_batch` the
 //! same over eight lanes; `lighting` evaluates lights; `gi` holds the
 //! indirect-light modes, `path_batch` the path pool, `photon_map` photons
-//! and `bsdf_sampling` the BSDFs' importance sampling; `sampling` is the
+//! and `bsdf_sampling` the BSDFs' importance sampling, `microfacet` the
+//! microfacet lobes' distributions; `sampling` is the
 //! sampler whose numbers are a pure function of (pixel, sample, seed).
 
 pub mod bsdf;
@@ -10,6 +11,7 @@ pub mod bsdf_sampling;
 pub mod gi;
 pub mod kd_tree;
 pub mod lighting;
+pub mod microfacet;
 pub mod normal_map;
 pub mod path_batch;
 pub mod photon_map;
