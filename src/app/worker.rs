@@ -40,7 +40,11 @@ impl SceneParams {
         scene.camera = self.camera.clone();
         scene.render = self.render.clone();
         scene.lights = self.lights.clone();
+        let emission_changed = scene.materials.len() != self.materials.len() || scene.materials.iter().zip(&self.materials).any(|(a, b)| a.emission != b.emission);
         scene.materials = self.materials.clone();
+        if emission_changed {
+            scene.refresh_emitters();
+        }
     }
 
     /// Equality that ignores textures (never edited; comparing texels every frame is waste).
@@ -57,6 +61,7 @@ impl SceneParams {
                     && a.mirror == b.mirror
                     && a.transmission == b.transmission
                     && a.ior == b.ior
+                    && a.emission == b.emission
             })
     }
 

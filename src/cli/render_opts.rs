@@ -122,6 +122,18 @@ pub struct RenderOpts {
     /// Rasterizers: cull copies made by `instances` by their bounding spheres (same image either way).
     #[arg(long = "cull-instances", value_name = "BOOL", default_value_t = defaults().cull_instances, action = clap::ArgAction::Set)]
     pub cull_instances: bool,
+    /// Area lights and the environment: shadow rays per light per shading point.
+    #[arg(long = "light-samples", default_value_t = defaults().light_samples, value_name = "N")]
+    pub light_samples: u32,
+    /// Area lights and the environment: combine light and BSDF sampling (on) or sample the lights alone (off).
+    #[arg(long, default_value = "on", value_name = "on|off")]
+    pub mis: String,
+    /// --shadows map: none (hard) | pcf (percentage-closer) | pcss (percentage-closer soft).
+    #[arg(long = "shadow-filter", default_value_t = defaults().shadow_filter.name().to_string(), value_name = "none|pcf|pcss")]
+    pub shadow_filter: String,
+    /// --shadow-filter pcf: the filter's radius in shadow-map texels.
+    #[arg(long = "pcf-radius", default_value_t = defaults().pcf_radius, value_name = "R")]
+    pub pcf_radius: f32,
 }
 
 impl RenderOpts {
@@ -136,6 +148,20 @@ impl RenderOpts {
         s.texture_filter = crate::scene::texture::TextureFilter::parse(&self.texture_filter).map_err(|e| format!("--texture-filter: {e}"))?;
         s.reflections = render::Reflections::parse(&self.reflections).map_err(|e| format!("--reflections: {e}"))?;
         s.shadow_volume = render::shadow::volume::VolumeMode::parse(&self.shadow_volume).map_err(|e| format!("--shadow-volume: {e}"))?;
+        if !(1..=render::MAX_LIGHT_SAMPLES).contains(&self.light_samples) {
+            return Err(format!("--light-samples {} is not between 1 and {}", self.light_samples, render::MAX_LIGHT_SAMPLES));
+        }
+        s.light_samples = self.light_samples;
+        s.shadow_filter = render::shadow::ShadowFilter::parse(&self.shadow_filter).map_err(|e| format!("--shadow-filter: {e}"))?;
+        if !(self.pcf_radius.is_finite() && (0.0..=64.0).contains(&self.pcf_radius)) {
+            return Err(format!("--pcf-radius {} is not a number from 0 to 64", self.pcf_radius));
+        }
+        s.pcf_radius = self.pcf_radius;
+        s.mis = match self.mis.as_str() {
+            "on" => true,
+            "off" => false,
+            other => return Err(format!("--mis {other} is neither on nor off")),
+        };
         if self.spp == 0 || self.spp > 65536 {
             return Err(format!("--spp {} is not between 1 and 65536", self.spp));
         }

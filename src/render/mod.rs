@@ -137,7 +137,7 @@ pub struct RenderSettings {
     /// which at grazing light is too little (acne). A debug knob.
     pub shadow_map_slope_bias: bool,
     /// Shadow rays from smooth-normal triangles facing away from the light
-    /// leave from the surface the normals imply (`transport::shade::shadow_origin`,
+    /// leave from the surface the normals imply (`transport::incidence::shadow_origin`,
     /// against the shadow terminator); false: from the hit point, as the book
     /// does, to show the speckles. A debug knob.
     pub terminator_lift: bool,
@@ -152,7 +152,21 @@ pub struct RenderSettings {
     /// bounding sphere is outside the view volume (`raster::cull`). The same
     /// image either way; a knob to measure and test that.
     pub cull_instances: bool,
+    /// Area lights and the environment: shadow rays per light per shading
+    /// point, stratified over the emitter (`transport::sampled_light`).
+    pub light_samples: u32,
+    /// Area lights and the environment: combine light sampling with BSDF
+    /// sampling by multiple importance sampling (power heuristic); false:
+    /// light sampling alone.
+    pub mis: bool,
+    /// `--shadows map`: how the map is read (hard, PCF or PCSS).
+    pub shadow_filter: shadow::ShadowFilter,
+    /// `--shadow-filter pcf`: the filter's radius in texels of the map.
+    pub pcf_radius: f32,
 }
+
+/// The most `RenderSettings::light_samples` a front end accepts.
+pub const MAX_LIGHT_SAMPLES: u32 = 4096;
 
 impl Default for RenderSettings {
     /// Every knob's default, at the default scene size.
@@ -185,6 +199,10 @@ impl Default for RenderSettings {
             reflections: Reflections::Ray,
             clip: raster::clip::ClipMode::Near,
             cull_instances: true,
+            light_samples: 1,
+            mis: true,
+            shadow_filter: shadow::ShadowFilter::None,
+            pcf_radius: 1.5,
         }
     }
 }
@@ -541,7 +559,7 @@ fn resolve_with<Q: SceneQuery, R: Recorder>(
     match (job.settings.view, hit) {
         (inspect::debug::View::Shaded, Some(h)) => {
             let mut path = transport::gi::PathState::new(pixel, job.sample, job.settings.spp, &job.settings.gi, job.photons);
-            let mut sh = transport::shade::Shading { scene, query, settings: job.settings, path: &mut path, counts, rec };
+            let mut sh = transport::shading::Shading { scene, query, settings: job.settings, path: &mut path, counts, rec };
             let shaded = with_shading_hit(job.settings.interpolation, h, |s| transport::shade::shade(&mut sh, s, -ray.dir, 0));
             match shaded {
                 Some(radiance) => radiance,

@@ -50,6 +50,7 @@ impl PreparedScene {
         // Scenes made in code (or edited) may hold triangles pushed since
         // loading; a no-op for scenes straight from a file.
         scene.triangles.share_corners();
+        scene.refresh_emitters();
         let start = Instant::now();
         let bvh = Bvh::build(&scene, &scene.triangles);
         let build_ms = start.elapsed().as_secs_f64() * 1e3;

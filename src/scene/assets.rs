@@ -24,6 +24,7 @@ const FILES: &[(&str, &[u8])] = &[
     ("textures/globe.png", include_bytes!("../../assets/textures/globe.png")),
     ("textures/bumps-normal.png", include_bytes!("../../assets/textures/bumps-normal.png")),
     ("textures/sky.hdr", include_bytes!("../../assets/textures/sky.hdr")),
+    ("textures/sky-sun.exr", include_bytes!("../../assets/textures/sky-sun.exr")),
 ];
 
 /// Reads a file a scene refers to: from the compiled-in assets for paths under

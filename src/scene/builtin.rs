@@ -17,6 +17,9 @@ const SCENES: &[(&str, &str)] = &[
     ("cornell-gi", include_str!("../../assets/scenes/cornell-gi.toml")),
     ("textures", include_str!("../../assets/scenes/textures.toml")),
     ("csg", include_str!("../../assets/scenes/csg.toml")),
+    ("cornell-box", include_str!("../../assets/scenes/cornell-box.toml")),
+    ("soft-shadows", include_str!("../../assets/scenes/soft-shadows.toml")),
+    ("sky", include_str!("../../assets/scenes/sky.toml")),
 ];
 
 /// The stress gallery's scenes (`gallery::cases`), each built to provoke
@@ -82,7 +85,7 @@ mod tests {
         for name in names() {
             let scene = load_builtin(name).unwrap().unwrap_or_else(|e| panic!("{name}: {e}"));
             assert!(scene.triangles.len() + scene.spheres.len() + scene.csgs.len() > 0, "{name} is empty");
-            assert!(!scene.lights.is_empty(), "{name} has no light");
+            assert!(!scene.lights.is_empty() || scene.has_sampled_lights(), "{name} has no light");
         }
     }
 

@@ -1,6 +1,9 @@
 //! The environment: a latitude-longitude image of radiance arriving from
 //! infinitely far away, seen by every ray that hits nothing (instead of the
 //! flat `background`), and so by mirrors (Computer Graphics from Scratch ch. 15).
+//! It is also a light: `EnvironmentLight` samples directions in proportion
+//! to luminance times `sin theta`, a piecewise-constant distribution over
+//! the image's texels built once per map.
 
 use crate::scene::texture::{Texture, Wrap};
 use crate::math::{Vec2, Vec3};
@@ -12,6 +15,19 @@ pub struct Environment {
     pub texture: Arc<Texture>,
     /// Scales the image's values into radiance.
     pub intensity: f32,
+    /// How directions are sampled when it lights surfaces (`None` where the
+    /// image is black: it lights nothing).
+    pub light: Option<Arc<EnvironmentLight>>,
+}
+
+/// Unit direction of the point `(u, v)` of a latitude-longitude image
+/// (`latlong_uv`'s inverse).
+#[inline]
+pub fn latlong_dir(uv: Vec2) -> Vec3 {
+    let phi = (uv.x - 0.5) * 2.0 * PI;
+    let lat = (uv.y - 0.5) * PI;
+    let c = lat.cos();
+    Vec3::new(phi.sin() * c, lat.sin(), -phi.cos() * c)
 }
 
 /// Where unit direction `dir` falls in a latitude-longitude image: u is the
@@ -26,6 +42,19 @@ pub fn latlong_uv(dir: Vec3) -> Vec2 {
 }
 
 impl Environment {
+    /// The environment of image `texture` scaled by `intensity`, with its
+    /// sampling distribution built.
+    pub fn new(texture: Arc<Texture>, intensity: f32) -> Environment {
+        let light = if intensity > 0.0 { EnvironmentLight::build(&texture).map(Arc::new) } else { None };
+        Environment { texture, intensity, light }
+    }
+
+    /// Whether it sends any light.
+    #[inline]
+    pub fn is_light(&self) -> bool {
+        self.light.is_some()
+    }
+
     /// Radiance arriving from direction `dir` (unit, pointing away from
     /// the scene): the image read bilinearly at its finest level, repeating
     /// around the horizon and clamped at the poles.
@@ -33,6 +62,110 @@ impl Environment {
     pub fn radiance(&self, dir: Vec3) -> Vec3 {
         let v = self.texture.levels[0].bilinear_uv(latlong_uv(dir), Wrap::Repeat, Wrap::Clamp) * self.intensity;
         if v.is_finite() { v } else { Vec3::ZERO }
+    }
+}
+
+/// Sampling the environment's directions: a row (latitude) chosen from
+/// the marginal distribution, then a column from that row's; inside the
+/// texel uniformly. Each texel weighs its luminance times `sin theta` (the
+/// solid angle a row's texels cover shrinks towards the poles), taken as
+/// the largest of it and its eight neighbours, because `radiance` reads
+/// bilinearly and so sees a bright texel half a texel around it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EnvironmentLight {
+    width: usize,
+    height: usize,
+    /// Per row, the running sum of its texels' weights (`width` entries,
+    /// the last the row's total); rows one after another.
+    columns: Vec<f32>,
+    /// The running sum of the rows' totals (`height` entries).
+    rows: Vec<f32>,
+}
+
+impl EnvironmentLight {
+    /// `None` when no texel has a finite, positive luminance.
+    pub fn build(texture: &Texture) -> Option<EnvironmentLight> {
+        let level = &texture.levels[0];
+        let (w, h) = (level.width as usize, level.height as usize);
+        if w == 0 || h == 0 {
+            return None;
+        }
+        let lum = |x: usize, y: usize| {
+            let c = level.texels[x + y * w];
+            let l = c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
+            if l.is_finite() && l > 0.0 { l } else { 0.0 }
+        };
+        let mut columns = Vec::with_capacity(w * h);
+        let mut rows = Vec::with_capacity(h);
+        let mut total = 0.0f64;
+        for y in 0..h {
+            let sin_theta = (PI * (y as f32 + 0.5) / h as f32).sin();
+            let mut row = 0.0f64;
+            for x in 0..w {
+                let mut m = 0.0f32;
+                for dy in [-1i64, 0, 1] {
+                    let yy = y as i64 + dy;
+                    if yy < 0 || yy >= h as i64 {
+                        continue;
+                    }
+                    for dx in [w - 1, 0, 1] {
+                        m = m.max(lum((x + dx) % w, yy as usize));
+                    }
+                }
+                row += (m * sin_theta) as f64;
+                columns.push(row as f32);
+            }
+            total += row;
+            rows.push(total as f32);
+        }
+        (total > 0.0 && total.is_finite()).then_some(EnvironmentLight { width: w, height: h, columns, rows })
+    }
+
+    /// A direction sampled by `u`, and its density in solid angle.
+    pub fn sample(&self, u: Vec2) -> Option<(Vec3, f32)> {
+        let (w, h) = (self.width, self.height);
+        let total = self.rows[h - 1];
+        let target = u.y * total;
+        let y = self.rows.partition_point(|&c| c <= target).min(h - 1);
+        let row_start = if y == 0 { 0.0 } else { self.rows[y - 1] };
+        let row = &self.columns[y * w..(y + 1) * w];
+        let row_total = row[w - 1];
+        if !(row_total > 0.0) {
+            return None;
+        }
+        // The rest of u.y, spread over the chosen row, places the point in
+        // the texel's height.
+        let fy = ((target - row_start) / (self.rows[y] - row_start)).clamp(0.0, 0.999_999);
+        let target_x = u.x * row_total;
+        let x = row.partition_point(|&c| c <= target_x).min(w - 1);
+        let col_start = if x == 0 { 0.0 } else { row[x - 1] };
+        let fx = ((target_x - col_start) / (row[x] - col_start)).clamp(0.0, 0.999_999);
+        let uv = Vec2::new((x as f32 + fx) / w as f32, 1.0 - (y as f32 + fy) / h as f32);
+        let dir = latlong_dir(uv);
+        let pdf = self.pdf_at(x, y);
+        (pdf > 0.0 && pdf.is_finite() && dir.is_finite()).then_some((dir, pdf))
+    }
+
+    /// The density in solid angle with which `sample` returns unit `dir`.
+    pub fn pdf(&self, dir: Vec3) -> f32 {
+        let uv = latlong_uv(dir);
+        let x = ((uv.x.rem_euclid(1.0) * self.width as f32) as usize).min(self.width - 1);
+        let y = (((1.0 - uv.y) * self.height as f32).max(0.0) as usize).min(self.height - 1);
+        self.pdf_at(x, y)
+    }
+
+    /// The density of texel (x, y) in solid angle: its share of the total
+    /// weight, over the solid angle it covers (`2 pi^2 sin theta / (w h)`).
+    fn pdf_at(&self, x: usize, y: usize) -> f32 {
+        let w = self.width;
+        let row = &self.columns[y * w..(y + 1) * w];
+        let weight = row[x] - if x == 0 { 0.0 } else { row[x - 1] };
+        let sin_theta = (PI * (y as f32 + 0.5) / self.height as f32).sin();
+        if !(weight > 0.0 && sin_theta > 0.0) {
+            return 0.0;
+        }
+        let share = weight / self.rows[self.height - 1];
+        share * (w * self.height) as f32 / (2.0 * PI * PI * sin_theta)
     }
 }
 
@@ -54,7 +187,7 @@ mod tests {
                 })
             })
             .collect();
-        let env = Environment { texture: Arc::new(Texture::new(4, 4, texels)), intensity: 2.0 };
+        let env = Environment::new(Arc::new(Texture::new(4, 4, texels)), 2.0);
         let at = |d: Vec3| env.radiance(d).x / 2.0;
         // The horizon is v = 0.5, texel row 1.5: rows 1 and 2 equally.
         // -z: u = 0.5, column 1.5 -> (11 + 12 + 21 + 22) / 4.
@@ -69,5 +202,40 @@ mod tests {
         assert_eq!(at(Vec3::Y), 100.0);
         assert_eq!(at(-Vec3::Y), 200.0);
         assert_eq!(latlong_uv(Vec3::X), Vec2::new(0.75, 0.5));
+    }
+
+    #[test]
+    fn directions_and_uvs_round_trip() {
+        for uv in [Vec2::new(0.1, 0.2), Vec2::new(0.75, 0.5), Vec2::new(0.4, 0.9)] {
+            let back = latlong_uv(latlong_dir(uv));
+            assert!((back - uv).length() < 1e-5, "{uv} -> {back}");
+        }
+    }
+
+    #[test]
+    fn sampled_densities_integrate_to_one_and_follow_brightness() {
+        // 8 x 4 texels, one bright texel; the density integrates to 1 over
+        // the sphere (a Riemann sum over directions), and samples land on
+        // the bright texel or its neighbours most of the time.
+        let mut texels = vec![Vec3::splat(0.1); 32];
+        texels[8 + 3] = Vec3::splat(100.0);
+        let light = EnvironmentLight::build(&Texture::new(8, 4, texels)).unwrap();
+        let n = 400;
+        let mut integral = 0.0f64;
+        for i in 0..n {
+            for j in 0..n {
+                let (u, v) = ((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
+                let dir = latlong_dir(Vec2::new(u, v));
+                let d_omega = 2.0 * PI * PI * ((v - 0.5) * PI).cos() / (n * n) as f32;
+                integral += (light.pdf(dir) * d_omega) as f64;
+            }
+        }
+        assert!((integral - 1.0).abs() < 0.01, "{integral}");
+        let (dir, pdf) = light.sample(Vec2::new(0.5, 0.5)).unwrap();
+        assert!((light.pdf(dir) - pdf).abs() < 1e-3 * pdf);
+        let bright = latlong_dir(Vec2::new(3.5 / 8.0, 1.0 - 1.5 / 4.0));
+        assert!(light.pdf(bright) > 10.0 * light.pdf(-bright));
+        // A black image lights nothing.
+        assert!(EnvironmentLight::build(&Texture::new(2, 2, vec![Vec3::ZERO; 4])).is_none());
     }
 }

@@ -90,6 +90,7 @@ struct MaterialDesc {
     mirror: Option<F3>,
     transmission: Option<F3>,
     ior: Option<f32>,
+    emission: Option<F3>,
     texture: Option<String>,
     wrap: Option<String>,
     uv_scale: Option<F2>,
@@ -314,6 +315,7 @@ fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str, two_
         mat.glossy = color(m.glossy, Vec3::ZERO, MAX_VALUE, &where_, "glossy")?;
         mat.mirror = color(m.mirror, Vec3::ZERO, MAX_VALUE, &where_, "mirror")?;
         mat.transmission = color(m.transmission, Vec3::ZERO, MAX_VALUE, &where_, "transmission")?;
+        mat.emission = color(m.emission, Vec3::ZERO, MAX_LIGHT, &where_, "emission")?;
         mat.sharpness = m.sharpness.unwrap_or(100.0);
         if !(mat.sharpness.is_finite() && mat.sharpness >= 0.0 && mat.sharpness <= MAX_VALUE) {
             return Err(format!("{where_}: sharpness must be a finite number >= 0 (at most {MAX_VALUE:e})"));
@@ -379,10 +381,22 @@ fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str, two_
             return Err(format!("{where_}: intensity must be a finite number from 0 to {MAX_VALUE:e}"));
         }
         let texture = load_texture_as(&base.join(&env.file), Encoding::Srgb).map_err(|e| format!("{where_}: file: {e}"))?;
-        scene.environment = Some(crate::scene::environment::Environment { texture: Arc::new(texture), intensity });
+        let non_finite = texture.levels[0].texels.iter().filter(|t| !t.is_finite()).count();
+        if non_finite > 0 {
+            scene.warnings.push(format!("{where_}: file: {non_finite} texels are not finite numbers; they send no light"));
+        }
+        let environment = crate::scene::environment::Environment::new(Arc::new(texture), intensity);
+        if !environment.is_light() && intensity > 0.0 {
+            scene.warnings.push(format!("{where_}: file: the image is black everywhere, so the environment lights nothing"));
+        }
+        scene.environment = Some(environment);
     }
     // Each triangle was pushed with corners of its own; store each corner once.
     scene.triangles.share_corners();
+    scene.refresh_emitters();
+    if scene.emitters.degenerate > 0 {
+        scene.warnings.push(format!("{} emissive triangles or spheres have no area and emit nothing", scene.emitters.degenerate));
+    }
     Ok(scene)
 }
 

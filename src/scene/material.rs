@@ -59,6 +59,9 @@ pub struct Material {
     pub mirror: Vec3,
     pub transmission: Vec3,
     pub ior: f32,
+    /// Emitted radiance (W m^-2 sr^-1) from the front side (both sides when
+    /// the object is two-sided): any surface with it is an area light.
+    pub emission: Vec3,
     /// Multiplies `lambertian` when present (linear values, decoded from sRGB).
     pub texture: Option<Arc<Texture>>,
     /// Addressing of the texture and normal map outside [0, 1].
@@ -86,6 +89,7 @@ impl Material {
             mirror: Vec3::ZERO,
             transmission: Vec3::ZERO,
             ior: 1.5,
+            emission: Vec3::ZERO,
             texture: None,
             wrap: Wrap::Repeat,
             uv_scale: Vec2::ONE,
@@ -103,6 +107,12 @@ impl Material {
     #[inline]
     pub fn has_glossy(&self) -> bool {
         self.glossy.cmpne(Vec3::ZERO).any()
+    }
+
+    /// True when surfaces of this material emit light.
+    #[inline]
+    pub fn is_emissive(&self) -> bool {
+        self.emission.cmpne(Vec3::ZERO).any()
     }
 
     /// True when shading this material casts secondary rays.

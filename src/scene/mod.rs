@@ -6,6 +6,7 @@ pub mod assets;
 pub mod builtin;
 pub mod camera;
 pub mod csg;
+pub mod emitters;
 pub mod environment;
 pub mod file;
 pub mod forest;
@@ -312,6 +313,9 @@ pub struct Scene {
     /// Per triangle, per corner: the normal map's tangent frame
     /// (`tangents::build_tangents`); empty when no material has a normal map.
     pub tangents: Vec<[glam::Vec4; 3]>,
+    /// The emissive triangles and spheres, gathered by `refresh_emitters`
+    /// (after loading, and whenever materials or geometry change).
+    pub emitters: std::sync::Arc<emitters::Emitters>,
 }
 
 /// Everything a renderer found about the surface a sample sees. Renderers
@@ -404,6 +408,18 @@ impl Scene {
     /// renderers work out their samples' footprints (`SurfaceHit::diff`).
     pub fn has_textures(&self) -> bool {
         self.materials.iter().any(|m| m.texture.is_some() || m.normal_map.is_some())
+    }
+
+    /// Gathers the emissive surfaces again (materials or geometry changed).
+    pub fn refresh_emitters(&mut self) {
+        self.emitters = std::sync::Arc::new(emitters::Emitters::build(self));
+    }
+
+    /// Whether direct light is sampled (area lights or an environment)
+    /// besides the point and directional lights that `direct_light` sums.
+    #[inline]
+    pub fn has_sampled_lights(&self) -> bool {
+        !self.emitters.is_empty() || self.environment.as_ref().is_some_and(|e| e.is_light())
     }
 
     /// The radiance a ray along unit `dir` sees when it hits nothing.

@@ -2,7 +2,7 @@
 //! framing of a bare `.obj` given on the command line.
 //!
 //! MTL mapping: `Kd` -> lambertian, `Ks` -> glossy, `Ns` -> sharpness,
-//! `map_Kd` -> texture. Other MTL terms are ignored.
+//! `Ke` -> emission, `map_Kd` -> texture. Other MTL terms are ignored.
 
 use crate::scene::assets::read_asset;
 use crate::input::{InputKind, MAX_COORDINATE, MAX_VALUE};
@@ -290,6 +290,16 @@ fn mtl_material(m: &tobj::Material) -> Result<Material, String> {
     let mut mat = Material::black();
     mat.lambertian = colour(m.diffuse, Vec3::splat(0.8), "Kd")?;
     mat.glossy = colour(m.specular, Vec3::ZERO, "Ks")?;
+    // tobj keeps the statements it does not model as text.
+    if let Some(ke) = m.unknown_param.get("Ke") {
+        let values: Vec<f32> = ke.split_whitespace().filter_map(|w| w.parse().ok()).collect();
+        let ke = match values[..] {
+            [g] => Some([g; 3]),
+            [r, g, b] => Some([r, g, b]),
+            _ => return Err(format!("Ke takes one or three numbers (r g b), found \"{}\"", ke.chars().take(40).collect::<String>())),
+        };
+        mat.emission = colour(ke, Vec3::ZERO, "Ke")?;
+    }
     mat.sharpness = m.shininess.unwrap_or(100.0);
     if !(mat.sharpness.is_finite() && (0.0..=MAX_VALUE).contains(&mat.sharpness)) {
         return Err(format!("Ns must be a finite number from 0 to {MAX_VALUE:e}, found {}", mat.sharpness));

@@ -38,6 +38,35 @@ pub struct LightSample {
     pub contribution: Radiance,
 }
 
+/// Which light a sample of an area light or the environment was drawn from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SampledLightKind {
+    /// A point on area light `Scene::emitters.lights[i]`.
+    Area(u32),
+    /// A direction of the environment.
+    Environment,
+    /// MIS's BSDF strategy: a direction sampled from the BSDF, and the
+    /// emitter or environment it found (if any).
+    BsdfHit,
+}
+
+/// One sample of an area light or the environment at a shading point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SampledLight {
+    pub kind: SampledLightKind,
+    /// The point on the light (none for the environment and misses).
+    pub point: Option<Vec3>,
+    pub w_i: Vec3,
+    /// The sampling strategy's density of `w_i` (solid angle).
+    pub pdf: f32,
+    /// The multiple importance sampling weight (1 without MIS).
+    pub mis_weight: f32,
+    /// Whether the light was unblocked (found, for the BSDF strategy).
+    pub visible: bool,
+    /// What it added to the surface's radiance.
+    pub contribution: Radiance,
+}
+
 /// What `shade()` and the ray casters report. Every method has an empty default.
 pub trait Recorder {
     /// False for `NoRecord`: lets callers skip work done only for the record.
@@ -49,6 +78,8 @@ pub trait Recorder {
     /// The closest hit of the current ray, or `None` for a miss.
     fn closest(&mut self, _hit: Option<&SurfaceHit>) {}
     fn light(&mut self, _sample: LightSample) {}
+    /// A sample of an area light or the environment (or MIS's BSDF sample).
+    fn sampled_light(&mut self, _sample: SampledLight) {}
     /// Radiance returned by the shading of the current ray's hit.
     fn shaded(&mut self, _depth: u32, _radiance: Radiance) {}
     /// While true, `primitive_test` and `node_visit` come from a shadow ray.
@@ -202,6 +233,8 @@ pub struct GlReadback {
 pub struct PixelTrace {
     pub rays: Vec<RayRecord>,
     pub lights: Vec<LightSample>,
+    /// Samples of area lights and the environment, in the order drawn.
+    pub sampled_lights: Vec<SampledLight>,
     pub fragments: Vec<FragmentRecord>,
     /// Rasterizers: the A-buffer of each CSG object at this sample, in draw order.
     pub csg_abuffers: Vec<CsgABufferRecord>,
@@ -228,9 +261,10 @@ impl PixelTrace {
     /// Adds `other`'s records after this one's (a rasterizer's layers, one
     /// record each, become the pixel's record).
     pub fn append(&mut self, other: PixelTrace) {
-        let PixelTrace { rays, lights, fragments, csg_abuffers, shaded, bounces, photon_estimates, .. } = other;
+        let PixelTrace { rays, lights, sampled_lights, fragments, csg_abuffers, shaded, bounces, photon_estimates, .. } = other;
         self.rays.extend(rays);
         self.lights.extend(lights);
+        self.sampled_lights.extend(sampled_lights);
         self.fragments.extend(fragments);
         self.csg_abuffers.extend(csg_abuffers);
         self.shaded.extend(shaded);
@@ -304,6 +338,10 @@ impl Recorder for PixelTrace {
 
     fn light(&mut self, sample: LightSample) {
         self.lights.push(sample);
+    }
+
+    fn sampled_light(&mut self, sample: SampledLight) {
+        self.sampled_lights.push(sample);
     }
 
     fn shaded(&mut self, depth: u32, radiance: Radiance) {

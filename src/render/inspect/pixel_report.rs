@@ -5,7 +5,7 @@
 use crate::math::Vec3;
 use crate::render::accel::intersect::Miss;
 use crate::render::accel::csg::SurfaceRef;
-use crate::render::inspect::pixel_record::{CsgABufferRecord, FragmentRecord, LightSample, PixelTrace, RayRecord};
+use crate::render::inspect::pixel_record::{CsgABufferRecord, FragmentRecord, LightSample, PixelTrace, RayRecord, SampledLight, SampledLightKind};
 use crate::render::PixelReplay;
 use crate::scene::{PrimitiveKind, Scene, SurfaceHit};
 use serde_json::{json, Value};
@@ -133,6 +133,22 @@ fn light_json(l: &LightSample) -> Value {
     j
 }
 
+/// What a sample of an area light or the environment is called in reports.
+fn sampled_light_name(kind: SampledLightKind) -> String {
+    match kind {
+        SampledLightKind::Area(i) => format!("area light {i}"),
+        SampledLightKind::Environment => "environment".into(),
+        SampledLightKind::BsdfHit => "BSDF sample".into(),
+    }
+}
+
+fn sampled_light_json(l: &SampledLight) -> Value {
+    json!({
+        "light": sampled_light_name(l.kind), "point": l.point.map(v3), "w_i": v3(l.w_i), "pdf": finite_or_null(l.pdf),
+        "mis_weight": l.mis_weight, "visible": l.visible, "contribution": v3(l.contribution),
+    })
+}
+
 fn fragment_json(f: &FragmentRecord) -> Value {
     json!({
         "kind": kind(f.kind), "primitive": f.primitive, "screen_barycentric": f.screen_barycentric.map(v3),
@@ -153,6 +169,10 @@ fn sample_json(scene: &Scene, t: &PixelTrace) -> Value {
             "surface": r.surface.as_ref().map(|h| hit_json(scene, h)),
             "output": v3(r.output),
         });
+    }
+    // Area lights' and the environment's samples only where a scene has them.
+    if !t.sampled_lights.is_empty() {
+        record["sampled_lights"] = t.sampled_lights.iter().map(sampled_light_json).collect();
     }
     // Indirect light's records appear only where a mode made them.
     if !t.bounces.is_empty() {
@@ -332,6 +352,19 @@ pub fn to_text(renderer: &str, scene: &Scene, x: u32, y: u32, replay: &PixelRepl
                 fmt3(l.incident),
                 l.cos_theta,
                 fmt3(l.bsdf),
+                fmt3(l.contribution)
+            );
+        }
+        for l in &t.sampled_lights {
+            let point = l.point.map(|p| format!(" at {}", fmt3(p))).unwrap_or_default();
+            let seen = if l.visible { "visible" } else { "blocked" };
+            let _ = writeln!(
+                s,
+                "  {}{point}: w_i {} pdf {:.4}, MIS weight {:.4}, {seen} -> {}",
+                sampled_light_name(l.kind),
+                fmt3(l.w_i),
+                l.pdf,
+                l.mis_weight,
                 fmt3(l.contribution)
             );
         }

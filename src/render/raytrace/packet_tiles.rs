@@ -814,7 +814,7 @@ mod tests {
                     let mut trace = PixelTrace::new();
                     with_shading_hit(interpolation, &hit, |h| {
                         let mut path = crate::render::transport::gi::PathState::new(0, 0, 1, &settings.gi, None);
-                        let mut sh = crate::render::transport::shade::Shading { scene: &prepared.scene, query: &query, settings: &settings, path: &mut path, counts: &mut RayCounts::default(), rec: &mut trace };
+                        let mut sh = crate::render::transport::shading::Shading { scene: &prepared.scene, query: &query, settings: &settings, path: &mut path, counts: &mut RayCounts::default(), rec: &mut trace };
                         shade(&mut sh, h, -ray.dir, 0)
                     });
                     expected.push(trace.lights.iter().find(|l| l.light == 0).and_then(|l| l.shadow_ray));

@@ -193,7 +193,7 @@ impl ShadowMaps {
     pub fn occluder(&self, scene: &Scene, light: usize, hit: &SurfaceHit, w_i: Vec3, bias: f32, slope_scaled: bool, lift: bool) -> Option<Occluder> {
         let map = self.maps.get(light).filter(|m| !m.faces.is_empty())?;
         // The same point a shadow ray would leave from (lifted on smooth triangles).
-        let p = crate::render::transport::shade::shadow_origin(scene, hit, w_i, lift);
+        let p = crate::render::transport::incidence::shadow_origin(scene, hit, w_i, lift);
         let n = self.size as f32;
         let (face, dist, texel_w) = match scene.lights[light] {
             Light::Point { position, .. } => {
@@ -220,6 +220,13 @@ impl ShadowMaps {
         } else {
             None
         }
+    }
+
+    /// The fraction of area light `light` (`Scene::emitters.lights`) that
+    /// `hit` sees according to the maps, filtered as `settings.shadow_filter`
+    /// says; `None` where the maps hold no map of that light.
+    pub fn area_light_visibility(&self, _scene: &Scene, _light: usize, _hit: &SurfaceHit, _settings: &RenderSettings) -> Option<f32> {
+        None
     }
 
     /// The `shadowmap` view at image position `pos` of a `width` x `height`

@@ -5,6 +5,24 @@
 pub mod map;
 pub mod volume;
 
+use crate::named::named_enum;
+
+named_enum! {
+    /// How a shadow map is read (`--shadow-filter`).
+    #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+    pub enum ShadowFilter ("shadow filter") {
+        /// The nearest texel: a hard edge, as from a point at the light's centre.
+        #[default]
+        None = "none",
+        /// Percentage-closer filtering: the fraction of texels within
+        /// `pcf_radius` that do not shadow the point (the same blur everywhere).
+        Pcf = "pcf",
+        /// Percentage-closer soft shadows: a blocker search, a penumbra width
+        /// estimated from the light's size, then PCF of that width.
+        Pcss = "pcss",
+    }
+}
+
 use crate::math::Ray;
 use crate::render::inspect::pixel_record::Recorder;
 use crate::render::{Occluder, RayCounts, SceneQuery};

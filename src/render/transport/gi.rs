@@ -26,11 +26,13 @@ pub struct PathState<'a> {
     pub rng: SampleRng,
     pub throughput: Vec3,
     pub photons: Option<&'a PhotonMap>,
+    /// How the ray being followed was chosen (weights the light it finds).
+    pub arrival: crate::render::transport::arrival::Arrival,
 }
 
 impl<'a> PathState<'a> {
     pub fn new(pixel: u32, sample: u32, spp: u32, gi: &GiSettings, photons: Option<&'a PhotonMap>) -> PathState<'a> {
-        PathState { rng: SampleRng::stratified(pixel, sample, spp, gi.seed), throughput: Vec3::ONE, photons }
+        PathState { rng: SampleRng::stratified(pixel, sample, spp, gi.seed), throughput: Vec3::ONE, photons, arrival: Default::default() }
     }
 }
 
@@ -74,8 +76,9 @@ pub fn roulette(depth: u32, throughput: Vec3, rng: &mut SampleRng) -> Option<(f3
     (rng.next_f32() < q).then_some((1.0 / q, q))
 }
 
-/// One sampled bounce off the non-delta lobes at `hit`: the direction and
-/// its weight, with the roulette applied; `None` when the path ends here.
+/// One sampled bounce off the non-delta lobes at `hit`: the direction, its
+/// weight with the roulette applied, and its density; `None` when the path
+/// ends here.
 #[allow(clippy::too_many_arguments)]
 pub fn sample_bounce<R: Recorder>(
     material: &crate::scene::Material,
@@ -85,7 +88,7 @@ pub fn sample_bounce<R: Recorder>(
     depth: u32,
     path: &mut PathState,
     rec: &mut R,
-) -> Option<(Vec3, Vec3)> {
+) -> Option<(Vec3, Vec3, f32)> {
     let choice = path.rng.next_f32();
     let u = path.rng.next_2d();
     let s = sample_bsdf(material, albedo, hit.shading_normal, w_o, choice, u)?;
@@ -98,7 +101,7 @@ pub fn sample_bounce<R: Recorder>(
         rec.bounce(Bounce { depth, w_i: s.w_i, pdf: s.pdf, weight: s.weight, throughput: path.throughput * s.weight, survival: survival.map_or(0.0, |x| x.1) });
     }
     let (scale, _) = survival?;
-    Some((s.w_i, s.weight * scale))
+    Some((s.w_i, s.weight * scale, s.pdf))
 }
 
 /// Choose between two delta lobes with weights `a` and `b` in proportion to

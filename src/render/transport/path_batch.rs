@@ -25,7 +25,7 @@ use crate::render::transport::gi;
 use crate::render::transport::gi::{GiMode, PathState};
 use crate::render::inspect::pixel_record::NoRecord;
 use crate::render::transport::shade;
-use crate::render::transport::shade::Shading;
+use crate::render::transport::shading::Shading;
 use crate::render::transport::shade_batch::{direct_in_lanes, shadow_rays_of, Batch, IN_ORDER, LANES};
 use crate::render::accel::packet::{Packet, HYBRID_ALONE, PACKET_RAYS};
 use crate::render::{BatchHit, PassJob, RayCounts, SceneQuery, ShadowMode};
@@ -38,7 +38,10 @@ use crate::scene::hit_lanes::{Floats, HitLanes, TriangleHitInput};
 /// Whether frames hand their samples' paths to a `PathPool`.
 #[inline]
 pub fn takes(job: &PassJob) -> bool {
-    job.settings.gi.mode == GiMode::Path
+    // Emitters and the environment are lit by `shade()`'s own code (light
+    // samples weighted against the bounces): those scenes follow its recursion.
+    let scene = &job.prepared.scene;
+    job.settings.gi.mode == GiMode::Path && !scene.has_sampled_lights() && !scene.materials.iter().any(|m| m.is_emissive())
 }
 
 /// `shade_batch` with `--gi path`, the paths not followed yet: the batch's
@@ -300,7 +303,7 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
             let hit = group.hits.get(k);
             let w_o = Vec3::new(group.w_o[0][k], group.w_o[1][k], group.w_o[2][k]);
             match gi::sample_bounce(material, group.albedo[k], &hit, w_o, self.depth, path, &mut NoRecord) {
-                Some((w_i, weight)) => self.go_on(group, k, w_i, weight),
+                Some((w_i, weight, _)) => self.go_on(group, k, w_i, weight),
                 None => self.beyond[s] = group.direct[k] + Vec3::ZERO,
             }
         }

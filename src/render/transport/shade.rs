@@ -4,30 +4,22 @@
 
 use crate::render::transport::bsdf::{surface_lane, DeltaLobes};
 use crate::render::transport::gi;
-use crate::render::transport::gi::{GiMode, PathState};
+use crate::render::transport::gi::GiMode;
 use crate::render::transport::lighting;
+use crate::render::transport::sampled_light;
+use crate::render::transport::arrival::Arrival;
+use crate::render::transport::incidence::Incidence;
+use crate::render::transport::shading::Shading;
 use crate::render::transport::lighting::{IncidenceLanes, LightVisibility};
 use crate::render::inspect::pixel_record::{LightSample, Recorder};
 use crate::render::differentials::{self, RayDifferential};
-use crate::render::{RayCounts, Reflections, RenderSettings, SceneQuery, ShadowMode};
+use crate::render::{Reflections, RenderSettings, SceneQuery, ShadowMode};
 use crate::math::lanes::V3;
 use crate::math::{Radiance, Ray, Vec2, Vec3};
-use crate::scene::{Differentials, Light, Material, Scene, SurfaceHit};
+use crate::scene::{Differentials, Material, Scene, SurfaceHit};
 #[cfg(test)]
 use std::f32::consts::PI;
 
-/// What shading one sample reads and writes besides the surface: the scene
-/// and its query, the settings, the sample's path (random numbers,
-/// throughput, photon map), the counters and the recorder. Passed down
-/// whole through every step of `shade()` and the rays it follows.
-pub struct Shading<'a, 'p, Q, R> {
-    pub scene: &'a Scene,
-    pub query: &'a Q,
-    pub settings: &'a RenderSettings,
-    pub path: &'a mut PathState<'p>,
-    pub counts: &'a mut RayCounts,
-    pub rec: &'a mut R,
-}
 
 /// Outgoing radiance towards `w_o` (unit, pointing away from the surface) at `hit`.
 pub fn shade<Q: SceneQuery, R: Recorder>(
@@ -80,13 +72,15 @@ pub fn ambient_term<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: imp
 /// frame without traced or mapped indirect light adds nothing to most
 /// surfaces, and its batches skip the call.
 #[inline(always)]
-pub fn adds_after_direct(settings: &RenderSettings, material: &Material) -> bool {
-    matches!(settings.gi.mode, GiMode::Path | GiMode::Photons) || material.has_secondary()
+pub fn adds_after_direct(scene: &Scene, settings: &RenderSettings, material: &Material) -> bool {
+    matches!(settings.gi.mode, GiMode::Path | GiMode::Photons) || material.has_secondary() || material.is_emissive() || scene.has_sampled_lights()
 }
 
-/// What `shade()` adds after direct light, in this order: traced or mapped
-/// indirect light, then mirror reflection and refraction. `l_o` is the
-/// ambient term plus direct light.
+/// What `shade()` adds after the point and directional lights, in this
+/// order: the surface's own emission, direct light from area lights and
+/// the environment, traced or mapped indirect light, then mirror
+/// reflection and refraction. `l_o` is the ambient term plus the point and
+/// directional lights' light.
 #[inline]
 pub fn after_direct<Q: SceneQuery, R: Recorder>(
     sh: &mut Shading<Q, R>,
@@ -98,6 +92,10 @@ pub fn after_direct<Q: SceneQuery, R: Recorder>(
     mut l_o: Radiance,
 ) -> Radiance {
     let Shading { settings, .. } = *sh;
+    if material.is_emissive() {
+        l_o += sampled_light::emitted_seen(sh, hit, w_o);
+    }
+    l_o += sampled_light::sampled_direct(sh, hit, material, albedo, w_o, depth);
     match settings.gi.mode {
         GiMode::Path if depth < settings.gi.max_path_depth() => {
             l_o += indirect_path(sh, hit, material, albedo, w_o, depth);
@@ -189,26 +187,30 @@ fn indirect_path<Q: SceneQuery, R: Recorder>(
     depth: u32,
 ) -> Radiance {
     let Shading { settings, .. } = *sh;
-    let Some((w_i, weight)) = gi::sample_bounce(material, albedo, hit, w_o, depth, sh.path, sh.rec) else {
+    let Some((w_i, weight, pdf)) = gi::sample_bounce(material, albedo, hit, w_o, depth, sh.path, sh.rec) else {
         return Vec3::ZERO;
     };
     let ray = hit.spawn_ray_front(w_i, settings.shadow_bump);
-    weight * follow(sh, &ray, depth, false, weight)
+    weight * follow(sh, &ray, depth, false, weight, Arrival::Bsdf { pdf, from: hit.position })
 }
 
 /// `radiance_along` with the path's throughput multiplied by `weight` for
-/// the rest of the path (Russian roulette reads it), restored afterwards.
+/// the rest of the path (Russian roulette reads it) and the ray chosen as
+/// `arrival` says, both restored afterwards.
 fn follow<Q: SceneQuery, R: Recorder>(
     sh: &mut Shading<Q, R>,
     ray: &Ray,
     depth: u32,
     inside: bool,
     weight: Vec3,
+    arrival: Arrival,
 ) -> Radiance {
-    let before = sh.path.throughput;
+    let (before, arrived) = (sh.path.throughput, sh.path.arrival);
     sh.path.throughput *= weight;
+    sh.path.arrival = arrival;
     let l = radiance_along(sh, ray, None, depth + 1, inside);
     sh.path.throughput = before;
+    sh.path.arrival = arrived;
     l
 }
 
@@ -234,7 +236,7 @@ fn indirect_photons<Q: SceneQuery, R: Recorder>(
             if let Some(s) = crate::render::transport::bsdf_sampling::sample_bsdf(material, albedo, hit.shading_normal, w_o, choice, u) {
                 if s.w_i.dot(hit.geometric_normal) > 0.0 {
                     let ray = hit.spawn_ray_front(s.w_i, settings.shadow_bump);
-                    sum += s.weight * follow(sh, &ray, depth, false, s.weight);
+                    sum += s.weight * follow(sh, &ray, depth, false, s.weight, Arrival::Gathered);
                 }
             }
         }
@@ -272,91 +274,9 @@ fn secondary_sampled<Q: SceneQuery, R: Recorder>(
         return Vec3::ZERO;
     };
     let weight = weight * survive;
-    weight * follow(sh, &ray, depth, inside, weight)
+    weight * follow(sh, &ray, depth, inside, weight, Arrival::Direct)
 }
 
-/// How one light arrives at a surface point: the first half of every light's
-/// term in `shade()`, before visibility and the BSDF.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Incidence {
-    /// Unit direction towards the light.
-    pub w_i: Vec3,
-    /// Distance to the light (infinite for directional lights).
-    pub distance: f32,
-    /// Incident radiance (point, CGPP 15.4.5: power / (4 pi d^2)) or
-    /// irradiance (directional), before visibility.
-    pub incident: Radiance,
-    /// `w_i . n` with the shading normal.
-    pub cos_theta: f32,
-}
-
-impl Incidence {
-    /// Light `light` at point `p` with unit shading normal `n`; `None` when
-    /// a point light sits exactly at `p` (it has no direction there and
-    /// contributes nothing).
-    #[inline]
-    pub fn of(light: &Light, p: Vec3, n: Vec3) -> Option<Incidence> {
-        let lane = lighting::incidence::<f32>(light, p.into(), n.into());
-        lane.exists.then(|| Incidence::from_lane(&lane))
-    }
-
-    /// One lane's incidence as this struct.
-    #[inline(always)]
-    pub fn from_lane(lane: &IncidenceLanes<f32>) -> Incidence {
-        Incidence { w_i: lane.w_i.into(), distance: lane.distance, incident: lane.incident.into(), cos_theta: lane.cos_theta }
-    }
-
-    /// Whether the light reaches the surface's lit side with some radiance:
-    /// only then can it contribute, and only then is a shadow ray cast.
-    #[inline]
-    pub fn illuminates(&self) -> bool {
-        !(self.cos_theta <= 0.0 || self.incident == Vec3::ZERO)
-    }
-
-    /// The shadow ray from `hit` towards the light, and its far end. It
-    /// leaves from `shadow_origin` and starts `bump` along the ray so it does
-    /// not hit P again (CGPP listing 15.20); it ends `bump` short of the light.
-    /// `lift`: `RenderSettings::terminator_lift`.
-    #[inline]
-    pub fn shadow_ray(&self, scene: &Scene, hit: &SurfaceHit, bump: f32, lift: bool) -> (Ray, f32) {
-        let leaving = SurfaceHit { position: shadow_origin(scene, hit, self.w_i, lift), ..*hit };
-        (leaving.spawn_ray_along(self.w_i, bump), self.distance - bump)
-    }
-}
-
-/// Where a shadow ray towards `w_i` leaves a surface point. Normally the hit
-/// point itself (the ray is then bumped along `w_i`, CGPP listing 15.20). But
-/// on a triangle with smooth vertex normals, where the shading normal faces
-/// the light while the flat facet faces away (the shadow terminator), a ray
-/// from the facet is blocked by the mesh's own neighbouring facets and leaves
-/// black speckles. There, following Hanika ("Hacking the shadow terminator",
-/// Ray Tracing Gems II, ch. 4), the origin is lifted onto the curved surface
-/// the vertex normals imply. Only there: elsewhere the lift would move the
-/// origin of a coarse, strongly bent triangle (the book's) far off its surface.
-/// Without `lift` (`RenderSettings::terminator_lift` off) always the hit point,
-/// to show the speckles it prevents.
-pub fn shadow_origin(scene: &Scene, hit: &SurfaceHit, w_i: Vec3, lift: bool) -> Vec3 {
-    if !lift || hit.kind != crate::scene::PrimitiveKind::Triangle || hit.geometric_normal.dot(w_i) > 0.0 {
-        return hit.position;
-    }
-    lifted_position(scene, hit)
-}
-
-/// The hit point lifted onto the surface implied by the vertex normals
-/// (Hanika's construction); the hit point itself on flat triangles.
-pub fn lifted_position(scene: &Scene, hit: &SurfaceHit) -> Vec3 {
-    let tri = &scene.triangle(hit.primitive);
-    let side = if hit.back_face { -1.0 } else { 1.0 };
-    let mut lifted = Vec3::ZERO;
-    for k in 0..3 {
-        let n = tri.n[k] * side;
-        let d = hit.position - tri.v[k];
-        // Keep only the part of P - v_k above the vertex's tangent plane.
-        let below = d.dot(n).min(0.0);
-        lifted += hit.barycentric[k] * (tri.v[k] + d - below * n);
-    }
-    if lifted.is_finite() { lifted } else { hit.position }
-}
 
 /// Gouraud shading: `shade()` at the triangle's three vertices (each seen
 /// from the eye), the results blended with the hit's barycentric weights.
@@ -401,14 +321,19 @@ fn secondary<Q: SceneQuery, R: Recorder>(
     let Shading { settings, .. } = *sh;
     let DeltaLobes { reflect_dir, reflect_weight, refract } = DeltaLobes::at(hit, material, w_o);
     let mut result = Vec3::ZERO;
+    // Delta lobes: the light they find counts whole.
+    let arrived = std::mem::take(&mut sh.path.arrival);
     if let Some((dir, weight)) = refract {
         let ray = hit.spawn_ray_back(dir, settings.shadow_bump);
         let rd = differentials::refracted(hit);
+        sh.path.arrival = Arrival::Direct;
         result += weight * radiance_along(sh, &ray, Some(&rd), depth + 1, true);
     }
     if reflect_weight != Vec3::ZERO {
+        sh.path.arrival = Arrival::Direct;
         result += reflect_weight * reflection(sh, hit, reflect_dir, -w_o, depth);
     }
+    sh.path.arrival = arrived;
     result
 }
 
@@ -458,7 +383,7 @@ pub fn radiance_along<Q: SceneQuery, R: Recorder>(
     match &hit {
         Some(h) => shade(sh, h, -ray.dir, depth),
         None => {
-            let l = scene.miss_radiance(ray.dir);
+            let l = sampled_light::miss_seen(sh, ray.dir);
             sh.rec.shaded(depth, l);
             l
         }
@@ -469,34 +394,6 @@ pub fn radiance_along<Q: SceneQuery, R: Recorder>(
 mod tests {
     use super::*;
     use crate::render::transport::bsdf::bsdf;
-
-    #[test]
-    fn shadow_origin_lifts_onto_the_smooth_surface() {
-        use crate::scene::{Triangle, PrimitiveKind};
-        use glam::Vec2;
-        let v = [Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0)];
-        // Normals leaning outwards, as on a convex dome: the implied surface bulges up (+z).
-        let n = [Vec3::new(-1.0, -1.0, 2.0).normalize(), Vec3::new(1.0, -0.2, 2.0).normalize(), Vec3::new(-0.2, 1.0, 2.0).normalize()];
-        let mut scene = Scene::default();
-        scene.triangles.push(Triangle { v, n, uv: [Vec2::ZERO; 3], material: 0, object: 0, two_sided: false });
-        let b = Vec3::splat(1.0 / 3.0);
-        let p = v[0] * b.x + v[1] * b.y + v[2] * b.z;
-        let hit = SurfaceHit {
-            position: p, geometric_normal: Vec3::Z, shading_normal: Vec3::Z, barycentric: b, uv: Vec2::ZERO, t: 1.0,
-            kind: PrimitiveKind::Triangle, primitive: 0, object: 0, material: 0, back_face: false, diff: crate::scene::Differentials::ZERO,
-        };
-        let lifted = lifted_position(&scene, &hit);
-        assert!(lifted.z > 0.05, "the origin must rise above the facet: {lifted}");
-        // At a vertex nothing moves; on a flat triangle nothing moves.
-        let at_vertex = SurfaceHit { position: v[1], barycentric: Vec3::new(0.0, 1.0, 0.0), ..hit };
-        assert!((lifted_position(&scene, &at_vertex) - v[1]).length() < 1e-6);
-        // Only towards a light behind the facet: otherwise the book's plain bump.
-        assert_eq!(shadow_origin(&scene, &hit, Vec3::Z, true), p);
-        assert_eq!(shadow_origin(&scene, &hit, Vec3::new(0.0, 0.6, -0.8), true), lifted);
-        assert_eq!(shadow_origin(&scene, &hit, Vec3::new(0.0, 0.6, -0.8), false), p, "no lift when it is turned off");
-        scene.triangles.set(0, Triangle { n: [Vec3::Z; 3], ..scene.triangles.at(0) });
-        assert!((lifted_position(&scene, &hit) - p).length() < 1e-7);
-    }
 
     #[test]
     fn lambertian_is_albedo_over_pi() {

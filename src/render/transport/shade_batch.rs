@@ -13,7 +13,8 @@ use crate::render::transport::lighting;
 use crate::render::transport::lighting::{IncidenceLanes, LightVisibility, SurfaceLanes};
 use crate::render::inspect::pixel_record::NoRecord;
 use crate::render::transport::shade;
-use crate::render::transport::shade::{Incidence, Shading};
+use crate::render::transport::incidence::Incidence;
+use crate::render::transport::shading::Shading;
 use crate::render::inspect::debug::View;
 use crate::render::transport::gi::{GiMode, PathState};
 use crate::render::{Interpolation, PassJob, RayCounts, SceneQuery, ShadowMode};
@@ -335,7 +336,7 @@ pub fn shade_batch<Q: SceneQuery>(job: &PassJob, query: &Q, batch: &Batch, block
     // random numbers: one lane's state serves them all there, and the
     // lanes that go on (mirror, glass) start theirs below, as fresh as
     // they would be.
-    let draws = settings.gi.mode != GiMode::None;
+    let draws = settings.gi.mode != GiMode::None || scene.has_sampled_lights();
     let mut paths: Option<[PathState; LANES]> = draws.then(|| std::array::from_fn(path));
     let (albedo, direct) = match paths.as_mut() {
         Some(paths) => direct_in_lanes(job, query, hits, &batch.w_o, n, paths, &IN_ORDER, blocked, counts),
@@ -343,14 +344,14 @@ pub fn shade_batch<Q: SceneQuery>(job: &PassJob, query: &Q, batch: &Batch, block
     };
     // A batch of one material (the common case) asks once whether anything
     // comes after direct light (lanes past `n` are dropped by the callers).
-    if n > 0 && hits.material[1..n].iter().all(|&m| m == hits.material[0]) && !shade::adds_after_direct(settings, &scene.materials[hits.material[0] as usize]) {
+    if n > 0 && hits.material[1..n].iter().all(|&m| m == hits.material[0]) && !shade::adds_after_direct(scene, settings, &scene.materials[hits.material[0] as usize]) {
         return direct;
     }
     let mut paths = paths.unwrap_or_else(|| std::array::from_fn(path));
     let mut out = [Radiance::ZERO; LANES];
     for i in 0..n {
         let material = &scene.materials[hits.material[i] as usize];
-        if !shade::adds_after_direct(settings, material) {
+        if !shade::adds_after_direct(scene, settings, material) {
             out[i] = direct[i];
             continue;
         }
@@ -573,7 +574,7 @@ pub fn shade_batch_pair<Q: SceneQuery>(job: &PassJob, query: &Q, pair: [&Batch; 
         return false;
     }
     let material = &scene.materials[index as usize];
-    if material.texture.is_some() || shade::adds_after_direct(settings, material) {
+    if material.texture.is_some() || shade::adds_after_direct(scene, settings, material) {
         return false;
     }
     // `direct_in_lanes`' one-material case, for each batch: the albedo
