@@ -853,7 +853,6 @@ fn finite(v: Option<F3>, where_: &str, key: &str) -> Result<Option<Vec3>, String
     }
 }
 
-/// A radiance, power or reflectance: finite and not negative.
 /// The glossy lobe's model, roughness and Fresnel term of material entry `m`.
 fn glossy_lobe(mat: &mut Material, m: &MaterialDesc, where_: &str) -> Result<(), String> {
     if let Some(name) = &m.glossy_model {
@@ -867,8 +866,11 @@ fn glossy_lobe(mat: &mut Material, m: &MaterialDesc, where_: &str) -> Result<(),
         };
     }
     if let Some(alpha) = m.roughness {
-        if !(alpha.is_finite() && (0.0..=1.0).contains(&alpha)) {
-            return Err(format!("{where_}: roughness must be a finite number from 0 to 1, found {alpha}"));
+        // An alpha of 0 would be a mirror, which the microfacet lobes cannot
+        // represent (their D is a delta there): refused, while tiny positive
+        // values are raised to the smallest alpha f32 evaluates.
+        if !(alpha.is_finite() && alpha > 0.0 && alpha <= 1.0) {
+            return Err(format!("{where_}: roughness must be a number greater than 0 and at most 1, found {alpha}"));
         }
         mat.roughness = alpha.max(MIN_ROUGHNESS);
     }
@@ -879,6 +881,7 @@ fn glossy_lobe(mat: &mut Material, m: &MaterialDesc, where_: &str) -> Result<(),
     }
 }
 
+/// A radiance, power or reflectance: finite and not negative.
 fn color(v: Option<F3>, default: Vec3, max: f32, where_: &str, key: &str) -> Result<Vec3, String> {
     let v = v.map(Vec3::from).unwrap_or(default);
     if !crate::math::is_finite(v) || v.min_element() < 0.0 || v.max_element() > max {
@@ -948,8 +951,9 @@ mod tests {
         assert_eq!(metal("glossy_model = \"beckmann\"").glossy_model, GlossyModel::Beckmann);
         assert_eq!(metal("glossy_model = \"phong\"").glossy_model, GlossyModel::Phong);
         assert_eq!(metal("glossy_model = \"blinn-phong\"").glossy_model, GlossyModel::BlinnPhong);
-        // Zero roughness is raised to the smallest alpha rather than dividing by zero.
-        assert_eq!(metal("roughness = 0.0").roughness, MIN_ROUGHNESS);
+        // A tiny roughness is raised to the smallest alpha rather than overflowing D.
+        assert_eq!(metal("roughness = 1e-7").roughness, MIN_ROUGHNESS);
+        assert_eq!(metal("roughness = 1.0").roughness, 1.0);
     }
 
     #[test]
@@ -958,6 +962,8 @@ mod tests {
             ("glossy_model = \"gxx\"", &["material \"metal\"", "glossy_model", "\"gxx\"", "\"ggx\"", "\"beckmann\""][..]),
             ("glossy_model = \"ward\"", &["material \"metal\"", "\"ward\"", "not supported"][..]),
             ("roughness = -0.1", &["material \"metal\"", "roughness"][..]),
+            ("roughness = 0.0", &["material \"metal\"", "roughness", "greater than 0"][..]),
+            ("roughness = inf", &["material \"metal\"", "roughness"][..]),
             ("roughness = 1.5", &["material \"metal\"", "roughness"][..]),
             ("roughness = nan", &["material \"metal\"", "roughness"][..]),
             ("fresnel = \"schlick\"", &["material \"metal\"", "fresnel", "not supported"][..]),
