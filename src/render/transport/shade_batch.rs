@@ -915,10 +915,13 @@ mod tests {
     /// Eight (or fewer) samples shaded together give each sample's
     /// one-wide `shade()` value bit for bit: on every built-in scene (glossy,
     /// mirror, glass, several lights), with flat and Phong normals, with and
-    /// without shadow rays, and with ambient occlusion's random rays.
+    /// without shadow rays, and with ambient occlusion's random rays; and
+    /// with every glossy model (GGX and Beckmann lanes among them, counted).
     #[test]
     fn batches_equal_one_sample_shading() {
+        use crate::scene::material::GlossyModel;
         let mut compared = 0;
+        let mut lit_by_model = [0usize; 4];
         for_each_shading_case(|name, job, query| {
             assert!(batchable(job));
             let settings = job.settings;
@@ -934,6 +937,10 @@ mod tests {
                 expected.clear();
             };
             for (hit, dir, pixel, one) in seen_samples(job, query) {
+                let material = &job.prepared.scene.materials[hit.material as usize];
+                if material.has_glossy() && one != Radiance::ZERO {
+                    lit_by_model[lighting::model_lane(material.glossy_model) as usize] += 1;
+                }
                 batch.push(settings.interpolation, &hit, dir, pixel, job.sample, 0);
                 expected.push(one);
                 // Odd-sized batches too: flush after five when the pixel index says so.
@@ -946,6 +953,10 @@ mod tests {
             }
         });
         assert!(compared > 3000, "only {compared} samples compared");
+        for model in [GlossyModel::Ggx, GlossyModel::Beckmann, GlossyModel::Phong, GlossyModel::BlinnPhong] {
+            let seen = lit_by_model[lighting::model_lane(model) as usize];
+            assert!(seen > 200, "only {seen} lit glossy samples of {model:?} compared");
+        }
     }
 
     /// Two full batches shaded together (`shade_batch_pair`, sixteen lanes)
