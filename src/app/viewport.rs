@@ -205,6 +205,32 @@ pub fn show(ui: &mut egui::Ui, viewed: &Viewed, edited: Edited) -> ViewportReque
             painter.text(*p + egui::vec2(8.0, -8.0), egui::Align2::LEFT_BOTTOM, format!("L{i}"), egui::FontId::monospace(12.0), Color32::YELLOW);
         }
     }
+    // Area lights: their outlines, labelled A0, A1, ... as the inspector lists them.
+    let outline_colour = Color32::from_rgb(255, 220, 80);
+    for (i, area) in viewed.scene.emitters.lights.iter().enumerate() {
+        for [a, b] in &area.outline {
+            if let Some(p) = overlay::project_segment(&view, &map, *a, *b) {
+                painter.line_segment(p, Stroke::new(3.0, Color32::from_black_alpha(140)));
+                painter.line_segment(p, Stroke::new(1.5, outline_colour));
+            }
+        }
+        if area.outline.is_empty() && area.radius > 0.0 {
+            // A sphere: the circle of its radius facing the camera.
+            let c = view.to_camera(area.centre);
+            if c.z < -view.near {
+                let ring: Vec<Pos2> = (0..=32)
+                    .map(|k| {
+                        let a = k as f32 / 32.0 * std::f32::consts::TAU;
+                        to_screen(view.project_camera(c + Vec3::new(a.cos(), a.sin(), 0.0) * area.radius))
+                    })
+                    .collect();
+                painter.add(egui::Shape::line(ring, Stroke::new(1.5, outline_colour)));
+            }
+        }
+        if let Some((p, _)) = view.project(area.centre) {
+            painter.text(to_screen(p) + egui::vec2(6.0, -6.0), egui::Align2::LEFT_BOTTOM, format!("A{i}"), egui::FontId::monospace(12.0), Color32::YELLOW);
+        }
+    }
     // Directional lights: an arrow in the corner along the projected direction.
     let mut corner = rect.left_top() + egui::vec2(28.0, 28.0);
     for (i, l) in lights.iter().enumerate() {

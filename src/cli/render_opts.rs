@@ -122,7 +122,7 @@ pub struct RenderOpts {
     /// Rasterizers: cull copies made by `instances` by their bounding spheres (same image either way).
     #[arg(long = "cull-instances", value_name = "BOOL", default_value_t = defaults().cull_instances, action = clap::ArgAction::Set)]
     pub cull_instances: bool,
-    /// Area lights and the environment: shadow rays per light per shading point.
+    /// Area lights and the environment: shadow rays per light per shading point (0: BSDF sampling alone).
     #[arg(long = "light-samples", default_value_t = defaults().light_samples, value_name = "N")]
     pub light_samples: u32,
     /// Area lights and the environment: combine light and BSDF sampling (on) or sample the lights alone (off).
@@ -148,8 +148,8 @@ impl RenderOpts {
         s.texture_filter = crate::scene::texture::TextureFilter::parse(&self.texture_filter).map_err(|e| format!("--texture-filter: {e}"))?;
         s.reflections = render::Reflections::parse(&self.reflections).map_err(|e| format!("--reflections: {e}"))?;
         s.shadow_volume = render::shadow::volume::VolumeMode::parse(&self.shadow_volume).map_err(|e| format!("--shadow-volume: {e}"))?;
-        if !(1..=render::MAX_LIGHT_SAMPLES).contains(&self.light_samples) {
-            return Err(format!("--light-samples {} is not between 1 and {}", self.light_samples, render::MAX_LIGHT_SAMPLES));
+        if self.light_samples > render::MAX_LIGHT_SAMPLES {
+            return Err(format!("--light-samples {} is above the maximum {} (0 turns light sampling off: BSDF sampling alone)", self.light_samples, render::MAX_LIGHT_SAMPLES));
         }
         s.light_samples = self.light_samples;
         s.shadow_filter = render::shadow::ShadowFilter::parse(&self.shadow_filter).map_err(|e| format!("--shadow-filter: {e}"))?;

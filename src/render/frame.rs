@@ -147,7 +147,7 @@ pub fn replay_pixel(renderer: &dyn Renderer, prepared: &PreparedScene, settings:
         if adaptive.is_some_and(|target| !accumulator::wants_more(sum, sum_sq, i, spp, target)) {
             break;
         }
-        let offset = sample_offset(i, spp);
+        let offset = sample_offset(i, spp, settings.gi.seed);
         let job = PassJob { prepared, view: &view, settings, offset, sample: i, photons: photons.as_deref(), active: None, rows: y..y + 1, cancel: &cancel };
         let mut rec = crate::render::inspect::pixel_record::PixelTrace::new();
         let value = renderer

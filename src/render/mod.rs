@@ -153,7 +153,8 @@ pub struct RenderSettings {
     /// image either way; a knob to measure and test that.
     pub cull_instances: bool,
     /// Area lights and the environment: shadow rays per light per shading
-    /// point, stratified over the emitter (`transport::sampled_light`).
+    /// point, stratified over the emitter (`transport::sampled_light`);
+    /// 0 finds them by BSDF sampling alone, for comparison.
     pub light_samples: u32,
     /// Area lights and the environment: combine light sampling with BSDF
     /// sampling by multiple importance sampling (power heuristic); false:
@@ -599,17 +600,27 @@ pub fn with_shading_hit<T>(interpolation: Interpolation, hit: &SurfaceHit, f: im
     }
 }
 
-/// Stratified sub-pixel positions: an n x n grid of cell centres when `spp`
-/// is a square, otherwise a Latin hypercube (one sample per row and per
-/// column of an spp x spp grid) with a fixed shuffle. Index 0 of 1 is the
-/// pixel centre. Both families of renderers use these positions, so their
-/// images agree at any spp.
-pub fn sample_offset(index: u32, spp: u32) -> Vec2 {
+/// Stratified, jittered sub-pixel positions: one point in each cell of an
+/// n x n grid when `spp` is a square, otherwise a Latin hypercube (one cell
+/// per row and per column of an spp x spp grid, columns in a fixed
+/// shuffle); inside its cell each point is placed by a hash of (sample,
+/// spp, seed). The same position serves every pixel of a pass, so both
+/// families (and OpenGL, which draws a pass at one offset) see the same
+/// points, and the image stays a pure function of (pixel, sample, seed).
+/// Jittered rather than at cell centres because centres quantize an edge's
+/// coverage to multiples of 1/n: a bias that does not fall as seeds change
+/// and that showed as whole rows off along a bright emitter's edge. One
+/// sample is the pixel centre.
+pub fn sample_offset(index: u32, spp: u32, seed: u64) -> Vec2 {
     let spp = spp.max(1);
+    if spp == 1 {
+        return Vec2::splat(0.5);
+    }
+    let jitter = transport::sampling::hashed_unit_pair(index as u64 | (spp as u64) << 32, seed);
     let n = (spp as f32).sqrt().round() as u32;
     if n * n == spp {
         let (i, j) = (index % n, index / n);
-        return Vec2::new((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
+        return Vec2::new((i as f32 + jitter.x) / n as f32, (j as f32 + jitter.y) / n as f32);
     }
     // A fixed permutation of the columns: multiply by a number coprime to spp.
     let mut k = (spp as f32 * 0.618_034).round() as u32 | 1;
@@ -617,7 +628,7 @@ pub fn sample_offset(index: u32, spp: u32) -> Vec2 {
         k += 2;
     }
     let col = (index as u64 * k as u64 % spp as u64) as u32;
-    Vec2::new((index as f32 + 0.5) / spp as f32, (col as f32 + 0.5) / spp as f32)
+    Vec2::new((index as f32 + jitter.x) / spp as f32, (col as f32 + jitter.y) / spp as f32)
 }
 
 fn gcd(a: u32, b: u32) -> u32 {
@@ -630,13 +641,13 @@ mod tests {
 
     #[test]
     fn one_sample_is_the_centre() {
-        assert_eq!(sample_offset(0, 1), Vec2::splat(0.5));
+        assert_eq!(sample_offset(0, 1, 7), Vec2::splat(0.5));
     }
 
     #[test]
     fn samples_are_stratified() {
         for spp in [2u32, 3, 4, 5, 8, 9, 16, 64] {
-            let pts: Vec<Vec2> = (0..spp).map(|i| sample_offset(i, spp)).collect();
+            let pts: Vec<Vec2> = (0..spp).map(|i| sample_offset(i, spp, 3)).collect();
             let n = (spp as f32).sqrt().round() as u32;
             let cells = if n * n == spp { n } else { spp };
             // One sample in each column stratum and in each row stratum.
@@ -653,9 +664,21 @@ mod tests {
                 assert_eq!(cols.len(), n as usize);
                 assert_eq!(rows.len(), n as usize);
             }
-            let mean = pts.iter().copied().sum::<Vec2>() / spp as f32;
-            assert!((mean - Vec2::splat(0.5)).length() < 0.5 / spp as f32 + 1e-6, "spp {spp}: {mean}");
+            assert!(pts.iter().all(|p| p.cmpge(Vec2::ZERO).all() && p.cmplt(Vec2::ONE).all()), "spp {spp}: {pts:?}");
         }
+    }
+
+    #[test]
+    fn jitter_moves_with_the_seed_and_covers_the_cell() {
+        // Another seed moves the point within the same cell; over many seeds
+        // the points spread over the whole cell, not its centre alone.
+        let (a, b) = (sample_offset(5, 16, 1), sample_offset(5, 16, 2));
+        assert_ne!(a, b);
+        assert_eq!((a * 4.0).floor(), (b * 4.0).floor());
+        let inside: Vec<Vec2> = (0..256).map(|seed| sample_offset(5, 16, seed) * 4.0 - (a * 4.0).floor()).collect();
+        let (lo, hi) = inside.iter().fold((Vec2::ONE, Vec2::ZERO), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+        assert!(lo.max_element() < 0.05 && hi.min_element() > 0.95, "{lo} {hi}");
+        assert_eq!(sample_offset(5, 16, 1), a, "a pure function");
     }
 
     #[test]

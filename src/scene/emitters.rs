@@ -76,6 +76,11 @@ pub struct Emitters {
 /// Most boundary edges kept per area light for drawing its outline.
 const MAX_OUTLINE_EDGES: usize = 4096;
 
+/// Most triangles of one area light whose shared edges are traced for its
+/// outline; a larger emissive mesh is outlined by its bounding box, so a
+/// million-triangle emitter costs no edge table of millions.
+const MAX_OUTLINE_TRIANGLES: usize = 65_536;
+
 impl Emitters {
     /// Gathers the emitters of `scene`.
     pub fn build(scene: &Scene) -> Emitters {
@@ -104,7 +109,11 @@ impl Emitters {
             *b = (b.0.min(lo), b.1.max(hi));
             e.lights[light as usize].power += power;
             if let Some(t) = tri {
-                light_triangles[light as usize].push(t);
+                let tris = &mut light_triangles[light as usize];
+                // One past the limit marks the light as outlined by its box.
+                if tris.len() <= MAX_OUTLINE_TRIANGLES {
+                    tris.push(t);
+                }
             }
         };
         let emissive: Vec<bool> = scene.materials.iter().map(|m| m.is_emissive() && luminance(m.emission) > 0.0).collect();
@@ -154,7 +163,7 @@ impl Emitters {
         for (light, ((lo, hi), tris)) in e.lights.iter_mut().zip(bounds.into_iter().zip(light_triangles)) {
             light.centre = (lo + hi) * 0.5;
             light.radius = (hi - lo).length() * 0.5;
-            light.outline = outline(&tris);
+            light.outline = if tris.len() > MAX_OUTLINE_TRIANGLES { box_outline(lo, hi) } else { outline(&tris) };
         }
         e
     }
@@ -166,6 +175,17 @@ impl Emitters {
 
     pub fn len(&self) -> usize {
         self.shapes.len()
+    }
+
+    /// About how many bytes of memory these tables hold (for the bounds
+    /// tests and the memory estimate): a few dozen per emissive primitive.
+    pub fn heap_bytes(&self) -> usize {
+        use std::mem::size_of;
+        let per_index_entry = size_of::<PrimitiveId>() + size_of::<u32>() + 8;
+        self.shapes.capacity() * size_of::<EmitterShape>()
+            + (self.pmf.capacity() + self.cdf.capacity() + self.light_of.capacity()) * size_of::<f32>()
+            + self.index_of.capacity() * per_index_entry
+            + self.lights.iter().map(|l| size_of::<AreaLight>() + l.outline.capacity() * size_of::<[Vec3; 2]>()).sum::<usize>()
     }
 
     /// A point on an emitter, seen from `p`: the emitter chosen by `u_choose`
@@ -302,6 +322,20 @@ fn finite(s: EmitterSample) -> Option<EmitterSample> {
 }
 
 /// The edges of `tris` that no other of them shares (a quad's four sides).
+/// The twelve edges of the box from `lo` to `hi`.
+fn box_outline(lo: Vec3, hi: Vec3) -> Vec<[Vec3; 2]> {
+    let corner = |i: usize| Vec3::new(if i & 1 == 0 { lo.x } else { hi.x }, if i & 2 == 0 { lo.y } else { hi.y }, if i & 4 == 0 { lo.z } else { hi.z });
+    let mut edges = Vec::with_capacity(12);
+    for i in 0..8 {
+        for bit in [1, 2, 4] {
+            if i & bit == 0 {
+                edges.push([corner(i), corner(i | bit)]);
+            }
+        }
+    }
+    edges
+}
+
 fn outline(tris: &[[Vec3; 3]]) -> Vec<[Vec3; 2]> {
     let key = |v: Vec3| v.to_array().map(f32::to_bits);
     let mut count: HashMap<([u32; 3], [u32; 3]), (u32, [Vec3; 2])> = HashMap::new();

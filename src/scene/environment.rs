@@ -142,7 +142,7 @@ impl EnvironmentLight {
         let fx = ((target_x - col_start) / (row[x] - col_start)).clamp(0.0, 0.999_999);
         let uv = Vec2::new((x as f32 + fx) / w as f32, 1.0 - (y as f32 + fy) / h as f32);
         let dir = latlong_dir(uv);
-        let pdf = self.pdf_at(x, y);
+        let pdf = self.pdf_at(x, y, dir);
         (pdf > 0.0 && pdf.is_finite() && dir.is_finite()).then_some((dir, pdf))
     }
 
@@ -151,16 +151,18 @@ impl EnvironmentLight {
         let uv = latlong_uv(dir);
         let x = ((uv.x.rem_euclid(1.0) * self.width as f32) as usize).min(self.width - 1);
         let y = (((1.0 - uv.y) * self.height as f32).max(0.0) as usize).min(self.height - 1);
-        self.pdf_at(x, y)
+        self.pdf_at(x, y, dir)
     }
 
-    /// The density of texel (x, y) in solid angle: its share of the total
-    /// weight, over the solid angle it covers (`2 pi^2 sin theta / (w h)`).
-    fn pdf_at(&self, x: usize, y: usize) -> f32 {
+    /// The density in solid angle of unit `dir` inside texel (x, y): the
+    /// texel's share of the total weight, spread uniformly over its area
+    /// in (u, v) as `sample` places points, over the Jacobian from (u, v)
+    /// to directions, `2 pi^2 sin theta` with the direction's own theta.
+    fn pdf_at(&self, x: usize, y: usize, dir: Vec3) -> f32 {
         let w = self.width;
         let row = &self.columns[y * w..(y + 1) * w];
         let weight = row[x] - if x == 0 { 0.0 } else { row[x - 1] };
-        let sin_theta = (PI * (y as f32 + 0.5) / self.height as f32).sin();
+        let sin_theta = (1.0 - dir.y * dir.y).max(0.0).sqrt();
         if !(weight > 0.0 && sin_theta > 0.0) {
             return 0.0;
         }

@@ -1,4 +1,5 @@
-//! Shading section (the debug view is in the top bar): shadows (none / ray / map / volume) and the ray bump,
+//! Shading section (the debug view is in the top bar): shadows (none / ray / map / volume, the map's filter) and the ray bump,
+//! light samples and MIS for area lights and the sky,
 //! samples per pixel, secondary depth, ambient, background, exposure and
 //! gamma on/off; the rasterizers' knobs (MSAA, early depth, affine, depth
 //! buffer format) and the wireframe view's line algorithm.
@@ -11,6 +12,7 @@ use crate::render::raster::clip::ClipMode;
 use crate::render::raster::depth_format::DepthFormat;
 use crate::render::inspect::wireframe::LineAlgorithm;
 use crate::render::shadow::volume::VolumeMode;
+use crate::render::shadow::ShadowFilter;
 use crate::render::{Interpolation, Reflections, RenderSettings, ShadowMode};
 use crate::scene::texture::TextureFilter;
 use crate::scene::RenderDefaults;
@@ -56,6 +58,18 @@ pub fn show(ui: &mut egui::Ui, settings: &mut ViewerSettings, look: &mut RenderD
                 let l = ui.label("map bias (texels)");
                 ui.add(egui::Slider::new(&mut s.shadow_map_bias, 0.0..=32.0)).labelled_by(l.id);
             });
+            // Area lights: how the map's hard edge is softened.
+            egui::ComboBox::from_label("shadow filter").selected_text(s.shadow_filter.name()).show_ui(ui, |ui| {
+                for f in ShadowFilter::ALL {
+                    ui.selectable_value(&mut s.shadow_filter, f, f.name());
+                }
+            });
+            if s.shadow_filter == ShadowFilter::Pcf {
+                ui.horizontal(|ui| {
+                    let l = ui.label("PCF radius (texels)");
+                    ui.add(egui::Slider::new(&mut s.pcf_radius, 0.0..=16.0)).labelled_by(l.id);
+                });
+            }
         }
         if s.shadows == ShadowMode::Volume {
             // Where the stencil counts volume faces: z-pass fails with the eye in a shadow.
@@ -66,6 +80,13 @@ pub fn show(ui: &mut egui::Ui, settings: &mut ViewerSettings, look: &mut RenderD
                 }
             });
         }
+        // Area lights and the environment: sampled, not summed.
+        ui.horizontal(|ui| {
+            let l = ui.label("light samples");
+            ui.add(egui::Slider::new(&mut s.light_samples, 0..=64)).labelled_by(l.id)
+                .on_hover_text("shadow rays per area light (and for the sky) per shading point; 0: found by BSDF sampling alone");
+            ui.checkbox(&mut s.mis, "MIS").on_hover_text("weight light and BSDF samples by the power heuristic; off: light sampling alone");
+        });
         gi_knobs(ui, &mut s.gi);
         ui.horizontal(|ui| {
             let l = ui.label("samples per pixel");

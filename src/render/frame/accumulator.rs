@@ -266,7 +266,7 @@ impl Accumulator {
                 prepared,
                 view: &view,
                 settings: &self.settings,
-                offset: sample_offset(self.pass, self.spp),
+                offset: sample_offset(self.pass, self.spp, self.settings.gi.seed),
                 sample: self.pass,
                 photons: self.photons.as_deref(),
                 active: self.adaptive.as_ref().map(|a| &a.active[span.clone()]),
@@ -394,7 +394,7 @@ impl Accumulator {
                     let passes = first..(first + group as u32).min(spp);
                     let jobs: Vec<PassJob> = passes
                         .clone()
-                        .map(|pass| PassJob { prepared, view: &view, settings, offset: sample_offset(pass, spp), sample: pass, photons, active: None, rows: rows.clone(), cancel })
+                        .map(|pass| PassJob { prepared, view: &view, settings, offset: sample_offset(pass, spp, settings.gi.seed), sample: pass, photons, active: None, rows: rows.clone(), cancel })
                         .collect();
                     let buffers = &mut pass_buffers[..jobs.len() * sum.len()];
                     counts += renderer.render_passes(&jobs, buffers);

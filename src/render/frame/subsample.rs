@@ -87,7 +87,7 @@ pub fn render_subsampled(
                 prepared,
                 view: &view,
                 settings,
-                offset: sample_offset(pass, spp),
+                offset: sample_offset(pass, spp, settings.gi.seed),
                 sample: pass,
                 photons: photons.as_deref(),
                 active: Some(active),

@@ -746,7 +746,7 @@ mod tests {
                 settings.gi.mode = gi;
                 let rows = 2..h;
                 let jobs: Vec<PassJob> = (passes..2 * passes)
-                    .map(|pass| PassJob { prepared: &prepared, view: &view, settings: &settings, offset: sample_offset(pass, settings.spp), sample: pass, photons: None, active: None, rows: rows.clone(), cancel: &cancel })
+                    .map(|pass| PassJob { prepared: &prepared, view: &view, settings: &settings, offset: sample_offset(pass, settings.spp, settings.gi.seed), sample: pass, photons: None, active: None, rows: rows.clone(), cancel: &cancel })
                     .collect();
                 let n = (rows.len() * w as usize).max(1);
                 let mut together = vec![Radiance::splat(-1.0); jobs.len() * n];
@@ -763,7 +763,7 @@ mod tests {
             }
             // One pass, or more than a packet holds, go pass by pass.
             let settings = RenderSettings { width: w, height: h, spp: 17, ..RenderSettings::for_scene(&prepared.scene) };
-            let jobs: Vec<PassJob> = (0..17).map(|pass| PassJob { prepared: &prepared, view: &view, settings: &settings, offset: sample_offset(pass, 17), sample: pass, photons: None, active: None, rows: 0..h, cancel: &cancel }).collect();
+            let jobs: Vec<PassJob> = (0..17).map(|pass| PassJob { prepared: &prepared, view: &view, settings: &settings, offset: sample_offset(pass, 17, settings.gi.seed), sample: pass, photons: None, active: None, rows: 0..h, cancel: &cancel }).collect();
             let mut out = vec![Radiance::ZERO; 17 * (w * h) as usize];
             assert!(cast_passes_packets(&jobs, &query, &mut out).is_none());
             assert!(cast_passes_packets(&jobs[..1], &query, &mut out[..(w * h) as usize]).is_none());

@@ -24,13 +24,28 @@ use crate::render::{SceneQuery, ShadowMode};
 use crate::scene::emitters::emitted;
 use crate::scene::{Material, SurfaceHit};
 
-/// Whether the BSDF strategy of multiple importance sampling is taken at a
-/// surface at `depth`: with MIS on, unless a path ends here (its bounce is
-/// the strategy with `--gi path`).
+/// Whether the BSDF strategy is taken at all: with MIS on, and alone when
+/// there are no light samples (`light_samples` 0, for comparison).
+#[inline]
+fn bsdf_strategy_on(settings: &crate::render::RenderSettings) -> bool {
+    settings.mis || settings.light_samples == 0
+}
+
+/// Whether a path continues from a surface at `depth`, so that its own
+/// bounce is the BSDF strategy there (`--gi path`).
+#[inline]
+fn path_continues<Q, R>(sh: &Shading<Q, R>, depth: u32) -> bool {
+    let settings = sh.settings;
+    settings.gi.mode == GiMode::Path && depth < settings.gi.max_path_depth()
+}
+
+/// Whether light samples at a surface at `depth` compete with a BSDF
+/// strategy (and are weighted against it): with MIS on, where a path's
+/// bounce or an extra BSDF-sampled ray is taken.
 #[inline]
 fn bsdf_strategy<Q, R>(sh: &Shading<Q, R>, depth: u32) -> bool {
     let settings = sh.settings;
-    settings.mis && (settings.gi.mode != GiMode::Path || depth < settings.gi.max_path_depth())
+    bsdf_strategy_on(settings) && (settings.gi.mode != GiMode::Path || path_continues(sh, depth))
 }
 
 /// The part of the radiance an emitter at `hit` sends towards `w_o` that
@@ -45,7 +60,7 @@ pub fn emitted_seen<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &Su
         Arrival::Direct => le,
         Arrival::Gathered => Vec3::ZERO,
         Arrival::Bsdf { pdf, from } => {
-            if !settings.mis {
+            if !bsdf_strategy_on(settings) {
                 return Vec3::ZERO;
             }
             let light_pdf = settings.light_samples as f32 * scene.emitters.pdf(scene, from, hit);
@@ -66,7 +81,7 @@ pub fn miss_seen<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, dir: Vec3) 
         Arrival::Direct => l,
         Arrival::Gathered => Vec3::ZERO,
         Arrival::Bsdf { pdf, .. } => {
-            if !settings.mis {
+            if !bsdf_strategy_on(settings) {
                 return Vec3::ZERO;
             }
             l * power_heuristic(pdf, settings.light_samples as f32 * light.pdf(dir))
@@ -76,7 +91,9 @@ pub fn miss_seen<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, dir: Vec3) 
 
 /// Direct light at `hit` from the area lights and the environment, seen
 /// from `w_o`: their light samples, and (MIS on, outside `--gi path`) one
-/// BSDF-sampled ray. Zero where the surface reflects nothing but by delta
+/// BSDF-sampled ray. With `light_samples` 0 the BSDF-sampled ray (or the
+/// path's bounce) alone finds these lights: the strategy MIS is measured
+/// against. Zero where the surface reflects nothing but by delta
 /// lobes, or the scene has no such lights.
 pub fn sampled_direct<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &SurfaceHit, material: &Material, albedo: Vec3, w_o: Vec3, depth: u32) -> Radiance {
     let Shading { scene, settings, .. } = *sh;
@@ -84,11 +101,11 @@ pub fn sampled_direct<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &
         return Vec3::ZERO;
     }
     let n = hit.shading_normal;
-    let count = settings.light_samples.max(1);
+    let count = settings.light_samples;
     let mis = bsdf_strategy(sh, depth);
     let mut l_o = Vec3::ZERO;
     let emitters = scene.emitters.clone();
-    if !emitters.is_empty() {
+    if !emitters.is_empty() && count > 0 {
         // Volumes give the hard shadow of each area light's centre, and maps
         // (filtered or not) one visibility for the whole light: asked once
         // per light and surface, and multiplying every sample of that light.
@@ -132,7 +149,7 @@ pub fn sampled_direct<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &
             }
         }
     }
-    if let Some(light) = scene.environment.as_ref().and_then(|e| e.light.clone()) {
+    if let Some(light) = scene.environment.as_ref().and_then(|e| e.light.clone()).filter(|_| count > 0) {
         for _ in 0..count {
             let u = sh.path.rng.next_2d();
             let Some((w_i, pdf)) = light.sample(u) else { continue };
@@ -154,7 +171,11 @@ pub fn sampled_direct<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &
             }
         }
     }
-    if mis && settings.gi.mode != GiMode::Path {
+    // The BSDF strategy's own ray, where no path bounce stands for it: with
+    // MIS outside path tracing, and with no light samples wherever the path
+    // does not go on (its last vertex, or no path at all).
+    let extra_bsdf_ray = if count == 0 { !path_continues(sh, depth) } else { mis && settings.gi.mode != GiMode::Path };
+    if extra_bsdf_ray {
         l_o += bsdf_sampled(sh, hit, material, albedo, w_o, count);
     }
     l_o
