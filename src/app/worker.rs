@@ -58,6 +58,8 @@ impl SceneParams {
                     && a.lambertian == b.lambertian
                     && a.glossy == b.glossy
                     && a.sharpness == b.sharpness
+                    && a.glossy_model == b.glossy_model
+                    && a.roughness == b.roughness
                     && a.mirror == b.mirror
                     && a.transmission == b.transmission
                     && a.ior == b.ior

@@ -5,6 +5,7 @@
 use crate::scene::mesh_cache::MeshCache;
 use crate::scene::obj::{self, NormalMode};
 use crate::scene::texture::{load_texture_as, Encoding, Wrap};
+use crate::scene::material::{GlossyModel, MIN_ROUGHNESS};
 use crate::scene::instanced::{InstanceLayer, LayerInstance};
 use crate::scene::placement::Placement;
 use crate::scene::{Camera, Fov, InstanceInfo, Light, Material, ObjectInfo, RenderDefaults, Scene, Sphere, Triangle};
@@ -83,6 +84,9 @@ struct MaterialDesc {
     lambertian: Option<F3>,
     glossy: Option<F3>,
     sharpness: Option<f32>,
+    glossy_model: Option<String>,
+    roughness: Option<f32>,
+    fresnel: Option<String>,
     mirror: Option<F3>,
     transmission: Option<F3>,
     ior: Option<f32>,
@@ -316,6 +320,7 @@ fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str, two_
         if !(mat.sharpness.is_finite() && mat.sharpness >= 0.0 && mat.sharpness <= MAX_VALUE) {
             return Err(format!("{where_}: sharpness must be a finite number >= 0 (at most {MAX_VALUE:e})"));
         }
+        glossy_lobe(&mut mat, m, &where_)?;
         mat.ior = m.ior.unwrap_or(1.5);
         if !(mat.ior.is_finite() && mat.ior > 0.0 && mat.ior <= MAX_IOR) {
             return Err(format!("{where_}: ior must be a finite number > 0 (at most {MAX_IOR})"));
@@ -848,6 +853,34 @@ fn finite(v: Option<F3>, where_: &str, key: &str) -> Result<Option<Vec3>, String
     }
 }
 
+/// The glossy lobe's model, roughness and Fresnel term of material entry `m`.
+fn glossy_lobe(mat: &mut Material, m: &MaterialDesc, where_: &str) -> Result<(), String> {
+    if let Some(name) = &m.glossy_model {
+        mat.glossy_model = match GlossyModel::parse(name) {
+            Some(model) => model,
+            None if name == "ward" => return Err(format!("{where_}: glossy_model \"ward\" is not supported yet (use \"blinn-phong\", \"phong\", \"ggx\" or \"beckmann\")")),
+            None => {
+                let names: Vec<String> = GlossyModel::NAMES.iter().map(|(n, _)| format!("\"{n}\"")).collect();
+                return Err(format!("{where_}: unknown glossy_model \"{name}\" (expected one of {})", names.join(", ")));
+            }
+        };
+    }
+    if let Some(alpha) = m.roughness {
+        // An alpha of 0 would be a mirror, which the microfacet lobes cannot
+        // represent (their D is a delta there): refused, while tiny positive
+        // values are raised to the smallest alpha f32 evaluates.
+        if !(alpha.is_finite() && alpha > 0.0 && alpha <= 1.0) {
+            return Err(format!("{where_}: roughness must be a number greater than 0 and at most 1, found {alpha}"));
+        }
+        mat.roughness = alpha.max(MIN_ROUGHNESS);
+    }
+    match m.fresnel.as_deref() {
+        None | Some("none") => Ok(()),
+        Some(other @ ("schlick" | "conductor")) => Err(format!("{where_}: fresnel \"{other}\" is not supported yet (only \"none\" is)")),
+        Some(other) => Err(format!("{where_}: unknown fresnel \"{other}\" (expected \"none\", \"schlick\" or \"conductor\")")),
+    }
+}
+
 /// A radiance, power or reflectance: finite and not negative.
 fn color(v: Option<F3>, default: Vec3, max: f32, where_: &str, key: &str) -> Result<Vec3, String> {
     let v = v.map(Vec3::from).unwrap_or(default);
@@ -892,5 +925,55 @@ fn shorten(s: &str, max: usize) -> String {
     match s.char_indices().nth(max) {
         Some((cut, _)) => format!("{}...", &s[..cut]),
         None => s.to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scene_with(material: &str) -> Result<Scene, String> {
+        let text = format!("[camera]\neye = [0.0, 0.0, 3.0]\ntarget = [0.0, 0.0, 0.0]\n\n[materials.metal]\n{material}\n");
+        parse_scene(&text, "test.toml", Path::new("."), "test")
+    }
+
+    fn metal(material: &str) -> Material {
+        let scene = scene_with(material).unwrap();
+        scene.materials.iter().find(|m| m.name == "metal").unwrap().clone()
+    }
+
+    #[test]
+    fn glossy_model_and_roughness_are_read() {
+        let m = metal("glossy = [0.9, 0.9, 0.9]");
+        assert_eq!((m.glossy_model, m.roughness), (GlossyModel::BlinnPhong, crate::scene::material::DEFAULT_ROUGHNESS));
+        let m = metal("glossy = [0.9, 0.9, 0.9]\nglossy_model = \"ggx\"\nroughness = 0.2\nfresnel = \"none\"");
+        assert_eq!((m.glossy_model, m.roughness), (GlossyModel::Ggx, 0.2));
+        assert_eq!(metal("glossy_model = \"beckmann\"").glossy_model, GlossyModel::Beckmann);
+        assert_eq!(metal("glossy_model = \"phong\"").glossy_model, GlossyModel::Phong);
+        assert_eq!(metal("glossy_model = \"blinn-phong\"").glossy_model, GlossyModel::BlinnPhong);
+        // A tiny roughness is raised to the smallest alpha rather than overflowing D.
+        assert_eq!(metal("roughness = 1e-7").roughness, MIN_ROUGHNESS);
+        assert_eq!(metal("roughness = 1.0").roughness, 1.0);
+    }
+
+    #[test]
+    fn bad_glossy_lobes_are_refused_with_the_key_named() {
+        for (entry, words) in [
+            ("glossy_model = \"gxx\"", &["material \"metal\"", "glossy_model", "\"gxx\"", "\"ggx\"", "\"beckmann\""][..]),
+            ("glossy_model = \"ward\"", &["material \"metal\"", "\"ward\"", "not supported"][..]),
+            ("roughness = -0.1", &["material \"metal\"", "roughness"][..]),
+            ("roughness = 0.0", &["material \"metal\"", "roughness", "greater than 0"][..]),
+            ("roughness = inf", &["material \"metal\"", "roughness"][..]),
+            ("roughness = 1.5", &["material \"metal\"", "roughness"][..]),
+            ("roughness = nan", &["material \"metal\"", "roughness"][..]),
+            ("fresnel = \"schlick\"", &["material \"metal\"", "fresnel", "not supported"][..]),
+            ("fresnel = \"conductor\"", &["material \"metal\"", "fresnel", "not supported"][..]),
+            ("fresnel = \"dielectric\"", &["material \"metal\"", "fresnel", "\"none\""][..]),
+        ] {
+            let e = scene_with(entry).err().unwrap_or_else(|| panic!("{entry}: accepted"));
+            for w in words {
+                assert!(e.contains(w), "{entry}: {e:?} does not contain {w}");
+            }
+        }
     }
 }

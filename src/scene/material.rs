@@ -6,14 +6,56 @@ use std::sync::Arc;
 
 pub const DEFAULT_MATERIAL: &str = "default";
 
+/// The microfacet alpha a material has when its entry gives none.
+pub const DEFAULT_ROUGHNESS: f32 = 0.1;
+/// The smallest microfacet alpha: smaller values are raised to it (as
+/// Mitsuba 3 does), so that `D` stays a finite number in f32.
+pub const MIN_ROUGHNESS: f32 = 1e-4;
+
+/// The shape of a material's glossy lobe (`glossy_model` in a scene file).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum GlossyModel {
+    /// Normalized Blinn-Phong `N(s) (n.h)^s` (uses `sharpness`).
+    #[default]
+    BlinnPhong,
+    /// Normalized Phong `(s + 2) / (2 pi) (r.w_i)^s`, r the mirror direction
+    /// of the viewer (uses `sharpness`).
+    Phong,
+    /// Microfacets with the GGX (Trowbridge-Reitz) distribution (uses `roughness`).
+    Ggx,
+    /// Microfacets with the Beckmann distribution (uses `roughness`).
+    Beckmann,
+}
+
+impl GlossyModel {
+    /// The names a scene file gives the models, with the model each names.
+    pub const NAMES: [(&'static str, GlossyModel); 4] =
+        [("blinn-phong", GlossyModel::BlinnPhong), ("phong", GlossyModel::Phong), ("ggx", GlossyModel::Ggx), ("beckmann", GlossyModel::Beckmann)];
+
+    /// The model named `name` in a scene file.
+    pub fn parse(name: &str) -> Option<GlossyModel> {
+        GlossyModel::NAMES.iter().find(|(n, _)| *n == name).map(|&(_, m)| m)
+    }
+
+    /// Whether the lobe is a microfacet one (shaped by `roughness`).
+    pub fn is_microfacet(self) -> bool {
+        matches!(self, GlossyModel::Ggx | GlossyModel::Beckmann)
+    }
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
     pub name: String,
     /// k_L: diffuse albedo; the BSDF term is k_L / pi.
     pub lambertian: Vec3,
-    /// k_G: normalized Blinn-Phong lobe weight.
+    /// k_G: the glossy lobe's weight (whichever `glossy_model` it has).
     pub glossy: Vec3,
+    /// The Blinn-Phong and Phong lobes' exponent s.
     pub sharpness: f32,
+    /// The shape of the glossy lobe.
+    pub glossy_model: GlossyModel,
+    /// The microfacet lobes' alpha (not squared), at least `MIN_ROUGHNESS`.
+    pub roughness: f32,
     pub mirror: Vec3,
     pub transmission: Vec3,
     pub ior: f32,
@@ -42,6 +84,8 @@ impl Material {
             lambertian: Vec3::ZERO,
             glossy: Vec3::ZERO,
             sharpness: 100.0,
+            glossy_model: GlossyModel::BlinnPhong,
+            roughness: DEFAULT_ROUGHNESS,
             mirror: Vec3::ZERO,
             transmission: Vec3::ZERO,
             ior: 1.5,

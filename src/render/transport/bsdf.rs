@@ -1,6 +1,6 @@
 //! The surfaces' scattering: the BSDF one sample evaluates (Lambertian plus
-//! normalized Blinn-Phong, CGPP listing 15.19, written once over lanes in
-//! `lighting`) and the delta lobes of mirrors and glass (Fresnel by Schlick's
+//! a glossy lobe: normalized Blinn-Phong, CGPP listing 15.19, Phong, or GGX
+//! or Beckmann microfacets; written once over lanes in `lighting`) and the delta lobes of mirrors and glass (Fresnel by Schlick's
 //! approximation, refraction by Snell's law).
 
 use crate::math::Vec3;
@@ -8,10 +8,8 @@ use crate::render::transport::lighting;
 use crate::render::transport::lighting::SurfaceLanes;
 use crate::scene::{Material, SurfaceHit};
 
-/// The BSDF of CGPP listing 15.19 for one sample (`lighting::bsdf`, one lane
-/// wide): Lambertian plus normalized Blinn-Phong,
-/// `f = k_L / pi + k_G N(s) max(0, n.h)^s` (`N` is
-/// `lighting::blinn_phong_normalization`).
+/// The BSDF for one sample (`lighting::bsdf`, one lane wide): Lambertian
+/// plus the material's glossy lobe, `f = k_L / pi + k_G lobe`.
 #[inline]
 pub fn bsdf(material: &Material, albedo: Vec3, n: Vec3, w_i: Vec3, w_o: Vec3) -> Vec3 {
     let surface = surface_lane(material, albedo, Vec3::ZERO, n, w_o);
@@ -28,6 +26,8 @@ pub(crate) fn surface_lane(material: &Material, albedo: Vec3, position: Vec3, n:
         albedo: albedo.into(),
         glossy: material.glossy.into(),
         sharpness: material.sharpness,
+        glossy_model: lighting::model_lane(material.glossy_model),
+        roughness: material.roughness,
     }
 }
 

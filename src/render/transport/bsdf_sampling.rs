@@ -1,9 +1,13 @@
 //! Importance sampling of the BSDF's non-delta lobes for path tracing: the
-//! Lambertian lobe by cosine and the normalized Blinn-Phong lobe by its half
-//! vector, chosen between in proportion to their albedo. `bsdf()` itself
-//! stays the one definition of the reflectance.
+//! Lambertian lobe by cosine and the glossy lobe by its model (Blinn-Phong
+//! by its half vector, Phong about the mirror direction, GGX by its visible
+//! normals, Beckmann by `D(h) cos_h`), chosen between in proportion to
+//! their albedo. `bsdf()` itself stays the one definition of the reflectance.
 
-use crate::render::transport::sampling::{blinn_phong_half, blinn_phong_pdf, cosine_hemisphere, cosine_hemisphere_lanes, cosine_hemisphere_pdf, cosine_hemisphere_pdf_lanes, from_local, from_local_lanes, luminance, reflect};
+use crate::render::transport::sampling::{blinn_phong_half, blinn_phong_pdf, cosine_hemisphere, cosine_hemisphere_lanes, cosine_hemisphere_pdf, cosine_hemisphere_pdf_lanes, from_local, from_local_lanes, luminance, reflect, tangents};
+use crate::render::transport::microfacet;
+use crate::scene::material::GlossyModel;
+use std::f32::consts::PI;
 use crate::math::lanes::{Lane, V3};
 use crate::render::transport::bsdf::bsdf;
 use crate::math::{Vec2, Vec3};
@@ -34,9 +38,65 @@ pub fn bsdf_pdf(material: &Material, albedo: Vec3, n: Vec3, w_o: Vec3, w_i: Vec3
     let p_d = diffuse_probability(material, albedo);
     let mut pdf = p_d * cosine_hemisphere_pdf(n.dot(w_i));
     if material.has_glossy() && p_d < 1.0 {
-        pdf += (1.0 - p_d) * blinn_phong_pdf(n, w_o, w_i, material.sharpness);
+        pdf += (1.0 - p_d) * glossy_pdf(material, n, w_o, w_i);
     }
     pdf
+}
+
+/// The density with which `sample_glossy` returns `w_i` (over the whole
+/// sphere: directions below the surface have density too, and are refused
+/// by `sample_bsdf`).
+fn glossy_pdf(material: &Material, n: Vec3, w_o: Vec3, w_i: Vec3) -> f32 {
+    let a = material.roughness;
+    match material.glossy_model {
+        GlossyModel::BlinnPhong => blinn_phong_pdf(n, w_o, w_i, material.sharpness),
+        GlossyModel::Phong => {
+            let c = reflect(w_o, n).normalize_or_zero().dot(w_i);
+            if c <= 0.0 {
+                return 0.0;
+            }
+            (material.sharpness + 1.0) / (2.0 * PI) * c.powf(material.sharpness)
+        }
+        GlossyModel::Ggx => {
+            // The visible normals' density `G1(w_o) (w_o.h) D(h) / cos_o`
+            // over the Jacobian `4 (w_o.h)` of reflection.
+            let cos_o = n.dot(w_o);
+            let h = (w_i + w_o).normalize_or_zero();
+            if cos_o <= 0.0 {
+                return 0.0;
+            }
+            microfacet::ggx_d(n.dot(h), a) * microfacet::ggx_g1(cos_o, w_o.dot(h), a) / (4.0 * cos_o)
+        }
+        GlossyModel::Beckmann => {
+            let h = (w_i + w_o).normalize_or_zero();
+            let (cos_h, o_h) = (n.dot(h), w_o.dot(h));
+            if cos_h <= 0.0 || o_h <= 0.0 {
+                return 0.0;
+            }
+            microfacet::beckmann_d(cos_h, a) * cos_h / (4.0 * o_h)
+        }
+    }
+}
+
+/// An incoming direction from the glossy lobe alone (not yet normalized,
+/// possibly below the surface); `None` where the lobe reflects nothing
+/// towards `w_o` (a microfacet lobe seen from below).
+fn sample_glossy(material: &Material, n: Vec3, w_o: Vec3, u: Vec2) -> Option<Vec3> {
+    let a = material.roughness;
+    Some(match material.glossy_model {
+        GlossyModel::BlinnPhong => reflect(w_o, from_local(blinn_phong_half(u, material.sharpness), n)),
+        // The Phong lobe is the Blinn-Phong half vector's distribution laid about r.
+        GlossyModel::Phong => from_local(blinn_phong_half(u, material.sharpness), reflect(w_o, n).try_normalize()?),
+        GlossyModel::Ggx => {
+            let (t, b) = tangents(n);
+            let v = Vec3::new(w_o.dot(t), w_o.dot(b), w_o.dot(n));
+            if v.z <= 0.0 {
+                return None;
+            }
+            reflect(w_o, from_local(microfacet::sample_ggx_visible(v.normalize(), a, u.x, u.y), n))
+        }
+        GlossyModel::Beckmann => reflect(w_o, from_local(microfacet::sample_beckmann(a, u.x, u.y), n)),
+    })
 }
 
 /// Samples an incoming direction at a surface with shading normal `n` seen
@@ -55,8 +115,7 @@ pub fn sample_bsdf(material: &Material, albedo: Vec3, n: Vec3, w_o: Vec3, choice
     let w_i = if choice < p_d {
         from_local(cosine_hemisphere(u), n)
     } else {
-        let h = from_local(blinn_phong_half(u, material.sharpness), n);
-        reflect(w_o, h)
+        sample_glossy(material, n, w_o, u)?
     };
     if !(n.dot(w_i) > 0.0) {
         return None;
@@ -158,6 +217,160 @@ mod tests {
                 if cos_o == 1.0 {
                     assert!(exact > 0.99, "sharpness {sharpness}: seen along the normal the lobe reflects {exact}, not all");
                 }
+            }
+        }
+    }
+
+    fn glossy_material(model: GlossyModel, roughness: f32, sharpness: f32) -> Material {
+        let mut m = Material::black();
+        m.glossy = Vec3::ONE;
+        m.glossy_model = model;
+        m.roughness = roughness;
+        m.sharpness = sharpness;
+        m
+    }
+
+    /// Sampling the Phong and microfacet lobes estimates their albedo (by
+    /// quadrature, sharing no code with the sampling) within 1%, and no
+    /// lobe reflects more than arrives. The microfacet lobes lose energy
+    /// as they roughen (single scattering, no Fresnel), as Mitsuba's do.
+    #[test]
+    fn phong_and_microfacet_sampling_estimate_the_lobes_albedo() {
+        let cases = [
+            (GlossyModel::Ggx, [0.05f32, 0.2, 0.5, 1.0].map(|a| (a, 0.0))),
+            (GlossyModel::Beckmann, [0.05f32, 0.2, 0.5, 1.0].map(|a| (a, 0.0))),
+            (GlossyModel::Phong, [1.0f32, 10.0, 50.0, 200.0].map(|s| (0.1, s))),
+        ];
+        for (model, params) in cases {
+            for (roughness, sharpness) in params {
+                let m = glossy_material(model, roughness, sharpness);
+                for cos_o in [1.0f32, 0.7, 0.3] {
+                    let w_o = Vec3::new((1.0 - cos_o * cos_o).sqrt(), 0.0, cos_o);
+                    let sampled = albedo_estimate(&m, w_o, 200_000).x;
+                    let exact = albedo_by_quadrature(&m, w_o);
+                    let what = format!("{model:?} alpha {roughness} s {sharpness}, cos_o {cos_o}: sampled {sampled}, quadrature {exact}");
+                    assert!((sampled - exact).abs() < 0.01 * exact.max(0.1), "{what}");
+                    assert!(exact <= 1.002 && exact > 0.2, "{what}");
+                }
+            }
+        }
+    }
+
+    /// Each glossy lobe's sampling density integrates to one over the
+    /// sphere (directions below the surface included: `sample_bsdf` refuses
+    /// those after drawing them), by a midpoint rule; Beckmann's `D cos`
+    /// sampling loses the half vectors that face away from `w_o`, so its
+    /// integral is one only where there are none of those (seen near the
+    /// normal, smooth) and below one otherwise.
+    #[test]
+    fn glossy_densities_integrate_to_one() {
+        let sphere_integral = |m: &Material, w_o: Vec3| {
+            let (n_theta, n_phi) = (800, 800);
+            let (d_theta, d_phi) = (PI as f64 / n_theta as f64, 2.0 * std::f64::consts::PI / n_phi as f64);
+            let mut sum = 0.0f64;
+            for i in 0..n_theta {
+                let theta = (i as f64 + 0.5) * d_theta;
+                for j in 0..n_phi {
+                    let phi = (j as f64 + 0.5) * d_phi;
+                    let w_i = Vec3::new((theta.sin() * phi.cos()) as f32, (theta.sin() * phi.sin()) as f32, theta.cos() as f32);
+                    sum += glossy_pdf(m, Vec3::Z, w_o, w_i) as f64 * theta.sin() * d_theta * d_phi;
+                }
+            }
+            sum
+        };
+        let near_normal = Vec3::new(0.3, 0.1, 0.9).normalize();
+        let grazing = Vec3::new(0.95, 0.0, 0.3).normalize();
+        for (model, roughness, sharpness) in [(GlossyModel::Ggx, 0.2, 0.0), (GlossyModel::Ggx, 0.7, 0.0), (GlossyModel::Phong, 0.1, 10.0), (GlossyModel::Phong, 0.1, 60.0)] {
+            for w_o in [near_normal, grazing] {
+                let integral = sphere_integral(&glossy_material(model, roughness, sharpness), w_o);
+                assert!((integral - 1.0).abs() < 5e-3, "{model:?} alpha {roughness} s {sharpness} w_o {w_o}: {integral}");
+            }
+        }
+        let beckmann = sphere_integral(&glossy_material(GlossyModel::Beckmann, 0.2, 0.0), near_normal);
+        assert!((beckmann - 1.0).abs() < 5e-3, "Beckmann: {beckmann}");
+        let beckmann = sphere_integral(&glossy_material(GlossyModel::Beckmann, 0.7, 0.0), grazing);
+        assert!(beckmann < 0.99 && beckmann > 0.5, "Beckmann: {beckmann}");
+    }
+
+    /// `sample_bsdf`'s directions against `bsdf_pdf` by Pearson's
+    /// chi-square test (16 x 32 bins over the hemisphere, p = 1e-4), for
+    /// every glossy model alone and mixed with a Lambertian lobe, seen
+    /// along the normal and obliquely: the density MIS weighs light samples
+    /// with is the one the BSDF strategy draws from. Samples refused below
+    /// the surface count as misses, as the density's missing mass does.
+    #[test]
+    fn sampled_directions_follow_bsdf_pdf() {
+        use crate::render::transport::sampling::tests::chi_square;
+        let cases = [
+            glossy_material(GlossyModel::Ggx, 0.3, 0.0),
+            glossy_material(GlossyModel::Ggx, 0.6, 0.0),
+            glossy_material(GlossyModel::Beckmann, 0.3, 0.0),
+            glossy_material(GlossyModel::Beckmann, 0.6, 0.0),
+            glossy_material(GlossyModel::Phong, 0.1, 5.0),
+            glossy_material(GlossyModel::Phong, 0.1, 30.0),
+            glossy_material(GlossyModel::BlinnPhong, 0.1, 20.0),
+        ];
+        for glossy_only in cases {
+            let mut mixed = glossy_only.clone();
+            mixed.lambertian = Vec3::new(0.3, 0.2, 0.1);
+            mixed.glossy = Vec3::splat(0.4);
+            for m in [glossy_only, mixed] {
+                for w_o in [Vec3::Z, Vec3::new(0.6, 0.0, 0.8), Vec3::new(-0.3, 0.9, 0.3).normalize()] {
+                    let mut choices = SampleRng::for_index(23, 0, 2);
+                    let (stat, threshold) = chi_square(
+                        &mut |u| sample_bsdf(&m, m.lambertian, Vec3::Z, w_o, choices.next_f32(), u).map(|s| s.w_i),
+                        &|w_i| bsdf_pdf(&m, m.lambertian, Vec3::Z, w_o, w_i),
+                        200_000,
+                    );
+                    let what = format!("{:?} alpha {} s {} k_L {}, w_o {w_o}", m.glossy_model, m.roughness, m.sharpness, m.lambertian);
+                    assert!(stat < threshold, "{what}: chi-square {stat} >= {threshold}");
+                }
+            }
+        }
+        // The test tells a lobe from a slightly rougher one: GGX's samples
+        // at alpha 0.3 against its density at alpha 0.36.
+        let (m, rougher) = (glossy_material(GlossyModel::Ggx, 0.3, 0.0), glossy_material(GlossyModel::Ggx, 0.36, 0.0));
+        let w_o = Vec3::new(0.6, 0.0, 0.8);
+        let mut choices = SampleRng::for_index(23, 0, 2);
+        let (stat, threshold) = chi_square(
+            &mut |u| sample_bsdf(&m, Vec3::ZERO, Vec3::Z, w_o, choices.next_f32(), u).map(|s| s.w_i),
+            &|w_i| bsdf_pdf(&rougher, Vec3::ZERO, Vec3::Z, w_o, w_i),
+            200_000,
+        );
+        assert!(stat > threshold, "alpha 0.3 passes for 0.36: {stat} < {threshold}");
+    }
+
+    /// A white furnace for nearly smooth GGX: `∫ f cos dw` over the
+    /// hemisphere is at most one (a microfacet lobe without Fresnel only
+    /// loses light, to shadowing) and close to one (little is shadowed
+    /// when alpha is small: the least here is 0.94, at alpha 0.1 seen at
+    /// cos 0.3). The lobe is narrow (about alpha wide about the
+    /// mirror direction r), so the midpoint rule runs in polar coordinates
+    /// about r with steps of 0.05 degrees, over 20 points across the
+    /// narrowest lobe: its error is far below the 1e-3 allowed.
+    #[test]
+    fn smooth_ggx_reflects_at_most_what_arrives() {
+        let (n_theta, n_phi) = (3600, 256);
+        let (d_theta, d_phi) = (std::f64::consts::PI / n_theta as f64, 2.0 * std::f64::consts::PI / n_phi as f64);
+        for alpha in [0.01f32, 0.05, 0.1] {
+            let m = glossy_material(GlossyModel::Ggx, alpha, 0.0);
+            for cos_o in [1.0f32, 0.7, 0.3] {
+                let w_o = Vec3::new((1.0 - cos_o * cos_o).sqrt(), 0.0, cos_o);
+                let r = reflect(w_o, Vec3::Z).normalize();
+                let mut sum = 0.0f64;
+                for i in 0..n_theta {
+                    let theta = (i as f64 + 0.5) * d_theta;
+                    for j in 0..n_phi {
+                        let phi = (j as f64 + 0.5) * d_phi;
+                        let local = Vec3::new((theta.sin() * phi.cos()) as f32, (theta.sin() * phi.sin()) as f32, theta.cos() as f32);
+                        let w_i = from_local(local, r);
+                        if w_i.z > 0.0 {
+                            sum += (bsdf(&m, Vec3::ZERO, Vec3::Z, w_i, w_o).x * w_i.z) as f64 * theta.sin() * d_theta * d_phi;
+                        }
+                    }
+                }
+                assert!(sum <= 1.001, "alpha {alpha}, cos_o {cos_o}: the lobe reflects {sum}");
+                assert!(sum > 0.9, "alpha {alpha}, cos_o {cos_o}: the lobe reflects only {sum}");
             }
         }
     }

@@ -9,6 +9,8 @@
 //! known differs between callers while the arithmetic must not.
 
 use crate::math::lanes::{exp2, pow, Lane, V3};
+use crate::render::transport::microfacet;
+use crate::scene::material::GlossyModel;
 use crate::scene::Light;
 use std::f32::consts::PI;
 
@@ -22,9 +24,25 @@ pub struct SurfaceLanes<L: Lane> {
     pub w_o: V3<L>,
     /// Diffuse albedo k_L (texture applied).
     pub albedo: V3<L>,
-    /// Blinn-Phong weight k_G and sharpness s.
+    /// The glossy lobe's weight k_G, and the Blinn-Phong and Phong lobes'
+    /// sharpness s.
     pub glossy: V3<L>,
     pub sharpness: L,
+    /// The glossy lobe's model, as `model_lane` codes it (lanes may differ).
+    pub glossy_model: L,
+    /// The microfacet lobes' alpha.
+    pub roughness: L,
+}
+
+/// `model` as the number `SurfaceLanes::glossy_model` holds.
+#[inline(always)]
+pub fn model_lane(model: GlossyModel) -> f32 {
+    match model {
+        GlossyModel::BlinnPhong => 0.0,
+        GlossyModel::Phong => 1.0,
+        GlossyModel::Ggx => 2.0,
+        GlossyModel::Beckmann => 3.0,
+    }
 }
 
 /// How one light arrives at a surface point, per lane, before visibility.
@@ -74,13 +92,23 @@ pub fn incidence<L: Lane>(light: &Light, p: V3<L>, n: V3<L>) -> IncidenceLanes<L
     IncidenceLanes { w_i, distance, incident, cos_theta: w_i.dot(n), exists }
 }
 
-/// The BSDF of CGPP listing 15.19: Lambertian plus normalized Blinn-Phong,
-/// `f = k_L / pi + k_G N(s) max(0, n.h)^s` with `N` from
-/// `blinn_phong_normalization`. The glossy lobe is
-/// left out where k_G = 0, and where it cannot matter: `c^s <= exp(-s (1 -
-/// c))` since `ln c <= c - 1`, so when that bound is below 1e-9 the lobe adds
-/// nothing visible and the power is not computed (in no lane, when no lane
-/// needs it).
+/// The BSDF: Lambertian plus a glossy lobe, `f = k_L / pi + k_G lobe`, the
+/// lobe chosen per lane by `glossy_model`:
+///
+/// - Blinn-Phong (CGPP listing 15.19): `N(s) max(0, n.h)^s` with `N` from
+///   `blinn_phong_normalization`;
+/// - Phong: `(s + 2) / (2 pi) max(0, r.w_i)^s`, r the mirror direction of
+///   `w_o` about n;
+/// - GGX and Beckmann: Mitsuba 3's `roughconductor` without Fresnel,
+///   `D(h) G1(w_i) G1(w_o) / (4 cos_i cos_o)` (`microfacet`), zero unless
+///   both directions are above the surface.
+///
+/// The glossy lobe is left out where k_G = 0, and the two power lobes where
+/// they cannot matter: `c^s <= exp(-s (1 - c))` since `ln c <= c - 1`, so
+/// when that bound is below 1e-9 the lobe adds nothing visible and the
+/// power is not computed (in no lane, when no lane needs it). Each model is
+/// computed only when some lane has it; each lane takes its own model's
+/// value, so a lane's bits do not depend on its neighbours'.
 #[inline(always)]
 pub fn bsdf<L: Lane>(s: &SurfaceLanes<L>, w_i: V3<L>) -> V3<L> {
     let like = s.sharpness;
@@ -89,15 +117,63 @@ pub fn bsdf<L: Lane>(s: &SurfaceLanes<L>, w_i: V3<L>) -> V3<L> {
     if !L::any(glossy) {
         return f;
     }
-    let w_h = (w_i + s.w_o).normalize_or_zero();
-    let c = s.normal.dot(w_h).max(like.splat(0.0));
-    let sharp = s.sharpness;
-    let needed = glossy & (sharp * (like.splat(1.0) - c)).lt(like.splat(20.7));
-    if !L::any(needed) {
-        return f;
+    let mut out = f;
+    for model in [GlossyModel::BlinnPhong, GlossyModel::Phong, GlossyModel::Ggx, GlossyModel::Beckmann] {
+        let lanes = glossy & s.glossy_model.eq(like.splat(model_lane(model)));
+        if !L::any(lanes) {
+            continue;
+        }
+        let (counted, lobe) = match model {
+            GlossyModel::BlinnPhong => {
+                let w_h = (w_i + s.w_o).normalize_or_zero();
+                power_lobe(lanes, s.sharpness, s.normal.dot(w_h), || blinn_phong_normalization(s.sharpness))
+            }
+            GlossyModel::Phong => {
+                let r = s.normal.scale(like.splat(2.0) * s.normal.dot(s.w_o)) - s.w_o;
+                let sharp = s.sharpness;
+                power_lobe(lanes, sharp, r.dot(w_i), || (sharp + like.splat(2.0)) * like.splat(0.5 / PI))
+            }
+            GlossyModel::Ggx | GlossyModel::Beckmann => {
+                let (above, lobe) = microfacet_lobe(s, w_i, model == GlossyModel::Ggx);
+                (lanes & above, lobe)
+            }
+        };
+        out = V3::select(counted, f + s.glossy.scale(lobe), out);
     }
-    let lobe = blinn_phong_normalization(sharp) * pow(c, sharp);
-    V3::select(needed, f + s.glossy.scale(lobe), f)
+    out
+}
+
+/// `norm() max(0, c)^s`, and the lanes of `lanes` where it is worth
+/// computing (see `bsdf`).
+#[inline(always)]
+fn power_lobe<L: Lane>(lanes: L::Mask, sharp: L, c: L, norm: impl FnOnce() -> L) -> (L::Mask, L) {
+    let c = c.max(c.splat(0.0));
+    let needed = lanes & (sharp * (c.splat(1.0) - c)).lt(c.splat(20.7));
+    if !L::any(needed) {
+        return (needed, c.splat(0.0));
+    }
+    (needed, norm() * pow(c, sharp))
+}
+
+/// `D(h) G1(w_i) G1(w_o) / (4 cos_i cos_o)` for the GGX (`ggx`) or
+/// Beckmann distribution, and where both directions are above the surface.
+#[inline(always)]
+fn microfacet_lobe<L: Lane>(s: &SurfaceLanes<L>, w_i: V3<L>, ggx: bool) -> (L::Mask, L) {
+    let zero = s.roughness.splat(0.0);
+    let a = s.roughness;
+    let cos_i = s.normal.dot(w_i);
+    let cos_o = s.normal.dot(s.w_o);
+    let h = (w_i + s.w_o).normalize_or_zero();
+    let cos_h = s.normal.dot(h);
+    let (i_h, o_h) = (w_i.dot(h), s.w_o.dot(h));
+    let (d, g) = if ggx {
+        (microfacet::ggx_d(cos_h, a), microfacet::ggx_g1(cos_i, i_h, a) * microfacet::ggx_g1(cos_o, o_h, a))
+    } else {
+        (microfacet::beckmann_d(cos_h, a), microfacet::beckmann_g1(cos_i, i_h, a) * microfacet::beckmann_g1(cos_o, o_h, a))
+    };
+    let above = cos_i.gt(zero) & cos_o.gt(zero);
+    let lobe = d * g / (zero.splat(4.0) * cos_i * cos_o);
+    (above, L::select(above, lobe, zero))
 }
 
 /// `N(s) = (s + 2)(s + 4) / (8 pi (2^(-s/2) + s))`: the factor that makes
@@ -148,4 +224,60 @@ pub fn direct_light<L: Lane, V: LightVisibility<L>>(lights: &[Light], s: &Surfac
         vis.reflected(index, &inc, lit, V3::select(lit, f, zero), V3::select(counted, contribution, zero));
     }
     l_o
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::Vec3;
+
+    fn surface(model: GlossyModel, glossy: Vec3, w_o: Vec3) -> SurfaceLanes<f32> {
+        SurfaceLanes {
+            position: Vec3::ZERO.into(),
+            normal: Vec3::Z.into(),
+            w_o: w_o.into(),
+            albedo: Vec3::ZERO.into(),
+            glossy: glossy.into(),
+            sharpness: 10.0,
+            glossy_model: model_lane(model),
+            roughness: 0.5,
+        }
+    }
+
+    fn close(got: V3<f32>, want: Vec3) -> bool {
+        (Vec3::new(got.x, got.y, got.z) - want).abs().max_element() < 1e-5
+    }
+
+    /// GGX at alpha 0.5, n = z, w_o = (0.6, 0, 0.8), w_i = z, worked by hand:
+    /// h = (0.6, 0, 1.8) / sqrt(3.6) = (0.316228, 0, 0.948683), cos_h^2 = 0.9;
+    /// D = 1 / (pi a^2 (sin_h^2 / a^2 + cos_h^2)^2) = 1 / (pi 0.25 1.3^2) = 0.753396;
+    /// G1(w_i) = 1 (along the normal); G1(w_o): tan^2 = 0.36 / 0.64 = 0.5625,
+    /// a^2 tan^2 = 0.140625, G1 = 2 / (1 + sqrt(1.140625)) = 2 / 2.068 = 0.967118;
+    /// f / k_G = D G / (4 cos_i cos_o) = 0.753396 0.967118 / 3.2 = 0.227695.
+    /// Beckmann's `D` there is exp(-(0.1 / 0.9) / 0.25) / (pi 0.25 0.9^2)
+    /// = 0.641180 / 0.636173 = 1.007872.
+    #[test]
+    fn ggx_lobe_has_its_hand_computed_value() {
+        let k_g = Vec3::new(0.9, 0.5, 0.2);
+        let w_o = Vec3::new(0.6, 0.0, 0.8);
+        let f = bsdf(&surface(GlossyModel::Ggx, k_g, w_o), Vec3::Z.into());
+        assert!(close(f, k_g * 0.227695), "{f:?}");
+        // Below the surface on either side the microfacet lobe is black.
+        let f = bsdf(&surface(GlossyModel::Ggx, k_g, w_o), Vec3::new(0.0, 0.6, -0.8).into());
+        assert!(close(f, Vec3::ZERO), "{f:?}");
+        let f = bsdf(&surface(GlossyModel::Ggx, k_g, Vec3::new(0.6, 0.0, -0.8)), Vec3::Z.into());
+        assert!(close(f, Vec3::ZERO), "{f:?}");
+        // Beckmann: the same configuration with its D and G1 (the latter 1:
+        // b = 1 / sqrt(0.140625) = 2.667 >= 1.6).
+        let f = bsdf(&surface(GlossyModel::Beckmann, Vec3::ONE, w_o), Vec3::Z.into());
+        assert!(close(f, Vec3::splat(1.007872 / 3.2)), "{f:?}");
+    }
+
+    /// Phong at s = 10 with w_o = (0.6, 0, 0.8): r = (-0.6, 0, 0.8), and
+    /// towards w_i = z, r.w_i = 0.8: f = 12 / (2 pi) 0.8^10 = 0.205070.
+    #[test]
+    fn phong_lobe_has_its_hand_computed_value() {
+        let f = bsdf(&surface(GlossyModel::Phong, Vec3::ONE, Vec3::new(0.6, 0.0, 0.8)), Vec3::Z.into());
+        assert!(close(f, Vec3::splat(0.205070)), "{f:?}");
+    }
 }

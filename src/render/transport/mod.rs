@@ -2,8 +2,9 @@
 //! `shade` is the one shading entry for a single sample and `shade_batch` the
 //! same over eight lanes; `lighting` evaluates lights; `gi` holds the
 //! indirect-light modes, `path_batch` the path pool, `photon_map` photons
-//! and `bsdf_sampling` the BSDFs' importance sampling; `sampled_light` samples area
-//! lights and the environment; `sampling` is the
+//! and `bsdf_sampling` the BSDFs' importance sampling, `microfacet` the
+//! microfacet lobes' distributions; `sampled_light` samples area lights and
+//! the environment; `sampling` is the
 //! sampler whose numbers are a pure function of (pixel, sample, seed).
 
 pub mod arrival;
@@ -13,6 +14,7 @@ pub mod gi;
 pub mod incidence;
 pub mod kd_tree;
 pub mod lighting;
+pub mod microfacet;
 pub mod normal_map;
 pub mod path_batch;
 pub mod photon_map;

@@ -501,7 +501,7 @@ pub fn luminance(c: Vec3) -> f32 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     #[test]
@@ -734,7 +734,7 @@ mod tests {
     /// over the hemisphere, binned in (cos theta, phi) with the expected
     /// counts integrated numerically, bins of small expectation pooled (as
     /// Mitsuba tests its BSDF sampling). Returns (statistic, threshold).
-    fn chi_square(sample: &mut dyn FnMut(Vec2) -> Option<Vec3>, pdf: &dyn Fn(Vec3) -> f32, n: usize) -> (f64, f64) {
+    pub(crate) fn chi_square(sample: &mut dyn FnMut(Vec2) -> Option<Vec3>, pdf: &dyn Fn(Vec3) -> f32, n: usize) -> (f64, f64) {
         const CT: usize = 16;
         const PH: usize = 32;
         let mut observed = vec![0f64; CT * PH];

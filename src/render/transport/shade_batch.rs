@@ -406,10 +406,11 @@ pub fn direct_in_lanes<Q: SceneQuery>(
         let mut sh = Shading { scene, query, settings, path: &mut paths[path_of[0]], counts: &mut *counts, rec: &mut NoRecord };
         let ambient = shade::ambient_term(&mut sh, || hits.get(0), a);
         albedo = [a; LANES];
-        MaterialLanes::Uniform { albedo: a, glossy: first.glossy, sharpness: first.sharpness, ambient }
+        MaterialLanes::Uniform { albedo: a, glossy: first.glossy, sharpness: first.sharpness, model: lighting::model_lane(first.glossy_model), roughness: first.roughness, ambient }
     } else {
         // Lanes past `n` get a black material.
         let (mut albedo_lanes, mut glossy, mut sharpness, mut ambient_lanes) = ([[0.0; LANES]; 3], [[0.0; LANES]; 3], [1.0; LANES], [[0.0; LANES]; 3]);
+        let (mut model, mut roughness) = ([0.0; LANES], [1.0; LANES]);
         for i in 0..n {
             let material = &scene.materials[hits.material[i] as usize];
             albedo[i] = shade::albedo_at(material, Vec2::new(hits.uv[0][i], hits.uv[1][i]), &hits.diff[i], settings);
@@ -421,8 +422,10 @@ pub fn direct_in_lanes<Q: SceneQuery>(
             }
             (ambient_lanes[0][i], ambient_lanes[1][i], ambient_lanes[2][i]) = (ambient.x, ambient.y, ambient.z);
             sharpness[i] = material.sharpness;
+            model[i] = lighting::model_lane(material.glossy_model);
+            roughness[i] = material.roughness;
         }
-        MaterialLanes::PerLane { albedo: albedo_lanes, glossy, sharpness, ambient: ambient_lanes }
+        MaterialLanes::PerLane { albedo: albedo_lanes, glossy, sharpness, model, roughness, ambient: ambient_lanes }
     };
     let mut visibility = BatchVisibility { job, query, hits, live: ((1u32 << n) - 1) as u8, blocked, counts: &mut *counts };
     let direct = dispatch!(simd_level(), simd => direct_light8(simd, job, &geometry, &materials, &mut visibility));
@@ -440,17 +443,27 @@ struct Geometry<'a> {
 /// A batch's material values as `direct_light8` loads them.
 enum MaterialLanes {
     /// The same in every lane (one material without a texture).
-    Uniform { albedo: Vec3, glossy: Vec3, sharpness: f32, ambient: Radiance },
-    /// One array per coordinate.
-    PerLane { albedo: [Floats; 3], glossy: [Floats; 3], sharpness: Floats, ambient: [Floats; 3] },
+    /// `model` is the glossy model's `lighting::model_lane` code.
+    Uniform { albedo: Vec3, glossy: Vec3, sharpness: f32, model: f32, roughness: f32, ambient: Radiance },
+    /// One array per coordinate (lanes may have different glossy models).
+    PerLane { albedo: [Floats; 3], glossy: [Floats; 3], sharpness: Floats, model: Floats, roughness: Floats, ambient: [Floats; 3] },
 }
 
 #[inline(always)]
 fn direct_light8<S: Simd, Q: SceneQuery>(simd: S, job: &PassJob, geometry: &Geometry, materials: &MaterialLanes, visibility: &mut BatchVisibility<Q>) -> [Radiance; LANES] {
     let like = <f32x8<S> as fearless_simd::SimdBase<S>>::splat(simd, 0.0);
-    let (albedo, glossy, sharpness, start) = match materials {
-        MaterialLanes::Uniform { albedo, glossy, sharpness, ambient } => (V3::splat(like, *albedo), V3::splat(like, *glossy), like.splat(*sharpness), V3::splat(like, *ambient)),
-        MaterialLanes::PerLane { albedo, glossy, sharpness, ambient } => (V3::from_soa(simd, albedo), V3::from_soa(simd, glossy), f32x8::simd_from(simd, *sharpness), V3::from_soa(simd, ambient)),
+    let (albedo, glossy, sharpness, glossy_model, roughness, start) = match materials {
+        MaterialLanes::Uniform { albedo, glossy, sharpness, model, roughness, ambient } => {
+            (V3::splat(like, *albedo), V3::splat(like, *glossy), like.splat(*sharpness), like.splat(*model), like.splat(*roughness), V3::splat(like, *ambient))
+        }
+        MaterialLanes::PerLane { albedo, glossy, sharpness, model, roughness, ambient } => (
+            V3::from_soa(simd, albedo),
+            V3::from_soa(simd, glossy),
+            f32x8::simd_from(simd, *sharpness),
+            f32x8::simd_from(simd, *model),
+            f32x8::simd_from(simd, *roughness),
+            V3::from_soa(simd, ambient),
+        ),
     };
     let surface = SurfaceLanes {
         position: V3::from_soa(simd, geometry.position),
@@ -459,6 +472,8 @@ fn direct_light8<S: Simd, Q: SceneQuery>(simd: S, job: &PassJob, geometry: &Geom
         albedo,
         glossy,
         sharpness,
+        glossy_model,
+        roughness,
     };
     lighting::direct_light(&job.prepared.scene.lights, &surface, start, visibility).scatter()
 }
@@ -574,7 +589,7 @@ pub fn shade_batch_pair<Q: SceneQuery>(job: &PassJob, query: &Q, pair: [&Batch; 
     if (albedo, ambient) != other {
         return false;
     }
-    let materials = MaterialLanes::Uniform { albedo, glossy: material.glossy, sharpness: material.sharpness, ambient };
+    let materials = MaterialLanes::Uniform { albedo, glossy: material.glossy, sharpness: material.sharpness, model: lighting::model_lane(material.glossy_model), roughness: material.roughness, ambient };
     let mut visibility = PairVisibility { shadows: settings.shadows, blocked, counts };
     dispatch!(simd_level(), simd => direct_light16(simd, job, pair, &materials, &mut visibility, out));
     true
@@ -585,7 +600,7 @@ pub fn shade_batch_pair<Q: SceneQuery>(job: &PassJob, query: &Q, pair: [&Batch; 
 #[inline(always)]
 fn direct_light16<S: Simd, V: LightVisibility<f32x16<S>>>(simd: S, job: &PassJob, [a, b]: [&Batch; 2], materials: &MaterialLanes, visibility: &mut V, out: &mut [[Radiance; LANES]; 2]) {
     let like = <f32x16<S> as fearless_simd::SimdBase<S>>::splat(simd, 0.0);
-    let MaterialLanes::Uniform { albedo, glossy, sharpness, ambient } = materials else {
+    let MaterialLanes::Uniform { albedo, glossy, sharpness, model, roughness, ambient } = materials else {
         unreachable!("pairs are one material")
     };
     let surface = SurfaceLanes {
@@ -595,6 +610,8 @@ fn direct_light16<S: Simd, V: LightVisibility<f32x16<S>>>(simd: S, job: &PassJob
         albedo: V3::splat(like, *albedo),
         glossy: V3::splat(like, *glossy),
         sharpness: like.splat(*sharpness),
+        glossy_model: like.splat(*model),
+        roughness: like.splat(*roughness),
     };
     let l_o = lighting::direct_light(&job.prepared.scene.lights, &surface, V3::splat(like, *ambient), visibility);
     let (x, y, z): ([f32; 16], [f32; 16], [f32; 16]) = (l_o.x.into(), l_o.y.into(), l_o.z.into());
@@ -838,8 +855,13 @@ mod tests {
     /// with shadow rays, flat normals without, and ambient occlusion's
     /// random rays. `check` gets the scene's name, the pass and its query.
     fn for_each_shading_case(mut check: impl FnMut(&str, &PassJob, &BvhQuery)) {
-        for name in builtin::names() {
-            let prepared = PreparedScene::new(builtin::load_builtin(name).unwrap().unwrap());
+        for (name, lobes) in builtin::names().iter().flat_map(|name| [(name, false), (name, true)]) {
+            let mut scene = builtin::load_builtin(name).unwrap().unwrap();
+            if lobes {
+                with_every_glossy_model(&mut scene);
+            }
+            let name = &format!("{name}{}", if lobes { " (every glossy model)" } else { "" });
+            let prepared = PreparedScene::new(scene);
             let query = BvhQuery::new(&prepared);
             let (w, h) = (29u32, 19u32);
             let view = prepared.scene.camera.view(w, h);
@@ -853,6 +875,22 @@ mod tests {
                 settings.gi.mode = gi;
                 let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: glam::Vec2::splat(0.5), sample: 0, photons: None, active: None, rows: 0..h, cancel: &cancel };
                 check(name, &job, &query);
+            }
+        }
+    }
+
+    /// `scene` with a glossy lobe on every material, the models taken in
+    /// turn (GGX, Beckmann, Phong, Blinn-Phong) with varied roughness and
+    /// sharpness: batches then hold one model, or several side by side.
+    fn with_every_glossy_model(scene: &mut crate::scene::Scene) {
+        use crate::scene::material::GlossyModel;
+        let models = [GlossyModel::Ggx, GlossyModel::Beckmann, GlossyModel::Phong, GlossyModel::BlinnPhong];
+        for (k, m) in scene.materials.iter_mut().enumerate() {
+            m.glossy_model = models[k % models.len()];
+            m.roughness = 0.05 + 0.15 * (k % 5) as f32;
+            m.sharpness = 3.0 + 20.0 * k as f32;
+            if m.glossy == Vec3::ZERO {
+                m.glossy = Vec3::new(0.3, 0.5, 0.4);
             }
         }
     }
@@ -877,10 +915,13 @@ mod tests {
     /// Eight (or fewer) samples shaded together give each sample's
     /// one-wide `shade()` value bit for bit: on every built-in scene (glossy,
     /// mirror, glass, several lights), with flat and Phong normals, with and
-    /// without shadow rays, and with ambient occlusion's random rays.
+    /// without shadow rays, and with ambient occlusion's random rays; and
+    /// with every glossy model (GGX and Beckmann lanes among them, counted).
     #[test]
     fn batches_equal_one_sample_shading() {
+        use crate::scene::material::GlossyModel;
         let mut compared = 0;
+        let mut lit_by_model = [0usize; 4];
         for_each_shading_case(|name, job, query| {
             assert!(batchable(job));
             let settings = job.settings;
@@ -896,6 +937,10 @@ mod tests {
                 expected.clear();
             };
             for (hit, dir, pixel, one) in seen_samples(job, query) {
+                let material = &job.prepared.scene.materials[hit.material as usize];
+                if material.has_glossy() && one != Radiance::ZERO {
+                    lit_by_model[lighting::model_lane(material.glossy_model) as usize] += 1;
+                }
                 batch.push(settings.interpolation, &hit, dir, pixel, job.sample, 0);
                 expected.push(one);
                 // Odd-sized batches too: flush after five when the pixel index says so.
@@ -908,6 +953,10 @@ mod tests {
             }
         });
         assert!(compared > 3000, "only {compared} samples compared");
+        for model in [GlossyModel::Ggx, GlossyModel::Beckmann, GlossyModel::Phong, GlossyModel::BlinnPhong] {
+            let seen = lit_by_model[lighting::model_lane(model) as usize];
+            assert!(seen > 200, "only {seen} lit glossy samples of {model:?} compared");
+        }
     }
 
     /// Two full batches shaded together (`shade_batch_pair`, sixteen lanes)
