@@ -93,14 +93,16 @@ pub fn fingerprint(scene: &Scene) -> u64 {
     h
 }
 
-/// Per material: (k_L, 0), (k_G, sharpness), (k_M, 0).
+/// Per material: (k_L, glossy model), (k_G, sharpness), (k_M, roughness);
+/// the model as `lighting::model_lane` codes it.
 pub const MATERIAL_FLOATS: usize = 12;
 
 pub fn materials(scene: &Scene) -> Vec<f32> {
     let mut out = Vec::with_capacity(scene.materials.len().max(1) * MATERIAL_FLOATS);
     for m in &scene.materials {
-        out.extend_from_slice(&[m.lambertian.x, m.lambertian.y, m.lambertian.z, 0.0, m.glossy.x, m.glossy.y, m.glossy.z, m.sharpness]);
-        out.extend_from_slice(&[m.mirror.x, m.mirror.y, m.mirror.z, 0.0]);
+        let model = crate::render::transport::lighting::model_lane(m.glossy_model);
+        out.extend_from_slice(&[m.lambertian.x, m.lambertian.y, m.lambertian.z, model, m.glossy.x, m.glossy.y, m.glossy.z, m.sharpness]);
+        out.extend_from_slice(&[m.mirror.x, m.mirror.y, m.mirror.z, m.roughness]);
     }
     if out.is_empty() {
         out.resize(MATERIAL_FLOATS, 0.0);

@@ -36,8 +36,10 @@ pub(super) unsafe fn compile(gl: &glow::Context, vertex: &str, fragment: &str) -
 /// What both fragment shaders share: the eye ray through this fragment's
 /// sample position, computed as `CameraView::eye_ray` computes it, and the
 /// shading of CGPP listing 15.19 (point lights `power / (4 pi d^2)`,
-/// directional lights, Lambertian `k_L / pi` plus normalized Blinn-Phong,
-/// the lobe skipped where `s (1 - c) >= 20.7`, ambient `albedo * ambient`).
+/// directional lights, Lambertian `k_L / pi` plus the material's glossy
+/// lobe as `lighting::bsdf` evaluates it: normalized Blinn-Phong or Phong,
+/// skipped where `s (1 - c) >= 20.7`, or GGX or Beckmann microfacets;
+/// ambient `albedo * ambient`).
 const COMMON: &str = r#"
 uniform vec3 eye;
 uniform mat3 camera_to_world;
@@ -50,7 +52,8 @@ uniform vec3 ambient;
 uniform int light_count;
 uniform bool y_down;
 
-// Per material: (k_L, 0), (k_G, sharpness), (k_M, 0).
+// Per material: (k_L, glossy model), (k_G, sharpness), (k_M, roughness); the
+// model 0 = Blinn-Phong, 1 = Phong, 2 = GGX, 3 = Beckmann.
 layout(std430, binding = 0) readonly buffer Materials { vec4 materials[]; };
 // Per light: (position or direction, 0 = point | 1 = directional), (power or irradiance, 0).
 layout(std430, binding = 1) readonly buffer Lights { vec4 lights[]; };
@@ -333,9 +336,45 @@ vec3 normalize_or_zero(vec3 v) {
     return l > 0.0 ? v / l : vec3(0.0);
 }
 
+// tan^2 of the angle whose cosine is c.
+float tan2_of(float c) {
+    float c2 = c * c;
+    return max(1.0 - c2, 0.0) / c2;
+}
+
+// The microfacet distribution D (GGX or Beckmann) at alpha a, as
+// `microfacet::ggx_d` and `beckmann_d` compute it.
+float microfacet_d(float cos_h, float a, bool ggx) {
+    if (cos_h <= 0.0) return 0.0;
+    float c2 = cos_h * cos_h;
+    float a2 = a * a;
+    float d;
+    if (ggx) {
+        float e = max(1.0 - c2, 0.0) / a2 + c2;
+        d = 1.0 / (PI * a2 * e * e);
+    } else {
+        d = exp(-tan2_of(cos_h) / a2) / (PI * a2 * (c2 * c2));
+    }
+    return d * cos_h > 1e-20 ? d : 0.0;
+}
+
+// Smith's one-sided shadowing G1 of a direction v (`cos_v = n.v`,
+// `v_h = v.h`), as `microfacet::ggx_g1` and `beckmann_g1` compute it.
+float smith_g1(float cos_v, float v_h, float a, bool ggx) {
+    if (v_h * cos_v <= 0.0) return 0.0;
+    float t = a * a * tan2_of(cos_v);
+    if (ggx) return 2.0 / (1.0 + sqrt(1.0 + t));
+    if (t <= 0.0) return 1.0;
+    float b = 1.0 / sqrt(t);
+    if (b >= 1.6) return 1.0;
+    return (3.535 * b + 2.181 * b * b) / (1.0 + 2.276 * b + 2.577 * b * b);
+}
+
 vec3 shade(vec3 p, vec3 n, vec3 g, vec3 w_o, uint m, vec3 albedo) {
     vec3 glossy = materials[3u * m + 1u].xyz;
     float s = materials[3u * m + 1u].w;
+    float model = materials[3u * m].w;
+    float alpha = materials[3u * m + 2u].w;
     vec3 l_o = albedo * ambient;
     for (int i = 0; i < light_count; i++) {
         vec4 a = lights[2 * i];
@@ -360,9 +399,25 @@ vec3 shade(vec3 p, vec3 n, vec3 g, vec3 w_o, uint m, vec3 albedo) {
         vec3 f = albedo * (1.0 / PI);
         if (glossy != vec3(0.0)) {
             vec3 w_h = normalize_or_zero(w_i + w_o);
-            float c = max(dot(n, w_h), 0.0);
-            if (s * (1.0 - c) < 20.7) {
-                f += glossy * ((s + 2.0) * (s + 4.0) / (8.0 * PI * (exp2(max(-0.5 * s, -126.0)) + s)) * pow(c, s));
+            if (model == 0.0) {
+                float c = max(dot(n, w_h), 0.0);
+                if (s * (1.0 - c) < 20.7) {
+                    f += glossy * ((s + 2.0) * (s + 4.0) / (8.0 * PI * (exp2(max(-0.5 * s, -126.0)) + s)) * pow(c, s));
+                }
+            } else if (model == 1.0) {
+                vec3 r = (2.0 * dot(n, w_o)) * n - w_o;
+                float c = max(dot(r, w_i), 0.0);
+                if (s * (1.0 - c) < 20.7) {
+                    f += glossy * ((s + 2.0) * (0.5 / PI) * pow(c, s));
+                }
+            } else {
+                float cos_o = dot(n, w_o);
+                if (cos_o > 0.0) {
+                    bool ggx = model == 2.0;
+                    float d = microfacet_d(dot(n, w_h), alpha, ggx);
+                    float g2 = smith_g1(cos_theta, dot(w_i, w_h), alpha, ggx) * smith_g1(cos_o, dot(w_o, w_h), alpha, ggx);
+                    f += glossy * (d * g2 / (4.0 * cos_theta * cos_o));
+                }
             }
         }
         l_o += (incident * f) * cos_theta;
