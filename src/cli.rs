@@ -202,7 +202,7 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
     opts.write_into(&mut settings)?;
     let admitted = render::admit::admit(renderer.as_ref(), &scene, &settings)?;
     // Said before the renderer loads its driver, which may fail.
-    for notice in &admitted.notices {
+    for notice in admitted.notices.iter().chain(&admitted.caveats) {
         eprintln!("note: {notice}");
     }
     renderer.ready(&admitted.settings)?;

@@ -448,7 +448,7 @@ impl WorkerLoop {
         // (or input made too big to allocate) is refused in one sentence.
         let admitted = render::admit::admit(renderer.as_ref(), &prepared.scene, &asked);
         let admitted = admitted.and_then(|a| renderer.ready(&a.settings).map(|()| a));
-        let render::admit::Admitted { settings, notices } = match admitted {
+        let render::admit::Admitted { settings, mut notices, caveats } = match admitted {
             Ok(a) => a,
             Err(e) => {
                 self.fail(&req, e);
@@ -457,6 +457,7 @@ impl WorkerLoop {
         };
         {
             let mut out = self.shared.output.lock().unwrap();
+            notices.extend(caveats);
             out.notices = notices;
             out.admitted = Some(settings.clone());
         }

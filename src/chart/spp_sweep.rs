@@ -38,7 +38,7 @@ pub fn sweep(
         for &spp in spps {
             progress(r.name(), spp);
             let admitted = render::admit::admit(r.as_ref(), &prepared.scene, &RenderSettings { spp, ..base.clone() })?;
-            admitted.notices.iter().for_each(|n| notice(n));
+            admitted.notices.iter().chain(&admitted.caveats).for_each(|n| notice(n));
             r.ready(&admitted.settings)?;
             let settings = admitted.settings;
             let mut best = f64::INFINITY;

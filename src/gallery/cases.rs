@@ -4,6 +4,7 @@
 
 use crate::render::raster::depth_format::DepthFormat;
 use crate::render::shadow::volume::VolumeMode;
+use crate::render::shadow::ShadowFilter;
 use crate::render::{RenderSettings, ShadowMode};
 use crate::scene::Scene;
 
@@ -54,6 +55,11 @@ pub struct GalleryCase {
     /// scene measured small, so the gallery stays quick); the viewer keeps
     /// the scene's size.
     pub size: Option<(u32, u32)>,
+    /// For cases whose settings are estimates with noise (sampled lights):
+    /// the relative difference from the truth a pixel may have before it
+    /// counts as wrong, instead of `measure::REL_TOLERANCE`, so that what is
+    /// counted is the method's error and not its noise.
+    pub noise_tolerance: Option<f32>,
 }
 
 fn map(s: &mut RenderSettings) {
@@ -73,7 +79,7 @@ const RAY_CAST_SHADOWS: Setting = Setting::new("raytrace:brute", "raytrace:brute
 
 /// Every case, in the order the gallery shows them.
 pub fn cases() -> Vec<GalleryCase> {
-    vec![
+    let mut all = vec![
         GalleryCase {
             name: "shadow-acne",
             scene: "stress-shadow",
@@ -88,6 +94,7 @@ pub fn cases() -> Vec<GalleryCase> {
             truth: RAY_CAST_SHADOWS,
             threshold: 40,
             size: None,
+            noise_tolerance: None,
         },
         GalleryCase {
             name: "peter-panning",
@@ -103,6 +110,7 @@ pub fn cases() -> Vec<GalleryCase> {
             truth: RAY_CAST_SHADOWS,
             threshold: 40,
             size: None,
+            noise_tolerance: None,
         },
         GalleryCase {
             name: "grazing-light",
@@ -118,6 +126,7 @@ pub fn cases() -> Vec<GalleryCase> {
             truth: RAY_CAST_SHADOWS,
             threshold: 40,
             size: None,
+            noise_tolerance: None,
         },
         GalleryCase {
             name: "shadow-terminator",
@@ -133,6 +142,7 @@ pub fn cases() -> Vec<GalleryCase> {
             truth: Setting::new("raytrace:brute", "raytrace:brute --shadows none (a convex object alone casts no shadow but its own)", |s| s.shadows = ShadowMode::None),
             threshold: 40,
             size: None,
+            noise_tolerance: None,
         },
         GalleryCase {
             name: "self-intersection",
@@ -151,6 +161,7 @@ pub fn cases() -> Vec<GalleryCase> {
             truth: Setting::new("raytrace", "raytrace --bump 1e-3", |s| s.shadow_bump = 1e-3),
             threshold: 40,
             size: Some((160, 100)),
+            noise_tolerance: None,
         },
         GalleryCase {
             name: "specular-aliasing",
@@ -163,6 +174,7 @@ pub fn cases() -> Vec<GalleryCase> {
             truth: Setting::new("raytrace", "raytrace --spp 1024", |s| s.spp = 1024),
             threshold: 400,
             size: None,
+            noise_tolerance: None,
         },
         GalleryCase {
             name: "near-plane",
@@ -175,6 +187,7 @@ pub fn cases() -> Vec<GalleryCase> {
             truth: Setting::new("raytrace:brute", "raytrace:brute", nothing),
             threshold: 40,
             size: None,
+            noise_tolerance: None,
         },
         GalleryCase {
             name: "t-junction-cracks",
@@ -199,6 +212,7 @@ pub fn cases() -> Vec<GalleryCase> {
             },
             threshold: 20,
             size: None,
+            noise_tolerance: None,
         },
         GalleryCase {
             name: "far-from-origin",
@@ -223,6 +237,7 @@ pub fn cases() -> Vec<GalleryCase> {
             },
             threshold: 40,
             size: None,
+            noise_tolerance: None,
         },
         GalleryCase {
             name: "zpass-eye-in-shadow",
@@ -241,6 +256,7 @@ pub fn cases() -> Vec<GalleryCase> {
             truth: RAY_CAST_SHADOWS,
             threshold: 40,
             size: Some((160, 100)),
+            noise_tolerance: None,
         },
         GalleryCase {
             name: "painter-cycles",
@@ -253,6 +269,7 @@ pub fn cases() -> Vec<GalleryCase> {
             truth: Setting::new("raytrace:brute", "raytrace:brute", nothing),
             threshold: 40,
             size: Some((160, 100)),
+            noise_tolerance: None,
         },
         GalleryCase {
             name: "z-fighting",
@@ -265,6 +282,7 @@ pub fn cases() -> Vec<GalleryCase> {
             truth: Setting::new("raytrace:brute", "raytrace:brute", nothing),
             threshold: 40,
             size: Some((160, 100)),
+            noise_tolerance: None,
         },
         GalleryCase {
             name: "z-fighting-near-plane",
@@ -283,6 +301,7 @@ pub fn cases() -> Vec<GalleryCase> {
             truth: Setting::new("raytrace:brute", "raytrace:brute", nothing),
             threshold: 40,
             size: Some((160, 100)),
+            noise_tolerance: None,
         },
         GalleryCase {
             name: "environment-reflections",
@@ -295,6 +314,7 @@ pub fn cases() -> Vec<GalleryCase> {
             truth: Setting::new("raytrace:brute", "raytrace:brute", nothing),
             threshold: 40,
             size: Some((160, 100)),
+            noise_tolerance: None,
         },
         GalleryCase {
             name: "subsample-misses",
@@ -309,9 +329,142 @@ pub fn cases() -> Vec<GalleryCase> {
             truth: Setting::new("raytrace:brute", "raytrace:brute", nothing),
             threshold: 40,
             size: Some((160, 100)),
+            noise_tolerance: None,
+        },
+    ];
+    all.extend(area_light_cases());
+    all
+}
+
+
+/// Area-light cases: enough light samples that the shading itself is
+/// quiet, so what differs is visibility (the shadow cases) or the sampling
+/// strategy (the MIS case).
+fn soft(s: &mut RenderSettings) {
+    s.spp = 16;
+    s.light_samples = 16;
+}
+
+fn soft_map(s: &mut RenderSettings, filter: ShadowFilter) {
+    soft(s);
+    s.shadows = ShadowMode::Map;
+    s.shadow_filter = filter;
+}
+
+/// The truth of the area-light shadow cases: the panel sampled with rays.
+const AREA_TRUTH: Setting = Setting::new("raytrace", "raytrace --spp 64 --light-samples 32", |s| {
+    s.spp = 64;
+    s.light_samples = 32;
+    s.shadows = ShadowMode::Ray;
+});
+
+/// The cases of lights with extent: soft shadows, which maps and volumes
+/// approximate, and light sampling against BSDF sampling.
+fn area_light_cases() -> Vec<GalleryCase> {
+    vec![
+        GalleryCase {
+            name: "area-light-hard-map",
+            scene: "soft-shadows",
+            method: "shadow map of an area light",
+            knob: "shadow-filter",
+            explanation: "a plain shadow map is drawn from the panel's centre: every shadow has a hard edge, the floating ball's faint blur becomes a dark disc and the post's widening shadow stays thin",
+            failing: Setting::new("rasterize", "--shadows map --shadow-filter none", |s| soft_map(s, ShadowFilter::None)),
+            cured: Setting::new("rasterize", "--shadows ray", |s| {
+                soft(s);
+                s.shadows = ShadowMode::Ray;
+            }),
+            truth: AREA_TRUTH,
+            threshold: AREA_THRESHOLD,
+            size: Some((160, 100)),
+            noise_tolerance: Some(AREA_NOISE),
+        },
+        GalleryCase {
+            name: "area-light-volume",
+            scene: "soft-shadows",
+            method: "shadow volume of an area light",
+            knob: "shadows",
+            explanation: "a shadow volume is cast from one point, the panel's centre: it cannot be soft, so every penumbra is a hard edge",
+            failing: Setting::new("rasterize", "--shadows volume", |s| {
+                soft(s);
+                s.shadows = ShadowMode::Volume;
+            }),
+            cured: Setting::new("rasterize", "--shadows ray", |s| {
+                soft(s);
+                s.shadows = ShadowMode::Ray;
+            }),
+            truth: AREA_TRUTH,
+            threshold: AREA_THRESHOLD,
+            size: Some((160, 100)),
+            noise_tolerance: Some(AREA_NOISE),
+        },
+        GalleryCase {
+            name: "pcf-contact-shadow",
+            scene: "soft-shadows",
+            method: "percentage-closer filtering",
+            knob: "shadow-filter",
+            explanation: "PCF blurs every edge by the same width: the resting ball's contact shadow, sharp where it touches the floor, is smeared as much as the far edge of its penumbra, and the post's shadow is blurred even at its foot; rays to the panel give each point its own penumbra",
+            failing: Setting::new("rasterize", "--shadows map --shadow-filter pcf --pcf-radius 12", |s| {
+                soft_map(s, ShadowFilter::Pcf);
+                s.pcf_radius = 12.0;
+            }),
+            cured: Setting::new("rasterize", "--shadows ray", |s| {
+                soft(s);
+                s.shadows = ShadowMode::Ray;
+            }),
+            truth: AREA_TRUTH,
+            threshold: AREA_THRESHOLD,
+            size: Some((160, 100)),
+            noise_tolerance: Some(AREA_NOISE),
+        },
+        GalleryCase {
+            name: "pcss-thin-post",
+            scene: "soft-shadows",
+            method: "percentage-closer soft shadows",
+            knob: "shadows",
+            explanation: "PCSS filters the map as wide as the penumbra it estimates: the thin post covers too few texels of that width, so light leaks through its shadow, which rays to the panel keep",
+            failing: Setting::new("rasterize", "--shadows map --shadow-filter pcss", |s| soft_map(s, ShadowFilter::Pcss)),
+            cured: Setting::new("rasterize", "--shadows ray", |s| {
+                soft(s);
+                s.shadows = ShadowMode::Ray;
+            }),
+            truth: AREA_TRUTH,
+            threshold: AREA_THRESHOLD,
+            size: Some((160, 100)),
+            noise_tolerance: Some(AREA_NOISE),
+        },
+        GalleryCase {
+            name: "light-sampling-alone",
+            scene: "stress-glossy-panel",
+            method: "light sampling without MIS",
+            knob: "mis",
+            explanation: "points sampled on the lights rarely fall in the glossy ball's narrow lobe: its reflection of the large panel is speckled; MIS adds BSDF samples, which find that reflection, and weighs each strategy where it is good",
+            failing: Setting::new("raytrace", "--spp 64 --light-samples 4 --mis off", |s| {
+                s.spp = 64;
+                s.light_samples = 4;
+                s.mis = false;
+            }),
+            cured: Setting::new("raytrace", "--spp 64 --light-samples 4", |s| {
+                s.spp = 64;
+                s.light_samples = 4;
+            }),
+            truth: Setting::new("raytrace", "raytrace --spp 1024 --light-samples 4", |s| {
+                s.spp = 1024;
+                s.light_samples = 4;
+            }),
+            // The floor keeps some noise in both; the speckled highlight is the difference.
+            threshold: 1000,
+            size: Some((160, 100)),
+            noise_tolerance: Some(AREA_NOISE),
         },
     ]
 }
+
+/// How far (relative) an area-light case's pixel may stray from the truth
+/// by the noise of 256 or more samples before it counts as wrong.
+const AREA_NOISE: f32 = 0.1;
+
+/// Wrong pixels (of 16,000) above which an area-light case fails.
+const AREA_THRESHOLD: usize = 400;
 
 /// The case called `name`.
 pub fn case_by_name(name: &str) -> Result<GalleryCase, String> {

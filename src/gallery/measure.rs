@@ -25,12 +25,17 @@ pub fn wrong_pixels(image: &[Radiance], truth: &[Radiance], width: u32, height: 
 
 /// Whether `a` is wrong against the truth `b` (the rule above).
 pub fn pixel_wrong(a: Radiance, b: Radiance) -> bool {
+    pixel_wrong_within(a, b, REL_TOLERANCE)
+}
+
+/// The rule above with a relative tolerance of `relative`.
+pub fn pixel_wrong_within(a: Radiance, b: Radiance, relative: f32) -> bool {
     if !(a.is_finite() && b.is_finite()) {
         return true;
     }
     (0..3).any(|c| {
         let d = (a[c] - b[c]).abs();
-        d > ABS_TOLERANCE && d > REL_TOLERANCE * a[c].abs().max(b[c].abs())
+        d > ABS_TOLERANCE && d > relative * a[c].abs().max(b[c].abs())
     })
 }
 
@@ -116,7 +121,10 @@ pub fn measure_case(case: &GalleryCase) -> Result<CaseResult, String> {
         if (sw, sh) != (w, h) {
             return Err(format!("gallery case {}: \"{}\" renders {sw}x{sh} but the truth is {w}x{h}", case.name, setting.description));
         }
-        let wrong = wrong_pixels(&image, &truth, w, h);
+        let wrong = match case.noise_tolerance {
+            Some(relative) => image.iter().zip(&truth).filter(|(a, b)| pixel_wrong_within(**a, **b, relative)).count(),
+            None => wrong_pixels(&image, &truth, w, h),
+        };
         measured.push(SettingResult { setting: format!("{} {}", setting.renderer, setting.description), wrong_pixels: wrong, image });
     }
     let cured = measured.pop().expect("two settings");

@@ -23,6 +23,9 @@ pub struct Admitted {
     pub settings: RenderSettings,
     /// One sentence per substitution, saying what changed and why.
     pub notices: Vec<String>,
+    /// One sentence per thing the settings, drawn as asked, approximate or
+    /// leave without effect (`approximations`): said, but nothing changed.
+    pub caveats: Vec<String>,
 }
 
 /// Settings a renderer can draw in place of ones it cannot, and the
@@ -38,15 +41,14 @@ pub struct Substitute {
 /// it draws), `Err` with why not. Loads no driver (`Renderer::ready` does).
 pub fn admit(renderer: &dyn Renderer, scene: &Scene, settings: &RenderSettings) -> Result<Admitted, String> {
     let mut refusal = match check(renderer, scene, settings) {
-        Ok(()) => return Ok(Admitted { settings: settings.clone(), notices: approximations(scene, settings) }),
+        Ok(()) => return Ok(Admitted { settings: settings.clone(), notices: Vec::new(), caveats: approximations(scene, settings) }),
         Err(e) => e,
     };
     for s in renderer.substitutes(settings) {
         match check(renderer, scene, &s.settings) {
             Ok(()) => {
-                let mut notices = vec![s.notice];
-                notices.extend(approximations(scene, &s.settings));
-                return Ok(Admitted { settings: s.settings, notices });
+                let caveats = approximations(scene, &s.settings);
+                return Ok(Admitted { settings: s.settings, notices: vec![s.notice], caveats });
             }
             // The most lenient substitute's refusal names what really stands in the way.
             Err(e) => refusal = e,
@@ -104,7 +106,7 @@ mod tests {
         let settings = RenderSettings { spp: 4, shadows: ShadowMode::Map, shadow_map_size: 256, msaa: 4, ..RenderSettings::for_scene(&sc) };
         for name in ["raytrace:brute", "raytrace:bvh", "rasterize"] {
             let a = admit(renderer_by_name(name).unwrap().as_ref(), &sc, &settings).unwrap();
-            assert_eq!(a, Admitted { settings: settings.clone(), notices: Vec::new() }, "{name}");
+            assert_eq!(a, Admitted { settings: settings.clone(), notices: Vec::new(), caveats: Vec::new() }, "{name}");
         }
     }
 
@@ -138,13 +140,14 @@ mod tests {
         let asked = RenderSettings { shadows: ShadowMode::Volume, ..RenderSettings::for_scene(&sc) };
         let a = admit(renderer_by_name("rasterize").unwrap().as_ref(), &sc, &asked).unwrap();
         assert_eq!(a.settings, asked);
-        assert_eq!(a.notices.len(), 1, "{:?}", a.notices);
-        assert!(a.notices[0].contains("hard shadow of its centre"), "{:?}", a.notices);
+        assert!(a.notices.is_empty(), "nothing is substituted: {:?}", a.notices);
+        assert_eq!(a.caveats.len(), 1, "{:?}", a.caveats);
+        assert!(a.caveats[0].contains("hard shadow of its centre"), "{:?}", a.caveats);
         // Filtered maps say nothing; a filter with ray shadows says it does nothing.
         let pcss = RenderSettings { shadows: ShadowMode::Map, shadow_filter: ShadowFilter::Pcss, ..asked.clone() };
-        assert!(admit(renderer_by_name("rasterize").unwrap().as_ref(), &sc, &pcss).unwrap().notices.is_empty());
+        assert!(admit(renderer_by_name("rasterize").unwrap().as_ref(), &sc, &pcss).unwrap().caveats.is_empty());
         let idle = RenderSettings { shadows: ShadowMode::Ray, shadow_filter: ShadowFilter::Pcf, ..asked };
-        let notes = admit(renderer_by_name("raytrace").unwrap().as_ref(), &sc, &idle).unwrap().notices;
+        let notes = admit(renderer_by_name("raytrace").unwrap().as_ref(), &sc, &idle).unwrap().caveats;
         assert!(notes.len() == 1 && notes[0].contains("changes nothing"), "{notes:?}");
         // OpenGL refuses lights it cannot sample, in one sentence.
         let e = admit(renderer_by_name("opengl").unwrap().as_ref(), &sc, &RenderSettings::for_scene(&sc)).unwrap_err();

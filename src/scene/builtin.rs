@@ -38,6 +38,7 @@ const STRESS_SCENES: &[(&str, &str)] = &[
     ("stress-tjunction-shared", include_str!("../../assets/scenes/stress-tjunction-shared.toml")),
     ("stress-specular", include_str!("../../assets/scenes/stress-specular.toml")),
     ("stress-terminator", include_str!("../../assets/scenes/stress-terminator.toml")),
+    ("stress-glossy-panel", include_str!("../../assets/scenes/stress-glossy-panel.toml")),
 ];
 
 /// The scene the viewer opens when given none.
