@@ -9,6 +9,7 @@ use crate::render::shadow::map as shadow_map;
 use crate::render::{Interpolation, RenderSettings, ShadowMode, DEFAULT_RAYTRACE};
 use crate::render::raster::depth_format::DepthFormat;
 use crate::render::shadow::volume::VolumeMode;
+use crate::render::shadow::ShadowFilter;
 use crate::render::raster::DEFAULT_RASTERIZE;
 use crate::render::Reflections;
 use crate::scene::texture::TextureFilter;
@@ -56,6 +57,18 @@ pub fn describe(renderer: &str, s: &RenderSettings) -> String {
         if s.shadow_map_bias != shadow_map::DEFAULT_BIAS {
             knob("shadow-map-bias", format!("{}", s.shadow_map_bias));
         }
+        if s.shadow_filter != ShadowFilter::None {
+            knob("shadow-filter", s.shadow_filter.name().to_string());
+            if s.shadow_filter == ShadowFilter::Pcf {
+                knob("pcf-radius", format!("{}", s.pcf_radius));
+            }
+        }
+    }
+    if s.light_samples != 1 {
+        knob("light-samples", s.light_samples.to_string());
+    }
+    if !s.mis {
+        knob("mis", "off".to_string());
     }
     if s.depth_buffer != DepthFormat::F32 {
         knob("depth-buffer", s.depth_buffer.name().to_string());
@@ -107,7 +120,7 @@ pub fn describe(renderer: &str, s: &RenderSettings) -> String {
 pub fn accepted(scene: &Scene, config: &Configuration) -> bool {
     crate::render::renderer_by_name(&config.renderer)
         .and_then(|r| crate::render::admit::admit(r.as_ref(), scene, &config.settings))
-        .is_ok_and(|a| a.notices.is_empty())
+        .is_ok_and(|a| a.notices.is_empty() && a.settings == config.settings)
 }
 
 /// What every swept configuration starts from: the scene's defaults, the
@@ -153,8 +166,37 @@ pub fn method_configurations(scene: &Scene, base: &RenderSettings) -> Vec<Config
         add("sub-sampling", ray, with(&|s| s.subsample = crate::render::frame::Subsample { step: 4, contrast }));
     }
 
+    // Lights with extent: light samples per shading point, light sampling
+    // alone (MIS off) and BSDF sampling alone (no light samples).
+    if scene.has_sampled_lights() {
+        for n in [4, 16] {
+            add("light sampling", ray, with(&|s| s.light_samples = n));
+        }
+        for n in [1, 4] {
+            add("light sampling", ray, with(&|s| {
+                s.light_samples = n;
+                s.mis = false;
+            }));
+        }
+        add("light sampling", ray, with(&|s| s.light_samples = 0));
+    }
+
+    // Soft shadows of area lights from maps: the three filters at two map
+    // sizes (volumes are below with the other shadows).
+    if !scene.emitters.is_empty() {
+        for size in [512, 2048] {
+            for filter in ShadowFilter::ALL {
+                add("soft shadows", raster, with(&|s| {
+                    s.shadows = ShadowMode::Map;
+                    s.shadow_map_size = size;
+                    s.shadow_filter = filter;
+                }));
+            }
+        }
+    }
+
     // Shadows: none, traced (above), or looked up in maps of a few sizes and biases.
-    let casts_shadows = !scene.lights.is_empty() && scene.triangles.len() + scene.spheres.len() > 1;
+    let casts_shadows = (!scene.lights.is_empty() || !scene.emitters.is_empty()) && scene.triangles.len() + scene.spheres.len() > 1;
     if casts_shadows {
         add("shadows", raster, with(&|s| s.shadows = ShadowMode::None));
         // Sizes whose maps for all the scene's lights would not fit in
@@ -305,6 +347,27 @@ mod tests {
         let teapot = crate::scene::builtin::load_builtin("teapot").unwrap().unwrap();
         let configs = method_configurations(&teapot, &RenderSettings::for_scene(&teapot));
         assert!(configs.iter().any(|c| c.renderer == "rasterize:painter"));
+    }
+
+    #[test]
+    fn lights_with_extent_sweep_light_samples_mis_and_shadow_filters() {
+        let scene = crate::scene::builtin::load_builtin("soft-shadows").unwrap().unwrap();
+        let configs = method_configurations(&scene, &RenderSettings::for_scene(&scene));
+        let labels: Vec<&str> = configs.iter().map(|c| c.label.as_str()).collect();
+        for expected in [
+            "raytrace:bvh --light-samples 16",
+            "raytrace:bvh --mis off",
+            "raytrace:bvh --light-samples 0",
+            "rasterize:fixed --shadows map --shadow-map-size 512",
+            "rasterize:fixed --shadows map --shadow-map-size 2048 --shadow-filter pcss",
+            "rasterize:fixed --shadows map --shadow-map-size 512 --shadow-filter pcf --pcf-radius 1.5",
+            "rasterize:fixed --shadows volume",
+        ] {
+            assert!(labels.contains(&expected), "{expected} missing from {labels:?}");
+        }
+        // A scene of point lights sweeps none of it.
+        let teapot = crate::scene::builtin::load_builtin("teapot").unwrap().unwrap();
+        assert!(method_configurations(&teapot, &RenderSettings::for_scene(&teapot)).iter().all(|c| c.group != "light sampling" && c.group != "soft shadows"));
     }
 
     #[test]
