@@ -12,7 +12,6 @@ use crate::render::inspect::debug::View;
 use crate::render::{layer_support, RenderSettings, Renderer, ShadowMode};
 use crate::render::shadow::map as shadow_map;
 use crate::render::shadow::ShadowFilter;
-use crate::named::Named;
 use crate::scene::Scene;
 
 /// Settings a renderer accepted.

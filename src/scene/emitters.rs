@@ -188,6 +188,48 @@ impl Emitters {
             + self.lights.iter().map(|l| size_of::<AreaLight>() + l.outline.capacity() * size_of::<[Vec3; 2]>()).sum::<usize>()
     }
 
+    /// Total emitted power (luminance): what a photon shot from the
+    /// emitters shares, and how often they are chosen beside other lights.
+    pub fn total_power(&self) -> f32 {
+        self.lights.iter().map(|l| l.power).sum()
+    }
+
+    /// Where a photon leaves the emitters: a primitive chosen by `u_choose`
+    /// in proportion to power, a point uniform on it by `u`, on the side
+    /// `u_side` picks for a two-sided triangle. Returns the point, the unit
+    /// normal of the side it leaves from, and the flux the photon carries
+    /// (before dividing by the photons shot): with a cosine-distributed
+    /// direction, `L_e * total_power / luminance(L_e)`.
+    pub fn sample_emission(&self, scene: &Scene, u_choose: f32, u: Vec2, u_side: f32) -> Option<(Vec3, Vec3, Vec3)> {
+        if self.shapes.is_empty() {
+            return None;
+        }
+        let k = self.cdf.partition_point(|&c| c <= u_choose).min(self.shapes.len() - 1);
+        let (point, normal, emission) = match self.shapes[k] {
+            EmitterShape::Triangle(i) => {
+                let t = scene.triangles.at(i as usize);
+                let r = u.x.sqrt();
+                let (b0, b1) = (1.0 - r, u.y * r);
+                let point = t.v[0] * b0 + t.v[1] * b1 + t.v[2] * (1.0 - b0 - b1);
+                let n = t.geometric_normal();
+                let n = if t.two_sided && u_side < 0.5 { -n } else { n };
+                (point, n, scene.materials[t.material as usize].emission)
+            }
+            EmitterShape::Sphere(i) => {
+                let s = &scene.spheres[i as usize];
+                // Uniform on the sphere.
+                let z = 1.0 - 2.0 * u.x;
+                let r = (1.0 - z * z).max(0.0).sqrt();
+                let phi = 2.0 * PI * u.y;
+                let n = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+                (s.center + n * s.radius, n, scene.materials[s.material as usize].emission)
+            }
+        };
+        let lum = luminance(emission);
+        let flux = emission * (self.total_power() / lum);
+        (lum > 0.0 && flux.is_finite() && point.is_finite()).then_some((point, normal, flux))
+    }
+
     /// A point on an emitter, seen from `p`: the emitter chosen by `u_choose`
     /// in proportion to power, the point placed on it by `u`. `None` where
     /// there are no emitters or the point is degenerate (on the emitter).

@@ -121,6 +121,13 @@ impl EnvironmentLight {
         (total > 0.0 && total.is_finite()).then_some(EnvironmentLight { width: w, height: h, columns, rows })
     }
 
+    /// About the integral of the luminance over the sphere (from the
+    /// sampling weights, which take each texel's brightest neighbour, so an
+    /// overestimate): how often photons leave the sky beside other lights.
+    pub fn flux_estimate(&self) -> f32 {
+        self.rows[self.height - 1] * 2.0 * PI * PI / (self.width * self.height) as f32
+    }
+
     /// A direction sampled by `u`, and its density in solid angle.
     pub fn sample(&self, u: Vec2) -> Option<(Vec3, f32)> {
         let (w, h) = (self.width, self.height);

@@ -91,8 +91,11 @@ impl PhotonMap {
             Some((lo, hi)) => ((lo + hi) * 0.5, ((hi - lo).length() * 0.5).max(1e-3)),
             None => (Vec3::ZERO, 1.0),
         };
-        // Lights are picked in proportion to the flux they send into the scene.
-        let flux: Vec<Vec3> = scene
+        // Lights are picked in proportion to the flux they send into the
+        // scene: the point and directional lights, then (one source each)
+        // the emissive surfaces and the environment. Only the choice needs
+        // the flux; each photon's power is divided by its own probability.
+        let mut flux: Vec<Vec3> = scene
             .lights
             .iter()
             .map(|l| match *l {
@@ -100,6 +103,11 @@ impl PhotonMap {
                 Light::Directional { irradiance, .. } => irradiance * (PI * radius * radius),
             })
             .collect();
+        let emitters_source = flux.len();
+        flux.push(Vec3::splat(scene.emitters.total_power()));
+        let sky = scene.environment.as_ref().and_then(|e| e.light.clone());
+        let sky_source = flux.len();
+        flux.push(Vec3::splat(sky.as_ref().map_or(0.0, |l| l.flux_estimate() * PI * radius * radius)));
         let weights: Vec<f32> = flux.iter().map(|f| luminance(*f).max(0.0)).collect();
         let total: f32 = weights.iter().sum();
         let shot = gi.photons;
@@ -118,16 +126,40 @@ impl PhotonMap {
                         pick -= w;
                     }
                     let p_light = weights[light] / total;
-                    let power = flux[light] / (shot as f32 * p_light);
-                    let ray = match scene.lights[light] {
-                        Light::Point { position, .. } => Ray::new(position, uniform_sphere(rng.next_2d())),
-                        Light::Directional { direction, .. } => {
-                            let d = direction.normalize_or_zero();
-                            let (t, b) = tangents(d);
-                            let o = uniform_disk(rng.next_2d()) * radius;
-                            Ray::new(center - d * (2.0 * radius) + t * o.x + b * o.y, d)
-                        }
+                    let share = 1.0 / (shot as f32 * p_light);
+                    let (ray, power) = if light == emitters_source {
+                        // A point on an emitter, a cosine-weighted direction
+                        // about its normal (as a Lambertian emitter sends light).
+                        let (u_choose, u, u_side) = (rng.next_f32(), rng.next_2d(), rng.next_f32());
+                        let Some((point, normal, flux)) = scene.emitters.sample_emission(scene, u_choose, u, u_side) else { return Vec::new() };
+                        let dir = from_local(cosine_hemisphere(rng.next_2d()), normal);
+                        (Ray::new(point + normal * bump, dir), flux * share)
+                    } else if light == sky_source {
+                        // A direction sampled from the sky, entering through a
+                        // disc across the scene's bounding sphere.
+                        let Some(l) = sky.as_ref() else { return Vec::new() };
+                        let Some((to_sky, pdf)) = l.sample(rng.next_2d()) else { return Vec::new() };
+                        let d = -to_sky;
+                        let (t, b) = tangents(d);
+                        let o = uniform_disk(rng.next_2d()) * radius;
+                        let radiance = scene.miss_radiance(to_sky);
+                        let ray = Ray::new(center - d * (2.0 * radius) + t * o.x + b * o.y, d);
+                        (ray, radiance * (PI * radius * radius / pdf) * share)
+                    } else {
+                        let ray = match scene.lights[light] {
+                            Light::Point { position, .. } => Ray::new(position, uniform_sphere(rng.next_2d())),
+                            Light::Directional { direction, .. } => {
+                                let d = direction.normalize_or_zero();
+                                let (t, b) = tangents(d);
+                                let o = uniform_disk(rng.next_2d()) * radius;
+                                Ray::new(center - d * (2.0 * radius) + t * o.x + b * o.y, d)
+                            }
+                        };
+                        (ray, flux[light] * share)
                     };
+                    if !power.is_finite() {
+                        return Vec::new();
+                    }
                     trace_photon(scene, &query, ray, power, bump, &mut rng)
                 })
                 .flatten_iter()
