@@ -532,3 +532,36 @@ fn photons_leave_area_lights_and_the_sky() {
     assert!((photons / path - 1.0).abs() < 0.03, "photons {photons} against path {path}");
     assert!(direct < 0.95 * path, "direct light alone {direct} is not short of {path}");
 }
+
+/// A replayed pixel lists its light samples: on the Cornell box's floor
+/// area-light samples with a point on the panel, a density and an MIS
+/// weight in [0, 1], and the BSDF strategy's ray; their contributions are
+/// the pixel's direct light from the panel. With `--mis off` the BSDF ray
+/// is gone and every weight is 1.
+#[test]
+fn replays_list_every_light_sample() {
+    use pinhole::render::inspect::pixel_record::SampledLightKind;
+    let mut scene = builtin("cornell-box");
+    (scene.render.width, scene.render.height) = (60, 60);
+    let prepared = PreparedScene::new(scene);
+    let raytrace = pinhole::render::renderer_by_name("raytrace").unwrap();
+    let settings = direct_settings(&prepared, 1, 4);
+    // A pixel on the floor, left of the bunny, in the panel's light.
+    let (x, y) = (12, 56);
+    let replay = pinhole::render::replay_pixel(raytrace.as_ref(), &prepared, &settings, x, y).unwrap();
+    let frame = render("raytrace", &prepared, &settings);
+    assert_eq!(replay.radiance, frame[(x + y * 60) as usize], "the replay is the frame's pixel");
+    let lights = &replay.samples[0].1.sampled_lights;
+    eprintln!("{lights:#?}");
+    let area: Vec<_> = lights.iter().filter(|l| matches!(l.kind, SampledLightKind::Area(_))).collect();
+    assert_eq!(area.len(), 4, "four light samples");
+    assert!(area.iter().all(|l| l.point.is_some_and(|p| (p.y - 1.98).abs() < 1e-3) && l.pdf > 0.0 && (0.0..=1.0).contains(&l.mis_weight)));
+    assert!(lights.iter().any(|l| l.kind == SampledLightKind::BsdfHit), "the BSDF strategy's ray is listed");
+    let direct: Vec3 = lights.iter().map(|l| l.contribution).sum();
+    assert!(direct.x > 0.0 && direct.x <= replay.radiance.x + 1e-6, "{direct} of {}", replay.radiance);
+
+    let off = RenderSettings { mis: false, ..settings };
+    let replay = pinhole::render::replay_pixel(raytrace.as_ref(), &prepared, &off, x, y).unwrap();
+    let lights = &replay.samples[0].1.sampled_lights;
+    assert!(lights.iter().all(|l| l.kind != SampledLightKind::BsdfHit && l.mis_weight == 1.0), "{lights:#?}");
+}
