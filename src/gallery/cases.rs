@@ -351,6 +351,12 @@ fn soft_map(s: &mut RenderSettings, filter: ShadowFilter) {
     s.shadow_filter = filter;
 }
 
+/// The cure of the area-light shadow cases: shadow rays to points on the panel.
+const AREA_RAYS: Setting = Setting::new("rasterize", "--shadows ray", |s| {
+    soft(s);
+    s.shadows = ShadowMode::Ray;
+});
+
 /// The truth of the area-light shadow cases: the panel sampled with rays.
 const AREA_TRUTH: Setting = Setting::new("raytrace", "raytrace --spp 64 --light-samples 32", |s| {
     s.spp = 64;
@@ -369,10 +375,7 @@ fn area_light_cases() -> Vec<GalleryCase> {
             knob: "shadow-filter",
             explanation: "a plain shadow map is drawn from the panel's centre: every shadow has a hard edge, the floating ball's faint blur becomes a dark disc and the post's widening shadow stays thin",
             failing: Setting::new("rasterize", "--shadows map --shadow-filter none", |s| soft_map(s, ShadowFilter::None)),
-            cured: Setting::new("rasterize", "--shadows ray", |s| {
-                soft(s);
-                s.shadows = ShadowMode::Ray;
-            }),
+            cured: AREA_RAYS,
             truth: AREA_TRUTH,
             threshold: AREA_THRESHOLD,
             size: Some((160, 100)),
@@ -388,10 +391,7 @@ fn area_light_cases() -> Vec<GalleryCase> {
                 soft(s);
                 s.shadows = ShadowMode::Volume;
             }),
-            cured: Setting::new("rasterize", "--shadows ray", |s| {
-                soft(s);
-                s.shadows = ShadowMode::Ray;
-            }),
+            cured: AREA_RAYS,
             truth: AREA_TRUTH,
             threshold: AREA_THRESHOLD,
             size: Some((160, 100)),
@@ -407,10 +407,7 @@ fn area_light_cases() -> Vec<GalleryCase> {
                 soft_map(s, ShadowFilter::Pcf);
                 s.pcf_radius = 12.0;
             }),
-            cured: Setting::new("rasterize", "--shadows ray", |s| {
-                soft(s);
-                s.shadows = ShadowMode::Ray;
-            }),
+            cured: AREA_RAYS,
             truth: AREA_TRUTH,
             threshold: AREA_THRESHOLD,
             size: Some((160, 100)),
@@ -423,10 +420,7 @@ fn area_light_cases() -> Vec<GalleryCase> {
             knob: "shadows",
             explanation: "PCSS filters the map as wide as the penumbra it estimates: the thin post covers too few texels of that width, so light leaks through its shadow, which rays to the panel keep",
             failing: Setting::new("rasterize", "--shadows map --shadow-filter pcss", |s| soft_map(s, ShadowFilter::Pcss)),
-            cured: Setting::new("rasterize", "--shadows ray", |s| {
-                soft(s);
-                s.shadows = ShadowMode::Ray;
-            }),
+            cured: AREA_RAYS,
             truth: AREA_TRUTH,
             threshold: AREA_THRESHOLD,
             size: Some((160, 100)),

@@ -197,7 +197,12 @@ impl ShadowMaps {
     /// True when these maps were built for `scene`'s lights at `size`.
     #[inline]
     pub fn matches(&self, scene: &Scene, size: u32) -> bool {
-        self.size == size.clamp(1, MAX_SIZE) && self.lights == scene.lights && self.area_lights == area_key(scene)
+        // Compared in place: asked on every lookup, so nothing is allocated.
+        let areas = &scene.emitters.lights;
+        self.size == size.clamp(1, MAX_SIZE)
+            && self.lights == scene.lights
+            && self.area_lights.len() == areas.len()
+            && self.area_lights.iter().zip(areas).all(|(&(object, centre), l)| object == l.object && centre == l.centre)
     }
 
     /// The map's verdict for light `light` at `hit`: the primitive stored in

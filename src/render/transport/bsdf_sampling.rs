@@ -158,6 +158,23 @@ mod tests {
     use super::*;
     use crate::render::transport::sampling::SampleRng;
 
+    /// The midpoint rule over the sphere of directions, `n_theta` x `n_phi`
+    /// cells in polar coordinates about the unit axis `about` (put it where
+    /// the integrand peaks, so its cells are finest there).
+    fn integrate_sphere(n_theta: usize, n_phi: usize, about: Vec3, f: impl Fn(Vec3) -> f64) -> f64 {
+        let (d_theta, d_phi) = (std::f64::consts::PI / n_theta as f64, 2.0 * std::f64::consts::PI / n_phi as f64);
+        let mut sum = 0.0f64;
+        for i in 0..n_theta {
+            let theta = (i as f64 + 0.5) * d_theta;
+            for j in 0..n_phi {
+                let phi = (j as f64 + 0.5) * d_phi;
+                let local = Vec3::new((theta.sin() * phi.cos()) as f32, (theta.sin() * phi.sin()) as f32, theta.cos() as f32);
+                sum += f(from_local(local, about)) * theta.sin() * d_theta * d_phi;
+            }
+        }
+        sum
+    }
+
     /// The Monte Carlo estimate of the directional albedo `∫ f cos dw`.
     fn albedo_estimate(m: &Material, w_o: Vec3, n: usize) -> Vec3 {
         let mut r = SampleRng::for_index(21, 0, 1);
@@ -264,20 +281,7 @@ mod tests {
     /// normal, smooth) and below one otherwise.
     #[test]
     fn glossy_densities_integrate_to_one() {
-        let sphere_integral = |m: &Material, w_o: Vec3| {
-            let (n_theta, n_phi) = (800, 800);
-            let (d_theta, d_phi) = (PI as f64 / n_theta as f64, 2.0 * std::f64::consts::PI / n_phi as f64);
-            let mut sum = 0.0f64;
-            for i in 0..n_theta {
-                let theta = (i as f64 + 0.5) * d_theta;
-                for j in 0..n_phi {
-                    let phi = (j as f64 + 0.5) * d_phi;
-                    let w_i = Vec3::new((theta.sin() * phi.cos()) as f32, (theta.sin() * phi.sin()) as f32, theta.cos() as f32);
-                    sum += glossy_pdf(m, Vec3::Z, w_o, w_i) as f64 * theta.sin() * d_theta * d_phi;
-                }
-            }
-            sum
-        };
+        let sphere_integral = |m: &Material, w_o: Vec3| integrate_sphere(800, 800, Vec3::Z, |w_i| glossy_pdf(m, Vec3::Z, w_o, w_i) as f64);
         let near_normal = Vec3::new(0.3, 0.1, 0.9).normalize();
         let grazing = Vec3::new(0.95, 0.0, 0.3).normalize();
         for (model, roughness, sharpness) in [(GlossyModel::Ggx, 0.2, 0.0), (GlossyModel::Ggx, 0.7, 0.0), (GlossyModel::Phong, 0.1, 10.0), (GlossyModel::Phong, 0.1, 60.0)] {
@@ -350,25 +354,12 @@ mod tests {
     /// narrowest lobe: its error is far below the 1e-3 allowed.
     #[test]
     fn smooth_ggx_reflects_at_most_what_arrives() {
-        let (n_theta, n_phi) = (3600, 256);
-        let (d_theta, d_phi) = (std::f64::consts::PI / n_theta as f64, 2.0 * std::f64::consts::PI / n_phi as f64);
         for alpha in [0.01f32, 0.05, 0.1] {
             let m = glossy_material(GlossyModel::Ggx, alpha, 0.0);
             for cos_o in [1.0f32, 0.7, 0.3] {
                 let w_o = Vec3::new((1.0 - cos_o * cos_o).sqrt(), 0.0, cos_o);
                 let r = reflect(w_o, Vec3::Z).normalize();
-                let mut sum = 0.0f64;
-                for i in 0..n_theta {
-                    let theta = (i as f64 + 0.5) * d_theta;
-                    for j in 0..n_phi {
-                        let phi = (j as f64 + 0.5) * d_phi;
-                        let local = Vec3::new((theta.sin() * phi.cos()) as f32, (theta.sin() * phi.sin()) as f32, theta.cos() as f32);
-                        let w_i = from_local(local, r);
-                        if w_i.z > 0.0 {
-                            sum += (bsdf(&m, Vec3::ZERO, Vec3::Z, w_i, w_o).x * w_i.z) as f64 * theta.sin() * d_theta * d_phi;
-                        }
-                    }
-                }
+                let sum = integrate_sphere(3600, 256, r, |w_i| if w_i.z > 0.0 { (bsdf(&m, Vec3::ZERO, Vec3::Z, w_i, w_o).x * w_i.z) as f64 } else { 0.0 });
                 assert!(sum <= 1.001, "alpha {alpha}, cos_o {cos_o}: the lobe reflects {sum}");
                 assert!(sum > 0.9, "alpha {alpha}, cos_o {cos_o}: the lobe reflects only {sum}");
             }

@@ -104,12 +104,14 @@ pub fn sampled_direct<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &
     let count = settings.light_samples;
     let mis = bsdf_strategy(sh, depth);
     let mut l_o = Vec3::ZERO;
-    let emitters = scene.emitters.clone();
+    let emitters = &scene.emitters;
     if !emitters.is_empty() && count > 0 {
         // Volumes give the hard shadow of each area light's centre, and maps
         // (filtered or not) one visibility for the whole light: asked once
-        // per light and surface, and multiplying every sample of that light.
-        let mut whole_light: Vec<Option<f32>> = Vec::new();
+        // per light and surface (kept on the stack for the first few
+        // lights, asked again for the rest), and multiplying every sample
+        // of that light.
+        let mut whole_light = [None::<f32>; 8];
         for k in 0..count {
             let u_choose = (k as f32 + sh.path.rng.next_f32()) / count as f32;
             let u = sh.path.rng.next_2d();
@@ -127,14 +129,13 @@ pub fn sampled_direct<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &
                 ShadowMode::Ray => unblocked(sh, hit, s.w_i, s.distance) as u8 as f32,
                 ShadowMode::Map | ShadowMode::Volume => {
                     let light = s.light as usize;
-                    if whole_light.len() <= light {
-                        whole_light.resize(light + 1, None);
-                    }
-                    match whole_light[light] {
+                    match whole_light.get(light).copied().flatten() {
                         Some(v) => v,
                         None => {
                             let v = light_visibility(sh, hit, light);
-                            whole_light[light] = Some(v);
+                            if let Some(slot) = whole_light.get_mut(light) {
+                                *slot = Some(v);
+                            }
                             v
                         }
                     }
@@ -149,7 +150,7 @@ pub fn sampled_direct<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &
             }
         }
     }
-    if let Some(light) = scene.environment.as_ref().and_then(|e| e.light.clone()).filter(|_| count > 0) {
+    if let Some(light) = scene.environment.as_ref().and_then(|e| e.light.as_deref()).filter(|_| count > 0) {
         for _ in 0..count {
             let u = sh.path.rng.next_2d();
             let Some((w_i, pdf)) = light.sample(u) else { continue };
