@@ -201,6 +201,51 @@ fn the_cornell_box_panel_at_256_spp_is_within_mitsubas_noise() {
     }
 }
 
+/// A very glossy ball and a diffuse floor under a small bright panel and a
+/// large dim one: light sampling alone is noisy in the ball's reflection
+/// of the large panel, BSDF sampling alone on the floor under the small
+/// one, and MIS is better than either.
+const MIS_SCENE: &str = r#"
+[camera]
+eye = [0.0, 1.0, 3.5]
+target = [0.0, 0.5, 0.0]
+fov_y_deg = 40.0
+[render]
+width = 48
+height = 36
+ambient = [0.0, 0.0, 0.0]
+background = [0.0, 0.0, 0.0]
+[materials.small]
+lambertian = [0.0, 0.0, 0.0]
+emission = [60.0, 60.0, 60.0]
+[materials.large]
+lambertian = [0.0, 0.0, 0.0]
+emission = [0.6, 0.6, 0.8]
+[materials.glossy]
+lambertian = [0.05, 0.05, 0.05]
+glossy = [0.8, 0.8, 0.8]
+sharpness = 800.0
+[materials.floor]
+lambertian = [0.6, 0.6, 0.6]
+[[object]]
+type = "quad"
+vertices = [[-0.15, 2.5, -0.15], [0.15, 2.5, -0.15], [0.15, 2.5, 0.15], [-0.15, 2.5, 0.15]]
+material = "small"
+[[object]]
+type = "quad"
+vertices = [[-4.0, 4.0, -4.0], [4.0, 4.0, -4.0], [4.0, 4.0, 4.0], [-4.0, 4.0, 4.0]]
+material = "large"
+[[object]]
+type = "sphere"
+center = [0.0, 0.5, 0.0]
+radius = 0.5
+material = "glossy"
+[[object]]
+type = "quad"
+vertices = [[-6.0, 0.0, 6.0], [6.0, 0.0, 6.0], [6.0, 0.0, -6.0], [-6.0, 0.0, -6.0]]
+material = "floor"
+"#;
+
 /// Noise of an unbiased estimator without a reference: the rmse between two
 /// renders with independent seeds is sqrt(2) times its own.
 fn noise(prepared: &PreparedScene, settings: &RenderSettings) -> f64 {
@@ -211,15 +256,9 @@ fn noise(prepared: &PreparedScene, settings: &RenderSettings) -> f64 {
     relative_rmse(&render("raytrace", prepared, &a), &render("raytrace", prepared, &b)) / 2f64.sqrt()
 }
 
-/// On `stress-glossy-panel` (a very glossy ball and a diffuse floor under a
-/// small bright panel and a large dim one) light sampling alone is noisy in
-/// the ball's reflection of the large panel, BSDF sampling alone on the
-/// floor under the small one, and MIS is better than either.
 #[test]
 fn mis_beats_each_strategy_alone() {
-    let mut scene = builtin("stress-glossy-panel");
-    (scene.render.width, scene.render.height) = (48, 30);
-    let prepared = PreparedScene::new(scene);
+    let prepared = PreparedScene::new(scene_from(MIS_SCENE));
     let mis = direct_settings(&prepared, 16, 1);
     let light_alone = RenderSettings { mis: false, ..mis.clone() };
     let bsdf_alone = RenderSettings { light_samples: 0, ..mis.clone() };

@@ -600,9 +600,6 @@ pub fn with_shading_hit<T>(interpolation: Interpolation, hit: &SurfaceHit, f: im
     }
 }
 
-/// The random stream of the passes' sub-pixel jitter (`sample_offset`).
-const PASS_JITTER_STREAM: u64 = 0x6a_6974_7465_72;
-
 /// Stratified, jittered sub-pixel positions: one point in each cell of an
 /// n x n grid when `spp` is a square, otherwise a Latin hypercube (one cell
 /// per row and per column of an spp x spp grid, columns in a fixed
@@ -619,8 +616,7 @@ pub fn sample_offset(index: u32, spp: u32, seed: u64) -> Vec2 {
     if spp == 1 {
         return Vec2::splat(0.5);
     }
-    let mut rng = transport::sampling::SampleRng::for_index(PASS_JITTER_STREAM, index as u64 | (spp as u64) << 32, seed);
-    let jitter = Vec2::new(rng.next_f32(), rng.next_f32());
+    let jitter = transport::sampling::hashed_unit_pair(index as u64 | (spp as u64) << 32, seed);
     let n = (spp as f32).sqrt().round() as u32;
     if n * n == spp {
         let (i, j) = (index % n, index / n);

@@ -56,6 +56,15 @@ fn mix64(mut z: u64) -> u64 {
 
 const GOLDEN: u64 = 0x9E37_79B9_7F4A_7C15;
 
+/// Two numbers in [0, 1) that are a pure function of `key` and `seed`
+/// (for draws shared by every pixel, such as a pass's sub-pixel jitter).
+pub fn hashed_unit_pair(key: u64, seed: u64) -> Vec2 {
+    let h = mix64(key.wrapping_mul(GOLDEN) ^ mix64(seed ^ 0x5851_F42D_4C95_7F2D));
+    // 24 bits each, so the f32 is exact and below 1.
+    let unit = |bits: u64| (bits & 0xFF_FFFF) as f32 / (1u64 << 24) as f32;
+    Vec2::new(unit(h), unit(h >> 32))
+}
+
 impl SampleRng {
     /// The stream of sample `sample` of pixel `pixel` (`x + y * width`).
     /// Cheap to make: the key is scrambled on the first draw, so samples
