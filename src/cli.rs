@@ -15,6 +15,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::Instant;
 
 mod render_opts;
+mod usage_error;
 use render_opts::RenderOpts;
 
 #[derive(Parser)]
@@ -134,12 +135,21 @@ pub enum Outcome {
 
 /// Parses the arguments and runs the command.
 pub fn run() -> Result<Outcome, String> {
-    let cli = match Cli::try_parse() {
+    use clap::{CommandFactory, FromArgMatches};
+    // Negative numbers reach the value parsers, which then name the option
+    // and its range, instead of reading as unknown flags.
+    let command = Cli::command().allow_negative_numbers(true).mut_subcommands(|s| s.allow_negative_numbers(true));
+    let parsed = command.clone().try_get_matches().and_then(|m| Cli::from_arg_matches(&m));
+    let cli = match parsed {
         Ok(c) => c,
+        Err(e) if e.use_stderr() => {
+            eprintln!("pinhole: {}", usage_error::one_sentence(&e, &command));
+            std::process::exit(2);
+        }
         Err(e) => {
-            // Help and version go to stdout with success; usage errors are clap's one-liners.
+            // Help and version go to stdout with success.
             let _ = e.print();
-            std::process::exit(if e.use_stderr() { 2 } else { 0 });
+            std::process::exit(0);
         }
     };
     let ran = match cli.command {
@@ -172,26 +182,36 @@ struct Loaded {
     load_ms: f64,
 }
 
+/// Most frames `bench --frames` times: 10,000 frames of a slow scene are
+/// already hours.
+const MAX_BENCH_FRAMES: u32 = 10_000;
+
 /// Most worker threads `--threads` starts: more only cost memory and start-up time.
 const MAX_THREADS: usize = 256;
+
+/// The worker threads of every subcommand: `--threads` (default: all
+/// cores), at least 1 and capped at `MAX_THREADS` with a warning.
+fn worker_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, String> {
+    if threads == Some(0) {
+        return Err("--threads must be at least 1".into());
+    }
+    let mut threads = threads.unwrap_or(0);
+    if threads > MAX_THREADS {
+        eprintln!("warning: --threads {threads} is more than {MAX_THREADS}; using {MAX_THREADS}");
+        threads = MAX_THREADS;
+    }
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| format!("cannot start {threads} worker threads: {e}"))
+}
 
 fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
     let renderer = render::renderer_by_name(&opts.renderer)?;
     // The options are checked before the scene loads (which can take seconds)
     // and written over the scene's settings once it has.
     opts.write_into(&mut RenderSettings::default())?;
-    let mut threads = opts.threads.unwrap_or(0);
-    if opts.threads == Some(0) {
-        return Err("--threads must be at least 1".into());
-    }
-    if threads > MAX_THREADS {
-        eprintln!("warning: --threads {threads} is more than {MAX_THREADS}; using {MAX_THREADS}");
-        threads = MAX_THREADS;
-    }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| format!("cannot start {threads} worker threads: {e}"))?;
+    let pool = worker_pool(opts.threads)?;
     let start = Instant::now();
     let scene: Scene = crate::scene::load::load_scene(scene_arg)?;
     let load_ms = start.elapsed().as_secs_f64() * 1e3;
@@ -264,7 +284,11 @@ fn cmd_render(scene_arg: &str, output: &Path, opts: &RenderOpts, stats: Option<&
     if let Some(dest) = stats.filter(|d| *d != "-") {
         crate::image_io::check_writable(Path::new(dest))?;
     }
+    let outputs: Vec<&Path> = std::iter::once(output).chain(stats.filter(|d| *d != "-").map(Path::new)).collect();
+    crate::file_identity::check_outputs(&outputs)?;
     let l = load(scene_arg, opts)?;
+    // Now that every input is read: none of them may be an output.
+    crate::file_identity::check_outputs(&outputs)?;
     let cancel = AtomicBool::new(false);
     let rows_done = AtomicU64::new(0);
     let total_rows = l.settings.height as u64 * l.settings.spp as u64;
@@ -326,10 +350,12 @@ fn write_json(dest: &str, j: &serde_json::Value) -> Result<(), String> {
 }
 
 fn cmd_bench(scene_arg: &str, opts: &RenderOpts, frames: u32) -> Result<(), String> {
-    if frames == 0 {
-        return Err("--frames must be at least 1".into());
+    if !(1..=MAX_BENCH_FRAMES).contains(&frames) {
+        return Err(format!("--frames {frames} is not between 1 and {MAX_BENCH_FRAMES}"));
     }
     let l = load(scene_arg, opts)?;
+    let bench_started = Instant::now();
+    let mut last_note = bench_started;
     let cancel = AtomicBool::new(false);
     let mut times = Vec::new();
     let mut first_ms = 0.0;
@@ -351,6 +377,12 @@ fn cmd_bench(scene_arg: &str, opts: &RenderOpts, frames: u32) -> Result<(), Stri
             first_ms = ms;
         }
         spare = frame.pixels;
+        // Long benchmarks say how far they are, every few seconds.
+        if last_note.elapsed().as_secs_f64() >= 2.0 && i < frames {
+            last_note = Instant::now();
+            let per_frame = bench_started.elapsed().as_secs_f64() / (i + 1) as f64;
+            eprintln!("bench: {i} of {frames} frames, about {:.0} s left", per_frame * (frames - i) as f64);
+        }
     }
     times.sort_by(f64::total_cmp);
     let median = times[times.len() / 2];
@@ -424,6 +456,7 @@ fn cmd_chart_methods(scene_arg: &str, output: &Path, metric: &str, reference: Op
     }
     // Shadow-map configurations too big for the scene's lights are left out of the sweep.
     let l = load(scene_arg, opts)?;
+    check_chart_outputs(output)?;
     let (w, h) = (l.settings.width, l.settings.height);
     if metric == crate::chart::ErrorMetric::Flip && (w * h) as usize > crate::metrics::MAX_FLIP_PIXELS {
         return Err(format!("--metric flip: {w}x{h} is more than the {} pixels FLIP is computed for", crate::metrics::MAX_FLIP_PIXELS));
@@ -436,6 +469,7 @@ fn cmd_chart_methods(scene_arg: &str, output: &Path, metric: &str, reference: Op
         .install(|| crate::chart::load_reference(&source, &l.prepared, w, h, cache.as_deref(), &cancel, None))?
         .ok_or("cancelled")?;
     eprintln!("reference: {}", truth.name);
+    check_chart_outputs(output)?;
     let configs = match gi {
         Some((spps, _)) => {
             if l.prepared.scene.render.ambient.max_element() <= 0.0 {
@@ -476,6 +510,12 @@ fn check_png_output(output: &Path) -> Result<(), String> {
     crate::image_io::check_writable(&output.with_extension("csv"))
 }
 
+/// Once the scene and reference are read, before measuring: the chart and
+/// its CSV are neither inputs nor the same file.
+fn check_chart_outputs(output: &Path) -> Result<(), String> {
+    crate::file_identity::check_outputs(&[output, &output.with_extension("csv")])
+}
+
 fn cmd_chart(scene_arg: &str, output: &Path, renderers: &str, spp_list: &str, reference: Option<&Path>, reference_spp: u32, opts: &RenderOpts) -> Result<(), String> {
     check_png_output(output)?;
     if !(1..=65536).contains(&reference_spp) {
@@ -487,16 +527,11 @@ fn cmd_chart(scene_arg: &str, output: &Path, renderers: &str, spp_list: &str, re
         render::renderer_by_name(n)?;
     }
     let l = load(scene_arg, opts)?;
+    check_chart_outputs(output)?;
     let (w, h) = (l.settings.width, l.settings.height);
     let reference = reference.map(Path::to_path_buf).or_else(|| l.prepared.scene.render.reference.clone());
     let reference_pixels = match reference.as_deref() {
-        Some(path) => {
-            let img = crate::image_io::load_image(path)?;
-            if (img.width, img.height) != (w, h) {
-                return Err(format!("{} is {}x{} but the render is {w}x{h}", path.display(), img.width, img.height));
-            }
-            img.pixels
-        }
+        Some(path) => crate::chart::reference::load_reference_file(path, w, h)?.pixels,
         None => {
             eprintln!("rendering the reference: raytrace:bvh at {reference_spp} spp");
             let r = render::renderer_by_name(render::DEFAULT_RAYTRACE)?;
@@ -507,6 +542,7 @@ fn cmd_chart(scene_arg: &str, output: &Path, renderers: &str, spp_list: &str, re
                 .pixels
         }
     };
+    check_chart_outputs(output)?;
     let points = l.pool.install(|| {
         crate::chart::spp_sweep::sweep(&l.prepared, &l.settings, &names, &spps, &reference_pixels, 3, |r, spp| eprintln!("measuring {r} at {spp} spp"), |n| eprintln!("note: {n}"))
     })?;
@@ -563,13 +599,7 @@ fn cmd_gallery(dir: &Path, only: Option<&str>, threads: Option<usize>) -> Result
         Some(name) => vec![gallery::case_by_name(name)?],
         None => gallery::cases(),
     };
-    if threads == Some(0) {
-        return Err("--threads must be at least 1".into());
-    }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads.unwrap_or(0))
-        .build()
-        .map_err(|e| format!("cannot start worker threads: {e}"))?;
+    let pool = worker_pool(threads)?;
     if dir.exists() && !dir.is_dir() {
         return Err(format!("{}: exists and is not a directory", dir.display()));
     }

@@ -75,6 +75,10 @@ pub fn read_file(path: &Path, kind: InputKind) -> Result<Vec<u8>, String> {
         return Err(format!("{name}: the {} is {} bytes, more than the limit of {}", kind.noun(), meta.len(), size_text(limit)));
     }
     let file = std::fs::File::open(path).map_err(|e| format!("{name}: cannot read {}: {e}", kind.noun()))?;
+    // Recorded before reading, so no output of this run may replace it.
+    if let Ok(opened) = file.metadata() {
+        crate::file_identity::record_input(path, &opened);
+    }
     // The file may grow between the size check and the read: never read past the limit.
     let mut bytes = Vec::with_capacity(meta.len() as usize);
     file.take(limit + 1).read_to_end(&mut bytes).map_err(|e| format!("{name}: cannot read {}: {e}", kind.noun()))?;

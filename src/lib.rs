@@ -7,6 +7,7 @@
 pub mod chart;
 pub mod cli;
 pub mod env_overrides;
+pub mod file_identity;
 pub mod gallery;
 pub mod image_io;
 pub mod input;

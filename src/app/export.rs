@@ -76,6 +76,8 @@ pub fn export(o: &Output, path: &Path) -> Result<String, String> {
     if o.width == 0 {
         return Err("nothing rendered yet".to_string());
     }
+    // Never over a scene, mesh or texture this session has read.
+    crate::file_identity::check_outputs(&[path])?;
     match ext.as_str() {
         "png" => image_io::write_atomic(path, &image_io::encode_png(o.width, o.height, &o.rgb8)?)?,
         "exr" => image_io::save_image(path, o.width, o.height, &o.linear, 1.0)?,

@@ -81,15 +81,23 @@ impl<'de> serde::Deserialize<'de> for Present {
 }
 
 impl ViewerSettings {
-    /// Brings loaded values into range: a renderer this build has, spp in
-    /// 1..=1024, a resolution scale in 0.1..=2.
-    pub fn sanitized(mut self, renderer_names: &[&str]) -> ViewerSettings {
+    /// Brings loaded values into range: a renderer this build has, every
+    /// render setting within the bounds the command line enforces
+    /// (`settings_check`; one out of range goes back to its default), spp
+    /// at most the viewer's 1024, a resolution scale in 0.1..=2. Returns one
+    /// sentence per value repaired.
+    pub fn sanitized(mut self, renderer_names: &[&str]) -> (ViewerSettings, Vec<String>) {
+        let mut said = Vec::new();
         if !renderer_names.contains(&self.renderer.as_str()) {
+            said.push(format!("saved renderer \"{}\" is not in this build; using {}", self.renderer, crate::render::DEFAULT_RAYTRACE));
             self.renderer = crate::render::DEFAULT_RAYTRACE.to_string();
         }
+        let (render, repaired) = crate::render::settings_check::repaired(self.render);
+        self.render = render;
+        said.extend(repaired);
         self.render.spp = self.render.spp.clamp(1, 1024);
-        self.res_scale = self.res_scale.clamp(0.1, 2.0);
-        self
+        self.res_scale = if self.res_scale.is_finite() { self.res_scale.clamp(0.1, 2.0) } else { 1.0 };
+        (self, said)
     }
 
     /// The knobs that suit one scene (shadow-map size and bias, the

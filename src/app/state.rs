@@ -88,7 +88,7 @@ impl PinholeApp {
             }
         }));
         let renderer_names = render::renderer_names();
-        let settings = saved.cloned().unwrap_or_default().sanitized(&renderer_names);
+        let (settings, repaired) = saved.cloned().unwrap_or_default().sanitized(&renderer_names);
         let mut app = PinholeApp {
             params: SceneParams::of(&scene),
             initial_camera: scene.camera.clone(),
@@ -123,6 +123,10 @@ impl PinholeApp {
             gallery: None,
         };
         app.install_scene(scene, scene_arg);
+        if !repaired.is_empty() {
+            let notes = app.message.take().into_iter().chain(repaired);
+            app.message = Some(notes.collect::<Vec<_>>().join("; "));
+        }
         app
     }
 

@@ -77,21 +77,7 @@ pub fn load_reference(
 ) -> Result<Option<Reference>, String> {
     match source {
         ReferenceSource::File(path) => {
-            let img = crate::image_io::load_image(path)?;
-            if (img.width, img.height) != (width, height) {
-                return Err(format!(
-                    "the reference {} is {}x{} but the images measured are {width}x{height}; render at its size (--width {} --height {})",
-                    path.display(),
-                    img.width,
-                    img.height,
-                    img.width,
-                    img.height
-                ));
-            }
-            let bad = img.pixels.iter().filter(|p| !p.is_finite()).count();
-            if bad > 0 {
-                return Err(format!("the reference {} has {bad} pixels that are not finite numbers; error against it means nothing", path.display()));
-            }
+            let img = load_reference_file(path, width, height)?;
             Ok(Some(Reference { pixels: img.pixels, width, height, name: source.describe() }))
         }
         ReferenceSource::PathTraced { spp } => {
@@ -117,6 +103,35 @@ pub fn load_reference(
             Ok(Some(Reference { pixels: frame.pixels, width, height, name: source.describe() }))
         }
     }
+}
+
+/// Reads a reference image and checks that error against it means
+/// something: its size is the measured images' size, and its pixels are
+/// finite, non-negative and not all black (relative error divides by it).
+pub fn load_reference_file(path: &Path, width: u32, height: u32) -> Result<crate::image_io::LinearImage, String> {
+    let img = crate::image_io::load_image(path)?;
+    if (img.width, img.height) != (width, height) {
+        return Err(format!(
+            "the reference {} is {}x{} but the images measured are {width}x{height}; render at its size (--width {} --height {})",
+            path.display(),
+            img.width,
+            img.height,
+            img.width,
+            img.height
+        ));
+    }
+    let bad = img.pixels.iter().filter(|p| !p.is_finite()).count();
+    if bad > 0 {
+        return Err(format!("the reference {} has {bad} pixels that are not finite numbers; error against it means nothing", path.display()));
+    }
+    let negative = img.pixels.iter().filter(|p| p.min_element() < 0.0).count();
+    if negative > 0 {
+        return Err(format!("the reference {} has {negative} pixels with negative values; radiance is never negative", path.display()));
+    }
+    if img.pixels.iter().all(|p| p.max_element() <= 0.0) {
+        return Err(format!("the reference {} is black everywhere; relative error against it is undefined", path.display()));
+    }
+    Ok(img)
 }
 
 /// Where path-traced references are kept: `PINHOLE_CACHE_DIR`, else the

@@ -148,82 +148,38 @@ impl RenderOpts {
         s.texture_filter = crate::scene::texture::TextureFilter::parse(&self.texture_filter).map_err(|e| format!("--texture-filter: {e}"))?;
         s.reflections = render::Reflections::parse(&self.reflections).map_err(|e| format!("--reflections: {e}"))?;
         s.shadow_volume = render::shadow::volume::VolumeMode::parse(&self.shadow_volume).map_err(|e| format!("--shadow-volume: {e}"))?;
-        if self.light_samples > render::MAX_LIGHT_SAMPLES {
-            return Err(format!("--light-samples {} is above the maximum {} (0 turns light sampling off: BSDF sampling alone)", self.light_samples, render::MAX_LIGHT_SAMPLES));
-        }
         s.light_samples = self.light_samples;
         s.shadow_filter = render::shadow::ShadowFilter::parse(&self.shadow_filter).map_err(|e| format!("--shadow-filter: {e}"))?;
-        if !(self.pcf_radius.is_finite() && (0.0..=64.0).contains(&self.pcf_radius)) {
-            return Err(format!("--pcf-radius {} is not a number from 0 to 64", self.pcf_radius));
-        }
         s.pcf_radius = self.pcf_radius;
         s.mis = match self.mis.as_str() {
             "on" => true,
             "off" => false,
             other => return Err(format!("--mis {other} is neither on nor off")),
         };
-        if self.spp == 0 || self.spp > 65536 {
-            return Err(format!("--spp {} is not between 1 and 65536", self.spp));
-        }
         s.spp = self.spp;
-        for (flag, v) in [("--width", self.width), ("--height", self.height)] {
-            if let Some(v) = v {
-                if !(1..=16384).contains(&v) {
-                    return Err(format!("{flag} {v} is not between 1 and 16384"));
-                }
-            }
-        }
         s.width = self.width.unwrap_or(s.width);
         s.height = self.height.unwrap_or(s.height);
         s.clip = render::raster::clip::ClipMode::parse(&self.clip).map_err(|e| format!("--clip: {e}"))?;
         s.cull_instances = self.cull_instances;
         s.affine = self.affine;
-        if let Some(b) = self.bump {
-            if !(b.is_finite() && b >= 0.0) {
-                return Err(format!("--bump {b} must be a finite number >= 0"));
-            }
-            s.shadow_bump = b;
-        }
-        if let Some(n) = self.shadow_map_size {
-            if !(1..=render::shadow::map::MAX_SIZE).contains(&n) {
-                return Err(format!("--shadow-map-size {n} is not between 1 and {}", render::shadow::map::MAX_SIZE));
-            }
-            s.shadow_map_size = n;
-        }
-        if let Some(b) = self.shadow_bias {
-            if !(b.is_finite() && b >= 0.0) {
-                return Err(format!("--shadow-bias {b} must be a finite number of texels >= 0"));
-            }
-            s.shadow_map_bias = b;
-        }
-        if !render::raster::msaa::COUNTS.contains(&self.msaa) {
-            return Err(format!("--msaa {} is not one of 1, 2, 4, 8", self.msaa));
-        }
+        s.shadow_bump = self.bump.unwrap_or(s.shadow_bump);
+        s.shadow_map_size = self.shadow_map_size.unwrap_or(s.shadow_map_size);
+        s.shadow_map_bias = self.shadow_bias.unwrap_or(s.shadow_map_bias);
         s.msaa = self.msaa;
         s.early_depth = self.early_depth && !self.forward;
         self.write_gi(&mut s.gi)?;
         s.depth_buffer = render::raster::depth_format::DepthFormat::parse(&self.depth_buffer).map_err(|e| format!("--depth-buffer: {e}"))?;
         s.lines = render::inspect::wireframe::LineAlgorithm::parse(&self.lines).map_err(|e| format!("--lines: {e}"))?;
-        if let Some(t) = self.adaptive {
-            if !(t > 0.0 && t.is_finite()) {
-                return Err(format!("--adaptive {t} must be a relative error > 0 (e.g. 0.05)"));
-            }
-            s.adaptive = Some(t);
-        }
-        if !render::frame::subsample::STEPS.contains(&self.subsample) {
-            return Err(format!("--subsample {} is not one of 1, 2, 4, 8, 16", self.subsample));
-        }
+        s.adaptive = self.adaptive.or(s.adaptive);
         s.subsample.step = self.subsample;
         if let Some(c) = self.subsample_contrast {
-            if !(c >= 0.0 && c.is_finite()) {
-                return Err(format!("--subsample-contrast {c} must be a contrast >= 0 (e.g. 0.3)"));
-            }
             if self.subsample == 1 {
                 return Err("--subsample-contrast refines a sub-sampled frame: give --subsample 2, 4, 8 or 16 too".into());
             }
             s.subsample.contrast = Some(c);
         }
-        Ok(())
+        // Every number's range, as the viewer checks its saved settings.
+        render::settings_check::check(s).map_err(|p| p.for_command_line())
     }
 
     /// The indirect-light options, checked, written into `gi`.
@@ -237,36 +193,12 @@ impl RenderOpts {
                 _ => return Err(format!("--bounces {n} is neither inf nor a number from 0 to {}", render::transport::gi::MAX_BOUNCES)),
             },
         };
-        if let Some(n) = self.ao_samples {
-            if !(1..=4096).contains(&n) {
-                return Err(format!("--ao-samples {n} is not between 1 and 4096"));
-            }
-            gi.ao_samples = n;
-        }
-        if let Some(d) = self.ao_distance {
-            if !(d > 0.0) || d.is_nan() {
-                return Err(format!("--ao-distance {d} must be a number > 0 (inf allowed)"));
-            }
-            gi.ao_distance = d;
-        }
-        if let Some(n) = self.photons {
-            if !(1..=50_000_000).contains(&n) {
-                return Err(format!("--photons {n} is not between 1 and 50000000"));
-            }
-            gi.photons = n;
-        }
-        if let Some(k) = self.photon_k {
-            if !(1..=4096).contains(&k) {
-                return Err(format!("--photon-k {k} is not between 1 and 4096"));
-            }
-            gi.photon_k = k;
-        }
-        if let Some(n) = self.final_gather {
-            if n > 4096 {
-                return Err(format!("--final-gather {n} is more than 4096"));
-            }
-            gi.final_gather = n;
-        }
+        // Ranges are checked with the other settings' (`settings_check`).
+        gi.ao_samples = self.ao_samples.unwrap_or(gi.ao_samples);
+        gi.ao_distance = self.ao_distance.unwrap_or(gi.ao_distance);
+        gi.photons = self.photons.unwrap_or(gi.photons);
+        gi.photon_k = self.photon_k.unwrap_or(gi.photon_k);
+        gi.final_gather = self.final_gather.unwrap_or(gi.final_gather);
         Ok(())
     }
 }

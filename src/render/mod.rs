@@ -18,6 +18,7 @@ pub mod opengl;
 pub mod prepared;
 pub mod raster;
 pub mod raytrace;
+pub mod settings_check;
 pub mod shadow;
 pub mod transport;
 

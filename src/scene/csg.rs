@@ -127,6 +127,35 @@ pub fn check_closed(triangles: &[Triangle]) -> Result<(), String> {
     Ok(())
 }
 
+/// The volume a closed surface encloses, positive when its triangles face
+/// outwards (counter-clockwise seen from outside) and negative when the
+/// whole solid is wound inside out.
+pub fn signed_volume(triangles: &[Triangle]) -> f64 {
+    triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.v.map(|v| v.as_dvec3());
+            a.dot(b.cross(c)) / 6.0
+        })
+        .sum()
+}
+
+/// Turns an inside-out solid right side out: each triangle's winding is
+/// reversed, and vertex normals that then point against their face follow it.
+pub fn turn_right_side_out(triangles: &mut [Triangle]) {
+    for t in triangles {
+        t.v.swap(1, 2);
+        t.n.swap(1, 2);
+        t.uv.swap(1, 2);
+        let face = (t.v[1] - t.v[0]).cross(t.v[2] - t.v[0]);
+        for n in &mut t.n {
+            if n.dot(face) < 0.0 {
+                *n = -*n;
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -146,5 +175,23 @@ mod tests {
         assert!(check_closed(&t).is_err());
         t.pop();
         assert!(check_closed(&t).unwrap_err().contains("3 of its edges"));
+    }
+
+    #[test]
+    fn an_inside_out_solid_has_negative_volume_until_turned() {
+        let (o, x, y, z) = (Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z);
+        let mut t = vec![tri(o, y, x), tri(o, x, z), tri(o, z, y), tri(x, y, z)];
+        assert!((signed_volume(&t) - 1.0 / 6.0).abs() < 1e-9);
+        for tr in &mut t {
+            tr.v.swap(0, 1);
+        }
+        assert!((signed_volume(&t) + 1.0 / 6.0).abs() < 1e-9);
+        assert_eq!(check_closed(&t), Ok(()), "inside out, it is still closed: the volume is what tells");
+        turn_right_side_out(&mut t);
+        assert!((signed_volume(&t) - 1.0 / 6.0).abs() < 1e-9);
+        for tr in &t {
+            let face = (tr.v[1] - tr.v[0]).cross(tr.v[2] - tr.v[0]);
+            assert!(tr.n.iter().all(|n| n.dot(face) >= 0.0));
+        }
     }
 }

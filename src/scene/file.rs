@@ -781,6 +781,12 @@ fn csg_node(
                     let file = d.file.as_deref().unwrap_or("?");
                     return Err(format!("{here}: the mesh \"{file}\" is not closed ({e}); a csg operand must be a closed solid"));
                 }
+                // Wound inside out, the solid would be its complement and vanish.
+                if crate::scene::csg::signed_volume(&tris) < 0.0 {
+                    crate::scene::csg::turn_right_side_out(&mut tris);
+                    let file = d.file.as_deref().unwrap_or("?");
+                    scene.warnings.push(format!("{here}: the mesh \"{file}\" is wound inside out (its triangles face inwards); its winding was reversed so the solid is what it encloses"));
+                }
                 let first = parts.triangles.len() as u32;
                 let mut lo = Vec3::splat(f32::INFINITY);
                 let mut hi = Vec3::splat(f32::NEG_INFINITY);

@@ -1,5 +1,7 @@
 //! Opening a scene by the argument the command line and the viewer take: a
-//! built-in scene's name, a `.toml` scene file or a bare `.obj`.
+//! built-in scene's name, a `.toml` scene file or a bare `.obj`. A bare word
+//! names a built-in scene before a file of that name; anything with a folder
+//! separator or a scene file's extension is a path.
 
 use crate::scene::builtin;
 use crate::scene::file::load_scene_file;
@@ -14,7 +16,12 @@ pub fn load_scene(arg: &str) -> Result<Scene, String> {
     if is_obj {
         return frame_bare_obj(&path);
     }
-    if path.exists() || arg.ends_with(".toml") || arg.contains('/') {
+    // A path is what looks like one (a folder in it, or a scene file's
+    // extension); a bare word is a built-in scene's name first, so a folder
+    // called `textures` beside you does not hide the built-in `textures`
+    // (`./textures` means the folder).
+    let looks_like_path = arg.contains('/') || arg.contains(std::path::MAIN_SEPARATOR) || arg.ends_with(".toml");
+    if looks_like_path || (builtin::source(arg).is_none() && path.exists()) {
         return load_scene_file(&path);
     }
     builtin::load_builtin(arg).ok_or_else(|| {

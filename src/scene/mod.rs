@@ -435,6 +435,33 @@ impl Scene {
         self.triangles.len()
     }
 
+    /// For each material, whether anything drawn uses it: triangles,
+    /// spheres, CSG leaves and the instance layer's copies. A material only
+    /// named in `[materials]` is not asked of any renderer.
+    pub fn materials_in_use(&self) -> Vec<bool> {
+        let mut used = vec![false; self.materials.len()];
+        let mut mark = |m: u32| {
+            if let Some(u) = used.get_mut(m as usize) {
+                *u = true;
+            }
+        };
+        self.triangles.materials().for_each(&mut mark);
+        self.spheres.iter().for_each(|s| mark(s.material));
+        for c in &self.csgs {
+            c.spheres.iter().for_each(|s| mark(s.material));
+            c.triangles.iter().for_each(|t| mark(t.material));
+        }
+        if let Some(layer) = &self.layer {
+            for inst in &layer.instances {
+                match inst.material {
+                    Some(m) => mark(m),
+                    None => layer.meshes[inst.mesh as usize].iter().for_each(|t| mark(t.material)),
+                }
+            }
+        }
+        used
+    }
+
     /// Triangles drawn, the two-level layer's included.
     pub fn total_triangles(&self) -> u64 {
         self.triangles.len() as u64 + self.layer.as_ref().map_or(0, |l| l.triangle_count())

@@ -203,6 +203,11 @@ impl Triangles {
     }
 
     /// The triangles in order.
+    /// Each triangle's material index, in order (no corners assembled).
+    pub fn materials(&self) -> impl Iterator<Item = u32> + '_ {
+        self.faces.iter().map(|f| f.material)
+    }
+
     pub fn iter(&self) -> Iter<'_> {
         Iter { store: self, faces: self.faces.iter() }
     }

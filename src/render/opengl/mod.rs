@@ -180,11 +180,14 @@ fn unsupported(scene: &Scene, settings: &RenderSettings) -> Result<(), String> {
     if scene.environment.as_ref().is_some_and(|e| e.is_light()) {
         return refuse("cannot light the scene with the [environment] yet; use raytrace or rasterize");
     }
-    if let Some(m) = scene.materials.iter().find(|m| m.transmission != crate::math::Vec3::ZERO) {
+    // Only materials something is drawn with: one merely named in the file asks nothing.
+    let in_use = scene.materials_in_use();
+    let mut drawn = scene.materials.iter().zip(in_use).filter(|(_, used)| *used).map(|(m, _)| m);
+    if let Some(m) = drawn.clone().find(|m| m.transmission != crate::math::Vec3::ZERO) {
         return refuse(&format!("cannot trace glass rays (material \"{}\")", m.name));
     }
     if settings.reflections == Reflections::Ray {
-        if let Some(m) = scene.materials.iter().find(|m| m.has_secondary()) {
+        if let Some(m) = drawn.find(|m| m.has_secondary()) {
             return refuse(&format!("cannot trace mirror rays; use --reflections env (material \"{}\")", m.name));
         }
     }
