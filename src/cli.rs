@@ -227,6 +227,7 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
     }
     renderer.ready(&admitted.settings)?;
     let prepared = pool.install(|| PreparedScene::new(scene));
+    pool.install(|| render::admit::admit_prepared(&prepared, &admitted.settings))?;
     Ok(Loaded { prepared, settings: admitted.settings, renderer, pool, load_ms })
 }
 

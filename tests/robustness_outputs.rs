@@ -229,3 +229,15 @@ fn saved_settings_out_of_range_are_repaired_by_the_command_lines_bounds() {
     let out = pinhole_in(&temp_dir(), &["render", "spheres", "-o", "o.exr", "--photons", "4000000000"]);
     assert_refused(&out, "--photons 4000000000 is not between 1 and 50000000");
 }
+
+#[test]
+fn a_photon_map_past_its_memory_budget_is_refused_before_it_is_built() {
+    let d = temp_dir();
+    let started = std::time::Instant::now();
+    let out = pinhole_in(&d, &["render", "cornell-gi", "-o", "o.exr", "--gi", "photons", "--photons", "50000000", "--width", "32", "--height", "24"]);
+    assert_refused(&out, "more than the photon map's budget of 4 GiB");
+    assert!(stderr(&out).contains("per photon shot, measured on 4096"), "{}", stderr(&out));
+    // Refused from the estimate, not after the build (which takes about a minute).
+    assert!(started.elapsed().as_secs() < 30);
+    assert!(!d.join("o.exr").exists());
+}

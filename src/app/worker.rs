@@ -448,6 +448,8 @@ impl WorkerLoop {
         // (or input made too big to allocate) is refused in one sentence.
         let admitted = render::admit::admit(renderer.as_ref(), &prepared.scene, &asked);
         let admitted = admitted.and_then(|a| renderer.ready(&a.settings).map(|()| a));
+        let pool = &self.pool;
+        let admitted = admitted.and_then(|a| pool.install(|| render::admit::admit_prepared(prepared, &a.settings)).map(|()| a));
         let render::admit::Admitted { settings, mut notices, caveats } = match admitted {
             Ok(a) => a,
             Err(e) => {

@@ -56,6 +56,16 @@ pub fn admit(renderer: &dyn Renderer, scene: &Scene, settings: &RenderSettings) 
     Err(refusal)
 }
 
+/// The gate's second half, once the scene is prepared (its BVH built):
+/// budgets that depend on what the scene does to light, measured by
+/// tracing a little of it. Today: the photon map's memory.
+pub fn admit_prepared(prepared: &crate::render::PreparedScene, settings: &RenderSettings) -> Result<(), String> {
+    if settings.gi.mode == crate::render::transport::gi::GiMode::Photons {
+        prepared.check_photon_budget(&settings.gi, settings.shadow_bump)?;
+    }
+    Ok(())
+}
+
 /// What admitted settings draw otherwise than the light transport they
 /// approximate, and settings that have nothing to act on: one sentence
 /// each, so nothing is left out without a word.

@@ -79,91 +79,71 @@ impl PreparedScene {
     }
 }
 
+/// The most memory a photon map's build may take (`check_budget`).
+pub const MAX_PHOTON_MAP_BYTES: u64 = 4 << 30;
+/// Bytes per stored photon at the build's peak. The kd-tree build holds its
+/// (position, photon) pairs (60 bytes) beside the finished positions,
+/// photons and split axes (61); measured, the peak resident memory grows by
+/// 132 bytes per stored photon (`cornell-gi`, 1 to 4 million shot).
+const PEAK_BYTES_PER_STORED: u64 = 136;
+/// Photons traced to measure how many each one stores.
+const PILOT_PHOTONS: u32 = 4096;
+
+impl PreparedScene {
+    /// Refuses, before building, a photon map whose build would take more
+    /// than `MAX_PHOTON_MAP_BYTES`. How many photons one shot stores depends
+    /// on the scene (walls bounce it on, open sky lets it go), so it is
+    /// measured: up to `PILOT_PHOTONS` of the map's own photons, spread over
+    /// its index range, are traced, and the estimate takes the mean plus
+    /// three standard errors.
+    pub fn check_photon_budget(&self, gi: &GiSettings, bump: f32) -> Result<(), String> {
+        let shot = gi.photons as u64;
+        let most_stored_per_shot = (MAX_PHOTON_BOUNCES - 1) as u64;
+        if shot * most_stored_per_shot * PEAK_BYTES_PER_STORED <= MAX_PHOTON_MAP_BYTES {
+            return Ok(());
+        }
+        let sources = Sources::of(&self.scene);
+        if !(sources.total > 0.0 && sources.total.is_finite()) {
+            return Ok(());
+        }
+        let query = BvhQuery::new(self);
+        let n = PILOT_PHOTONS.min(gi.photons);
+        let counts: Vec<f64> = (0..n)
+            .into_par_iter()
+            .map(|k| {
+                let i = (k as u64 * shot / n as u64) as u32;
+                sources.shoot(&self.scene, &query, i, gi.photons, gi.seed, bump).len() as f64
+            })
+            .collect();
+        let mean = counts.iter().sum::<f64>() / n as f64;
+        let var = counts.iter().map(|c| (c - mean) * (c - mean)).sum::<f64>() / (n.max(2) - 1) as f64;
+        let per_shot = mean + 3.0 * (var / n as f64).sqrt();
+        let bytes = shot as f64 * per_shot * PEAK_BYTES_PER_STORED as f64;
+        if bytes <= MAX_PHOTON_MAP_BYTES as f64 {
+            return Ok(());
+        }
+        let most = (MAX_PHOTON_MAP_BYTES as f64 / (per_shot * PEAK_BYTES_PER_STORED as f64)) as u64;
+        Err(format!(
+            "--photons {shot} would store about {:.0} million photons ({mean:.2} per photon shot, measured on {n}) and take about {:.1} GiB to build, more than the photon map's budget of {} GiB; use at most {most} photons",
+            shot as f64 * mean / 1e6,
+            bytes / (1u64 << 30) as f64,
+            MAX_PHOTON_MAP_BYTES >> 30
+        ))
+    }
+}
+
 thread_local! {
     static NEIGHBOURS: RefCell<Vec<Neighbour>> = const { RefCell::new(Vec::new()) };
 }
 
 impl PhotonMap {
     fn build(prepared: &PreparedScene, gi: &GiSettings, bump: f32) -> PhotonMap {
-        let scene = &prepared.scene;
         let query = BvhQuery::new(prepared);
-        let (center, radius) = match scene.bounds() {
-            Some((lo, hi)) => ((lo + hi) * 0.5, ((hi - lo).length() * 0.5).max(1e-3)),
-            None => (Vec3::ZERO, 1.0),
-        };
-        // Lights are picked in proportion to the flux they send into the
-        // scene: the point and directional lights, then (one source each)
-        // the emissive surfaces and the environment. Only the choice needs
-        // the flux; each photon's power is divided by its own probability.
-        let mut flux: Vec<Vec3> = scene
-            .lights
-            .iter()
-            .map(|l| match *l {
-                Light::Point { power, .. } => power,
-                Light::Directional { irradiance, .. } => irradiance * (PI * radius * radius),
-            })
-            .collect();
-        let emitters_source = flux.len();
-        flux.push(Vec3::splat(scene.emitters.total_power()));
-        let sky = scene.environment.as_ref().and_then(|e| e.light.clone());
-        let sky_source = flux.len();
-        flux.push(Vec3::splat(sky.as_ref().map_or(0.0, |l| l.flux_estimate() * PI * radius * radius)));
-        let weights: Vec<f32> = flux.iter().map(|f| luminance(*f).max(0.0)).collect();
-        let total: f32 = weights.iter().sum();
+        let sources = Sources::of(&prepared.scene);
+        let radius = sources.radius;
         let shot = gi.photons;
-        let photons: Vec<Photon> = if total > 0.0 && total.is_finite() && shot > 0 {
-            (0..shot)
-                .into_par_iter()
-                .map(|i| {
-                    let mut rng = SampleRng::for_index(PHOTON_STREAM, i as u64, gi.seed);
-                    let mut pick = rng.next_f32() * total;
-                    let mut light = weights.len() - 1;
-                    for (k, w) in weights.iter().enumerate() {
-                        if pick < *w {
-                            light = k;
-                            break;
-                        }
-                        pick -= w;
-                    }
-                    let p_light = weights[light] / total;
-                    let share = 1.0 / (shot as f32 * p_light);
-                    let (ray, power) = if light == emitters_source {
-                        // A point on an emitter, a cosine-weighted direction
-                        // about its normal (as a Lambertian emitter sends light).
-                        let (u_choose, u, u_side) = (rng.next_f32(), rng.next_2d(), rng.next_f32());
-                        let Some((point, normal, flux)) = scene.emitters.sample_emission(scene, u_choose, u, u_side) else { return Vec::new() };
-                        let dir = from_local(cosine_hemisphere(rng.next_2d()), normal);
-                        (Ray::new(point + normal * bump, dir), flux * share)
-                    } else if light == sky_source {
-                        // A direction sampled from the sky, entering through a
-                        // disc across the scene's bounding sphere.
-                        let Some(l) = sky.as_ref() else { return Vec::new() };
-                        let Some((to_sky, pdf)) = l.sample(rng.next_2d()) else { return Vec::new() };
-                        let d = -to_sky;
-                        let (t, b) = tangents(d);
-                        let o = uniform_disk(rng.next_2d()) * radius;
-                        let radiance = scene.miss_radiance(to_sky);
-                        let ray = Ray::new(center - d * (2.0 * radius) + t * o.x + b * o.y, d);
-                        (ray, radiance * (PI * radius * radius / pdf) * share)
-                    } else {
-                        let ray = match scene.lights[light] {
-                            Light::Point { position, .. } => Ray::new(position, uniform_sphere(rng.next_2d())),
-                            Light::Directional { direction, .. } => {
-                                let d = direction.normalize_or_zero();
-                                let (t, b) = tangents(d);
-                                let o = uniform_disk(rng.next_2d()) * radius;
-                                Ray::new(center - d * (2.0 * radius) + t * o.x + b * o.y, d)
-                            }
-                        };
-                        (ray, flux[light] * share)
-                    };
-                    if !power.is_finite() {
-                        return Vec::new();
-                    }
-                    trace_photon(scene, &query, ray, power, bump, &mut rng)
-                })
-                .flatten_iter()
-                .collect()
+        let photons: Vec<Photon> = if sources.total > 0.0 && sources.total.is_finite() && shot > 0 {
+            (0..shot).into_par_iter().map(|i| sources.shoot(&prepared.scene, &query, i, shot, gi.seed, bump)).flatten_iter().collect()
         } else {
             Vec::new()
         };
@@ -205,6 +185,99 @@ impl PhotonMap {
             }
             sum / (PI * r2)
         })
+    }
+}
+
+/// Where photons leave from: the point and directional lights, then (one
+/// source each) the emissive surfaces and the environment, picked in
+/// proportion to the flux they send into the scene. Only the choice needs
+/// the flux; each photon's power is divided by its own probability.
+struct Sources {
+    flux: Vec<Vec3>,
+    weights: Vec<f32>,
+    total: f32,
+    emitters_source: usize,
+    sky_source: usize,
+    sky: Option<Arc<crate::scene::environment::EnvironmentLight>>,
+    /// The scene's bounding sphere: parallel light enters through a disc across it.
+    center: Vec3,
+    radius: f32,
+}
+
+impl Sources {
+    fn of(scene: &Scene) -> Sources {
+        let (center, radius) = match scene.bounds() {
+            Some((lo, hi)) => ((lo + hi) * 0.5, ((hi - lo).length() * 0.5).max(1e-3)),
+            None => (Vec3::ZERO, 1.0),
+        };
+        let mut flux: Vec<Vec3> = scene
+            .lights
+            .iter()
+            .map(|l| match *l {
+                Light::Point { power, .. } => power,
+                Light::Directional { irradiance, .. } => irradiance * (PI * radius * radius),
+            })
+            .collect();
+        let emitters_source = flux.len();
+        flux.push(Vec3::splat(scene.emitters.total_power()));
+        let sky = scene.environment.as_ref().and_then(|e| e.light.clone());
+        let sky_source = flux.len();
+        flux.push(Vec3::splat(sky.as_ref().map_or(0.0, |l| l.flux_estimate() * PI * radius * radius)));
+        let weights: Vec<f32> = flux.iter().map(|f| luminance(*f).max(0.0)).collect();
+        let total: f32 = weights.iter().sum();
+        Sources { flux, weights, total, emitters_source, sky_source, sky, center, radius }
+    }
+
+    /// Photon `i` of `shot`: its light, its first ray and power, and what it
+    /// stores on its way. A function of (i, shot, seed) alone.
+    fn shoot(&self, scene: &Scene, query: &BvhQuery, i: u32, shot: u32, seed: u64, bump: f32) -> Vec<Photon> {
+        let (center, radius) = (self.center, self.radius);
+        let mut rng = SampleRng::for_index(PHOTON_STREAM, i as u64, seed);
+        let mut pick = rng.next_f32() * self.total;
+        let mut light = self.weights.len() - 1;
+        for (k, w) in self.weights.iter().enumerate() {
+            if pick < *w {
+                light = k;
+                break;
+            }
+            pick -= w;
+        }
+        let p_light = self.weights[light] / self.total;
+        let share = 1.0 / (shot as f32 * p_light);
+        let (ray, power) = if light == self.emitters_source {
+            // A point on an emitter, a cosine-weighted direction
+            // about its normal (as a Lambertian emitter sends light).
+            let (u_choose, u, u_side) = (rng.next_f32(), rng.next_2d(), rng.next_f32());
+            let Some((point, normal, flux)) = scene.emitters.sample_emission(scene, u_choose, u, u_side) else { return Vec::new() };
+            let dir = from_local(cosine_hemisphere(rng.next_2d()), normal);
+            (Ray::new(point + normal * bump, dir), flux * share)
+        } else if light == self.sky_source {
+            // A direction sampled from the sky, entering through a
+            // disc across the scene's bounding sphere.
+            let Some(l) = self.sky.as_ref() else { return Vec::new() };
+            let Some((to_sky, pdf)) = l.sample(rng.next_2d()) else { return Vec::new() };
+            let d = -to_sky;
+            let (t, b) = tangents(d);
+            let o = uniform_disk(rng.next_2d()) * radius;
+            let radiance = scene.miss_radiance(to_sky);
+            let ray = Ray::new(center - d * (2.0 * radius) + t * o.x + b * o.y, d);
+            (ray, radiance * (PI * radius * radius / pdf) * share)
+        } else {
+            let ray = match scene.lights[light] {
+                Light::Point { position, .. } => Ray::new(position, uniform_sphere(rng.next_2d())),
+                Light::Directional { direction, .. } => {
+                    let d = direction.normalize_or_zero();
+                    let (t, b) = tangents(d);
+                    let o = uniform_disk(rng.next_2d()) * radius;
+                    Ray::new(center - d * (2.0 * radius) + t * o.x + b * o.y, d)
+                }
+            };
+            (ray, self.flux[light] * share)
+        };
+        if !power.is_finite() {
+            return Vec::new();
+        }
+        trace_photon(scene, query, ray, power, bump, &mut rng)
     }
 }
 
