@@ -14,6 +14,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::Instant;
 
+mod interrupt;
 mod render_opts;
 mod usage_error;
 use render_opts::RenderOpts;
@@ -152,6 +153,9 @@ pub fn run() -> Result<Outcome, String> {
             std::process::exit(0);
         }
     };
+    if cli.command.is_some() {
+        interrupt::install();
+    }
     let ran = match cli.command {
         None => return Ok(Outcome::OpenViewer { scene: cli.scene, screenshot: cli.screenshot }),
         Some(Command::Render { scene, output, opts, stats }) => cmd_render(&scene, &output, &opts, stats.as_deref()),
@@ -170,6 +174,10 @@ pub fn run() -> Result<Outcome, String> {
         Some(Command::Gallery { output, case, threads }) => cmd_gallery(&output, case.as_deref(), threads),
         Some(Command::List) => cmd_list(),
     };
+    if interrupt::interrupted() {
+        // Said by the handler already; nothing was written.
+        std::process::exit(interrupt::EXIT_INTERRUPTED);
+    }
     ran.map(|()| Outcome::Done)
 }
 
@@ -290,7 +298,7 @@ fn cmd_render(scene_arg: &str, output: &Path, opts: &RenderOpts, stats: Option<&
     let l = load(scene_arg, opts)?;
     // Now that every input is read: none of them may be an output.
     crate::file_identity::check_outputs(&outputs)?;
-    let cancel = AtomicBool::new(false);
+    let cancel = interrupt::flag();
     let rows_done = AtomicU64::new(0);
     let total_rows = l.settings.height as u64 * l.settings.spp as u64;
     let show_progress = std::io::stderr().is_terminal();
@@ -302,7 +310,7 @@ fn cmd_render(scene_arg: &str, output: &Path, opts: &RenderOpts, stats: Option<&
         }
         let bands = if show_progress { 32 } else { 1 };
         let r = l.pool.install(|| {
-            render::render_frame_in_bands(l.renderer.as_ref(), &l.prepared, &l.settings, &cancel, None, bands, Some(&rows_done))
+            render::render_frame_in_bands(l.renderer.as_ref(), &l.prepared, &l.settings, cancel, None, bands, Some(&rows_done))
         });
         done.store(true, Ordering::Relaxed);
         r
@@ -357,7 +365,7 @@ fn cmd_bench(scene_arg: &str, opts: &RenderOpts, frames: u32) -> Result<(), Stri
     let l = load(scene_arg, opts)?;
     let bench_started = Instant::now();
     let mut last_note = bench_started;
-    let cancel = AtomicBool::new(false);
+    let cancel = interrupt::flag();
     let mut times = Vec::new();
     let mut first_ms = 0.0;
     let mut counts = RayCounts::default();
@@ -368,7 +376,7 @@ fn cmd_bench(scene_arg: &str, opts: &RenderOpts, frames: u32) -> Result<(), Stri
         let start = Instant::now();
         let frame = l
             .pool
-            .install(|| render::render_frame_reusing(l.renderer.as_ref(), &l.prepared, &l.settings, &cancel, std::mem::take(&mut spare)))
+            .install(|| render::render_frame_reusing(l.renderer.as_ref(), &l.prepared, &l.settings, cancel, std::mem::take(&mut spare)))
             .ok_or("the render was cancelled")?;
         let ms = start.elapsed().as_secs_f64() * 1e3;
         if i > 0 {
@@ -463,11 +471,11 @@ fn cmd_chart_methods(scene_arg: &str, output: &Path, metric: &str, reference: Op
         return Err(format!("--metric flip: {w}x{h} is more than the {} pixels FLIP is computed for", crate::metrics::MAX_FLIP_PIXELS));
     }
     let source = crate::chart::ReferenceSource::choose(reference, &l.prepared, reference_spp);
-    let cancel = AtomicBool::new(false);
+    let cancel = interrupt::flag();
     let cache = crate::chart::reference::default_cache_dir();
     let truth = l
         .pool
-        .install(|| crate::chart::load_reference(&source, &l.prepared, w, h, cache.as_deref(), &cancel, None))?
+        .install(|| crate::chart::load_reference(&source, &l.prepared, w, h, cache.as_deref(), cancel, None))?
         .ok_or("cancelled")?;
     eprintln!("reference: {}", truth.name);
     check_chart_outputs(output)?;
@@ -484,8 +492,8 @@ fn cmd_chart_methods(scene_arg: &str, output: &Path, metric: &str, reference: Op
     for (i, c) in configs.iter().enumerate() {
         eprintln!("[{}/{}] {}", i + 1, configs.len(), c.label);
         let m = match gi {
-            Some(_) => l.pool.install(|| crate::chart::gi_sweep::measure_with_builds(&l.prepared, c, &truth, &cancel)),
-            None => l.pool.install(|| crate::chart::measure(&l.prepared, c, &truth, 3, &cancel)),
+            Some(_) => l.pool.install(|| crate::chart::gi_sweep::measure_with_builds(&l.prepared, c, &truth, cancel)),
+            None => l.pool.install(|| crate::chart::measure(&l.prepared, c, &truth, 3, cancel)),
         };
         points.push(m?.ok_or("cancelled")?);
     }
@@ -538,7 +546,7 @@ fn cmd_chart(scene_arg: &str, output: &Path, renderers: &str, spp_list: &str, re
             let r = render::renderer_by_name(render::DEFAULT_RAYTRACE)?;
             let settings = RenderSettings { spp: reference_spp, ..l.settings.clone() };
             l.pool
-                .install(|| render::render_frame(r.as_ref(), &l.prepared, &settings, &AtomicBool::new(false), None))
+                .install(|| render::render_frame(r.as_ref(), &l.prepared, &settings, interrupt::flag(), None))
                 .ok_or("cancelled")?
                 .pixels
         }
@@ -609,6 +617,9 @@ fn cmd_gallery(dir: &Path, only: Option<&str>, threads: Option<usize>) -> Result
     let start = Instant::now();
     let mut results = Vec::new();
     for (i, case) in cases.iter().enumerate() {
+        if interrupt::interrupted() {
+            return Err("interrupted".into());
+        }
         eprintln!("[{}/{}] {}: {} ...", i + 1, cases.len(), case.name, case.method);
         let t = Instant::now();
         let r = pool.install(|| gallery::measure_case(case))?;
