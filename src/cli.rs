@@ -139,7 +139,10 @@ pub fn run() -> Result<Outcome, String> {
     use clap::{CommandFactory, FromArgMatches};
     // Negative numbers reach the value parsers, which then name the option
     // and its range, instead of reading as unknown flags.
-    let command = Cli::command().allow_negative_numbers(true).mut_subcommands(|s| s.allow_negative_numbers(true));
+    // Options' values may start with '-' (`--bump -1e-9` is a value out of
+    // range, not an unknown flag `-1`); so may positional numbers.
+    let hyphens = |a: clap::Arg| if a.get_action().takes_values() && !a.is_positional() { a.allow_hyphen_values(true) } else { a };
+    let command = Cli::command().allow_negative_numbers(true).mut_subcommands(|s| s.allow_negative_numbers(true).mut_args(hyphens));
     let parsed = command.clone().try_get_matches().and_then(|m| Cli::from_arg_matches(&m));
     let cli = match parsed {
         Ok(c) => c,

@@ -335,3 +335,58 @@ fn mutated_images() {
         run_image(&dir, name, &bytes);
     });
 }
+
+/// Every numeric option at its documented bound (drawn) and just beyond it
+/// (refused in one sentence naming the option), on the command line.
+/// Bounds whose drawing alone is heavy (50 million photons, 4096-texel
+/// cube maps) are checked only beyond.
+#[test]
+fn options_at_and_just_beyond_their_bounds() {
+    let dir = work_dir("options");
+    let run = |extra: &[&str]| {
+        let mut args = vec!["render", "one-triangle", "-o", "o.exr"];
+        for size in [["--width", "8"], ["--height", "6"]] {
+            if extra[0] != size[0] {
+                args.extend_from_slice(&size);
+            }
+        }
+        args.extend_from_slice(extra);
+        std::process::Command::new(env!("CARGO_BIN_EXE_pinhole")).current_dir(&dir).args(&args).output().unwrap()
+    };
+    let cases: &[(&str, Option<&str>, &[&str])] = &[
+        ("--spp", Some("1"), &["0", "65537", "-1", "nan"]),
+        ("--width", Some("1"), &["0", "16385", "-8"]),
+        ("--height", Some("16384"), &["0", "16385"]),
+        ("--light-samples", Some("4096"), &["4097", "-1"]),
+        ("--pcf-radius", Some("64"), &["64.001", "-0.5", "nan", "inf"]),
+        ("--bump", Some("0"), &["-1e-9", "nan", "inf"]),
+        ("--shadow-map-size", Some("1"), &["0", "4097"]),
+        ("--shadow-bias", Some("0"), &["-0.1", "nan"]),
+        ("--msaa", Some("8"), &["3", "16", "0"]),
+        ("--adaptive", Some("1e-6"), &["0", "-1", "inf"]),
+        ("--subsample", Some("16"), &["3", "32", "0"]),
+        ("--bounces", Some("100"), &["101", "-1", "many"]),
+        ("--ao-samples", Some("4096"), &["0", "4097"]),
+        ("--ao-distance", Some("inf"), &["0", "-1", "nan"]),
+        ("--photons", Some("1"), &["0", "50000001"]),
+        ("--photon-k", Some("4096"), &["0", "4097"]),
+        ("--final-gather", Some("4096"), &["4097"]),
+        ("--seed", Some("18446744073709551615"), &["18446744073709551616", "-1"]),
+        ("--threads", Some("1"), &["0", "-2"]),
+    ];
+    for (flag, at, beyond) in cases {
+        if let Some(v) = at {
+            let out = run(&[flag, v]);
+            assert!(out.status.success(), "{flag} {v}: {}", String::from_utf8_lossy(&out.stderr));
+            let img = pinhole::image_io::load_image(&dir.join("o.exr")).unwrap();
+            assert!(img.pixels.iter().all(|p| p.is_finite()), "{flag} {v}: a pixel is not finite");
+        }
+        for v in *beyond {
+            let out = run(&[flag, v]);
+            let e = String::from_utf8_lossy(&out.stderr);
+            assert!(!out.status.success(), "{flag} {v} was accepted");
+            assert_eq!(e.trim_end().lines().count(), 1, "{flag} {v}: {e}");
+            assert!(e.contains(flag), "{flag} {v}: the error does not name the option: {e}");
+        }
+    }
+}

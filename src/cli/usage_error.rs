@@ -20,7 +20,10 @@ pub fn one_sentence(e: &clap::Error, cmd: &clap::Command) -> String {
                 Some(bare) => format!("argument {bare}"),
                 None => token.clone(),
             };
-            let accepted = match text(ContextKind::ValidValue) {
+            if value.is_empty() {
+                return format!("{name} needs a value");
+            }
+            let accepted = match text(ContextKind::ValidValue).filter(|v| !v.is_empty()) {
                 Some(valid) => Some(format!("one of {valid}")),
                 None => find_arg(cmd, &token).and_then(accepted_values),
             };
@@ -91,6 +94,8 @@ mod tests {
         assert_eq!(one_sentence(&e, &cmd), "--seed: \"-1\" is not a whole number from 0 to 18446744073709551615");
         let e = T::try_parse_from(["t", "-1"]).err().unwrap();
         assert_eq!(one_sentence(&e, &cmd), "argument X: \"-1\" is not a whole number from 0 to 4294967295");
+        let e = T::try_parse_from(["t", "1", "--seed"]).err().unwrap();
+        assert_eq!(one_sentence(&e, &cmd), "--seed needs a value");
         let e = T::try_parse_from(["t", "1", "--nope"]).err().unwrap();
         let s = one_sentence(&e, &cmd);
         assert_eq!(s.lines().count(), 1, "{s}");
