@@ -9,6 +9,7 @@
 //! failed is kept in `REGRESSIONS` and checked on every run.
 
 use pinhole::scene::Scene;
+use pinhole::math::Vec3;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
@@ -388,5 +389,118 @@ fn options_at_and_just_beyond_their_bounds() {
             assert_eq!(e.trim_end().lines().count(), 1, "{flag} {v}: {e}");
             assert!(e.contains(flag), "{flag} {v}: the error does not name the option: {e}");
         }
+    }
+}
+
+/// References for charts with random sizes and pixels (black, negative,
+/// NaN, ordinary): each is accepted only when error against it means
+/// something, and refused otherwise in one sentence.
+#[test]
+fn reference_images_of_every_kind() {
+    let dir = work_dir("references");
+    let mut rng = seed(7);
+    let (mut accepted, mut refused) = (0, 0);
+    for case in 0..cases().min(200) {
+        let (w, h) = *rng.pick(&[(16u32, 12u32), (16, 12), (8, 6), (17, 12)]);
+        let kind = rng.below(4);
+        let pixels: Vec<Vec3> = (0..w * h)
+            .map(|_| {
+                let v = (rng.below(1000) as f32) / 500.0;
+                match (kind, rng.below(40)) {
+                    (0, _) => Vec3::ZERO,
+                    (1, 0) => Vec3::new(v, -v - 0.01, v),
+                    (2, 0) => Vec3::new(f32::NAN, v, v),
+                    _ => Vec3::splat(v),
+                }
+            })
+            .collect();
+        let path = dir.join(format!("r{case}.exr"));
+        pinhole::image_io::save_image(&path, w, h, &pixels, 1.0).unwrap();
+        match pinhole::chart::reference::load_reference_file(&path, 16, 12) {
+            Ok(img) => {
+                accepted += 1;
+                assert!(img.pixels.iter().all(|p| p.is_finite() && p.min_element() >= 0.0), "case {case}");
+                assert!(img.pixels.iter().any(|p| p.max_element() > 0.0), "case {case}: an all-black reference was accepted");
+            }
+            Err(e) => {
+                refused += 1;
+                assert_eq!(e.lines().count(), 1, "case {case}: {e}");
+                assert!(e.contains(&format!("r{case}.exr")), "case {case}: {e}");
+            }
+        }
+    }
+    assert!(accepted > 0 && refused > 0, "{accepted} accepted, {refused} refused");
+}
+
+/// The closed cube with a random set of faces wound the other way: all of
+/// them (inside out) is turned right side out with a warning and renders;
+/// some of them is refused as not consistently wound.
+#[test]
+fn closed_meshes_turned_inside_out() {
+    let dir = work_dir("inside-out");
+    let faces = [[5, 6, 7], [5, 7, 8], [2, 1, 4], [2, 4, 3], [6, 2, 3], [6, 3, 7], [1, 5, 8], [1, 8, 4], [8, 7, 3], [8, 3, 4], [1, 2, 6], [1, 6, 5]];
+    let mut rng = seed(8);
+    for case in 0..40 {
+        let flip_all = case % 2 == 0;
+        let mut obj = String::from("v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n");
+        let mut flipped = 0;
+        for f in faces {
+            let flip = flip_all || rng.below(2) == 0;
+            flipped += flip as usize;
+            let [a, b, c] = if flip { [f[0], f[2], f[1]] } else { f };
+            obj += &format!("f {a} {b} {c}\n");
+        }
+        std::fs::write(dir.join("cube.obj"), &obj).unwrap();
+        let scene = "[camera]\neye = [0, 0, 5]\ntarget = [0, 0, 0]\n[[light]]\ntype = \"point\"\nposition = [0, 2, 5]\npower = [80, 80, 80]\n\
+[[object]]\ntype = \"csg\"\nop = \"union\"\na = { type = \"mesh\", file = \"cube.obj\" }\nb = { type = \"sphere\", center = [3, 0, 0], radius = 0.5 }\n";
+        std::fs::write(dir.join("s.toml"), scene).unwrap();
+        match pinhole::scene::file::load_scene_file(&dir.join("s.toml")) {
+            Ok(s) => {
+                assert!(flipped == 0 || flipped == faces.len(), "case {case}: {flipped} faces flipped yet accepted");
+                assert_eq!(s.warnings.iter().any(|w| w.contains("inside out")), flipped == faces.len(), "case {case}: {:?}", s.warnings);
+                let pixels = render_tiny(&s, "raytrace");
+                assert!(pixels.iter().all(|p| p.is_finite()));
+            }
+            Err(e) => {
+                assert!(flipped > 0 && flipped < faces.len(), "case {case}: {e}");
+                assert_eq!(e.lines().count(), 1, "{e}");
+            }
+        }
+    }
+}
+
+/// Outputs reached through random chains of symlinks, `..` and hard links:
+/// refused exactly when they land on an input.
+#[test]
+fn output_paths_that_alias_inputs() {
+    let dir = work_dir("alias");
+    std::fs::create_dir_all(dir.join("a/b")).unwrap();
+    let input = dir.join("a/scene.toml");
+    std::fs::write(&input, "x").unwrap();
+    // Read through the one reader, as a scene is.
+    pinhole::input::read_file(&input, pinhole::input::InputKind::Scene).unwrap();
+    let mut rng = seed(9);
+    for case in 0..60 {
+        let target_is_input = rng.below(2) == 0;
+        let name = if target_is_input { "scene.toml".to_string() } else { format!("out{case}.exr") };
+        let path = match rng.below(3) {
+            0 => dir.join("a/b/..").join(&name),
+            1 => {
+                let link = dir.join(format!("link{case}"));
+                std::os::unix::fs::symlink(dir.join("a").join(&name), &link).unwrap();
+                link
+            }
+            _ => {
+                if target_is_input {
+                    let hard = dir.join(format!("hard{case}.toml"));
+                    std::fs::hard_link(&input, &hard).unwrap();
+                    hard
+                } else {
+                    dir.join("a/./").join(&name)
+                }
+            }
+        };
+        let r = pinhole::file_identity::check_outputs(&[&path]);
+        assert_eq!(r.is_err(), target_is_input, "case {case}: {} -> {r:?}", path.display());
     }
 }
