@@ -1,5 +1,6 @@
 //! A seeded mutation fuzzer over everything pinhole reads: scene TOML (the
-//! built-in scenes, mutated), OBJ/MTL pairs and image files (PNG, EXR).
+//! built-in scenes, mutated), OBJ/MTL pairs, PLY meshes (ASCII and binary)
+//! and image files (PNG, EXR).
 //!
 //! Each case must end without a panic, with either an error of at most
 //! three lines and `MAX_ERROR_CHARS` characters, or a scene that renders
@@ -19,7 +20,7 @@ const MAX_ERROR_CHARS: usize = 1000;
 const DEFAULT_CASES: usize = 300;
 
 /// Inputs that once crashed, hung or gave a bad message: (kind, file text).
-/// Kinds: "toml", "obj" (with "mtl" = the MTL beside it, "OBJ\0MTL"), "image".
+/// Kinds: "toml", "obj" (with "mtl" = the MTL beside it, "OBJ\0MTL"), "ply", "image".
 const REGRESSIONS: &[(&str, &str)] = &[
     // tobj panicked on MTL colours with fewer than three numbers.
     ("obj", "mtllib a.mtl\nusemtl a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n\0newmtl a\nKd 0.5\nKa 1\nKs 0.5\nKe 1\n"),
@@ -34,6 +35,13 @@ const REGRESSIONS: &[(&str, &str)] = &[
     ("toml", "[[object]]\ntype = \"sphere\"\ncenter = [0, 0, -3]\nradius = 1\nscale = 1e38\n"),
     ("toml", "[camera]\neye = [0, 0, 3, 99]\n"),
     ("toml", "[[object]]\ntype = \"quad\"\nvertices = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]\nscale = \"x\"\n"),
+    // PLY headers that lie about their counts, lists longer than the file,
+    // indices beyond the vertices, a property-less element counted in billions.
+    ("ply", "ply\nformat ascii 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"),
+    ("ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uint int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n4294967295 0 1 2\n"),
+    ("ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n"),
+    ("ply", "ply\nformat binary_little_endian 1.0\nelement nothing 4000000000\nelement vertex 3\nproperty uchar x\nproperty uchar y\nproperty uchar z\nelement face 1\nproperty list uchar uchar vertex_indices\nend_header\n\0\0\0\x01\0\0\0\x01\0\x03\0\x01\x02"),
+    ("ply", "ply\nformat binary_big_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n\0\0"),
 ];
 
 /// splitmix64: small, seeded, and the same everywhere.
@@ -209,6 +217,13 @@ fn run_obj(dir: &Path, obj: &[u8], mtl: &[u8]) {
     check("obj", &shown, r);
 }
 
+fn run_ply(dir: &Path, bytes: &[u8]) {
+    let path = dir.join("m.ply");
+    std::fs::write(&path, bytes).unwrap();
+    let r = catch_unwind(AssertUnwindSafe(|| pinhole::scene::load::load_scene(path.to_str().unwrap()).map(Some)));
+    check("ply", bytes, r);
+}
+
 fn run_image(dir: &Path, name: &str, bytes: &[u8]) {
     let path = dir.join(name);
     std::fs::write(&path, bytes).unwrap();
@@ -248,6 +263,7 @@ fn regressions_stay_fixed() {
                 let (obj, mtl) = input.split_once('\0').unwrap();
                 run_obj(&dir, obj.as_bytes(), mtl.as_bytes());
             }
+            "ply" => run_ply(&dir, input.as_bytes()),
             _ => run_image(&dir, "r.png", input.as_bytes()),
         }
     }
@@ -333,5 +349,42 @@ fn mutated_images() {
             }
         }
         run_image(&dir, name, &bytes);
+    });
+}
+
+#[test]
+fn mutated_ply_meshes() {
+    let dir = work_dir("ply");
+    let mut rng = seed(4);
+    let ascii = "ply\nformat ascii 1.0\ncomment a square and a triangle\nelement vertex 5\nproperty float x\nproperty float y\nproperty float z\n\
+                 property float nx\nproperty float ny\nproperty float nz\nproperty float u\nproperty float v\nelement face 2\n\
+                 property list uchar int vertex_indices\nend_header\n-1 -1 -2 0 0 1 0 0\n1 -1 -2 0 0 1 1 0\n1 1 -2 0 0 1 1 1\n-1 1 -2 0 0 1 0 1\n\
+                 0 2 -3 0 0 1 0.5 0.5\n4 0 1 2 3\n3 3 2 4\n";
+    let mut binary = b"ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n\
+                       element face 1\nproperty list uchar uint vertex_indices\nend_header\n"
+        .to_vec();
+    for p in [[-1.0f32, -1.0, -2.0], [1.0, -1.0, -2.0], [1.0, 1.0, -2.0], [-1.0, 1.0, -2.0]] {
+        p.iter().for_each(|x| binary.extend(x.to_le_bytes()));
+    }
+    binary.push(4);
+    [0u32, 1, 2, 3].iter().for_each(|i| binary.extend(i.to_le_bytes()));
+    counted("ply meshes", || {
+        for _ in 0..cases() {
+            if rng.below(2) == 0 {
+                run_ply(&dir, &mutate(&mut rng, ascii.as_bytes()));
+            } else {
+                // Binary: byte flips, special bytes and cuts, never line edits.
+                let mut bytes = binary.clone();
+                for _ in 0..1 + rng.below(4) {
+                    let i = rng.below(bytes.len());
+                    match rng.below(3) {
+                        0 => bytes[i] ^= 1 << rng.below(8),
+                        1 => bytes[i] = *rng.pick(&[0u8, 0xff, 0x7f, 0x80]),
+                        _ => bytes.truncate(i.max(4)),
+                    }
+                }
+                run_ply(&dir, &bytes);
+            }
+        }
     });
 }
