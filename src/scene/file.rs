@@ -5,7 +5,7 @@
 use crate::scene::mesh_cache::MeshCache;
 use crate::scene::obj::{self, NormalMode};
 use crate::scene::texture::{load_texture_as, Encoding, Wrap};
-use crate::scene::material::{GlossyModel, MIN_ROUGHNESS};
+use crate::scene::material::{Fresnel, GlossyModel, MIN_ROUGHNESS};
 use crate::scene::instanced::{InstanceLayer, LayerInstance};
 use crate::scene::placement::Placement;
 use crate::scene::{Camera, Fov, InstanceInfo, Light, Material, ObjectInfo, RenderDefaults, Scene, Sphere, Triangle};
@@ -87,6 +87,8 @@ struct MaterialDesc {
     glossy_model: Option<String>,
     roughness: Option<f32>,
     fresnel: Option<String>,
+    eta: Option<F3>,
+    k: Option<F3>,
     mirror: Option<F3>,
     transmission: Option<F3>,
     ior: Option<f32>,
@@ -874,11 +876,27 @@ fn glossy_lobe(mat: &mut Material, m: &MaterialDesc, where_: &str) -> Result<(),
         }
         mat.roughness = alpha.max(MIN_ROUGHNESS);
     }
-    match m.fresnel.as_deref() {
-        None | Some("none") => Ok(()),
-        Some(other @ ("schlick" | "conductor")) => Err(format!("{where_}: fresnel \"{other}\" is not supported yet (only \"none\" is)")),
-        Some(other) => Err(format!("{where_}: unknown fresnel \"{other}\" (expected \"none\", \"schlick\" or \"conductor\")")),
+    mat.fresnel = match m.fresnel.as_deref() {
+        None | Some("none") => Fresnel::None,
+        Some("schlick") => Fresnel::Schlick,
+        Some("conductor") => {
+            let (Some(eta), Some(k)) = (m.eta, m.k) else {
+                let missing = if m.eta.is_none() { "eta" } else { "k" };
+                return Err(format!("{where_}: fresnel \"conductor\" needs `{missing}` (the conductor's complex index of refraction eta + i k, three numbers each)"));
+            };
+            Fresnel::Conductor { eta: color(Some(eta), Vec3::ZERO, MAX_VALUE, where_, "eta")?, k: color(Some(k), Vec3::ZERO, MAX_VALUE, where_, "k")? }
+        }
+        Some(other) => {
+            let names: Vec<String> = Fresnel::NAMES.iter().map(|n| format!("\"{n}\"")).collect();
+            return Err(format!("{where_}: unknown fresnel \"{other}\" (expected one of {})", names.join(", ")));
+        }
+    };
+    if !matches!(mat.fresnel, Fresnel::Conductor { .. }) {
+        if let Some(key) = [("eta", m.eta.is_some()), ("k", m.k.is_some())].iter().find(|(_, present)| *present).map(|(key, _)| key) {
+            return Err(format!("{where_}: `{key}` is given but fresnel is \"{}\"; `eta` and `k` belong to fresnel = \"conductor\"", mat.fresnel.name()));
+        }
     }
+    Ok(())
 }
 
 /// A radiance, power or reflectance: finite and not negative.
@@ -954,6 +972,10 @@ mod tests {
         // A tiny roughness is raised to the smallest alpha rather than overflowing D.
         assert_eq!(metal("roughness = 1e-7").roughness, MIN_ROUGHNESS);
         assert_eq!(metal("roughness = 1.0").roughness, 1.0);
+        assert_eq!(metal("glossy = [0.9, 0.9, 0.9]").fresnel, Fresnel::None);
+        assert_eq!(metal("fresnel = \"schlick\"").fresnel, Fresnel::Schlick);
+        let conductor = metal("fresnel = \"conductor\"\neta = [0.2, 0.9, 1.1]\nk = [3.9, 2.4, 2.2]").fresnel;
+        assert_eq!(conductor, Fresnel::Conductor { eta: Vec3::new(0.2, 0.9, 1.1), k: Vec3::new(3.9, 2.4, 2.2) });
     }
 
     #[test]
@@ -966,9 +988,13 @@ mod tests {
             ("roughness = inf", &["material \"metal\"", "roughness"][..]),
             ("roughness = 1.5", &["material \"metal\"", "roughness"][..]),
             ("roughness = nan", &["material \"metal\"", "roughness"][..]),
-            ("fresnel = \"schlick\"", &["material \"metal\"", "fresnel", "not supported"][..]),
-            ("fresnel = \"conductor\"", &["material \"metal\"", "fresnel", "not supported"][..]),
-            ("fresnel = \"dielectric\"", &["material \"metal\"", "fresnel", "\"none\""][..]),
+            ("fresnel = \"conductor\"", &["material \"metal\"", "conductor", "`eta`"][..]),
+            ("fresnel = \"conductor\"\neta = [0.2, 0.9, 1.1]", &["material \"metal\"", "conductor", "`k`"][..]),
+            ("fresnel = \"dielectric\"", &["material \"metal\"", "fresnel", "\"none\"", "\"conductor\""][..]),
+            ("eta = [0.2, 0.9, 1.1]", &["material \"metal\"", "`eta`", "\"none\"", "conductor"][..]),
+            ("fresnel = \"schlick\"\nk = [3.9, 2.4, 2.2]", &["material \"metal\"", "`k`", "\"schlick\"", "conductor"][..]),
+            ("fresnel = \"conductor\"\neta = [0.2, -0.9, 1.1]\nk = [3.9, 2.4, 2.2]", &["material \"metal\"", "`eta`", "not negative"][..]),
+            ("fresnel = \"conductor\"\neta = [0.2, 0.9, 1.1]\nk = [3.9, nan, 2.2]", &["material \"metal\"", "`k`", "finite"][..]),
         ] {
             let e = scene_with(entry).err().unwrap_or_else(|| panic!("{entry}: accepted"));
             for w in words {
