@@ -1,5 +1,6 @@
 //! Opening a scene by the argument the command line and the viewer take: a
-//! built-in scene's name, a `.toml` scene file or a bare mesh (`.obj`, `.ply`).
+//! built-in scene's name, a `.toml` scene file, a bare mesh (`.obj`,
+//! `.ply`) or a glTF (`.gltf`, `.glb`).
 
 use crate::scene::builtin;
 use crate::scene::file::load_scene_file;
@@ -9,13 +10,34 @@ use std::path::PathBuf;
 
 /// Where a scene argument points: a built-in name, a `.toml` or a bare mesh.
 pub fn load_scene(arg: &str) -> Result<Scene, String> {
+    load_scene_with_camera(arg, None)
+}
+
+/// `load_scene`, looking through the camera called `camera` (a glTF's):
+/// refused when the scene has no camera of that name.
+pub fn load_scene_with_camera(arg: &str, camera: Option<&str>) -> Result<Scene, String> {
     let path = PathBuf::from(arg);
+    if crate::scene::gltf::is_gltf(&path) {
+        return crate::scene::gltf::frame_bare_gltf(&path, camera);
+    }
+    let mut scene = load_scene_by_kind(arg, &path)?;
+    if let Some(wanted) = camera {
+        let found = scene.named_cameras.iter().find(|(n, _)| n == wanted).map(|(_, c)| c.clone());
+        scene.camera = found.ok_or_else(|| {
+            let names: Vec<String> = scene.named_cameras.iter().map(|(n, _)| format!("\"{n}\"")).collect();
+            format!("{arg}: no camera is named \"{wanted}\" (its cameras: {})", if names.is_empty() { "none".into() } else { names.join(", ") })
+        })?;
+    }
+    Ok(scene)
+}
+
+fn load_scene_by_kind(arg: &str, path: &std::path::Path) -> Result<Scene, String> {
     let is_mesh = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj") || e.eq_ignore_ascii_case("ply"));
     if is_mesh {
-        return frame_bare_mesh(&path);
+        return frame_bare_mesh(path);
     }
     if path.exists() || arg.ends_with(".toml") || arg.contains('/') {
-        return load_scene_file(&path);
+        return load_scene_file(path);
     }
     builtin::load_builtin(arg).ok_or_else(|| {
         format!(
