@@ -25,7 +25,7 @@ use render_opts::RenderOpts;
 pub struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
-    /// Scene to open in the viewer: a .toml, a .obj or a built-in name.
+    /// Scene to open in the viewer: a .toml, a mesh (.obj, .ply), a glTF (.gltf, .glb) or a built-in name.
     scene: Option<String>,
     /// Open the window, wait for the full-quality frame, save a screenshot of the window there, exit.
     #[arg(long, value_name = "OUT.png")]
@@ -224,7 +224,7 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
     opts.write_into(&mut RenderSettings::default())?;
     let pool = worker_pool(opts.threads)?;
     let start = Instant::now();
-    let scene: Scene = crate::scene::load::load_scene(scene_arg)?;
+    let scene: Scene = crate::scene::load::load_scene_with_camera(scene_arg, opts.camera.as_deref())?;
     let load_ms = start.elapsed().as_secs_f64() * 1e3;
     for w in &scene.warnings {
         eprintln!("warning: {w}");

@@ -19,7 +19,7 @@ pub enum InputKind {
 
 /// Largest scene file (TOML): 16 MiB.
 pub const MAX_SCENE_BYTES: u64 = 16 << 20;
-/// Largest OBJ file: 512 MiB.
+/// Largest mesh file (OBJ, PLY): 512 MiB.
 pub const MAX_MESH_BYTES: u64 = 512 << 20;
 /// Largest MTL file: 16 MiB.
 pub const MAX_MTL_BYTES: u64 = 16 << 20;
@@ -54,7 +54,7 @@ impl InputKind {
     fn noun(self) -> &'static str {
         match self {
             InputKind::Scene => "scene file",
-            InputKind::Mesh => "OBJ file",
+            InputKind::Mesh => "mesh file",
             InputKind::Mtl => "MTL file",
             InputKind::Image => "image",
         }

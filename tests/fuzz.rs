@@ -1,5 +1,6 @@
 //! A seeded mutation fuzzer over everything pinhole reads: scene TOML (the
-//! built-in scenes, mutated), OBJ/MTL pairs and image files (PNG, EXR).
+//! built-in scenes, mutated), OBJ/MTL pairs, PLY meshes (ASCII and binary),
+//! glTF files (the vendored samples, mutated) and image files (PNG, EXR).
 //!
 //! Each case must end without a panic, with either an error of at most
 //! three lines and `MAX_ERROR_CHARS` characters, or a scene that renders
@@ -20,7 +21,7 @@ const MAX_ERROR_CHARS: usize = 1000;
 const DEFAULT_CASES: usize = 300;
 
 /// Inputs that once crashed, hung or gave a bad message: (kind, file text).
-/// Kinds: "toml", "obj" (with "mtl" = the MTL beside it, "OBJ\0MTL"), "image".
+/// Kinds: "toml", "obj" (with "mtl" = the MTL beside it, "OBJ\0MTL"), "ply", "gltf", "image".
 const REGRESSIONS: &[(&str, &str)] = &[
     // tobj panicked on MTL colours with fewer than three numbers.
     ("obj", "mtllib a.mtl\nusemtl a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n\0newmtl a\nKd 0.5\nKa 1\nKs 0.5\nKe 1\n"),
@@ -35,6 +36,20 @@ const REGRESSIONS: &[(&str, &str)] = &[
     ("toml", "[[object]]\ntype = \"sphere\"\ncenter = [0, 0, -3]\nradius = 1\nscale = 1e38\n"),
     ("toml", "[camera]\neye = [0, 0, 3, 99]\n"),
     ("toml", "[[object]]\ntype = \"quad\"\nvertices = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]\nscale = \"x\"\n"),
+    // PLY headers that lie about their counts, lists longer than the file,
+    // indices beyond the vertices, a property-less element counted in billions.
+    ("ply", "ply\nformat ascii 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"),
+    ("ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uint int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n4294967295 0 1 2\n"),
+    ("ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n"),
+    ("ply", "ply\nformat binary_little_endian 1.0\nelement nothing 4000000000\nelement vertex 3\nproperty uchar x\nproperty uchar y\nproperty uchar z\nelement face 1\nproperty list uchar uchar vertex_indices\nend_header\n\0\0\0\x01\0\0\0\x01\0\x03\0\x01\x02"),
+    ("ply", "ply\nformat binary_big_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n\0\0"),
+    // glTF: an accessor past its view, a node cycle, a buffer outside the folder, a cut GLB.
+    ("gltf", "{\"asset\": {\"version\": \"2.0\"}, \"scenes\": [{\"nodes\": [0]}], \"nodes\": [{\"mesh\": 0}], \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0}}]}], \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 3000000, \"type\": \"VEC3\", \"min\": [0, 0, 0], \"max\": [1, 1, 1]}], \"bufferViews\": [{\"buffer\": 0, \"byteLength\": 36}], \"buffers\": [{\"byteLength\": 36, \"uri\": \"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA\"}]}"),
+    ("gltf", "{\"asset\": {\"version\": \"2.0\"}, \"scenes\": [{\"nodes\": [0]}], \"nodes\": [{\"children\": [1]}, {\"children\": [0]}]}"),
+    // The gltf crate's validation indexed a POSITION accessor beyond the list.
+    ("gltf", "{\"asset\": {\"version\": \"2.0\"}, \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 2}}]}]}"),
+    ("gltf", "{\"asset\": {\"version\": \"2.0\"}, \"buffers\": [{\"byteLength\": 4, \"uri\": \"../../../etc/passwd\"}]}"),
+    ("gltf", "glTF\x02\0\0\0\x40\0\0\0\x20\0\0\0JSON{\"asset\": {\"version\": \"2.0\"}}"),
 ];
 
 /// splitmix64: small, seeded, and the same everywhere.
@@ -210,6 +225,21 @@ fn run_obj(dir: &Path, obj: &[u8], mtl: &[u8]) {
     check("obj", &shown, r);
 }
 
+fn run_ply(dir: &Path, bytes: &[u8]) {
+    let path = dir.join("m.ply");
+    std::fs::write(&path, bytes).unwrap();
+    let r = catch_unwind(AssertUnwindSafe(|| pinhole::scene::load::load_scene(path.to_str().unwrap()).map(Some)));
+    check("ply", bytes, r);
+}
+
+fn run_gltf(dir: &Path, bytes: &[u8]) {
+    let name = if bytes.starts_with(b"glTF") { "m.glb" } else { "m.gltf" };
+    let path = dir.join(name);
+    std::fs::write(&path, bytes).unwrap();
+    let r = catch_unwind(AssertUnwindSafe(|| pinhole::scene::load::load_scene(path.to_str().unwrap()).map(Some)));
+    check("gltf", bytes, r);
+}
+
 fn run_image(dir: &Path, name: &str, bytes: &[u8]) {
     let path = dir.join(name);
     std::fs::write(&path, bytes).unwrap();
@@ -249,6 +279,8 @@ fn regressions_stay_fixed() {
                 let (obj, mtl) = input.split_once('\0').unwrap();
                 run_obj(&dir, obj.as_bytes(), mtl.as_bytes());
             }
+            "ply" => run_ply(&dir, input.as_bytes()),
+            "gltf" => run_gltf(&dir, input.as_bytes()),
             _ => run_image(&dir, "r.png", input.as_bytes()),
         }
     }
@@ -503,4 +535,54 @@ fn output_paths_that_alias_inputs() {
         let r = pinhole::file_identity::check_outputs(&[&path]);
         assert_eq!(r.is_err(), target_is_input, "case {case}: {} -> {r:?}", path.display());
     }
+#[test]
+fn mutated_ply_meshes() {
+    let dir = work_dir("ply");
+    let mut rng = seed(4);
+    let ascii = "ply\nformat ascii 1.0\ncomment a square and a triangle\nelement vertex 5\nproperty float x\nproperty float y\nproperty float z\n\
+                 property float nx\nproperty float ny\nproperty float nz\nproperty float u\nproperty float v\nelement face 2\n\
+                 property list uchar int vertex_indices\nend_header\n-1 -1 -2 0 0 1 0 0\n1 -1 -2 0 0 1 1 0\n1 1 -2 0 0 1 1 1\n-1 1 -2 0 0 1 0 1\n\
+                 0 2 -3 0 0 1 0.5 0.5\n4 0 1 2 3\n3 3 2 4\n";
+    let mut binary = b"ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n\
+                       element face 1\nproperty list uchar uint vertex_indices\nend_header\n"
+        .to_vec();
+    for p in [[-1.0f32, -1.0, -2.0], [1.0, -1.0, -2.0], [1.0, 1.0, -2.0], [-1.0, 1.0, -2.0]] {
+        p.iter().for_each(|x| binary.extend(x.to_le_bytes()));
+    }
+    binary.push(4);
+    [0u32, 1, 2, 3].iter().for_each(|i| binary.extend(i.to_le_bytes()));
+    counted("ply meshes", || {
+        for _ in 0..cases() {
+            if rng.below(2) == 0 {
+                run_ply(&dir, &mutate(&mut rng, ascii.as_bytes()));
+            } else {
+                // Binary: byte flips, special bytes and cuts, never line edits.
+                let mut bytes = binary.clone();
+                for _ in 0..1 + rng.below(4) {
+                    let i = rng.below(bytes.len());
+                    match rng.below(3) {
+                        0 => bytes[i] ^= 1 << rng.below(8),
+                        1 => bytes[i] = *rng.pick(&[0u8, 0xff, 0x7f, 0x80]),
+                        _ => bytes.truncate(i.max(4)),
+                    }
+                }
+                run_ply(&dir, &bytes);
+            }
+        }
+    });
+}
+
+#[test]
+fn mutated_gltf_files() {
+    let dir = work_dir("gltf");
+    let mut rng = seed(5);
+    let samples = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/gltf");
+    let corpus: Vec<Vec<u8>> = ["Box.gltf", "Cameras.gltf"].iter().map(|f| std::fs::read(samples.join(f)).unwrap()).collect();
+    counted("gltf files", || {
+        for _ in 0..cases() {
+            let seed_bytes = rng.pick(&corpus).clone();
+            let input = mutate(&mut rng, &seed_bytes);
+            run_gltf(&dir, &input);
+        }
+    });
 }

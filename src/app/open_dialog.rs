@@ -83,7 +83,7 @@ impl Default for OpenDialog {
     }
 }
 
-/// Folders first, then .toml and .obj files, each sorted by name; hidden entries skipped.
+/// Folders first, then scene, mesh and glTF files (.toml, .obj, .ply, .gltf, .glb), each sorted by name; hidden entries skipped.
 pub fn list_dir(dir: &Path) -> Result<Vec<(PathBuf, bool)>, String> {
     let rd = std::fs::read_dir(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let mut out: Vec<(PathBuf, bool)> = rd
@@ -92,7 +92,7 @@ pub fn list_dir(dir: &Path) -> Result<Vec<(PathBuf, bool)>, String> {
         .filter(|(p, is_dir)| {
             let hidden = p.file_name().is_some_and(|n| n.to_string_lossy().starts_with('.'));
             let ext = p.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
-            !hidden && (*is_dir || matches!(ext.as_deref(), Some("toml") | Some("obj")))
+            !hidden && (*is_dir || matches!(ext.as_deref(), Some("toml" | "obj" | "ply" | "gltf" | "glb")))
         })
         .collect();
     out.sort_by(|a, b| b.1.cmp(&a.1).then_with(|| a.0.cmp(&b.0)));

@@ -586,7 +586,8 @@ impl PinholeApp {
                 egui::ScrollArea::vertical().show(ui, |ui| {
                     let (width, height) = (self.scene.render.width, self.scene.render.height);
                     let panels = &mut self.settings.panels;
-                    requests |= crate::app::panels::camera::show(ui, &mut panels.camera, &mut self.params.camera, &mut self.settings.res_scale, (width, height));
+                    let named = &self.scene.named_cameras;
+                    requests |= crate::app::panels::camera::show(ui, &mut panels.camera, &mut self.params.camera, &mut self.settings.res_scale, (width, height), named);
                     crate::app::panels::lights::show(ui, &mut panels.lights, &mut self.params.lights, &self.params.camera, &self.scene);
                     crate::app::panels::materials::show(ui, &mut panels.materials, &mut self.params.materials);
                     let in_force = crate::app::panels::shading::InForce { admitted: admitted.as_ref(), notices: &notices };

@@ -60,6 +60,7 @@ impl SceneParams {
                     && a.sharpness == b.sharpness
                     && a.glossy_model == b.glossy_model
                     && a.roughness == b.roughness
+                    && a.fresnel == b.fresnel
                     && a.mirror == b.mirror
                     && a.transmission == b.transmission
                     && a.ior == b.ior

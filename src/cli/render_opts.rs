@@ -22,6 +22,9 @@ pub struct RenderOpts {
     /// raytrace | rasterize, or a variant (see `pinhole list`).
     #[arg(long, default_value = "raytrace")]
     pub renderer: String,
+    /// glTF: look through the camera of this name (default: its first perspective camera).
+    #[arg(long, value_name = "NAME")]
+    pub camera: Option<String>,
     #[arg(long)]
     pub width: Option<u32>,
     #[arg(long)]

@@ -5,8 +5,8 @@
 use crate::scene::mesh_cache::MeshCache;
 use crate::scene::obj::{self, NormalMode};
 use crate::scene::texture::{load_texture_as, Encoding, Wrap};
-use crate::scene::material::{GlossyModel, MIN_ROUGHNESS};
-use crate::scene::instanced::{InstanceLayer, LayerInstance};
+use crate::scene::material::{Fresnel, GlossyModel, MIN_ROUGHNESS};
+use crate::scene::instanced::{build_layer, Layered, MeshCopy};
 use crate::scene::placement::Placement;
 use crate::scene::{Camera, Fov, InstanceInfo, Light, Material, ObjectInfo, RenderDefaults, Scene, Sphere, Triangle};
 use crate::input::{MAX_COORDINATE, MAX_LIGHT, MAX_VALUE};
@@ -87,6 +87,8 @@ struct MaterialDesc {
     glossy_model: Option<String>,
     roughness: Option<f32>,
     fresnel: Option<String>,
+    eta: Option<F3>,
+    k: Option<F3>,
     mirror: Option<F3>,
     transmission: Option<F3>,
     ior: Option<f32>,
@@ -213,15 +215,6 @@ pub const FLATTEN_LIMIT: usize = 2_000_000;
 /// `parse_scene`, choosing how copies are held.
 pub fn parse_scene_with(text: &str, origin: &str, base: &Path, name: &str, two_level: TwoLevel) -> Result<Scene, String> {
     parse_scene_unbounded(text, origin, base, name, two_level).map_err(|e| crate::input::bounded_message(&e))
-}
-
-/// Copies bound for the two-level layer, gathered while objects are added:
-/// their virtual indices come after every flattened triangle.
-#[derive(Default)]
-struct Layered {
-    flattened: usize,
-    /// Per object: its id, its placed mesh and its copies.
-    objects: Vec<(u32, Arc<Vec<Triangle>>, Vec<MeshCopy>)>,
 }
 
 /// `parse_scene` before its message is bounded: messages quote names from
@@ -403,43 +396,6 @@ fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str, two_
 /// Turns `span` of the file into "file:line".
 type At<'a> = dyn Fn(std::ops::Range<usize>) -> String + 'a;
 
-/// Places the copies gathered in `layered` after every flattened triangle.
-fn build_layer(scene: &mut Scene, layered: Layered) -> Result<(), String> {
-    if layered.objects.is_empty() {
-        return Ok(());
-    }
-    let mut layer = InstanceLayer::default();
-    let mut base = scene.triangles.len() as u64;
-    for (object, mesh, copies) in layered.objects {
-        let (center, radius) = bounding_sphere(&mesh);
-        let mesh_index = layer.meshes.len() as u32;
-        let len = mesh.len() as u64;
-        layer.meshes.push(mesh);
-        for copy in copies {
-            let placement = copy.placement.unwrap_or_else(|| Placement::new(Vec3::ZERO, Vec3::ZERO, Vec3::ONE));
-            if base + len >= 1 << 30 {
-                return Err(format!("{}: the copies hold more than 2^30 triangles, the most a primitive id can name", scene.name));
-            }
-            let m = placement.matrix();
-            let stretch = m.x_axis.truncate().length().max(m.y_axis.truncate().length()).max(m.z_axis.truncate().length());
-            let c = m.transform_point3(center);
-            let r = radius * stretch * (1.0 + 1e-5) + 1e-6 * c.abs().max_element();
-            let range = base as usize..(base + len) as usize;
-            scene.instances.push(InstanceInfo { object, index: copy.index.unwrap_or(0), triangles: range, center: c, radius: r });
-            layer.instances.push(LayerInstance { mesh: mesh_index, placement, material: copy.material, base: base as u32 });
-            base += len;
-        }
-    }
-    scene.layer = Some(Arc::new(layer));
-    Ok(())
-}
-
-/// The centre of the bounding box of `tris` and the distance to its farthest vertex.
-fn bounding_sphere(tris: &[Triangle]) -> (Vec3, f32) {
-    let info = InstanceInfo::new(0, 0, 0..0, tris.iter().cloned());
-    (info.center, info.radius)
-}
-
 #[allow(clippy::too_many_arguments)]
 fn add_object(
     scene: &mut Scene,
@@ -582,6 +538,19 @@ fn add_object(
                 }
             }
         }
+        "gltf" => {
+            only(&["file"])?;
+            reject(where_, "gltf object (its own materials and sides are used)", &[("material", o.material.is_some()), ("two_sided", o.two_sided.is_some())])?;
+            let file = o.file.as_ref().ok_or(format!("{where_}: a gltf object needs `file`"))?;
+            let path = base.join(file);
+            let parts = crate::scene::gltf::add_gltf(scene, &path, &placement, object, layered).map_err(|e| format!("{where_}: {e}"))?;
+            scene.lights.extend(parts.lights);
+            scene.named_cameras.extend(parts.cameras.into_iter().map(|c| (c.name, c.camera)));
+            if !parts.ignored.is_empty() {
+                scene.warnings.push(format!("{}: not drawn: {}", path.display(), parts.ignored.join("; ")));
+            }
+            return Ok(());
+        }
         "triangle" | "quad" => {
             only(&["vertices", "normals", "uvs"])?;
             let count = if kind == "triangle" { 3 } else { 4 };
@@ -667,7 +636,7 @@ fn add_object(
             let root = csg_node(scene, o, object, where_, "", base, meshes, at, explicit_material, 0, &mut parts)?;
             scene.csgs.push(crate::scene::csg::Csg::new(root, parts.spheres, parts.triangles, object));
         }
-        other => return Err(format!("{where_}: unknown object type \"{other}\" (expected mesh, triangle, quad, sphere or csg)")),
+        other => return Err(format!("{where_}: unknown object type \"{other}\" (expected mesh, gltf, triangle, quad, sphere or csg)")),
     }
     // Placement (scale, translate) can carry in-range vertices out of range.
     if let Some(t) = scene.triangles.range(first..scene.triangles.len()).find(|t| t.v.iter().any(|v| !(v.abs().max_element() <= MAX_COORDINATE))) {
@@ -680,16 +649,6 @@ fn add_object(
     };
     scene.objects.push(ObjectInfo { name, kind: kind.to_string(), triangles: first..scene.triangles.len() });
     Ok(())
-}
-
-/// One placed copy of a mesh object's triangles.
-struct MeshCopy {
-    /// The copy's own placement, applied after the object's (`None`: the object itself).
-    placement: Option<Placement>,
-    /// The copy's material, or the object's when `None` (then the MTL's).
-    material: Option<u32>,
-    /// Index in the object's `instances` list, `None` for an object without one.
-    index: Option<u32>,
 }
 
 /// The copies an `instances` list asks for, checked: every error names the
@@ -880,11 +839,27 @@ fn glossy_lobe(mat: &mut Material, m: &MaterialDesc, where_: &str) -> Result<(),
         }
         mat.roughness = alpha.max(MIN_ROUGHNESS);
     }
-    match m.fresnel.as_deref() {
-        None | Some("none") => Ok(()),
-        Some(other @ ("schlick" | "conductor")) => Err(format!("{where_}: fresnel \"{other}\" is not supported yet (only \"none\" is)")),
-        Some(other) => Err(format!("{where_}: unknown fresnel \"{other}\" (expected \"none\", \"schlick\" or \"conductor\")")),
+    mat.fresnel = match m.fresnel.as_deref() {
+        None | Some("none") => Fresnel::None,
+        Some("schlick") => Fresnel::Schlick,
+        Some("conductor") => {
+            let (Some(eta), Some(k)) = (m.eta, m.k) else {
+                let missing = if m.eta.is_none() { "eta" } else { "k" };
+                return Err(format!("{where_}: fresnel \"conductor\" needs `{missing}` (the conductor's complex index of refraction eta + i k, three numbers each)"));
+            };
+            Fresnel::Conductor { eta: color(Some(eta), Vec3::ZERO, MAX_VALUE, where_, "eta")?, k: color(Some(k), Vec3::ZERO, MAX_VALUE, where_, "k")? }
+        }
+        Some(other) => {
+            let names: Vec<String> = Fresnel::NAMES.iter().map(|n| format!("\"{n}\"")).collect();
+            return Err(format!("{where_}: unknown fresnel \"{other}\" (expected one of {})", names.join(", ")));
+        }
+    };
+    if !matches!(mat.fresnel, Fresnel::Conductor { .. }) {
+        if let Some(key) = [("eta", m.eta.is_some()), ("k", m.k.is_some())].iter().find(|(_, present)| *present).map(|(key, _)| key) {
+            return Err(format!("{where_}: `{key}` is given but fresnel is \"{}\"; `eta` and `k` belong to fresnel = \"conductor\"", mat.fresnel.name()));
+        }
     }
+    Ok(())
 }
 
 /// A radiance, power or reflectance: finite and not negative.
@@ -960,6 +935,10 @@ mod tests {
         // A tiny roughness is raised to the smallest alpha rather than overflowing D.
         assert_eq!(metal("roughness = 1e-7").roughness, MIN_ROUGHNESS);
         assert_eq!(metal("roughness = 1.0").roughness, 1.0);
+        assert_eq!(metal("glossy = [0.9, 0.9, 0.9]").fresnel, Fresnel::None);
+        assert_eq!(metal("fresnel = \"schlick\"").fresnel, Fresnel::Schlick);
+        let conductor = metal("fresnel = \"conductor\"\neta = [0.2, 0.9, 1.1]\nk = [3.9, 2.4, 2.2]").fresnel;
+        assert_eq!(conductor, Fresnel::Conductor { eta: Vec3::new(0.2, 0.9, 1.1), k: Vec3::new(3.9, 2.4, 2.2) });
     }
 
     #[test]
@@ -972,9 +951,13 @@ mod tests {
             ("roughness = inf", &["material \"metal\"", "roughness"][..]),
             ("roughness = 1.5", &["material \"metal\"", "roughness"][..]),
             ("roughness = nan", &["material \"metal\"", "roughness"][..]),
-            ("fresnel = \"schlick\"", &["material \"metal\"", "fresnel", "not supported"][..]),
-            ("fresnel = \"conductor\"", &["material \"metal\"", "fresnel", "not supported"][..]),
-            ("fresnel = \"dielectric\"", &["material \"metal\"", "fresnel", "\"none\""][..]),
+            ("fresnel = \"conductor\"", &["material \"metal\"", "conductor", "`eta`"][..]),
+            ("fresnel = \"conductor\"\neta = [0.2, 0.9, 1.1]", &["material \"metal\"", "conductor", "`k`"][..]),
+            ("fresnel = \"dielectric\"", &["material \"metal\"", "fresnel", "\"none\"", "\"conductor\""][..]),
+            ("eta = [0.2, 0.9, 1.1]", &["material \"metal\"", "`eta`", "\"none\"", "conductor"][..]),
+            ("fresnel = \"schlick\"\nk = [3.9, 2.4, 2.2]", &["material \"metal\"", "`k`", "\"schlick\"", "conductor"][..]),
+            ("fresnel = \"conductor\"\neta = [0.2, -0.9, 1.1]\nk = [3.9, 2.4, 2.2]", &["material \"metal\"", "`eta`", "not negative"][..]),
+            ("fresnel = \"conductor\"\neta = [0.2, 0.9, 1.1]\nk = [3.9, nan, 2.2]", &["material \"metal\"", "`k`", "finite"][..]),
         ] {
             let e = scene_with(entry).err().unwrap_or_else(|| panic!("{entry}: accepted"));
             for w in words {

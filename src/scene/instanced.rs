@@ -9,8 +9,9 @@
 //! world-space triangle of any index with the very arithmetic flattening
 //! uses, so a copy renders as its flattened triangles would.
 
+use crate::math::Vec3;
 use crate::scene::placement::Placement;
-use crate::scene::Triangle;
+use crate::scene::{InstanceInfo, Scene, Triangle};
 use std::sync::Arc;
 
 /// One copy in the layer.
@@ -72,3 +73,60 @@ impl InstanceLayer {
         self.meshes.iter().map(|m| std::mem::size_of_val(&m[..])).sum::<usize>() + std::mem::size_of_val(&self.instances[..])
     }
 }
+
+/// Copies bound for the two-level layer, gathered while objects are added:
+/// their virtual indices come after every flattened triangle.
+#[derive(Default)]
+pub struct Layered {
+    pub flattened: usize,
+    /// Per object: its id, its placed mesh and its copies.
+    pub objects: Vec<(u32, Arc<Vec<Triangle>>, Vec<MeshCopy>)>,
+}
+
+/// One placed copy of a mesh object's triangles.
+pub struct MeshCopy {
+    /// The copy's own placement, applied after the object's (`None`: the object itself).
+    pub placement: Option<Placement>,
+    /// The copy's material, or the object's when `None` (then the MTL's).
+    pub material: Option<u32>,
+    /// Index in the object's `instances` list, `None` for an object without one.
+    pub index: Option<u32>,
+}
+
+/// Places the copies gathered in `layered` after every flattened triangle.
+pub fn build_layer(scene: &mut Scene, layered: Layered) -> Result<(), String> {
+    if layered.objects.is_empty() {
+        return Ok(());
+    }
+    let mut layer = InstanceLayer::default();
+    let mut base = scene.triangles.len() as u64;
+    for (object, mesh, copies) in layered.objects {
+        let (center, radius) = bounding_sphere(&mesh);
+        let mesh_index = layer.meshes.len() as u32;
+        let len = mesh.len() as u64;
+        layer.meshes.push(mesh);
+        for copy in copies {
+            let placement = copy.placement.unwrap_or_else(|| Placement::new(Vec3::ZERO, Vec3::ZERO, Vec3::ONE));
+            if base + len >= 1 << 30 {
+                return Err(format!("{}: the copies hold more than 2^30 triangles, the most a primitive id can name", scene.name));
+            }
+            let m = placement.matrix();
+            let stretch = m.x_axis.truncate().length().max(m.y_axis.truncate().length()).max(m.z_axis.truncate().length());
+            let c = m.transform_point3(center);
+            let r = radius * stretch * (1.0 + 1e-5) + 1e-6 * c.abs().max_element();
+            let range = base as usize..(base + len) as usize;
+            scene.instances.push(InstanceInfo { object, index: copy.index.unwrap_or(0), triangles: range, center: c, radius: r });
+            layer.instances.push(LayerInstance { mesh: mesh_index, placement, material: copy.material, base: base as u32 });
+            base += len;
+        }
+    }
+    scene.layer = Some(Arc::new(layer));
+    Ok(())
+}
+
+/// The centre of the bounding box of `tris` and the distance to its farthest vertex.
+pub fn bounding_sphere(tris: &[Triangle]) -> (Vec3, f32) {
+    let info = InstanceInfo::new(0, 0, 0..0, tris.iter().cloned());
+    (info.center, info.radius)
+}
+

@@ -43,6 +43,35 @@ impl GlossyModel {
     }
 }
 
+/// The Fresnel term of a material's glossy lobe (`fresnel` in a scene file):
+/// how its reflectance changes with the angle between the light and the
+/// microfacet (the half vector).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum Fresnel {
+    /// F = 1: the lobe reflects `glossy` at every angle.
+    #[default]
+    None,
+    /// Schlick's approximation with F0 = `glossy`: `F0 + (1 - F0) (1 - cos)^5`.
+    Schlick,
+    /// The exact Fresnel reflectance of a conductor with complex index of
+    /// refraction `eta + i k` per channel, scaled by `glossy`.
+    Conductor { eta: Vec3, k: Vec3 },
+}
+
+impl Fresnel {
+    /// The names a scene file gives the Fresnel terms.
+    pub const NAMES: [&'static str; 3] = ["none", "schlick", "conductor"];
+
+    /// The scene file's name of this term.
+    pub fn name(self) -> &'static str {
+        match self {
+            Fresnel::None => "none",
+            Fresnel::Schlick => "schlick",
+            Fresnel::Conductor { .. } => "conductor",
+        }
+    }
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
     pub name: String,
@@ -56,6 +85,8 @@ pub struct Material {
     pub glossy_model: GlossyModel,
     /// The microfacet lobes' alpha (not squared), at least `MIN_ROUGHNESS`.
     pub roughness: f32,
+    /// The glossy lobe's Fresnel term.
+    pub fresnel: Fresnel,
     pub mirror: Vec3,
     pub transmission: Vec3,
     pub ior: f32,
@@ -86,6 +117,7 @@ impl Material {
             sharpness: 100.0,
             glossy_model: GlossyModel::BlinnPhong,
             roughness: DEFAULT_ROUGHNESS,
+            fresnel: Fresnel::None,
             mirror: Vec3::ZERO,
             transmission: Vec3::ZERO,
             ior: 1.5,

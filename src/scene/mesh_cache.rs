@@ -1,9 +1,10 @@
-//! OBJ meshes parsed once per scene load: every object naming the same
-//! file with the same normal and texture modes shares one parse, and places
-//! its own copy of the triangles.
+//! Mesh files (OBJ, PLY) parsed once per scene load: every object naming
+//! the same file with the same normal and texture modes shares one parse,
+//! and places its own copy of the triangles.
 
 use crate::scene::assets::canonical_path;
-use crate::scene::obj::{load_obj, LoadedMesh, MtlTextures, NormalMode};
+use crate::scene::mesh_file::load_mesh_file;
+use crate::scene::obj::{LoadedMesh, MtlTextures, NormalMode};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::rc::Rc;
@@ -41,8 +42,9 @@ impl MeshCache {
         if let Some(mesh) = self.meshes.get(&key) {
             return Ok(Rc::clone(mesh));
         }
-        let mesh = Rc::new(load_obj(path, mode, textures)?);
+        let mesh = Rc::new(load_mesh_file(path, mode, textures)?);
         self.meshes.insert(key, Rc::clone(&mesh));
         Ok(mesh)
     }
 }
+

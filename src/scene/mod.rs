@@ -10,13 +10,16 @@ pub mod emitters;
 pub mod environment;
 pub mod file;
 pub mod forest;
+pub mod gltf;
 pub mod hit_lanes;
 pub mod instanced;
 pub mod load;
 pub mod mesh_cache;
+pub mod mesh_file;
 pub mod material;
 pub mod obj;
 pub mod placement;
+pub mod ply;
 pub mod recentre;
 pub mod tangents;
 pub mod texture;
@@ -313,6 +316,9 @@ pub struct Scene {
     /// Per triangle, per corner: the normal map's tangent frame
     /// (`tangents::build_tangents`); empty when no material has a normal map.
     pub tangents: Vec<[glam::Vec4; 3]>,
+    /// Cameras a loaded file offers by name (a glTF's), for `--camera` and
+    /// the viewer's camera list; `camera` is the one in use.
+    pub named_cameras: Vec<(String, Camera)>,
     /// The emissive triangles and spheres, gathered by `refresh_emitters`
     /// (after loading, and whenever materials or geometry change).
     pub emitters: std::sync::Arc<emitters::Emitters>,

@@ -7,7 +7,7 @@
 use crate::scene::assets::read_asset;
 use crate::input::{InputKind, MAX_COORDINATE, MAX_VALUE};
 use crate::scene::texture::load_texture;
-use crate::scene::{Camera, Fov, Light, Material, ObjectInfo, Scene, Triangle, Triangles};
+use crate::scene::{Camera, Fov, Light, Material, Scene, Triangle, Triangles};
 use crate::math::{Vec2, Vec3};
 use serde::Deserialize;
 use std::path::Path;
@@ -209,7 +209,7 @@ fn load_obj_unbounded(path: &Path, mode: NormalMode, textures: MtlTextures) -> R
 
 /// Area-weighted vertex normals (the un-normalized face normal is already
 /// area-weighted).
-fn smooth_normals(pos: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
+pub(crate) fn smooth_normals(pos: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
     let mut acc = vec![Vec3::ZERO; pos.len()];
     for idx in indices.chunks_exact(3) {
         let (a, b, c) = (pos[idx[0] as usize], pos[idx[1] as usize], pos[idx[2] as usize]);
@@ -221,37 +221,6 @@ fn smooth_normals(pos: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
         }
     }
     acc
-}
-
-/// A scene around a bare `.obj`: camera on +z looking at the bounding-box
-/// centre with the whole box in view, one point light above and behind it.
-pub fn frame_bare_obj(path: &Path) -> Result<Scene, String> {
-    let mesh = load_obj(path, NormalMode::Auto, MtlTextures::Used)?;
-    let mut scene = Scene {
-        name: path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "mesh".into()),
-        ..Scene::default()
-    };
-    scene.warnings = mesh.warnings;
-    if mesh.degenerate > 0 {
-        scene.warnings.push(format!("{}: skipped {} triangles with zero area", path.display(), mesh.degenerate));
-    }
-    scene.materials = mesh.materials;
-    let fallback = scene.default_material_index();
-    scene.triangles = mesh
-        .triangles
-        .iter()
-        .map(|mut t| {
-            if t.material == u32::MAX {
-                t.material = fallback;
-            }
-            t
-        })
-        .collect();
-    scene.objects.push(ObjectInfo { name: scene.name.clone(), kind: "mesh".into(), triangles: 0..scene.triangles.len() });
-    let (lo, hi) = scene.bounds().ok_or("the OBJ has no geometry")?;
-    frame_camera(&mut scene, lo, hi);
-    scene.triangles.share_corners();
-    Ok(scene)
 }
 
 /// Points the camera at a bounding box from +z with the box in view, and adds

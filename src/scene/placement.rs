@@ -30,6 +30,17 @@ impl Placement {
         Placement { matrix, normal_matrix, uniform_scale, identity, flips }
     }
 
+    /// A placement by any affine matrix (a glTF node's world transform).
+    pub fn from_matrix(matrix: glam::Mat4) -> Placement {
+        let normal_matrix = glam::Mat3::from_mat4(matrix).inverse().transpose();
+        let (scale, rotation, _) = matrix.to_scale_rotation_translation();
+        let rebuilt = glam::Mat4::from_scale_rotation_translation(scale, rotation, matrix.w_axis.truncate());
+        let uniform_scale = (scale.x == scale.y && scale.y == scale.z && rebuilt.abs_diff_eq(matrix, 1e-6)).then_some(scale.x);
+        let identity = matrix == glam::Mat4::IDENTITY;
+        let flips = matrix.determinant() < 0.0;
+        Placement { matrix, normal_matrix, uniform_scale, identity, flips }
+    }
+
     /// The 4x4 matrix of the placement.
     pub fn matrix(&self) -> glam::Mat4 {
         self.matrix

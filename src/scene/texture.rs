@@ -227,7 +227,13 @@ pub fn load_texture(path: &Path) -> Result<Texture, String> {
 /// `load_texture` with the 8-bit values read as `encoding` says.
 pub fn load_texture_as(path: &Path, encoding: Encoding) -> Result<Texture, String> {
     let bytes = read_asset(path, InputKind::Image).map_err(|e| format!("cannot read {e}"))?;
-    let img = decode_image(&bytes, &path.display().to_string())?;
+    decode_texture(bytes, &path.display().to_string(), encoding)
+}
+
+/// An image file's bytes as a texture (see `load_texture`); `name` names
+/// the image in messages.
+pub fn decode_texture(bytes: Vec<u8>, name: &str, encoding: Encoding) -> Result<Texture, String> {
+    let img = decode_image(&bytes, name)?;
     drop(bytes);
     let is_float = matches!(img, image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_));
     let rgb = img.into_rgb32f();
@@ -236,10 +242,7 @@ pub fn load_texture_as(path: &Path, encoding: Encoding) -> Result<Texture, Strin
         let c = Vec3::new(p[0], p[1], p[2]);
         if is_float {
             if let Some(bad) = c.to_array().into_iter().find(|v| !(v.is_finite() && (0.0..=MAX_VALUE).contains(v))) {
-                return Err(format!(
-                    "{}: texel ({x}, {y}) is {bad}; texels must be finite numbers from 0 to {MAX_VALUE:e}",
-                    path.display()
-                ));
+                return Err(format!("{name}: texel ({x}, {y}) is {bad}; texels must be finite numbers from 0 to {MAX_VALUE:e}"));
             }
             texels.push(c);
         } else if encoding == Encoding::Srgb {

@@ -1,15 +1,28 @@
-//! Camera section: eye, target, up, field of view (x or y), near, far,
-//! resolution scale; reset and frame-all.
+//! Camera section: the file's named cameras (a glTF's), eye, target, up,
+//! field of view (x or y), near, far, resolution scale; reset and frame-all.
 
 use eframe::egui;
 use crate::app::panels::{section, vec3_edit, Requests};
 use crate::scene::{Camera, Fov};
 
-/// `scene_size`: the scene's image size, which `res_scale` scales.
-pub fn show(ui: &mut egui::Ui, open: &mut bool, cam: &mut Camera, res_scale: &mut f32, scene_size: (u32, u32)) -> Requests {
+/// `scene_size`: the scene's image size, which `res_scale` scales;
+/// `named`: the cameras the scene's file offers, each a button that looks
+/// through it.
+pub fn show(ui: &mut egui::Ui, open: &mut bool, cam: &mut Camera, res_scale: &mut f32, scene_size: (u32, u32), named: &[(String, Camera)]) -> Requests {
     let mut requests = Requests::default();
     section(ui, "Camera", open, |ui| {
         let mut moved = false;
+        if !named.is_empty() {
+            ui.horizontal_wrapped(|ui| {
+                ui.label("look through");
+                for (name, c) in named {
+                    if ui.selectable_label(cam == c, name).clicked() {
+                        *cam = c.clone();
+                        moved = true;
+                    }
+                }
+            });
+        }
         moved |= vec3_edit(ui, "eye", &mut cam.eye, 0.01);
         moved |= vec3_edit(ui, "target", &mut cam.target, 0.01);
         vec3_edit(ui, "up", &mut cam.up, 0.01);

@@ -28,6 +28,7 @@ pub(crate) fn surface_lane(material: &Material, albedo: Vec3, position: Vec3, n:
         sharpness: material.sharpness,
         glossy_model: lighting::model_lane(material.glossy_model),
         roughness: material.roughness,
+        fresnel: lighting::FresnelLanes::splat(0.0, material.fresnel),
     }
 }
 

@@ -10,7 +10,7 @@
 
 use crate::math::lanes::{exp2, pow, Lane, V3};
 use crate::render::transport::microfacet;
-use crate::scene::material::GlossyModel;
+use crate::scene::material::{Fresnel, GlossyModel};
 use crate::scene::Light;
 use std::f32::consts::PI;
 
@@ -32,6 +32,39 @@ pub struct SurfaceLanes<L: Lane> {
     pub glossy_model: L,
     /// The microfacet lobes' alpha.
     pub roughness: L,
+    /// The glossy lobe's Fresnel term.
+    pub fresnel: FresnelLanes<L>,
+}
+
+/// A glossy lobe's Fresnel term per lane: which one (`fresnel_lane`'s
+/// code) and, for a conductor, its complex index of refraction `eta + i k`.
+#[derive(Clone, Copy)]
+pub struct FresnelLanes<L: Lane> {
+    pub model: L,
+    pub eta: V3<L>,
+    pub k: V3<L>,
+}
+
+impl<L: Lane> FresnelLanes<L> {
+    /// `fresnel` in every lane.
+    #[inline(always)]
+    pub fn splat(like: L, fresnel: Fresnel) -> Self {
+        let (eta, k) = match fresnel {
+            Fresnel::Conductor { eta, k } => (eta, k),
+            _ => (glam::Vec3::ZERO, glam::Vec3::ZERO),
+        };
+        FresnelLanes { model: like.splat(fresnel_lane(fresnel)), eta: V3::splat(like, eta), k: V3::splat(like, k) }
+    }
+}
+
+/// `fresnel` as the number `FresnelLanes::model` holds.
+#[inline(always)]
+pub fn fresnel_lane(fresnel: Fresnel) -> f32 {
+    match fresnel {
+        Fresnel::None => 0.0,
+        Fresnel::Schlick => 1.0,
+        Fresnel::Conductor { .. } => 2.0,
+    }
 }
 
 /// `model` as the number `SurfaceLanes::glossy_model` holds.
@@ -103,6 +136,12 @@ pub fn incidence<L: Lane>(light: &Light, p: V3<L>, n: V3<L>) -> IncidenceLanes<L
 ///   `D(h) G1(w_i) G1(w_o) / (4 cos_i cos_o)` (`microfacet`), zero unless
 ///   both directions are above the surface.
 ///
+/// The lobe's weight is k_G itself with `fresnel = none`; otherwise it
+/// depends on the cosine between the light and the half vector
+/// (`glossy_weight`): Schlick's `F0 + (1 - F0)(1 - cos)^5` with F0 = k_G, or
+/// k_G times a conductor's exact Fresnel reflectance. For the microfacet
+/// lobes that gives Cook-Torrance's `F D G / (4 cos_i cos_o)`.
+///
 /// The glossy lobe is left out where k_G = 0, and the two power lobes where
 /// they cannot matter: `c^s <= exp(-s (1 - c))` since `ln c <= c - 1`, so
 /// when that bound is below 1e-9 the lobe adds nothing visible and the
@@ -117,6 +156,7 @@ pub fn bsdf<L: Lane>(s: &SurfaceLanes<L>, w_i: V3<L>) -> V3<L> {
     if !L::any(glossy) {
         return f;
     }
+    let weight = glossy_weight(s, w_i);
     let mut out = f;
     for model in [GlossyModel::BlinnPhong, GlossyModel::Phong, GlossyModel::Ggx, GlossyModel::Beckmann] {
         let lanes = glossy & s.glossy_model.eq(like.splat(model_lane(model)));
@@ -138,9 +178,62 @@ pub fn bsdf<L: Lane>(s: &SurfaceLanes<L>, w_i: V3<L>) -> V3<L> {
                 (lanes & above, lobe)
             }
         };
-        out = V3::select(counted, f + s.glossy.scale(lobe), out);
+        out = V3::select(counted, f + weight.scale(lobe), out);
     }
     out
+}
+
+/// The glossy lobe's weight towards `w_i`: k_G where there is no Fresnel
+/// term (the same bits: nothing is computed when no lane has one),
+/// Schlick's approximation with F0 = k_G, or k_G times a conductor's
+/// reflectance, at the cosine between `w_i` and the half vector.
+#[inline(always)]
+fn glossy_weight<L: Lane>(s: &SurfaceLanes<L>, w_i: V3<L>) -> V3<L> {
+    let zero = s.sharpness.splat(0.0);
+    let model = s.fresnel.model;
+    let schlick = model.eq(zero.splat(fresnel_lane(Fresnel::Schlick)));
+    let conductor = model.eq(zero.splat(fresnel_lane(Fresnel::Conductor { eta: glam::Vec3::ZERO, k: glam::Vec3::ZERO })));
+    if !L::any(schlick | conductor) {
+        return s.glossy;
+    }
+    let h = (w_i + s.w_o).normalize_or_zero();
+    let c = w_i.dot(h).max(zero).min(zero.splat(1.0));
+    let mut weight = s.glossy;
+    if L::any(schlick) {
+        let m = zero.splat(1.0) - c;
+        let m5 = m * m * m * m * m;
+        let f0 = s.glossy;
+        let one = V3::new(zero.splat(1.0), zero.splat(1.0), zero.splat(1.0));
+        weight = V3::select(schlick, f0 + (one - f0).scale(m5), weight);
+    }
+    if L::any(conductor) {
+        let (eta, k) = (s.fresnel.eta, s.fresnel.k);
+        let f = V3::new(conductor_fresnel(c, eta.x, k.x), conductor_fresnel(c, eta.y, k.y), conductor_fresnel(c, eta.z, k.z));
+        weight = V3::select(conductor, s.glossy * f, weight);
+    }
+    weight
+}
+
+/// The unpolarized Fresnel reflectance of a conductor with complex index
+/// of refraction `eta + i k`, lit at the cosine `c` (in [0, 1]) from
+/// outside: the mean of the s- and p-polarized reflectances, with
+/// `a^2 + b^2 = |n^2 - sin^2|` and `a` the real part of `sqrt(n^2 - sin^2)`.
+/// 1 where the expression has no value (a lossless index of 1 at grazing
+/// light).
+#[inline(always)]
+pub fn conductor_fresnel<L: Lane>(c: L, eta: L, k: L) -> L {
+    let one = c.splat(1.0);
+    let cos2 = c * c;
+    let sin2 = one - cos2;
+    let t = eta * eta - k * k - sin2;
+    let a2b2 = (t * t + c.splat(4.0) * eta * eta * k * k).max(c.splat(0.0)).sqrt();
+    let a = ((a2b2 + t) * c.splat(0.5)).max(c.splat(0.0)).sqrt();
+    let two_ac = c.splat(2.0) * a * c;
+    let r_s = (a2b2 + cos2 - two_ac) / (a2b2 + cos2 + two_ac);
+    let (p1, p2) = (a2b2 * cos2 + sin2 * sin2, two_ac * sin2);
+    let r_p = r_s * (p1 - p2) / (p1 + p2);
+    let f = (r_s + r_p) * c.splat(0.5);
+    L::select(f.eq(f), f, one)
 }
 
 /// `norm() max(0, c)^s`, and the lanes of `lanes` where it is worth
@@ -241,6 +334,7 @@ mod tests {
             sharpness: 10.0,
             glossy_model: model_lane(model),
             roughness: 0.5,
+            fresnel: FresnelLanes::splat(0.0, Fresnel::None),
         }
     }
 
@@ -279,5 +373,81 @@ mod tests {
     fn phong_lobe_has_its_hand_computed_value() {
         let f = bsdf(&surface(GlossyModel::Phong, Vec3::ONE, Vec3::new(0.6, 0.0, 0.8)), Vec3::Z.into());
         assert!(close(f, Vec3::splat(0.205070)), "{f:?}");
+    }
+
+    /// A conductor's reflectance against the Fresnel equations in complex
+    /// arithmetic (f64, written here from the equations, not from the code
+    /// under test): with n = eta + i k and w = sqrt(n^2 - sin^2),
+    /// r_s = (cos - w) / (cos + w), r_p = (n^2 cos - w) / (n^2 cos + w),
+    /// F = (|r_s|^2 + |r_p|^2) / 2.
+    #[test]
+    fn conductor_fresnel_matches_the_complex_fresnel_equations() {
+        type C = (f64, f64);
+        let mul = |a: C, b: C| (a.0 * b.0 - a.1 * b.1, a.0 * b.1 + a.1 * b.0);
+        let div = |a: C, b: C| {
+            let d = b.0 * b.0 + b.1 * b.1;
+            ((a.0 * b.0 + a.1 * b.1) / d, (a.1 * b.0 - a.0 * b.1) / d)
+        };
+        let sqrt = |a: C| {
+            let r = (a.0 * a.0 + a.1 * a.1).sqrt();
+            (((r + a.0) / 2.0).sqrt(), ((r - a.0) / 2.0).sqrt().copysign(a.1))
+        };
+        let norm2 = |a: C| a.0 * a.0 + a.1 * a.1;
+        let exact = |c: f64, eta: f64, k: f64| {
+            let n2 = mul((eta, k), (eta, k));
+            let w = sqrt((n2.0 - (1.0 - c * c), n2.1));
+            let r_s = div((c - w.0, -w.1), (c + w.0, w.1));
+            let n2c = (n2.0 * c, n2.1 * c);
+            let r_p = div((n2c.0 - w.0, n2c.1 - w.1), (n2c.0 + w.0, n2c.1 + w.1));
+            (norm2(r_s) + norm2(r_p)) / 2.0
+        };
+        for (eta, k) in [(0.2f32, 3.9f32), (0.9, 2.4), (1.1, 2.2), (1.5, 0.0), (2.9, 3.1), (0.05, 0.1)] {
+            for c in [1.0f32, 0.9, 0.6, 0.3, 0.1, 0.01] {
+                let (got, want) = (conductor_fresnel(c, eta, k) as f64, exact(c as f64, eta as f64, k as f64));
+                assert!((got - want).abs() < 2e-5, "eta {eta} k {k} cos {c}: {got}, equations {want}");
+            }
+            // Along the normal: ((eta - 1)^2 + k^2) / ((eta + 1)^2 + k^2).
+            let normal = ((eta - 1.0).powi(2) + k * k) / ((eta + 1.0).powi(2) + k * k);
+            assert!((conductor_fresnel(1.0f32, eta, k) - normal).abs() < 1e-6);
+            // Grazing light is reflected whole.
+            assert!((conductor_fresnel(0.0f32, eta, k) - 1.0).abs() < 1e-6);
+        }
+        assert_eq!(conductor_fresnel(0.0f32, 1.0, 0.0), 1.0);
+    }
+
+    /// The glossy weight of each Fresnel term: GGX at the hand-computed
+    /// configuration of `ggx_lobe_has_its_hand_computed_value`, where the
+    /// light w_i = z makes the cosine with h = (0.316228, 0, 0.948683)
+    /// 0.948683: Schlick with F0 = 0.04 gives 0.04 + 0.96 (0.051317)^5 =
+    /// 0.040000346; a conductor eta 0.2, k 3.9 gives its Fresnel value
+    /// times k_G; none gives k_G.
+    #[test]
+    fn fresnel_terms_weight_the_glossy_lobe() {
+        let w_o = Vec3::new(0.6, 0.0, 0.8);
+        let lobe = 0.227695;
+        let mut s = surface(GlossyModel::Ggx, Vec3::splat(0.04), w_o);
+        s.fresnel = FresnelLanes::splat(0.0, Fresnel::Schlick);
+        let f = bsdf(&s, Vec3::Z.into());
+        let schlick = 0.04 + 0.96 * (1.0f32 - 0.948683).powi(5);
+        assert!(close(f, Vec3::splat(schlick * lobe)), "{f:?}");
+        // At grazing incidence Schlick tends to 1 whatever F0 is: w_o and
+        // w_i nearly opposite about the normal, nearly along the surface.
+        let grazing = Vec3::new(0.999, 0.0, 0.0447).normalize();
+        let mut s = surface(GlossyModel::BlinnPhong, Vec3::splat(0.04), grazing);
+        s.sharpness = 1.0;
+        let w_i: V3<f32> = Vec3::new(-0.999, 0.0, 0.0447).normalize().into();
+        let plain = bsdf(&s, w_i).x;
+        s.fresnel = FresnelLanes::splat(0.0, Fresnel::Schlick);
+        let weighted = bsdf(&s, w_i).x;
+        assert!(weighted > 10.0 * plain, "Schlick {weighted}, none {plain}");
+        let (eta, k) = (Vec3::new(0.2, 0.9, 1.1), Vec3::new(3.9, 2.4, 2.2));
+        let k_g = Vec3::new(1.0, 0.5, 0.25);
+        let mut s = surface(GlossyModel::Ggx, k_g, w_o);
+        s.fresnel = FresnelLanes::splat(0.0, Fresnel::Conductor { eta, k });
+        let f = bsdf(&s, Vec3::Z.into());
+        let c = 0.948683f32;
+        let want = k_g * Vec3::new(conductor_fresnel(c, eta.x, k.x), conductor_fresnel(c, eta.y, k.y), conductor_fresnel(c, eta.z, k.z)) * lobe;
+        assert!(close(f, want), "{f:?} {want}");
+        assert!(want.x < k_g.x * lobe && want.x > 0.8 * k_g.x * lobe, "{want}");
     }
 }

@@ -10,7 +10,7 @@
 //! gives that sample alone, which is what pixel replays run.
 
 use crate::render::transport::lighting;
-use crate::render::transport::lighting::{IncidenceLanes, LightVisibility, SurfaceLanes};
+use crate::render::transport::lighting::{FresnelLanes, IncidenceLanes, LightVisibility, SurfaceLanes};
 use crate::render::inspect::pixel_record::NoRecord;
 use crate::render::transport::shade;
 use crate::render::transport::incidence::Incidence;
@@ -22,6 +22,7 @@ use crate::math::lanes::{mask_bits, mask_from_bits, simd_level, Lane, V3};
 use crate::math::{Radiance, Ray, Vec2, Vec3};
 use crate::scene::hit_lanes::{EyeSamples, Floats, HitLanes, TriangleHitInput};
 use crate::scene::{CameraView, Light, PrimitiveKind, Scene, SurfaceHit};
+use crate::scene::material::Fresnel;
 use fearless_simd::{dispatch, f32x16, f32x8, Simd, SimdCombine, SimdFrom};
 
 /// Samples per batch.
@@ -406,11 +407,11 @@ pub fn direct_in_lanes<Q: SceneQuery>(
         let mut sh = Shading { scene, query, settings, path: &mut paths[path_of[0]], counts: &mut *counts, rec: &mut NoRecord };
         let ambient = shade::ambient_term(&mut sh, || hits.get(0), a);
         albedo = [a; LANES];
-        MaterialLanes::Uniform { albedo: a, glossy: first.glossy, sharpness: first.sharpness, model: lighting::model_lane(first.glossy_model), roughness: first.roughness, ambient }
+        MaterialLanes::Uniform { albedo: a, glossy: first.glossy, sharpness: first.sharpness, model: lighting::model_lane(first.glossy_model), roughness: first.roughness, fresnel: first.fresnel, ambient }
     } else {
         // Lanes past `n` get a black material.
         let (mut albedo_lanes, mut glossy, mut sharpness, mut ambient_lanes) = ([[0.0; LANES]; 3], [[0.0; LANES]; 3], [1.0; LANES], [[0.0; LANES]; 3]);
-        let (mut model, mut roughness) = ([0.0; LANES], [1.0; LANES]);
+        let (mut model, mut roughness, mut fresnel) = ([0.0; LANES], [1.0; LANES], FresnelSoa::default());
         for i in 0..n {
             let material = &scene.materials[hits.material[i] as usize];
             albedo[i] = shade::albedo_at(material, Vec2::new(hits.uv[0][i], hits.uv[1][i]), &hits.diff[i], settings);
@@ -424,8 +425,9 @@ pub fn direct_in_lanes<Q: SceneQuery>(
             sharpness[i] = material.sharpness;
             model[i] = lighting::model_lane(material.glossy_model);
             roughness[i] = material.roughness;
+            fresnel.set(i, material.fresnel);
         }
-        MaterialLanes::PerLane { albedo: albedo_lanes, glossy, sharpness, model, roughness, ambient: ambient_lanes }
+        MaterialLanes::PerLane { albedo: albedo_lanes, glossy, sharpness, model, roughness, fresnel, ambient: ambient_lanes }
     };
     let mut visibility = BatchVisibility { job, query, hits, live: ((1u32 << n) - 1) as u8, blocked, counts: &mut *counts };
     let direct = dispatch!(simd_level(), simd => direct_light8(simd, job, &geometry, &materials, &mut visibility));
@@ -444,24 +446,55 @@ struct Geometry<'a> {
 enum MaterialLanes {
     /// The same in every lane (one material without a texture).
     /// `model` is the glossy model's `lighting::model_lane` code.
-    Uniform { albedo: Vec3, glossy: Vec3, sharpness: f32, model: f32, roughness: f32, ambient: Radiance },
+    Uniform { albedo: Vec3, glossy: Vec3, sharpness: f32, model: f32, roughness: f32, fresnel: Fresnel, ambient: Radiance },
     /// One array per coordinate (lanes may have different glossy models).
-    PerLane { albedo: [Floats; 3], glossy: [Floats; 3], sharpness: Floats, model: Floats, roughness: Floats, ambient: [Floats; 3] },
+    PerLane { albedo: [Floats; 3], glossy: [Floats; 3], sharpness: Floats, model: Floats, roughness: Floats, fresnel: FresnelSoa, ambient: [Floats; 3] },
+}
+
+/// Lanes' Fresnel terms, one array per value (`lighting::FresnelLanes`).
+#[derive(Default)]
+struct FresnelSoa {
+    model: Floats,
+    eta: [Floats; 3],
+    k: [Floats; 3],
+}
+
+impl FresnelSoa {
+    fn set(&mut self, i: usize, fresnel: Fresnel) {
+        self.model[i] = lighting::fresnel_lane(fresnel);
+        if let Fresnel::Conductor { eta, k } = fresnel {
+            for a in 0..3 {
+                (self.eta[a][i], self.k[a][i]) = (eta[a], k[a]);
+            }
+        }
+    }
+
+    #[inline(always)]
+    fn load<S: Simd>(&self, simd: S) -> FresnelLanes<f32x8<S>> {
+        FresnelLanes { model: f32x8::simd_from(simd, self.model), eta: V3::from_soa(simd, &self.eta), k: V3::from_soa(simd, &self.k) }
+    }
 }
 
 #[inline(always)]
 fn direct_light8<S: Simd, Q: SceneQuery>(simd: S, job: &PassJob, geometry: &Geometry, materials: &MaterialLanes, visibility: &mut BatchVisibility<Q>) -> [Radiance; LANES] {
     let like = <f32x8<S> as fearless_simd::SimdBase<S>>::splat(simd, 0.0);
-    let (albedo, glossy, sharpness, glossy_model, roughness, start) = match materials {
-        MaterialLanes::Uniform { albedo, glossy, sharpness, model, roughness, ambient } => {
-            (V3::splat(like, *albedo), V3::splat(like, *glossy), like.splat(*sharpness), like.splat(*model), like.splat(*roughness), V3::splat(like, *ambient))
-        }
-        MaterialLanes::PerLane { albedo, glossy, sharpness, model, roughness, ambient } => (
+    let (albedo, glossy, sharpness, glossy_model, roughness, fresnel, start) = match materials {
+        MaterialLanes::Uniform { albedo, glossy, sharpness, model, roughness, fresnel, ambient } => (
+            V3::splat(like, *albedo),
+            V3::splat(like, *glossy),
+            like.splat(*sharpness),
+            like.splat(*model),
+            like.splat(*roughness),
+            FresnelLanes::splat(like, *fresnel),
+            V3::splat(like, *ambient),
+        ),
+        MaterialLanes::PerLane { albedo, glossy, sharpness, model, roughness, fresnel, ambient } => (
             V3::from_soa(simd, albedo),
             V3::from_soa(simd, glossy),
             f32x8::simd_from(simd, *sharpness),
             f32x8::simd_from(simd, *model),
             f32x8::simd_from(simd, *roughness),
+            fresnel.load(simd),
             V3::from_soa(simd, ambient),
         ),
     };
@@ -474,6 +507,7 @@ fn direct_light8<S: Simd, Q: SceneQuery>(simd: S, job: &PassJob, geometry: &Geom
         sharpness,
         glossy_model,
         roughness,
+        fresnel,
     };
     lighting::direct_light(&job.prepared.scene.lights, &surface, start, visibility).scatter()
 }
@@ -589,7 +623,7 @@ pub fn shade_batch_pair<Q: SceneQuery>(job: &PassJob, query: &Q, pair: [&Batch; 
     if (albedo, ambient) != other {
         return false;
     }
-    let materials = MaterialLanes::Uniform { albedo, glossy: material.glossy, sharpness: material.sharpness, model: lighting::model_lane(material.glossy_model), roughness: material.roughness, ambient };
+    let materials = MaterialLanes::Uniform { albedo, glossy: material.glossy, sharpness: material.sharpness, model: lighting::model_lane(material.glossy_model), roughness: material.roughness, fresnel: material.fresnel, ambient };
     let mut visibility = PairVisibility { shadows: settings.shadows, blocked, counts };
     dispatch!(simd_level(), simd => direct_light16(simd, job, pair, &materials, &mut visibility, out));
     true
@@ -600,7 +634,7 @@ pub fn shade_batch_pair<Q: SceneQuery>(job: &PassJob, query: &Q, pair: [&Batch; 
 #[inline(always)]
 fn direct_light16<S: Simd, V: LightVisibility<f32x16<S>>>(simd: S, job: &PassJob, [a, b]: [&Batch; 2], materials: &MaterialLanes, visibility: &mut V, out: &mut [[Radiance; LANES]; 2]) {
     let like = <f32x16<S> as fearless_simd::SimdBase<S>>::splat(simd, 0.0);
-    let MaterialLanes::Uniform { albedo, glossy, sharpness, model, roughness, ambient } = materials else {
+    let MaterialLanes::Uniform { albedo, glossy, sharpness, model, roughness, fresnel, ambient } = materials else {
         unreachable!("pairs are one material")
     };
     let surface = SurfaceLanes {
@@ -612,6 +646,7 @@ fn direct_light16<S: Simd, V: LightVisibility<f32x16<S>>>(simd: S, job: &PassJob
         sharpness: like.splat(*sharpness),
         glossy_model: like.splat(*model),
         roughness: like.splat(*roughness),
+        fresnel: FresnelLanes::splat(like, *fresnel),
     };
     let l_o = lighting::direct_light(&job.prepared.scene.lights, &surface, V3::splat(like, *ambient), visibility);
     let (x, y, z): ([f32; 16], [f32; 16], [f32; 16]) = (l_o.x.into(), l_o.y.into(), l_o.z.into());
