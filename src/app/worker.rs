@@ -61,6 +61,7 @@ impl SceneParams {
                     && a.glossy_model == b.glossy_model
                     && a.roughness == b.roughness
                     && a.fresnel == b.fresnel
+                    && a.diffuse_model == b.diffuse_model
                     && a.mirror == b.mirror
                     && a.transmission == b.transmission
                     && a.ior == b.ior

@@ -5,7 +5,7 @@
 use crate::scene::mesh_cache::MeshCache;
 use crate::scene::obj::{self, NormalMode};
 use crate::scene::texture::{load_texture_as, Encoding, Wrap};
-use crate::scene::material::{Fresnel, GlossyModel, MIN_ROUGHNESS};
+use crate::scene::material::{DiffuseModel, Fresnel, GlossyModel, MIN_ROUGHNESS};
 use crate::scene::instanced::{InstanceLayer, LayerInstance};
 use crate::scene::placement::Placement;
 use crate::scene::{Camera, Fov, InstanceInfo, Light, Material, ObjectInfo, RenderDefaults, Scene, Sphere, Triangle};
@@ -82,6 +82,10 @@ struct LightDesc {
 #[serde(deny_unknown_fields)]
 struct MaterialDesc {
     lambertian: Option<F3>,
+    diffuse_model: Option<String>,
+    sigma: Option<f32>,
+    darkening: Option<f32>,
+    bands: Option<i64>,
     glossy: Option<F3>,
     sharpness: Option<f32>,
     glossy_model: Option<String>,
@@ -322,6 +326,7 @@ fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str, two_
         if !(mat.sharpness.is_finite() && mat.sharpness >= 0.0 && mat.sharpness <= MAX_VALUE) {
             return Err(format!("{where_}: sharpness must be a finite number >= 0 (at most {MAX_VALUE:e})"));
         }
+        mat.diffuse_model = diffuse_lobe(m, &where_)?;
         glossy_lobe(&mut mat, m, &where_)?;
         mat.ior = m.ior.unwrap_or(1.5);
         if !(mat.ior.is_finite() && mat.ior > 0.0 && mat.ior <= MAX_IOR) {
@@ -855,6 +860,47 @@ fn finite(v: Option<F3>, where_: &str, key: &str) -> Result<Option<Vec3>, String
     }
 }
 
+/// The most toon bands a material may have.
+const MAX_BANDS: i64 = 256;
+
+/// The diffuse lobe's model and its parameter of material entry `m`.
+fn diffuse_lobe(m: &MaterialDesc, where_: &str) -> Result<DiffuseModel, String> {
+    let model = match m.diffuse_model.as_deref() {
+        None | Some("lambert") => DiffuseModel::Lambert,
+        Some("oren-nayar") => {
+            let sigma = m.sigma.unwrap_or(0.0);
+            if !(sigma.is_finite() && (0.0..=std::f32::consts::FRAC_PI_2).contains(&sigma)) {
+                return Err(format!("{where_}: sigma must be an angle in radians from 0 to pi/2, found {sigma}"));
+            }
+            DiffuseModel::OrenNayar { sigma }
+        }
+        Some("minnaert") => {
+            let darkening = m.darkening.unwrap_or(1.0);
+            if !(darkening.is_finite() && (0.0..=1.0).contains(&darkening)) {
+                return Err(format!("{where_}: darkening must be a number from 0 to 1, found {darkening}"));
+            }
+            DiffuseModel::Minnaert { darkening }
+        }
+        Some("toon") => {
+            let bands = m.bands.unwrap_or(2);
+            if !(1..=MAX_BANDS).contains(&bands) {
+                return Err(format!("{where_}: bands must be a whole number from 1 to {MAX_BANDS}, found {bands}"));
+            }
+            DiffuseModel::Toon { bands: bands as u32 }
+        }
+        Some(other) => {
+            let names: Vec<String> = DiffuseModel::NAMES.iter().map(|n| format!("\"{n}\"")).collect();
+            return Err(format!("{where_}: unknown diffuse_model \"{other}\" (expected one of {})", names.join(", ")));
+        }
+    };
+    for (key, present, owner) in [("sigma", m.sigma.is_some(), "oren-nayar"), ("darkening", m.darkening.is_some(), "minnaert"), ("bands", m.bands.is_some(), "toon")] {
+        if present && model.name() != owner {
+            return Err(format!("{where_}: `{key}` is given but diffuse_model is \"{}\"; `{key}` belongs to diffuse_model = \"{owner}\"", model.name()));
+        }
+    }
+    Ok(model)
+}
+
 /// The glossy lobe's model, roughness and Fresnel term of material entry `m`.
 fn glossy_lobe(mat: &mut Material, m: &MaterialDesc, where_: &str) -> Result<(), String> {
     if let Some(name) = &m.glossy_model {
@@ -973,6 +1019,10 @@ mod tests {
         assert_eq!(metal("roughness = 1e-7").roughness, MIN_ROUGHNESS);
         assert_eq!(metal("roughness = 1.0").roughness, 1.0);
         assert_eq!(metal("glossy = [0.9, 0.9, 0.9]").fresnel, Fresnel::None);
+        assert_eq!(metal("lambertian = [0.5, 0.5, 0.5]").diffuse_model, DiffuseModel::Lambert);
+        assert_eq!(metal("diffuse_model = \"oren-nayar\"\nsigma = 0.3").diffuse_model, DiffuseModel::OrenNayar { sigma: 0.3 });
+        assert_eq!(metal("diffuse_model = \"minnaert\"\ndarkening = 0.6").diffuse_model, DiffuseModel::Minnaert { darkening: 0.6 });
+        assert_eq!(metal("diffuse_model = \"toon\"\nbands = 3").diffuse_model, DiffuseModel::Toon { bands: 3 });
         assert_eq!(metal("fresnel = \"schlick\"").fresnel, Fresnel::Schlick);
         let conductor = metal("fresnel = \"conductor\"\neta = [0.2, 0.9, 1.1]\nk = [3.9, 2.4, 2.2]").fresnel;
         assert_eq!(conductor, Fresnel::Conductor { eta: Vec3::new(0.2, 0.9, 1.1), k: Vec3::new(3.9, 2.4, 2.2) });
@@ -989,6 +1039,17 @@ mod tests {
             ("roughness = 1.5", &["material \"metal\"", "roughness"][..]),
             ("roughness = nan", &["material \"metal\"", "roughness"][..]),
             ("fresnel = \"conductor\"", &["material \"metal\"", "conductor", "`eta`"][..]),
+            ("diffuse_model = \"oren\"", &["material \"metal\"", "diffuse_model", "\"oren-nayar\"", "\"toon\""][..]),
+            ("diffuse_model = \"oren-nayar\"\nsigma = -0.1", &["material \"metal\"", "sigma"][..]),
+            ("diffuse_model = \"oren-nayar\"\nsigma = nan", &["material \"metal\"", "sigma"][..]),
+            ("diffuse_model = \"oren-nayar\"\nsigma = 2.0", &["material \"metal\"", "sigma", "pi/2"][..]),
+            ("diffuse_model = \"minnaert\"\ndarkening = -0.5", &["material \"metal\"", "darkening"][..]),
+            ("diffuse_model = \"minnaert\"\ndarkening = nan", &["material \"metal\"", "darkening"][..]),
+            ("diffuse_model = \"toon\"\nbands = 0", &["material \"metal\"", "bands"][..]),
+            ("diffuse_model = \"toon\"\nbands = -3", &["material \"metal\"", "bands"][..]),
+            ("diffuse_model = \"toon\"\nbands = 2.5", &["bands"][..]),
+            ("sigma = 0.3", &["material \"metal\"", "`sigma`", "\"lambert\"", "oren-nayar"][..]),
+            ("diffuse_model = \"toon\"\ndarkening = 0.3", &["material \"metal\"", "`darkening`", "\"toon\"", "minnaert"][..]),
             ("fresnel = \"conductor\"\neta = [0.2, 0.9, 1.1]", &["material \"metal\"", "conductor", "`k`"][..]),
             ("fresnel = \"dielectric\"", &["material \"metal\"", "fresnel", "\"none\"", "\"conductor\""][..]),
             ("eta = [0.2, 0.9, 1.1]", &["material \"metal\"", "`eta`", "\"none\"", "conductor"][..]),

@@ -43,6 +43,48 @@ impl GlossyModel {
     }
 }
 
+/// The shape of a material's diffuse lobe (`diffuse_model` in a scene
+/// file), with its parameter; every model reflects the albedo k_L.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum DiffuseModel {
+    /// `k_L / pi`.
+    #[default]
+    Lambert,
+    /// Oren and Nayar's rough diffuse surface (their qualitative model),
+    /// `sigma` the standard deviation of the facets' slope angle in radians.
+    OrenNayar { sigma: f32 },
+    /// Minnaert's moon-like lobe `k_L (k + 1) / (2 pi) cos_i^(k-1) cos_o^(1-k)`,
+    /// k = `darkening` in [0, 1] (1 is Lambert).
+    Minnaert { darkening: f32 },
+    /// Cel shading: `cos_i` rounded to one of `bands` lit tones (or dark).
+    Toon { bands: u32 },
+}
+
+impl DiffuseModel {
+    /// The names a scene file gives the models.
+    pub const NAMES: [&'static str; 4] = ["lambert", "oren-nayar", "minnaert", "toon"];
+
+    /// The scene file's name of this model.
+    pub fn name(self) -> &'static str {
+        match self {
+            DiffuseModel::Lambert => "lambert",
+            DiffuseModel::OrenNayar { .. } => "oren-nayar",
+            DiffuseModel::Minnaert { .. } => "minnaert",
+            DiffuseModel::Toon { .. } => "toon",
+        }
+    }
+
+    /// The model's one parameter as a number (0 for Lambert).
+    pub fn parameter(self) -> f32 {
+        match self {
+            DiffuseModel::Lambert => 0.0,
+            DiffuseModel::OrenNayar { sigma } => sigma,
+            DiffuseModel::Minnaert { darkening } => darkening,
+            DiffuseModel::Toon { bands } => bands as f32,
+        }
+    }
+}
+
 /// The Fresnel term of a material's glossy lobe (`fresnel` in a scene file):
 /// how its reflectance changes with the angle between the light and the
 /// microfacet (the half vector).
@@ -77,6 +119,8 @@ pub struct Material {
     pub name: String,
     /// k_L: diffuse albedo; the BSDF term is k_L / pi.
     pub lambertian: Vec3,
+    /// The shape of the diffuse lobe.
+    pub diffuse_model: DiffuseModel,
     /// k_G: the glossy lobe's weight (whichever `glossy_model` it has).
     pub glossy: Vec3,
     /// The Blinn-Phong and Phong lobes' exponent s.
@@ -113,6 +157,7 @@ impl Material {
         Material {
             name: String::new(),
             lambertian: Vec3::ZERO,
+            diffuse_model: DiffuseModel::Lambert,
             glossy: Vec3::ZERO,
             sharpness: 100.0,
             glossy_model: GlossyModel::BlinnPhong,

@@ -24,6 +24,7 @@ pub(crate) fn surface_lane(material: &Material, albedo: Vec3, position: Vec3, n:
         normal: n.into(),
         w_o: w_o.into(),
         albedo: albedo.into(),
+        diffuse: lighting::DiffuseLanes::splat(0.0, material.diffuse_model),
         glossy: material.glossy.into(),
         sharpness: material.sharpness,
         glossy_model: lighting::model_lane(material.glossy_model),

@@ -10,7 +10,7 @@
 //! gives that sample alone, which is what pixel replays run.
 
 use crate::render::transport::lighting;
-use crate::render::transport::lighting::{FresnelLanes, IncidenceLanes, LightVisibility, SurfaceLanes};
+use crate::render::transport::lighting::{DiffuseLanes, FresnelLanes, IncidenceLanes, LightVisibility, SurfaceLanes};
 use crate::render::inspect::pixel_record::NoRecord;
 use crate::render::transport::shade;
 use crate::render::transport::incidence::Incidence;
@@ -22,7 +22,7 @@ use crate::math::lanes::{mask_bits, mask_from_bits, simd_level, Lane, V3};
 use crate::math::{Radiance, Ray, Vec2, Vec3};
 use crate::scene::hit_lanes::{EyeSamples, Floats, HitLanes, TriangleHitInput};
 use crate::scene::{CameraView, Light, PrimitiveKind, Scene, SurfaceHit};
-use crate::scene::material::Fresnel;
+use crate::scene::material::{DiffuseModel, Fresnel};
 use fearless_simd::{dispatch, f32x16, f32x8, Simd, SimdCombine, SimdFrom};
 
 /// Samples per batch.
@@ -407,11 +407,12 @@ pub fn direct_in_lanes<Q: SceneQuery>(
         let mut sh = Shading { scene, query, settings, path: &mut paths[path_of[0]], counts: &mut *counts, rec: &mut NoRecord };
         let ambient = shade::ambient_term(&mut sh, || hits.get(0), a);
         albedo = [a; LANES];
-        MaterialLanes::Uniform { albedo: a, glossy: first.glossy, sharpness: first.sharpness, model: lighting::model_lane(first.glossy_model), roughness: first.roughness, fresnel: first.fresnel, ambient }
+        MaterialLanes::Uniform { albedo: a, diffuse: first.diffuse_model, glossy: first.glossy, sharpness: first.sharpness, model: lighting::model_lane(first.glossy_model), roughness: first.roughness, fresnel: first.fresnel, ambient }
     } else {
         // Lanes past `n` get a black material.
         let (mut albedo_lanes, mut glossy, mut sharpness, mut ambient_lanes) = ([[0.0; LANES]; 3], [[0.0; LANES]; 3], [1.0; LANES], [[0.0; LANES]; 3]);
         let (mut model, mut roughness, mut fresnel) = ([0.0; LANES], [1.0; LANES], FresnelSoa::default());
+        let mut diffuse = [[0.0; LANES]; 2];
         for i in 0..n {
             let material = &scene.materials[hits.material[i] as usize];
             albedo[i] = shade::albedo_at(material, Vec2::new(hits.uv[0][i], hits.uv[1][i]), &hits.diff[i], settings);
@@ -426,8 +427,9 @@ pub fn direct_in_lanes<Q: SceneQuery>(
             model[i] = lighting::model_lane(material.glossy_model);
             roughness[i] = material.roughness;
             fresnel.set(i, material.fresnel);
+            (diffuse[0][i], diffuse[1][i]) = (lighting::diffuse_lane(material.diffuse_model), material.diffuse_model.parameter());
         }
-        MaterialLanes::PerLane { albedo: albedo_lanes, glossy, sharpness, model, roughness, fresnel, ambient: ambient_lanes }
+        MaterialLanes::PerLane { albedo: albedo_lanes, diffuse, glossy, sharpness, model, roughness, fresnel, ambient: ambient_lanes }
     };
     let mut visibility = BatchVisibility { job, query, hits, live: ((1u32 << n) - 1) as u8, blocked, counts: &mut *counts };
     let direct = dispatch!(simd_level(), simd => direct_light8(simd, job, &geometry, &materials, &mut visibility));
@@ -446,9 +448,9 @@ struct Geometry<'a> {
 enum MaterialLanes {
     /// The same in every lane (one material without a texture).
     /// `model` is the glossy model's `lighting::model_lane` code.
-    Uniform { albedo: Vec3, glossy: Vec3, sharpness: f32, model: f32, roughness: f32, fresnel: Fresnel, ambient: Radiance },
+    Uniform { albedo: Vec3, diffuse: DiffuseModel, glossy: Vec3, sharpness: f32, model: f32, roughness: f32, fresnel: Fresnel, ambient: Radiance },
     /// One array per coordinate (lanes may have different glossy models).
-    PerLane { albedo: [Floats; 3], glossy: [Floats; 3], sharpness: Floats, model: Floats, roughness: Floats, fresnel: FresnelSoa, ambient: [Floats; 3] },
+    PerLane { albedo: [Floats; 3], diffuse: [Floats; 2], glossy: [Floats; 3], sharpness: Floats, model: Floats, roughness: Floats, fresnel: FresnelSoa, ambient: [Floats; 3] },
 }
 
 /// Lanes' Fresnel terms, one array per value (`lighting::FresnelLanes`).
@@ -478,9 +480,10 @@ impl FresnelSoa {
 #[inline(always)]
 fn direct_light8<S: Simd, Q: SceneQuery>(simd: S, job: &PassJob, geometry: &Geometry, materials: &MaterialLanes, visibility: &mut BatchVisibility<Q>) -> [Radiance; LANES] {
     let like = <f32x8<S> as fearless_simd::SimdBase<S>>::splat(simd, 0.0);
-    let (albedo, glossy, sharpness, glossy_model, roughness, fresnel, start) = match materials {
-        MaterialLanes::Uniform { albedo, glossy, sharpness, model, roughness, fresnel, ambient } => (
+    let (albedo, diffuse, glossy, sharpness, glossy_model, roughness, fresnel, start) = match materials {
+        MaterialLanes::Uniform { albedo, diffuse, glossy, sharpness, model, roughness, fresnel, ambient } => (
             V3::splat(like, *albedo),
+            DiffuseLanes::splat(like, *diffuse),
             V3::splat(like, *glossy),
             like.splat(*sharpness),
             like.splat(*model),
@@ -488,8 +491,9 @@ fn direct_light8<S: Simd, Q: SceneQuery>(simd: S, job: &PassJob, geometry: &Geom
             FresnelLanes::splat(like, *fresnel),
             V3::splat(like, *ambient),
         ),
-        MaterialLanes::PerLane { albedo, glossy, sharpness, model, roughness, fresnel, ambient } => (
+        MaterialLanes::PerLane { albedo, diffuse, glossy, sharpness, model, roughness, fresnel, ambient } => (
             V3::from_soa(simd, albedo),
+            DiffuseLanes { model: f32x8::simd_from(simd, diffuse[0]), param: f32x8::simd_from(simd, diffuse[1]) },
             V3::from_soa(simd, glossy),
             f32x8::simd_from(simd, *sharpness),
             f32x8::simd_from(simd, *model),
@@ -503,6 +507,7 @@ fn direct_light8<S: Simd, Q: SceneQuery>(simd: S, job: &PassJob, geometry: &Geom
         normal: V3::from_soa(simd, geometry.normal),
         w_o: V3::from_soa(simd, geometry.w_o),
         albedo,
+        diffuse,
         glossy,
         sharpness,
         glossy_model,
@@ -623,7 +628,7 @@ pub fn shade_batch_pair<Q: SceneQuery>(job: &PassJob, query: &Q, pair: [&Batch; 
     if (albedo, ambient) != other {
         return false;
     }
-    let materials = MaterialLanes::Uniform { albedo, glossy: material.glossy, sharpness: material.sharpness, model: lighting::model_lane(material.glossy_model), roughness: material.roughness, fresnel: material.fresnel, ambient };
+    let materials = MaterialLanes::Uniform { albedo, diffuse: material.diffuse_model, glossy: material.glossy, sharpness: material.sharpness, model: lighting::model_lane(material.glossy_model), roughness: material.roughness, fresnel: material.fresnel, ambient };
     let mut visibility = PairVisibility { shadows: settings.shadows, blocked, counts };
     dispatch!(simd_level(), simd => direct_light16(simd, job, pair, &materials, &mut visibility, out));
     true
@@ -634,7 +639,7 @@ pub fn shade_batch_pair<Q: SceneQuery>(job: &PassJob, query: &Q, pair: [&Batch; 
 #[inline(always)]
 fn direct_light16<S: Simd, V: LightVisibility<f32x16<S>>>(simd: S, job: &PassJob, [a, b]: [&Batch; 2], materials: &MaterialLanes, visibility: &mut V, out: &mut [[Radiance; LANES]; 2]) {
     let like = <f32x16<S> as fearless_simd::SimdBase<S>>::splat(simd, 0.0);
-    let MaterialLanes::Uniform { albedo, glossy, sharpness, model, roughness, fresnel, ambient } = materials else {
+    let MaterialLanes::Uniform { albedo, diffuse, glossy, sharpness, model, roughness, fresnel, ambient } = materials else {
         unreachable!("pairs are one material")
     };
     let surface = SurfaceLanes {
@@ -642,6 +647,7 @@ fn direct_light16<S: Simd, V: LightVisibility<f32x16<S>>>(simd: S, job: &PassJob
         normal: join_lanes(simd, &a.hits.shading_normal, &b.hits.shading_normal),
         w_o: join_lanes(simd, &a.w_o, &b.w_o),
         albedo: V3::splat(like, *albedo),
+        diffuse: DiffuseLanes::splat(like, *diffuse),
         glossy: V3::splat(like, *glossy),
         sharpness: like.splat(*sharpness),
         glossy_model: like.splat(*model),
@@ -916,11 +922,16 @@ mod tests {
 
     /// `scene` with a glossy lobe on every material, the models taken in
     /// turn (GGX, Beckmann, Phong, Blinn-Phong) with varied roughness and
-    /// sharpness: batches then hold one model, or several side by side.
+    /// sharpness, and the diffuse models and Fresnel terms in turns of
+    /// their own: batches then hold one model, or several side by side.
     fn with_every_glossy_model(scene: &mut crate::scene::Scene) {
-        use crate::scene::material::GlossyModel;
+        use crate::scene::material::{DiffuseModel, Fresnel, GlossyModel};
         let models = [GlossyModel::Ggx, GlossyModel::Beckmann, GlossyModel::Phong, GlossyModel::BlinnPhong];
+        let diffuse = [DiffuseModel::OrenNayar { sigma: 0.4 }, DiffuseModel::Lambert, DiffuseModel::Minnaert { darkening: 0.6 }, DiffuseModel::Toon { bands: 3 }, DiffuseModel::OrenNayar { sigma: 0.0 }];
+        let fresnel = [Fresnel::Schlick, Fresnel::None, Fresnel::Conductor { eta: Vec3::new(0.2, 0.9, 1.1), k: Vec3::new(3.9, 2.4, 2.2) }];
         for (k, m) in scene.materials.iter_mut().enumerate() {
+            m.diffuse_model = diffuse[k % diffuse.len()];
+            m.fresnel = fresnel[k % fresnel.len()];
             m.glossy_model = models[k % models.len()];
             m.roughness = 0.05 + 0.15 * (k % 5) as f32;
             m.sharpness = 3.0 + 20.0 * k as f32;
