@@ -90,6 +90,7 @@ struct MaterialDesc {
     sharpness: Option<f32>,
     glossy_model: Option<String>,
     roughness: Option<f32>,
+    roughness_uv: Option<F2>,
     fresnel: Option<String>,
     eta: Option<F3>,
     k: Option<F3>,
@@ -355,7 +356,9 @@ fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str, two_
     let mut layered = Layered::default();
     for (i, o) in desc.object.iter().enumerate() {
         let where_ = format!("{}: object {}", at(o.span()), i + 1);
+        let before = scene.triangles.len();
         add_object(&mut scene, o.get_ref(), i as u32, &where_, base, &mut meshes, &at, two_level, &mut layered)?;
+        ward_has_uvs(&scene, before, &where_)?;
     }
     build_layer(&mut scene, layered)?;
     for (index, path, where_, encoding) in textures {
@@ -377,7 +380,7 @@ fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str, two_
             }
         }
     }
-    if scene.materials.iter().any(|m| m.normal_map.is_some()) {
+    if scene.materials.iter().any(|m| m.normal_map.is_some() || m.glossy_model == GlossyModel::Ward) {
         scene.tangents = crate::scene::tangents::build_tangents(&scene);
     }
     if let Some(env) = &desc.environment {
@@ -860,6 +863,23 @@ fn finite(v: Option<F3>, where_: &str, key: &str) -> Result<Option<Vec3>, String
     }
 }
 
+/// Ward's lobe is laid along the tangent frame the uvs give: refused on the
+/// triangles from `first` on (one object's) that have a Ward material but
+/// no uvs (all three corners' uvs the same, as a mesh without them loads).
+fn ward_has_uvs(scene: &Scene, first: usize, where_: &str) -> Result<(), String> {
+    for i in first..scene.triangles.len() {
+        let t = scene.triangles.at(i);
+        let material = &scene.materials[t.material as usize];
+        if material.glossy_model == GlossyModel::Ward && t.uv[0] == t.uv[1] && t.uv[1] == t.uv[2] {
+            return Err(format!(
+                "{where_}: material \"{}\" has glossy_model = \"ward\", which needs uvs for its tangent frame, but this object's triangles have none",
+                material.name
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// The most toon bands a material may have.
 const MAX_BANDS: i64 = 256;
 
@@ -906,7 +926,6 @@ fn glossy_lobe(mat: &mut Material, m: &MaterialDesc, where_: &str) -> Result<(),
     if let Some(name) = &m.glossy_model {
         mat.glossy_model = match GlossyModel::parse(name) {
             Some(model) => model,
-            None if name == "ward" => return Err(format!("{where_}: glossy_model \"ward\" is not supported yet (use \"blinn-phong\", \"phong\", \"ggx\" or \"beckmann\")")),
             None => {
                 let names: Vec<String> = GlossyModel::NAMES.iter().map(|(n, _)| format!("\"{n}\"")).collect();
                 return Err(format!("{where_}: unknown glossy_model \"{name}\" (expected one of {})", names.join(", ")));
@@ -921,6 +940,18 @@ fn glossy_lobe(mat: &mut Material, m: &MaterialDesc, where_: &str) -> Result<(),
             return Err(format!("{where_}: roughness must be a number greater than 0 and at most 1, found {alpha}"));
         }
         mat.roughness = alpha.max(MIN_ROUGHNESS);
+    }
+    if let Some(uv) = m.roughness_uv {
+        let uv = Vec2::from(uv);
+        if mat.glossy_model != GlossyModel::Ward {
+            return Err(format!("{where_}: `roughness_uv` is given but glossy_model is not \"ward\"; `roughness_uv` belongs to glossy_model = \"ward\""));
+        }
+        if !(uv.is_finite() && uv.min_element() > 0.0 && uv.max_element() <= 1.0) {
+            return Err(format!("{where_}: roughness_uv must be two numbers greater than 0 and at most 1, found [{}, {}]", uv.x, uv.y));
+        }
+        mat.roughness_uv = uv.max(Vec2::splat(MIN_ROUGHNESS));
+    } else if mat.glossy_model == GlossyModel::Ward {
+        mat.roughness_uv = Vec2::splat(mat.roughness);
     }
     mat.fresnel = match m.fresnel.as_deref() {
         None | Some("none") => Fresnel::None,
@@ -1015,6 +1046,9 @@ mod tests {
         assert_eq!(metal("glossy_model = \"beckmann\"").glossy_model, GlossyModel::Beckmann);
         assert_eq!(metal("glossy_model = \"phong\"").glossy_model, GlossyModel::Phong);
         assert_eq!(metal("glossy_model = \"blinn-phong\"").glossy_model, GlossyModel::BlinnPhong);
+        let ward = metal("glossy_model = \"ward\"\nroughness_uv = [0.1, 0.4]");
+        assert_eq!((ward.glossy_model, ward.roughness_uv), (GlossyModel::Ward, Vec2::new(0.1, 0.4)));
+        assert_eq!(metal("glossy_model = \"ward\"\nroughness = 0.3").roughness_uv, Vec2::splat(0.3));
         // A tiny roughness is raised to the smallest alpha rather than overflowing D.
         assert_eq!(metal("roughness = 1e-7").roughness, MIN_ROUGHNESS);
         assert_eq!(metal("roughness = 1.0").roughness, 1.0);
@@ -1032,7 +1066,10 @@ mod tests {
     fn bad_glossy_lobes_are_refused_with_the_key_named() {
         for (entry, words) in [
             ("glossy_model = \"gxx\"", &["material \"metal\"", "glossy_model", "\"gxx\"", "\"ggx\"", "\"beckmann\""][..]),
-            ("glossy_model = \"ward\"", &["material \"metal\"", "\"ward\"", "not supported"][..]),
+            ("roughness_uv = [0.1, 0.2]", &["material \"metal\"", "`roughness_uv`", "\"ward\""][..]),
+            ("glossy_model = \"ward\"\nroughness_uv = [0.1, 0.0]", &["material \"metal\"", "roughness_uv", "greater than 0"][..]),
+            ("glossy_model = \"ward\"\nroughness_uv = [nan, 0.1]", &["material \"metal\"", "roughness_uv"][..]),
+            ("glossy_model = \"ward\"\nroughness_uv = [-0.1, 0.1]", &["material \"metal\"", "roughness_uv"][..]),
             ("roughness = -0.1", &["material \"metal\"", "roughness"][..]),
             ("roughness = 0.0", &["material \"metal\"", "roughness", "greater than 0"][..]),
             ("roughness = inf", &["material \"metal\"", "roughness"][..]),

@@ -25,12 +25,15 @@ pub enum GlossyModel {
     Ggx,
     /// Microfacets with the Beckmann distribution (uses `roughness`).
     Beckmann,
+    /// Ward's anisotropic lobe, alpha_u and alpha_v (`roughness_uv`) along
+    /// the surface's tangent (growing u) and bitangent.
+    Ward,
 }
 
 impl GlossyModel {
     /// The names a scene file gives the models, with the model each names.
-    pub const NAMES: [(&'static str, GlossyModel); 4] =
-        [("blinn-phong", GlossyModel::BlinnPhong), ("phong", GlossyModel::Phong), ("ggx", GlossyModel::Ggx), ("beckmann", GlossyModel::Beckmann)];
+    pub const NAMES: [(&'static str, GlossyModel); 5] =
+        [("blinn-phong", GlossyModel::BlinnPhong), ("phong", GlossyModel::Phong), ("ggx", GlossyModel::Ggx), ("beckmann", GlossyModel::Beckmann), ("ward", GlossyModel::Ward)];
 
     /// The model named `name` in a scene file.
     pub fn parse(name: &str) -> Option<GlossyModel> {
@@ -129,6 +132,8 @@ pub struct Material {
     pub glossy_model: GlossyModel,
     /// The microfacet lobes' alpha (not squared), at least `MIN_ROUGHNESS`.
     pub roughness: f32,
+    /// Ward's alpha along u and along v, each at least `MIN_ROUGHNESS`.
+    pub roughness_uv: Vec2,
     /// The glossy lobe's Fresnel term.
     pub fresnel: Fresnel,
     pub mirror: Vec3,
@@ -162,6 +167,7 @@ impl Material {
             sharpness: 100.0,
             glossy_model: GlossyModel::BlinnPhong,
             roughness: DEFAULT_ROUGHNESS,
+            roughness_uv: Vec2::splat(DEFAULT_ROUGHNESS),
             fresnel: Fresnel::None,
             mirror: Vec3::ZERO,
             transmission: Vec3::ZERO,

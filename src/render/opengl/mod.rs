@@ -180,6 +180,9 @@ fn unsupported(scene: &Scene, settings: &RenderSettings) -> Result<(), String> {
     if scene.environment.as_ref().is_some_and(|e| e.is_light()) {
         return refuse("cannot light the scene with the [environment] yet; use raytrace or rasterize");
     }
+    if let Some(m) = scene.materials.iter().find(|m| m.has_glossy() && m.glossy_model == crate::scene::material::GlossyModel::Ward) {
+        return refuse(&format!("cannot draw glossy_model \"ward\" yet (material \"{}\"); use raytrace or rasterize", m.name));
+    }
     if let Some(m) = scene.materials.iter().find(|m| m.diffuse_model != crate::scene::material::DiffuseModel::Lambert) {
         return refuse(&format!("cannot draw diffuse_model \"{}\" yet (material \"{}\"); use raytrace or rasterize", m.diffuse_model.name(), m.name));
     }

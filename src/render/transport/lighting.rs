@@ -32,8 +32,14 @@ pub struct SurfaceLanes<L: Lane> {
     pub sharpness: L,
     /// The glossy lobe's model, as `model_lane` codes it (lanes may differ).
     pub glossy_model: L,
-    /// The microfacet lobes' alpha.
+    /// The microfacet lobes' alpha, and Ward's alpha along u.
     pub roughness: L,
+    /// Ward's alpha along v.
+    pub roughness_v: L,
+    /// The surface's tangent (the direction of growing u), not necessarily
+    /// unit or orthogonal to the normal; zero where there is none. Only
+    /// Ward's lobe reads it.
+    pub tangent: V3<L>,
     /// The glossy lobe's Fresnel term.
     pub fresnel: FresnelLanes<L>,
 }
@@ -105,7 +111,21 @@ pub fn model_lane(model: GlossyModel) -> f32 {
         GlossyModel::Phong => 1.0,
         GlossyModel::Ggx => 2.0,
         GlossyModel::Beckmann => 3.0,
+        GlossyModel::Ward => 4.0,
     }
+}
+
+/// The alpha `SurfaceLanes::roughness` holds for `material`: Ward's alpha
+/// along u for its lobe, else the microfacet alpha.
+#[inline(always)]
+pub fn roughness_u(material: &crate::scene::Material) -> f32 {
+    if material.glossy_model == GlossyModel::Ward { material.roughness_uv.x } else { material.roughness }
+}
+
+/// The alpha `SurfaceLanes::roughness_v` holds: Ward's alpha along v.
+#[inline(always)]
+pub fn roughness_v(material: &crate::scene::Material) -> f32 {
+    material.roughness_uv.y
 }
 
 /// How one light arrives at a surface point, per lane, before visibility.
@@ -189,7 +209,7 @@ pub fn bsdf<L: Lane>(s: &SurfaceLanes<L>, w_i: V3<L>) -> V3<L> {
     }
     let weight = glossy_weight(s, w_i);
     let mut out = f;
-    for model in [GlossyModel::BlinnPhong, GlossyModel::Phong, GlossyModel::Ggx, GlossyModel::Beckmann] {
+    for model in [GlossyModel::BlinnPhong, GlossyModel::Phong, GlossyModel::Ggx, GlossyModel::Beckmann, GlossyModel::Ward] {
         let lanes = glossy & s.glossy_model.eq(like.splat(model_lane(model)));
         if !L::any(lanes) {
             continue;
@@ -206,6 +226,10 @@ pub fn bsdf<L: Lane>(s: &SurfaceLanes<L>, w_i: V3<L>) -> V3<L> {
             }
             GlossyModel::Ggx | GlossyModel::Beckmann => {
                 let (above, lobe) = microfacet_lobe(s, w_i, model == GlossyModel::Ggx);
+                (lanes & above, lobe)
+            }
+            GlossyModel::Ward => {
+                let (above, lobe) = ward_lobe(s, w_i);
                 (lanes & above, lobe)
             }
         };
@@ -352,6 +376,41 @@ fn microfacet_lobe<L: Lane>(s: &SurfaceLanes<L>, w_i: V3<L>, ggx: bool) -> (L::M
     (above, L::select(above, lobe, zero))
 }
 
+/// Ward's anisotropic lobe,
+/// `exp(-((h.t / a_u)^2 + (h.b / a_v)^2) / (h.n)^2) / (4 pi a_u a_v sqrt(cos_i cos_o))`
+/// with h = w_i + w_o (its length cancels) and (t, b, n) the frame
+/// `ward_frame` builds, and where both directions are above the surface.
+#[inline(always)]
+fn ward_lobe<L: Lane>(s: &SurfaceLanes<L>, w_i: V3<L>) -> (L::Mask, L) {
+    let zero = s.roughness.splat(0.0);
+    let n = s.normal;
+    let (cos_i, cos_o) = (n.dot(w_i), n.dot(s.w_o));
+    let above = cos_i.gt(zero) & cos_o.gt(zero);
+    let (t, b) = ward_frame(n, s.tangent);
+    let h = w_i + s.w_o;
+    let (au, av) = (s.roughness, s.roughness_v);
+    let (x, y, z) = (h.dot(t) / au, h.dot(b) / av, h.dot(n));
+    let e = -((x * x + y * y) / (z * z)) * zero.splat(std::f32::consts::LOG2_E);
+    let in_range = e.ge(zero.splat(-126.0));
+    let d = exp2(e.max(zero.splat(-126.0))) / (zero.splat(4.0 * PI) * au * av * (cos_i * cos_o).max(zero).sqrt());
+    let lobe = L::select(in_range & above, d, zero);
+    (above, lobe)
+}
+
+/// The unit tangent and bitangent of Ward's frame at unit normal `n`:
+/// `tangent` made orthogonal to n, or where that leaves nothing (no
+/// tangent, or one along n) a fixed perpendicular, `x cross n` (`y cross n`
+/// when n is near x). The bitangent is `n cross t`.
+#[inline(always)]
+pub fn ward_frame<L: Lane>(n: V3<L>, tangent: V3<L>) -> (V3<L>, V3<L>) {
+    let like = n.x;
+    let t = (tangent - n.scale(n.dot(tangent))).normalize_or_zero();
+    let near_x = n.x.max(-n.x).gt(like.splat(0.9));
+    let axis = V3::select(near_x, V3::splat(like, glam::Vec3::Y), V3::splat(like, glam::Vec3::X));
+    let t = V3::select(t.is_zero(), axis.cross(n).normalize(), t);
+    (t, n.cross(t))
+}
+
 /// `N(s) = (s + 2)(s + 4) / (8 pi (2^(-s/2) + s))`: the factor that makes
 /// the Blinn-Phong lobe `N(s) (n.h)^s` reflect exactly what arrives when
 /// seen along the normal, and less at every other angle (the horizon cuts
@@ -418,6 +477,8 @@ mod tests {
             sharpness: 10.0,
             glossy_model: model_lane(model),
             roughness: 0.5,
+            roughness_v: 0.5,
+            tangent: Vec3::ZERO.into(),
             fresnel: FresnelLanes::splat(0.0, Fresnel::None),
         }
     }

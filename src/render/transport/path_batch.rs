@@ -305,7 +305,7 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
             }
             let hit = group.hits.get(k);
             let w_o = Vec3::new(group.w_o[0][k], group.w_o[1][k], group.w_o[2][k]);
-            match gi::sample_bounce(material, group.albedo[k], &hit, w_o, self.depth, path, &mut NoRecord) {
+            match gi::sample_bounce(scene, material, group.albedo[k], &hit, w_o, self.depth, path, &mut NoRecord) {
                 Some((w_i, weight, _)) => self.go_on(group, k, w_i, weight),
                 None => self.beyond[s] = group.direct[k] + Vec3::ZERO,
             }
