@@ -183,12 +183,6 @@ fn unsupported(scene: &Scene, settings: &RenderSettings) -> Result<(), String> {
     if let Some(m) = scene.materials.iter().find(|m| m.has_glossy() && m.glossy_model == crate::scene::material::GlossyModel::Ward) {
         return refuse(&format!("cannot draw glossy_model \"ward\" yet (material \"{}\"); use raytrace or rasterize", m.name));
     }
-    if let Some(m) = scene.materials.iter().find(|m| m.diffuse_model != crate::scene::material::DiffuseModel::Lambert) {
-        return refuse(&format!("cannot draw diffuse_model \"{}\" yet (material \"{}\"); use raytrace or rasterize", m.diffuse_model.name(), m.name));
-    }
-    if let Some(m) = scene.materials.iter().find(|m| m.has_glossy() && m.fresnel != crate::scene::material::Fresnel::None) {
-        return refuse(&format!("cannot draw a Fresnel term on glossy lobes yet (material \"{}\" has fresnel = \"{}\"); use raytrace or rasterize", m.name, m.fresnel.name()));
-    }
     if let Some(m) = scene.materials.iter().find(|m| m.transmission != crate::math::Vec3::ZERO) {
         return refuse(&format!("cannot trace glass rays (material \"{}\")", m.name));
     }
