@@ -99,6 +99,27 @@ fn editing_a_material_colour_rerenders_with_it() {
 }
 
 #[test]
+fn choosing_a_diffuse_model_in_the_panel_rerenders_with_it() {
+    use pinhole::scene::material::DiffuseModel;
+    let mut h = harness(small_scene("one-triangle"));
+    let before = shown(h.state());
+    h.get_by_label("Materials").click();
+    h.step();
+    h.step();
+    h.get_by_label("green diffuse model").click();
+    h.step();
+    h.step();
+    h.get_by_label("toon").click();
+    settle(&mut h);
+    let app = h.state();
+    let green = app.params().materials.iter().find(|m| m.name == "green").unwrap();
+    assert_eq!(green.diffuse_model, DiffuseModel::Toon { bands: 3 });
+    let after = shown(app);
+    assert_ne!(before, after, "the toon lobe changed nothing");
+    assert_eq!(after, reference(app));
+}
+
+#[test]
 fn moving_a_light_in_the_panel_and_by_its_marker() {
     let mut h = harness(small_scene("one-triangle"));
     let before = shown(h.state());

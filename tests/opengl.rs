@@ -134,6 +134,58 @@ fn every_builtin_scene_agrees_with_brute_force() {
     assert_eq!(drawn, 2 * agreement_scenes().len());
 }
 
+/// Each diffuse model and Fresnel term in the fragment shader against the
+/// ray caster, on `spheres` and `teapot` with every material given the
+/// model (and a glossy lobe, for the Fresnel terms): at least 99% of
+/// pixels within 1e-3, per model. And the comparison can fail: the shader
+/// drawing Lambert where the ray caster draws Oren-Nayar does not pass.
+#[test]
+fn each_reflection_model_agrees_with_the_ray_caster() {
+    use pinhole::scene::material::{DiffuseModel, Fresnel};
+    let Some(_) = driver() else { return };
+    let gl = renderer_by_name("opengl").unwrap();
+    let reference_renderer = renderer_by_name("raytrace:bvh").unwrap();
+    let conductor = Fresnel::Conductor { eta: Vec3::new(0.2, 0.9, 1.1), k: Vec3::new(3.9, 2.4, 2.2) };
+    let variants = [
+        ("oren-nayar", DiffuseModel::OrenNayar { sigma: 0.5 }, Fresnel::None),
+        ("minnaert", DiffuseModel::Minnaert { darkening: 0.4 }, Fresnel::None),
+        ("toon", DiffuseModel::Toon { bands: 3 }, Fresnel::None),
+        ("schlick", DiffuseModel::Lambert, Fresnel::Schlick),
+        ("conductor", DiffuseModel::Lambert, conductor),
+    ];
+    let with = |name: &str, diffuse: DiffuseModel, fresnel: Fresnel| {
+        let mut sc = scene(name);
+        for m in &mut sc.materials {
+            m.diffuse_model = diffuse;
+            m.fresnel = fresnel;
+            if fresnel != Fresnel::None && !m.has_glossy() {
+                m.glossy = Vec3::splat(0.3);
+            }
+        }
+        sc
+    };
+    for name in ["spheres", "teapot"] {
+        for (label, diffuse, fresnel) in variants {
+            let sc = with(name, diffuse, fresnel);
+            let s = settings(&sc);
+            if let Err(e) = gl.check(&sc, &s) {
+                panic!("{name} {label}: refused: {e}");
+            }
+            let prepared = PreparedScene::new(sc);
+            let (a, b) = (render(gl.as_ref(), &prepared, &s), render(reference_renderer.as_ref(), &prepared, &s));
+            assert!(a.iter().all(|p| p.is_finite()), "{name} {label}: a pixel is not finite");
+            let (fraction, wrong) = agreement(&a, &b);
+            eprintln!("{name} {label}: {:.3}% agree ({wrong} pixels differ)", fraction * 100.0);
+            assert!(fraction >= 0.99, "{name} {label}: only {:.3}% of pixels within 1e-3", fraction * 100.0);
+        }
+    }
+    let rough = PreparedScene::new(with("spheres", DiffuseModel::OrenNayar { sigma: 0.5 }, Fresnel::None));
+    let lambert = PreparedScene::new(with("spheres", DiffuseModel::Lambert, Fresnel::None));
+    let s = settings(&rough.scene);
+    let (fraction, _) = agreement(&render(gl.as_ref(), &lambert, &s), &render(reference_renderer.as_ref(), &rough, &s));
+    assert!(fraction < 0.99, "Lambert passes for Oren-Nayar on {:.2}% of pixels", fraction * 100.0);
+}
+
 #[test]
 fn the_forest_of_ten_thousand_copies_agrees_with_brute_force() {
     // 10,000 bunny copies (694 M triangles, never flattened): one mesh in

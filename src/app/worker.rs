@@ -60,7 +60,9 @@ impl SceneParams {
                     && a.sharpness == b.sharpness
                     && a.glossy_model == b.glossy_model
                     && a.roughness == b.roughness
+                    && a.roughness_uv == b.roughness_uv
                     && a.fresnel == b.fresnel
+                    && a.diffuse_model == b.diffuse_model
                     && a.mirror == b.mirror
                     && a.transmission == b.transmission
                     && a.ior == b.ior

@@ -5,7 +5,7 @@
 use crate::scene::mesh_cache::MeshCache;
 use crate::scene::obj::{self, NormalMode};
 use crate::scene::texture::{load_texture_as, Encoding, Wrap};
-use crate::scene::material::{Fresnel, GlossyModel, MIN_ROUGHNESS};
+use crate::scene::material::{DiffuseModel, Fresnel, GlossyModel, MIN_ROUGHNESS};
 use crate::scene::instanced::{build_layer, Layered, MeshCopy};
 use crate::scene::placement::Placement;
 use crate::scene::{Camera, Fov, InstanceInfo, Light, Material, ObjectInfo, RenderDefaults, Scene, Sphere, Triangle};
@@ -82,10 +82,15 @@ struct LightDesc {
 #[serde(deny_unknown_fields)]
 struct MaterialDesc {
     lambertian: Option<F3>,
+    diffuse_model: Option<String>,
+    sigma: Option<f32>,
+    darkening: Option<f32>,
+    bands: Option<i64>,
     glossy: Option<F3>,
     sharpness: Option<f32>,
     glossy_model: Option<String>,
     roughness: Option<f32>,
+    roughness_uv: Option<F2>,
     fresnel: Option<String>,
     eta: Option<F3>,
     k: Option<F3>,
@@ -313,6 +318,7 @@ fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str, two_
         if !(mat.sharpness.is_finite() && mat.sharpness >= 0.0 && mat.sharpness <= MAX_VALUE) {
             return Err(format!("{where_}: sharpness must be a finite number >= 0 (at most {MAX_VALUE:e})"));
         }
+        mat.diffuse_model = diffuse_lobe(m, &where_)?;
         glossy_lobe(&mut mat, m, &where_)?;
         mat.ior = m.ior.unwrap_or(1.5);
         if !(mat.ior.is_finite() && mat.ior > 0.0 && mat.ior <= MAX_IOR) {
@@ -341,7 +347,9 @@ fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str, two_
     let mut layered = Layered::default();
     for (i, o) in desc.object.iter().enumerate() {
         let where_ = format!("{}: object {}", at(o.span()), i + 1);
+        let before = scene.triangles.len();
         add_object(&mut scene, o.get_ref(), i as u32, &where_, base, &mut meshes, &at, two_level, &mut layered)?;
+        ward_has_uvs(&scene, before, &where_)?;
     }
     build_layer(&mut scene, layered)?;
     for (index, path, where_, encoding) in textures {
@@ -363,7 +371,7 @@ fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str, two_
             }
         }
     }
-    if scene.materials.iter().any(|m| m.normal_map.is_some()) {
+    if scene.materials.iter().any(|m| m.normal_map.is_some() || m.glossy_model == GlossyModel::Ward) {
         scene.tangents = crate::scene::tangents::build_tangents(&scene);
     }
     if let Some(env) = &desc.environment {
@@ -818,12 +826,69 @@ fn finite(v: Option<F3>, where_: &str, key: &str) -> Result<Option<Vec3>, String
     }
 }
 
+/// Ward's lobe is laid along the tangent frame the uvs give: refused on the
+/// triangles from `first` on (one object's) that have a Ward material but
+/// no uvs (all three corners' uvs the same, as a mesh without them loads).
+fn ward_has_uvs(scene: &Scene, first: usize, where_: &str) -> Result<(), String> {
+    for i in first..scene.triangles.len() {
+        let t = scene.triangles.at(i);
+        let material = &scene.materials[t.material as usize];
+        if material.glossy_model == GlossyModel::Ward && t.uv[0] == t.uv[1] && t.uv[1] == t.uv[2] {
+            return Err(format!(
+                "{where_}: material \"{}\" has glossy_model = \"ward\", which needs uvs for its tangent frame, but this object's triangles have none",
+                material.name
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The most toon bands a material may have.
+const MAX_BANDS: i64 = 256;
+
+/// The diffuse lobe's model and its parameter of material entry `m`.
+fn diffuse_lobe(m: &MaterialDesc, where_: &str) -> Result<DiffuseModel, String> {
+    let model = match m.diffuse_model.as_deref() {
+        None | Some("lambert") => DiffuseModel::Lambert,
+        Some("oren-nayar") => {
+            let sigma = m.sigma.unwrap_or(0.0);
+            if !(sigma.is_finite() && (0.0..=std::f32::consts::FRAC_PI_2).contains(&sigma)) {
+                return Err(format!("{where_}: sigma must be an angle in radians from 0 to pi/2, found {sigma}"));
+            }
+            DiffuseModel::OrenNayar { sigma }
+        }
+        Some("minnaert") => {
+            let darkening = m.darkening.unwrap_or(1.0);
+            if !(darkening.is_finite() && (0.0..=1.0).contains(&darkening)) {
+                return Err(format!("{where_}: darkening must be a number from 0 to 1, found {darkening}"));
+            }
+            DiffuseModel::Minnaert { darkening }
+        }
+        Some("toon") => {
+            let bands = m.bands.unwrap_or(2);
+            if !(1..=MAX_BANDS).contains(&bands) {
+                return Err(format!("{where_}: bands must be a whole number from 1 to {MAX_BANDS}, found {bands}"));
+            }
+            DiffuseModel::Toon { bands: bands as u32 }
+        }
+        Some(other) => {
+            let names: Vec<String> = DiffuseModel::NAMES.iter().map(|n| format!("\"{n}\"")).collect();
+            return Err(format!("{where_}: unknown diffuse_model \"{other}\" (expected one of {})", names.join(", ")));
+        }
+    };
+    for (key, present, owner) in [("sigma", m.sigma.is_some(), "oren-nayar"), ("darkening", m.darkening.is_some(), "minnaert"), ("bands", m.bands.is_some(), "toon")] {
+        if present && model.name() != owner {
+            return Err(format!("{where_}: `{key}` is given but diffuse_model is \"{}\"; `{key}` belongs to diffuse_model = \"{owner}\"", model.name()));
+        }
+    }
+    Ok(model)
+}
+
 /// The glossy lobe's model, roughness and Fresnel term of material entry `m`.
 fn glossy_lobe(mat: &mut Material, m: &MaterialDesc, where_: &str) -> Result<(), String> {
     if let Some(name) = &m.glossy_model {
         mat.glossy_model = match GlossyModel::parse(name) {
             Some(model) => model,
-            None if name == "ward" => return Err(format!("{where_}: glossy_model \"ward\" is not supported yet (use \"blinn-phong\", \"phong\", \"ggx\" or \"beckmann\")")),
             None => {
                 let names: Vec<String> = GlossyModel::NAMES.iter().map(|(n, _)| format!("\"{n}\"")).collect();
                 return Err(format!("{where_}: unknown glossy_model \"{name}\" (expected one of {})", names.join(", ")));
@@ -838,6 +903,18 @@ fn glossy_lobe(mat: &mut Material, m: &MaterialDesc, where_: &str) -> Result<(),
             return Err(format!("{where_}: roughness must be a number greater than 0 and at most 1, found {alpha}"));
         }
         mat.roughness = alpha.max(MIN_ROUGHNESS);
+    }
+    if let Some(uv) = m.roughness_uv {
+        let uv = Vec2::from(uv);
+        if mat.glossy_model != GlossyModel::Ward {
+            return Err(format!("{where_}: `roughness_uv` is given but glossy_model is not \"ward\"; `roughness_uv` belongs to glossy_model = \"ward\""));
+        }
+        if !(uv.is_finite() && uv.min_element() > 0.0 && uv.max_element() <= 1.0) {
+            return Err(format!("{where_}: roughness_uv must be two numbers greater than 0 and at most 1, found [{}, {}]", uv.x, uv.y));
+        }
+        mat.roughness_uv = uv.max(Vec2::splat(MIN_ROUGHNESS));
+    } else if mat.glossy_model == GlossyModel::Ward {
+        mat.roughness_uv = Vec2::splat(mat.roughness);
     }
     mat.fresnel = match m.fresnel.as_deref() {
         None | Some("none") => Fresnel::None,
@@ -932,10 +1009,17 @@ mod tests {
         assert_eq!(metal("glossy_model = \"beckmann\"").glossy_model, GlossyModel::Beckmann);
         assert_eq!(metal("glossy_model = \"phong\"").glossy_model, GlossyModel::Phong);
         assert_eq!(metal("glossy_model = \"blinn-phong\"").glossy_model, GlossyModel::BlinnPhong);
+        let ward = metal("glossy_model = \"ward\"\nroughness_uv = [0.1, 0.4]");
+        assert_eq!((ward.glossy_model, ward.roughness_uv), (GlossyModel::Ward, Vec2::new(0.1, 0.4)));
+        assert_eq!(metal("glossy_model = \"ward\"\nroughness = 0.3").roughness_uv, Vec2::splat(0.3));
         // A tiny roughness is raised to the smallest alpha rather than overflowing D.
         assert_eq!(metal("roughness = 1e-7").roughness, MIN_ROUGHNESS);
         assert_eq!(metal("roughness = 1.0").roughness, 1.0);
         assert_eq!(metal("glossy = [0.9, 0.9, 0.9]").fresnel, Fresnel::None);
+        assert_eq!(metal("lambertian = [0.5, 0.5, 0.5]").diffuse_model, DiffuseModel::Lambert);
+        assert_eq!(metal("diffuse_model = \"oren-nayar\"\nsigma = 0.3").diffuse_model, DiffuseModel::OrenNayar { sigma: 0.3 });
+        assert_eq!(metal("diffuse_model = \"minnaert\"\ndarkening = 0.6").diffuse_model, DiffuseModel::Minnaert { darkening: 0.6 });
+        assert_eq!(metal("diffuse_model = \"toon\"\nbands = 3").diffuse_model, DiffuseModel::Toon { bands: 3 });
         assert_eq!(metal("fresnel = \"schlick\"").fresnel, Fresnel::Schlick);
         let conductor = metal("fresnel = \"conductor\"\neta = [0.2, 0.9, 1.1]\nk = [3.9, 2.4, 2.2]").fresnel;
         assert_eq!(conductor, Fresnel::Conductor { eta: Vec3::new(0.2, 0.9, 1.1), k: Vec3::new(3.9, 2.4, 2.2) });
@@ -945,13 +1029,27 @@ mod tests {
     fn bad_glossy_lobes_are_refused_with_the_key_named() {
         for (entry, words) in [
             ("glossy_model = \"gxx\"", &["material \"metal\"", "glossy_model", "\"gxx\"", "\"ggx\"", "\"beckmann\""][..]),
-            ("glossy_model = \"ward\"", &["material \"metal\"", "\"ward\"", "not supported"][..]),
+            ("roughness_uv = [0.1, 0.2]", &["material \"metal\"", "`roughness_uv`", "\"ward\""][..]),
+            ("glossy_model = \"ward\"\nroughness_uv = [0.1, 0.0]", &["material \"metal\"", "roughness_uv", "greater than 0"][..]),
+            ("glossy_model = \"ward\"\nroughness_uv = [nan, 0.1]", &["material \"metal\"", "roughness_uv"][..]),
+            ("glossy_model = \"ward\"\nroughness_uv = [-0.1, 0.1]", &["material \"metal\"", "roughness_uv"][..]),
             ("roughness = -0.1", &["material \"metal\"", "roughness"][..]),
             ("roughness = 0.0", &["material \"metal\"", "roughness", "greater than 0"][..]),
             ("roughness = inf", &["material \"metal\"", "roughness"][..]),
             ("roughness = 1.5", &["material \"metal\"", "roughness"][..]),
             ("roughness = nan", &["material \"metal\"", "roughness"][..]),
             ("fresnel = \"conductor\"", &["material \"metal\"", "conductor", "`eta`"][..]),
+            ("diffuse_model = \"oren\"", &["material \"metal\"", "diffuse_model", "\"oren-nayar\"", "\"toon\""][..]),
+            ("diffuse_model = \"oren-nayar\"\nsigma = -0.1", &["material \"metal\"", "sigma"][..]),
+            ("diffuse_model = \"oren-nayar\"\nsigma = nan", &["material \"metal\"", "sigma"][..]),
+            ("diffuse_model = \"oren-nayar\"\nsigma = 2.0", &["material \"metal\"", "sigma", "pi/2"][..]),
+            ("diffuse_model = \"minnaert\"\ndarkening = -0.5", &["material \"metal\"", "darkening"][..]),
+            ("diffuse_model = \"minnaert\"\ndarkening = nan", &["material \"metal\"", "darkening"][..]),
+            ("diffuse_model = \"toon\"\nbands = 0", &["material \"metal\"", "bands"][..]),
+            ("diffuse_model = \"toon\"\nbands = -3", &["material \"metal\"", "bands"][..]),
+            ("diffuse_model = \"toon\"\nbands = 2.5", &["bands"][..]),
+            ("sigma = 0.3", &["material \"metal\"", "`sigma`", "\"lambert\"", "oren-nayar"][..]),
+            ("diffuse_model = \"toon\"\ndarkening = 0.3", &["material \"metal\"", "`darkening`", "\"toon\"", "minnaert"][..]),
             ("fresnel = \"conductor\"\neta = [0.2, 0.9, 1.1]", &["material \"metal\"", "conductor", "`k`"][..]),
             ("fresnel = \"dielectric\"", &["material \"metal\"", "fresnel", "\"none\"", "\"conductor\""][..]),
             ("eta = [0.2, 0.9, 1.1]", &["material \"metal\"", "`eta`", "\"none\"", "conductor"][..]),

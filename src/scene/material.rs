@@ -25,12 +25,15 @@ pub enum GlossyModel {
     Ggx,
     /// Microfacets with the Beckmann distribution (uses `roughness`).
     Beckmann,
+    /// Ward's anisotropic lobe, alpha_u and alpha_v (`roughness_uv`) along
+    /// the surface's tangent (growing u) and bitangent.
+    Ward,
 }
 
 impl GlossyModel {
     /// The names a scene file gives the models, with the model each names.
-    pub const NAMES: [(&'static str, GlossyModel); 4] =
-        [("blinn-phong", GlossyModel::BlinnPhong), ("phong", GlossyModel::Phong), ("ggx", GlossyModel::Ggx), ("beckmann", GlossyModel::Beckmann)];
+    pub const NAMES: [(&'static str, GlossyModel); 5] =
+        [("blinn-phong", GlossyModel::BlinnPhong), ("phong", GlossyModel::Phong), ("ggx", GlossyModel::Ggx), ("beckmann", GlossyModel::Beckmann), ("ward", GlossyModel::Ward)];
 
     /// The model named `name` in a scene file.
     pub fn parse(name: &str) -> Option<GlossyModel> {
@@ -40,6 +43,48 @@ impl GlossyModel {
     /// Whether the lobe is a microfacet one (shaped by `roughness`).
     pub fn is_microfacet(self) -> bool {
         matches!(self, GlossyModel::Ggx | GlossyModel::Beckmann)
+    }
+}
+
+/// The shape of a material's diffuse lobe (`diffuse_model` in a scene
+/// file), with its parameter; every model reflects the albedo k_L.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum DiffuseModel {
+    /// `k_L / pi`.
+    #[default]
+    Lambert,
+    /// Oren and Nayar's rough diffuse surface (their qualitative model),
+    /// `sigma` the standard deviation of the facets' slope angle in radians.
+    OrenNayar { sigma: f32 },
+    /// Minnaert's moon-like lobe `k_L (k + 1) / (2 pi) cos_i^(k-1) cos_o^(1-k)`,
+    /// k = `darkening` in [0, 1] (1 is Lambert).
+    Minnaert { darkening: f32 },
+    /// Cel shading: `cos_i` rounded to one of `bands` lit tones (or dark).
+    Toon { bands: u32 },
+}
+
+impl DiffuseModel {
+    /// The names a scene file gives the models.
+    pub const NAMES: [&'static str; 4] = ["lambert", "oren-nayar", "minnaert", "toon"];
+
+    /// The scene file's name of this model.
+    pub fn name(self) -> &'static str {
+        match self {
+            DiffuseModel::Lambert => "lambert",
+            DiffuseModel::OrenNayar { .. } => "oren-nayar",
+            DiffuseModel::Minnaert { .. } => "minnaert",
+            DiffuseModel::Toon { .. } => "toon",
+        }
+    }
+
+    /// The model's one parameter as a number (0 for Lambert).
+    pub fn parameter(self) -> f32 {
+        match self {
+            DiffuseModel::Lambert => 0.0,
+            DiffuseModel::OrenNayar { sigma } => sigma,
+            DiffuseModel::Minnaert { darkening } => darkening,
+            DiffuseModel::Toon { bands } => bands as f32,
+        }
     }
 }
 
@@ -77,6 +122,8 @@ pub struct Material {
     pub name: String,
     /// k_L: diffuse albedo; the BSDF term is k_L / pi.
     pub lambertian: Vec3,
+    /// The shape of the diffuse lobe.
+    pub diffuse_model: DiffuseModel,
     /// k_G: the glossy lobe's weight (whichever `glossy_model` it has).
     pub glossy: Vec3,
     /// The Blinn-Phong and Phong lobes' exponent s.
@@ -85,6 +132,8 @@ pub struct Material {
     pub glossy_model: GlossyModel,
     /// The microfacet lobes' alpha (not squared), at least `MIN_ROUGHNESS`.
     pub roughness: f32,
+    /// Ward's alpha along u and along v, each at least `MIN_ROUGHNESS`.
+    pub roughness_uv: Vec2,
     /// The glossy lobe's Fresnel term.
     pub fresnel: Fresnel,
     pub mirror: Vec3,
@@ -113,10 +162,12 @@ impl Material {
         Material {
             name: String::new(),
             lambertian: Vec3::ZERO,
+            diffuse_model: DiffuseModel::Lambert,
             glossy: Vec3::ZERO,
             sharpness: 100.0,
             glossy_model: GlossyModel::BlinnPhong,
             roughness: DEFAULT_ROUGHNESS,
+            roughness_uv: Vec2::splat(DEFAULT_ROUGHNESS),
             fresnel: Fresnel::None,
             mirror: Vec3::ZERO,
             transmission: Vec3::ZERO,

@@ -11,9 +11,13 @@ use std::collections::HashMap;
 
 /// Per triangle the unit tangent at each corner (xyz) and the handedness
 /// of the frame (w = +1 or -1: the bitangent is `w * n x t`). Triangles
-/// whose material has no normal map get zeros.
+/// whose material has neither a normal map nor Ward's anisotropic lobe get
+/// zeros.
 pub fn build_tangents(scene: &Scene) -> Vec<[Vec4; 3]> {
-    let mapped = |m: u32| scene.materials[m as usize].normal_map.is_some();
+    let mapped = |m: u32| {
+        let m = &scene.materials[m as usize];
+        m.normal_map.is_some() || m.glossy_model == crate::scene::material::GlossyModel::Ward
+    };
     // The tangent and bitangent of each triangle, from its uv derivatives.
     let per_triangle: Vec<Option<(Vec3, Vec3)>> = scene
         .triangles

@@ -183,8 +183,8 @@ fn unsupported(scene: &Scene, settings: &RenderSettings) -> Result<(), String> {
     // Only materials something is drawn with: one merely named in the file asks nothing.
     let in_use = scene.materials_in_use();
     let mut drawn = scene.materials.iter().zip(in_use).filter(|(_, used)| *used).map(|(m, _)| m);
-    if let Some(m) = drawn.clone().find(|m| m.has_glossy() && m.fresnel != crate::scene::material::Fresnel::None) {
-        return refuse(&format!("cannot draw a Fresnel term on glossy lobes yet (material \"{}\" has fresnel = \"{}\"); use raytrace or rasterize", m.name, m.fresnel.name()));
+    if let Some(m) = drawn.clone().find(|m| m.has_glossy() && m.glossy_model == crate::scene::material::GlossyModel::Ward) {
+        return refuse(&format!("cannot draw glossy_model \"ward\" yet (material \"{}\"); use raytrace or rasterize", m.name));
     }
     if let Some(m) = drawn.clone().find(|m| m.transmission != crate::math::Vec3::ZERO) {
         return refuse(&format!("cannot trace glass rays (material \"{}\")", m.name));

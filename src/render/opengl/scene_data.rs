@@ -93,9 +93,11 @@ pub fn fingerprint(scene: &Scene) -> u64 {
     h
 }
 
-/// Per material: (k_L, glossy model), (k_G, sharpness), (k_M, roughness);
-/// the model as `lighting::model_lane` codes it.
-pub const MATERIAL_FLOATS: usize = 12;
+/// Per material: (k_L, glossy model), (k_G, sharpness), (k_M, roughness),
+/// (eta, Fresnel term), (k, diffuse model), (diffuse parameter, 0, 0, 0);
+/// the models and the Fresnel term as `lighting::model_lane`,
+/// `diffuse_lane` and `fresnel_lane` code them.
+pub const MATERIAL_FLOATS: usize = 24;
 
 pub fn materials(scene: &Scene) -> Vec<f32> {
     let mut out = Vec::with_capacity(scene.materials.len().max(1) * MATERIAL_FLOATS);
@@ -103,6 +105,14 @@ pub fn materials(scene: &Scene) -> Vec<f32> {
         let model = crate::render::transport::lighting::model_lane(m.glossy_model);
         out.extend_from_slice(&[m.lambertian.x, m.lambertian.y, m.lambertian.z, model, m.glossy.x, m.glossy.y, m.glossy.z, m.sharpness]);
         out.extend_from_slice(&[m.mirror.x, m.mirror.y, m.mirror.z, m.roughness]);
+        let (eta, k) = match m.fresnel {
+            crate::scene::material::Fresnel::Conductor { eta, k } => (eta, k),
+            _ => (crate::math::Vec3::ZERO, crate::math::Vec3::ZERO),
+        };
+        let fresnel = crate::render::transport::lighting::fresnel_lane(m.fresnel);
+        let diffuse = crate::render::transport::lighting::diffuse_lane(m.diffuse_model);
+        out.extend_from_slice(&[eta.x, eta.y, eta.z, fresnel, k.x, k.y, k.z, diffuse]);
+        out.extend_from_slice(&[m.diffuse_model.parameter(), 0.0, 0.0, 0.0]);
     }
     if out.is_empty() {
         out.resize(MATERIAL_FLOATS, 0.0);

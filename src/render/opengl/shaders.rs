@@ -52,8 +52,9 @@ uniform vec3 ambient;
 uniform int light_count;
 uniform bool y_down;
 
-// Per material: (k_L, glossy model), (k_G, sharpness), (k_M, roughness); the
-// model 0 = Blinn-Phong, 1 = Phong, 2 = GGX, 3 = Beckmann.
+// Per material six vec4: (k_L, glossy model), (k_G, sharpness), (k_M,
+// roughness), (eta, Fresnel term), (k, diffuse model), (diffuse parameter);
+// the glossy model 0 = Blinn-Phong, 1 = Phong, 2 = GGX, 3 = Beckmann.
 layout(std430, binding = 0) readonly buffer Materials { vec4 materials[]; };
 // Per light: (position or direction, 0 = point | 1 = directional), (power or irradiance, 0).
 layout(std430, binding = 1) readonly buffer Lights { vec4 lights[]; };
@@ -205,7 +206,7 @@ vec3 sample_texture(ivec2 t, vec2 uv, vec2 duv_dx, vec2 duv_dy) {
 }
 
 vec3 albedo_at(uint m, vec2 uv, vec2 duv_dx, vec2 duv_dy) {
-    vec3 k = materials[3u * m].xyz;
+    vec3 k = materials[6u * m].xyz;
     if (!has_albedo_map) return k;
     return k * sample_texture(albedo_map, uv, duv_dx, duv_dy);
 }
@@ -370,11 +371,66 @@ float smith_g1(float cos_v, float v_h, float a, bool ggx) {
     return (3.535 * b + 2.181 * b * b) / (1.0 + 2.276 * b + 2.577 * b * b);
 }
 
+// The diffuse lobe's factor on k_L, as `lighting::diffuse` computes it:
+// model 0 = Lambert, 1 = Oren-Nayar (sigma), 2 = Minnaert (darkening),
+// 3 = toon (bands).
+float diffuse_factor(float model, float param, vec3 n, vec3 w_i, vec3 w_o) {
+    float inv_pi = 1.0 / PI;
+    if (model == 0.0) return inv_pi;
+    float cos_i = dot(n, w_i);
+    float cos_o = dot(n, w_o);
+    if (model == 1.0) {
+        float s2 = param * param;
+        float a = 1.0 - 0.5 * s2 / (s2 + 0.33);
+        float b = 0.45 * s2 / (s2 + 0.09);
+        float t = max(dot(w_i - n * cos_i, w_o - n * cos_o), 0.0) / max(max(cos_i, cos_o), 1e-4);
+        return inv_pi * (a + b * t);
+    }
+    if (model == 2.0) {
+        float ratio = max(cos_i, 1e-4) / max(cos_o, 1e-4);
+        return inv_pi * ((param + 1.0) * 0.5 * pow(ratio, param - 1.0));
+    }
+    float q = min(floor(max(cos_i, 0.0) * param + 0.5) / param, 1.0);
+    return q > 0.0 ? inv_pi * (q / cos_i) : 0.0;
+}
+
+// A conductor's Fresnel reflectance, as `lighting::conductor_fresnel`.
+float conductor_fresnel(float c, float eta, float k) {
+    float cos2 = c * c;
+    float sin2 = 1.0 - cos2;
+    float t = eta * eta - k * k - sin2;
+    float a2b2 = sqrt(max(t * t + 4.0 * eta * eta * k * k, 0.0));
+    float a = sqrt(max((a2b2 + t) * 0.5, 0.0));
+    float two_ac = 2.0 * a * c;
+    float r_s = (a2b2 + cos2 - two_ac) / (a2b2 + cos2 + two_ac);
+    float p1 = a2b2 * cos2 + sin2 * sin2;
+    float p2 = two_ac * sin2;
+    float r_p = r_s * (p1 - p2) / (p1 + p2);
+    float f = (r_s + r_p) * 0.5;
+    return isnan(f) ? 1.0 : f;
+}
+
+// The glossy lobe's weight, as `lighting::glossy_weight`: k_G (Fresnel
+// term 0), Schlick with F0 = k_G (1), or k_G times a conductor's
+// reflectance (2), at the cosine c between the light and the half vector.
+vec3 glossy_weight(vec3 glossy, vec4 eta, vec3 k, float c) {
+    if (eta.w == 0.0) return glossy;
+    c = clamp(c, 0.0, 1.0);
+    if (eta.w == 1.0) {
+        float m = 1.0 - c;
+        return glossy + (vec3(1.0) - glossy) * (m * m * m * m * m);
+    }
+    return glossy * vec3(conductor_fresnel(c, eta.x, k.x), conductor_fresnel(c, eta.y, k.y), conductor_fresnel(c, eta.z, k.z));
+}
+
 vec3 shade(vec3 p, vec3 n, vec3 g, vec3 w_o, uint m, vec3 albedo) {
-    vec3 glossy = materials[3u * m + 1u].xyz;
-    float s = materials[3u * m + 1u].w;
-    float model = materials[3u * m].w;
-    float alpha = materials[3u * m + 2u].w;
+    vec3 glossy = materials[6u * m + 1u].xyz;
+    float s = materials[6u * m + 1u].w;
+    float model = materials[6u * m].w;
+    float alpha = materials[6u * m + 2u].w;
+    vec4 fresnel = materials[6u * m + 3u];
+    vec4 conductor_k = materials[6u * m + 4u];
+    float diffuse_param = materials[6u * m + 5u].x;
     vec3 l_o = albedo * ambient;
     for (int i = 0; i < light_count; i++) {
         vec4 a = lights[2 * i];
@@ -396,19 +452,20 @@ vec3 shade(vec3 p, vec3 n, vec3 g, vec3 w_o, uint m, vec3 albedo) {
 #ifdef SHADOW_MAP
         if (shadowed(i, p, g, w_i)) continue;
 #endif
-        vec3 f = albedo * (1.0 / PI);
+        vec3 f = albedo * diffuse_factor(conductor_k.w, diffuse_param, n, w_i, w_o);
         if (glossy != vec3(0.0)) {
             vec3 w_h = normalize_or_zero(w_i + w_o);
+            vec3 weight = glossy_weight(glossy, fresnel, conductor_k.xyz, dot(w_i, w_h));
             if (model == 0.0) {
                 float c = max(dot(n, w_h), 0.0);
                 if (s * (1.0 - c) < 20.7) {
-                    f += glossy * ((s + 2.0) * (s + 4.0) / (8.0 * PI * (exp2(max(-0.5 * s, -126.0)) + s)) * pow(c, s));
+                    f += weight * ((s + 2.0) * (s + 4.0) / (8.0 * PI * (exp2(max(-0.5 * s, -126.0)) + s)) * pow(c, s));
                 }
             } else if (model == 1.0) {
                 vec3 r = (2.0 * dot(n, w_o)) * n - w_o;
                 float c = max(dot(r, w_i), 0.0);
                 if (s * (1.0 - c) < 20.7) {
-                    f += glossy * ((s + 2.0) * (0.5 / PI) * pow(c, s));
+                    f += weight * ((s + 2.0) * (0.5 / PI) * pow(c, s));
                 }
             } else {
                 float cos_o = dot(n, w_o);
@@ -416,13 +473,13 @@ vec3 shade(vec3 p, vec3 n, vec3 g, vec3 w_o, uint m, vec3 albedo) {
                     bool ggx = model == 2.0;
                     float d = microfacet_d(dot(n, w_h), alpha, ggx);
                     float g2 = smith_g1(cos_theta, dot(w_i, w_h), alpha, ggx) * smith_g1(cos_o, dot(w_o, w_h), alpha, ggx);
-                    f += glossy * (d * g2 / (4.0 * cos_theta * cos_o));
+                    f += weight * (d * g2 / (4.0 * cos_theta * cos_o));
                 }
             }
         }
         l_o += (incident * f) * cos_theta;
     }
-    vec3 mirror = materials[3u * m + 2u].xyz;
+    vec3 mirror = materials[6u * m + 2u].xyz;
     if (mirror_env && mirror != vec3(0.0)) {
         float cos_o = clamp(dot(w_o, g), -1.0, 1.0);
         l_o += mirror * miss_radiance(normalize(2.0 * cos_o * g - w_o));

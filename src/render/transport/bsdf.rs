@@ -6,28 +6,61 @@
 use crate::math::Vec3;
 use crate::render::transport::lighting;
 use crate::render::transport::lighting::SurfaceLanes;
-use crate::scene::{Material, SurfaceHit};
+use crate::scene::material::GlossyModel;
+use crate::scene::tangents::tangent_at;
+use crate::scene::{Material, Scene, SurfaceHit};
 
-/// The BSDF for one sample (`lighting::bsdf`, one lane wide): Lambertian
-/// plus the material's glossy lobe, `f = k_L / pi + k_G lobe`.
+/// Where a BSDF is evaluated: the unit shading normal and the surface's
+/// tangent (growing u; zero where there is none, and then a fixed
+/// perpendicular stands in). Only Ward's anisotropic lobe reads the
+/// tangent, so a bare normal converts into a frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadingFrame {
+    pub n: Vec3,
+    pub tangent: Vec3,
+}
+
+impl From<Vec3> for ShadingFrame {
+    #[inline(always)]
+    fn from(n: Vec3) -> Self {
+        ShadingFrame { n, tangent: Vec3::ZERO }
+    }
+}
+
+impl ShadingFrame {
+    /// The frame at `hit` for `material`: the tangent is looked up only for
+    /// Ward's lobe, which is the only one to read it.
+    #[inline]
+    pub fn at(scene: &Scene, hit: &SurfaceHit, material: &Material) -> Self {
+        let tangent = if material.glossy_model == GlossyModel::Ward { tangent_at(scene, hit).truncate() } else { Vec3::ZERO };
+        ShadingFrame { n: hit.shading_normal, tangent }
+    }
+}
+
+/// The BSDF for one sample (`lighting::bsdf`, one lane wide): the diffuse
+/// lobe plus the material's glossy lobe, `f = f_d + k_G lobe`, at `frame`
+/// (a normal, or a normal and tangent).
 #[inline]
-pub fn bsdf(material: &Material, albedo: Vec3, n: Vec3, w_i: Vec3, w_o: Vec3) -> Vec3 {
-    let surface = surface_lane(material, albedo, Vec3::ZERO, n, w_o);
+pub fn bsdf(material: &Material, albedo: Vec3, frame: impl Into<ShadingFrame>, w_i: Vec3, w_o: Vec3) -> Vec3 {
+    let surface = surface_lane(material, albedo, Vec3::ZERO, frame.into(), w_o);
     lighting::bsdf(&surface, w_i.into()).into()
 }
 
 /// One sample's surface as the lane-generic lighting code reads it.
 #[inline(always)]
-pub(crate) fn surface_lane(material: &Material, albedo: Vec3, position: Vec3, n: Vec3, w_o: Vec3) -> SurfaceLanes<f32> {
+pub(crate) fn surface_lane(material: &Material, albedo: Vec3, position: Vec3, frame: ShadingFrame, w_o: Vec3) -> SurfaceLanes<f32> {
     SurfaceLanes {
         position: position.into(),
-        normal: n.into(),
+        normal: frame.n.into(),
         w_o: w_o.into(),
         albedo: albedo.into(),
+        diffuse: lighting::DiffuseLanes::splat(0.0, material.diffuse_model),
         glossy: material.glossy.into(),
         sharpness: material.sharpness,
         glossy_model: lighting::model_lane(material.glossy_model),
-        roughness: material.roughness,
+        roughness: lighting::roughness_u(material),
+        roughness_v: lighting::roughness_v(material),
+        tangent: frame.tangent.into(),
         fresnel: lighting::FresnelLanes::splat(0.0, material.fresnel),
     }
 }

@@ -6,10 +6,10 @@
 
 use crate::render::transport::sampling::{blinn_phong_half, blinn_phong_pdf, cosine_hemisphere, cosine_hemisphere_lanes, cosine_hemisphere_pdf, cosine_hemisphere_pdf_lanes, from_local, from_local_lanes, luminance, reflect, tangents};
 use crate::render::transport::microfacet;
-use crate::scene::material::GlossyModel;
+use crate::scene::material::{DiffuseModel, GlossyModel};
 use std::f32::consts::PI;
 use crate::math::lanes::{Lane, V3};
-use crate::render::transport::bsdf::bsdf;
+use crate::render::transport::bsdf::{bsdf, ShadingFrame};
 use crate::math::{Vec2, Vec3};
 use crate::scene::Material;
 
@@ -33,20 +33,54 @@ fn diffuse_probability(material: &Material, albedo: Vec3) -> f32 {
     if d + g > 0.0 { d / (d + g) } else { 0.0 }
 }
 
-/// The density with which `sample_bsdf` returns `w_i`.
-pub fn bsdf_pdf(material: &Material, albedo: Vec3, n: Vec3, w_o: Vec3, w_i: Vec3) -> f32 {
+/// The density with which `sample_bsdf` returns `w_i` at `frame` (a
+/// normal, or a normal and tangent).
+pub fn bsdf_pdf(material: &Material, albedo: Vec3, frame: impl Into<ShadingFrame>, w_o: Vec3, w_i: Vec3) -> f32 {
+    let frame = frame.into();
+    let n = frame.n;
     let p_d = diffuse_probability(material, albedo);
-    let mut pdf = p_d * cosine_hemisphere_pdf(n.dot(w_i));
+    let mut pdf = p_d * diffuse_pdf(material, n, w_i);
     if material.has_glossy() && p_d < 1.0 {
-        pdf += (1.0 - p_d) * glossy_pdf(material, n, w_o, w_i);
+        pdf += (1.0 - p_d) * glossy_pdf(material, frame, w_o, w_i);
     }
     pdf
+}
+
+/// Ward's (t, b, n) frame at `frame`, as `lighting::ward_frame` builds it.
+fn ward_axes(frame: ShadingFrame) -> (Vec3, Vec3) {
+    let (t, b) = crate::render::transport::lighting::ward_frame(V3::from(frame.n), V3::from(frame.tangent));
+    (t.into(), b.into())
+}
+
+/// The density with which `sample_diffuse` returns `w_i`: Minnaert's
+/// lobe by `(k + 1) / (2 pi) cos^k` (its own `cos_i^k` shape, so that its
+/// sample weight is bounded), the others by the cosine.
+fn diffuse_pdf(material: &Material, n: Vec3, w_i: Vec3) -> f32 {
+    match material.diffuse_model {
+        DiffuseModel::Minnaert { darkening } => {
+            let c = n.dot(w_i);
+            if c <= 0.0 {
+                return 0.0;
+            }
+            (darkening + 1.0) / (2.0 * PI) * c.powf(darkening)
+        }
+        _ => cosine_hemisphere_pdf(n.dot(w_i)),
+    }
+}
+
+/// An incoming direction from the diffuse lobe alone (see `diffuse_pdf`).
+fn sample_diffuse(material: &Material, n: Vec3, u: Vec2) -> Vec3 {
+    match material.diffuse_model {
+        DiffuseModel::Minnaert { darkening } => from_local(blinn_phong_half(u, darkening), n),
+        _ => from_local(cosine_hemisphere(u), n),
+    }
 }
 
 /// The density with which `sample_glossy` returns `w_i` (over the whole
 /// sphere: directions below the surface have density too, and are refused
 /// by `sample_bsdf`).
-fn glossy_pdf(material: &Material, n: Vec3, w_o: Vec3, w_i: Vec3) -> f32 {
+fn glossy_pdf(material: &Material, frame: ShadingFrame, w_o: Vec3, w_i: Vec3) -> f32 {
+    let n = frame.n;
     let a = material.roughness;
     match material.glossy_model {
         GlossyModel::BlinnPhong => blinn_phong_pdf(n, w_o, w_i, material.sharpness),
@@ -75,13 +109,47 @@ fn glossy_pdf(material: &Material, n: Vec3, w_o: Vec3, w_i: Vec3) -> f32 {
             }
             microfacet::beckmann_d(cos_h, a) * cos_h / (4.0 * o_h)
         }
+        GlossyModel::Ward => {
+            // The half vector's density `ward_d(h) cos_h` over the Jacobian.
+            let h = (w_i + w_o).normalize_or_zero();
+            let (t, b) = ward_axes(frame);
+            let local = Vec3::new(h.dot(t), h.dot(b), h.dot(n));
+            let o_h = w_o.dot(h);
+            if local.z <= 0.0 || o_h <= 0.0 {
+                return 0.0;
+            }
+            ward_half_density(local, material.roughness_uv) / (4.0 * o_h)
+        }
     }
+}
+
+/// The density `exp(-((x / a_u)^2 + (y / a_v)^2) / z^2) / (pi a_u a_v z^3)`
+/// of Ward's sampled half vector `(x, y, z)` (local frame, z > 0), that is
+/// its normalized distribution times the cosine.
+fn ward_half_density(h: Vec3, alpha: Vec2) -> f32 {
+    let (x, y) = (h.x / alpha.x, h.y / alpha.y);
+    (-(x * x + y * y) / (h.z * h.z)).exp() / (PI * alpha.x * alpha.y * h.z * h.z * h.z)
+}
+
+/// A half vector from `ward_half_density` (local frame): the azimuth with
+/// `tan phi = (a_v / a_u) tan(2 pi u2)`, then
+/// `tan^2 theta = -ln(1 - u1) / (cos^2 phi / a_u^2 + sin^2 phi / a_v^2)`.
+fn sample_ward_half(alpha: Vec2, u: Vec2) -> Vec3 {
+    let turn = 2.0 * PI * u.y;
+    let phi = (alpha.y * turn.sin()).atan2(alpha.x * turn.cos());
+    let (sin_phi, cos_phi) = phi.sin_cos();
+    let spread = cos_phi * cos_phi / (alpha.x * alpha.x) + sin_phi * sin_phi / (alpha.y * alpha.y);
+    let tan2 = -(1.0 - u.x).ln() / spread;
+    let cos = 1.0 / (1.0 + tan2).sqrt();
+    let sin = (1.0 - cos * cos).max(0.0).sqrt();
+    Vec3::new(sin * cos_phi, sin * sin_phi, cos)
 }
 
 /// An incoming direction from the glossy lobe alone (not yet normalized,
 /// possibly below the surface); `None` where the lobe reflects nothing
 /// towards `w_o` (a microfacet lobe seen from below).
-fn sample_glossy(material: &Material, n: Vec3, w_o: Vec3, u: Vec2) -> Option<Vec3> {
+fn sample_glossy(material: &Material, frame: ShadingFrame, w_o: Vec3, u: Vec2) -> Option<Vec3> {
+    let n = frame.n;
     let a = material.roughness;
     Some(match material.glossy_model {
         GlossyModel::BlinnPhong => reflect(w_o, from_local(blinn_phong_half(u, material.sharpness), n)),
@@ -96,6 +164,11 @@ fn sample_glossy(material: &Material, n: Vec3, w_o: Vec3, u: Vec2) -> Option<Vec
             reflect(w_o, from_local(microfacet::sample_ggx_visible(v.normalize(), a, u.x, u.y), n))
         }
         GlossyModel::Beckmann => reflect(w_o, from_local(microfacet::sample_beckmann(a, u.x, u.y), n)),
+        GlossyModel::Ward => {
+            let (t, b) = ward_axes(frame);
+            let h = sample_ward_half(material.roughness_uv, u);
+            reflect(w_o, t * h.x + b * h.y + n * h.z)
+        }
     })
 }
 
@@ -103,30 +176,32 @@ fn sample_glossy(material: &Material, n: Vec3, w_o: Vec3, u: Vec2) -> Option<Vec
 /// from `w_o`; `choice` picks the lobe, `u` places the direction. `None` when
 /// the material reflects nothing diffusely or glossily, or the sample falls
 /// below the surface (that path ends: its light is absorbed).
-pub fn sample_bsdf(material: &Material, albedo: Vec3, n: Vec3, w_o: Vec3, choice: f32, u: Vec2) -> Option<BsdfSample> {
+pub fn sample_bsdf(material: &Material, albedo: Vec3, frame: impl Into<ShadingFrame>, w_o: Vec3, choice: f32, u: Vec2) -> Option<BsdfSample> {
+    let frame = frame.into();
+    let n = frame.n;
     let p_d = diffuse_probability(material, albedo);
     let has_glossy = material.has_glossy() && p_d < 1.0;
     if p_d <= 0.0 && !has_glossy {
         return None;
     }
-    if !has_glossy {
+    if !has_glossy && material.diffuse_model == DiffuseModel::Lambert {
         return sample_lambertian(albedo, n, u);
     }
-    let w_i = if choice < p_d {
-        from_local(cosine_hemisphere(u), n)
+    let w_i = if choice < p_d || !has_glossy {
+        sample_diffuse(material, n, u)
     } else {
-        sample_glossy(material, n, w_o, u)?
+        sample_glossy(material, frame, w_o, u)?
     };
     if !(n.dot(w_i) > 0.0) {
         return None;
     }
     let w_i = w_i.normalize();
     let cos_i = n.dot(w_i);
-    let pdf = bsdf_pdf(material, albedo, n, w_o, w_i);
+    let pdf = bsdf_pdf(material, albedo, frame, w_o, w_i);
     if !(pdf > 0.0 && pdf.is_finite()) {
         return None;
     }
-    let weight = bsdf(material, albedo, n, w_i, w_o) * (cos_i / pdf);
+    let weight = bsdf(material, albedo, frame, w_i, w_o) * (cos_i / pdf);
     weight.is_finite().then_some(BsdfSample { w_i, pdf, weight })
 }
 
@@ -202,6 +277,11 @@ mod tests {
     /// `∫ f cos dw` of the glossy lobe by a midpoint rule over the hemisphere:
     /// an estimate that shares no code with the sampling.
     fn albedo_by_quadrature(m: &Material, w_o: Vec3) -> f32 {
+        albedo_by_quadrature_with(m, Vec3::ZERO, w_o)
+    }
+
+    /// `∫ f cos dw` of the whole BSDF with diffuse albedo `albedo`.
+    fn albedo_by_quadrature_with(m: &Material, albedo: Vec3, w_o: Vec3) -> f32 {
         let (n_theta, n_phi) = (200, 400);
         let (d_theta, d_phi) = (std::f32::consts::FRAC_PI_2 / n_theta as f32, 2.0 * std::f32::consts::PI / n_phi as f32);
         let mut sum = 0.0f64;
@@ -210,7 +290,7 @@ mod tests {
             for j in 0..n_phi {
                 let phi = (j as f32 + 0.5) * d_phi;
                 let w_i = Vec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos());
-                sum += (bsdf(m, Vec3::ZERO, Vec3::Z, w_i, w_o).x * w_i.z * theta.sin() * d_theta * d_phi) as f64;
+                sum += (bsdf(m, albedo, Vec3::Z, w_i, w_o).x * w_i.z * theta.sin() * d_theta * d_phi) as f64;
             }
         }
         sum as f32
@@ -281,7 +361,7 @@ mod tests {
     /// normal, smooth) and below one otherwise.
     #[test]
     fn glossy_densities_integrate_to_one() {
-        let sphere_integral = |m: &Material, w_o: Vec3| integrate_sphere(800, 800, Vec3::Z, |w_i| glossy_pdf(m, Vec3::Z, w_o, w_i) as f64);
+        let sphere_integral = |m: &Material, w_o: Vec3| integrate_sphere(800, 800, Vec3::Z, |w_i| glossy_pdf(m, Vec3::Z.into(), w_o, w_i) as f64);
         let near_normal = Vec3::new(0.3, 0.1, 0.9).normalize();
         let grazing = Vec3::new(0.95, 0.0, 0.3).normalize();
         for (model, roughness, sharpness) in [(GlossyModel::Ggx, 0.2, 0.0), (GlossyModel::Ggx, 0.7, 0.0), (GlossyModel::Phong, 0.1, 10.0), (GlossyModel::Phong, 0.1, 60.0)] {
@@ -342,6 +422,108 @@ mod tests {
             200_000,
         );
         assert!(stat > threshold, "alpha 0.3 passes for 0.36: {stat} < {threshold}");
+    }
+
+    /// The diffuse models' sampling: directions against `bsdf_pdf` by the
+    /// chi-square test (Minnaert by its own `cos^k` density, the others by
+    /// the cosine; alone and beside a GGX lobe), and the sample weights'
+    /// mean against the directional albedo by quadrature (`∫ f cos dw`,
+    /// sharing no code with the sampling) within 1%.
+    #[test]
+    fn diffuse_models_sample_their_pdf_and_albedo() {
+        use crate::render::transport::sampling::tests::chi_square;
+        let models = [DiffuseModel::OrenNayar { sigma: 0.5 }, DiffuseModel::Minnaert { darkening: 0.0 }, DiffuseModel::Minnaert { darkening: 0.6 }, DiffuseModel::Toon { bands: 3 }];
+        for model in models {
+            let mut alone = Material::black();
+            alone.lambertian = Vec3::splat(0.7);
+            alone.diffuse_model = model;
+            let mut mixed = glossy_material(GlossyModel::Ggx, 0.3, 0.0);
+            mixed.glossy = Vec3::splat(0.3);
+            mixed.lambertian = Vec3::splat(0.5);
+            mixed.diffuse_model = model;
+            for m in [alone, mixed] {
+                for w_o in [Vec3::Z, Vec3::new(0.6, 0.0, 0.8), Vec3::new(-0.3, 0.9, 0.3).normalize()] {
+                    let mut choices = SampleRng::for_index(24, 0, 2);
+                    let (stat, threshold) = chi_square(
+                        &mut |u| sample_bsdf(&m, m.lambertian, Vec3::Z, w_o, choices.next_f32(), u).map(|s| s.w_i),
+                        &|w_i| bsdf_pdf(&m, m.lambertian, Vec3::Z, w_o, w_i),
+                        200_000,
+                    );
+                    let what = format!("{model:?} k_G {}, w_o {w_o}", m.glossy);
+                    assert!(stat < threshold, "{what}: chi-square {stat} >= {threshold}");
+                    let sampled = albedo_estimate(&m, w_o, 200_000).x;
+                    let exact = albedo_by_quadrature_with(&m, m.lambertian, w_o);
+                    assert!((sampled - exact).abs() < 0.01 * exact.max(0.1), "{what}: sampled {sampled}, quadrature {exact}");
+                }
+            }
+        }
+        // The test tells Minnaert's density from the cosine's.
+        let mut m = Material::black();
+        m.lambertian = Vec3::splat(0.7);
+        m.diffuse_model = DiffuseModel::Minnaert { darkening: 0.3 };
+        let mut lambert = m.clone();
+        lambert.diffuse_model = DiffuseModel::Lambert;
+        let (stat, threshold) = chi_square(
+            &mut |u| sample_bsdf(&m, m.lambertian, Vec3::Z, Vec3::Z, 0.5, u).map(|s| s.w_i),
+            &|w_i| bsdf_pdf(&lambert, m.lambertian, Vec3::Z, Vec3::Z, w_i),
+            200_000,
+        );
+        assert!(stat > threshold, "Minnaert's samples pass for the cosine's: {stat} < {threshold}");
+    }
+
+    /// Ward's sampling along a tangent frame (a tangent that is not unit
+    /// nor orthogonal to n, made so): its directions against `bsdf_pdf` by
+    /// the chi-square test, anisotropic and isotropic, alone and beside a
+    /// Lambertian lobe; the sample weights' mean against the albedo by
+    /// quadrature within 2%; and the test tells alpha (0.1, 0.4) from
+    /// (0.4, 0.1), so the frame's orientation is what the pdf says.
+    #[test]
+    fn ward_samples_its_pdf_along_the_tangent() {
+        use crate::render::transport::sampling::tests::chi_square;
+        let frame = ShadingFrame { n: Vec3::Z, tangent: Vec3::new(0.8, 0.6, 0.3) };
+        let ward = |au: f32, av: f32| {
+            let mut m = glossy_material(GlossyModel::Ward, 0.1, 0.0);
+            m.roughness_uv = Vec2::new(au, av);
+            m
+        };
+        let chi = |m: &Material, pdf_of: &Material, w_o: Vec3| {
+            let mut choices = SampleRng::for_index(25, 0, 2);
+            chi_square(
+                &mut |u| sample_bsdf(m, m.lambertian, frame, w_o, choices.next_f32(), u).map(|s| s.w_i),
+                &|w_i| bsdf_pdf(pdf_of, m.lambertian, frame, w_o, w_i),
+                200_000,
+            )
+        };
+        for (au, av) in [(0.1f32, 0.4f32), (0.3, 0.3), (0.5, 0.15)] {
+            let alone = ward(au, av);
+            let mut mixed = alone.clone();
+            mixed.lambertian = Vec3::splat(0.4);
+            mixed.glossy = Vec3::splat(0.5);
+            for m in [alone, mixed] {
+                for w_o in [Vec3::Z, Vec3::new(0.6, 0.0, 0.8), Vec3::new(-0.3, 0.9, 0.3).normalize()] {
+                    let (stat, threshold) = chi(&m, &m, w_o);
+                    let what = format!("Ward ({au}, {av}) k_L {}, w_o {w_o}", m.lambertian);
+                    assert!(stat < threshold, "{what}: chi-square {stat} >= {threshold}");
+                }
+            }
+            let m = ward(au, av);
+            for w_o in [Vec3::Z, Vec3::new(0.6, 0.0, 0.8)] {
+                let mut r = SampleRng::for_index(26, 0, 1);
+                let n = 200_000;
+                let mut sum = 0.0f64;
+                for _ in 0..n {
+                    let choice = r.next_f32();
+                    if let Some(s) = sample_bsdf(&m, Vec3::ZERO, frame, w_o, choice, r.next_2d()) {
+                        sum += s.weight.x as f64;
+                    }
+                }
+                let sampled = sum / n as f64;
+                let exact = integrate_sphere(400, 800, Vec3::Z, |w_i| if w_i.z > 0.0 { (bsdf(&m, Vec3::ZERO, frame, w_i, w_o).x * w_i.z) as f64 } else { 0.0 });
+                assert!((sampled - exact).abs() < 0.02 * exact, "Ward ({au}, {av}) w_o {w_o}: sampled {sampled}, quadrature {exact}");
+            }
+        }
+        let (stat, threshold) = chi(&ward(0.1, 0.4), &ward(0.4, 0.1), Vec3::new(0.6, 0.0, 0.8));
+        assert!(stat > threshold, "Ward (0.1, 0.4) passes for (0.4, 0.1): {stat} < {threshold}");
     }
 
     /// A white furnace for nearly smooth GGX: `∫ f cos dw` over the

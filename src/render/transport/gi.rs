@@ -81,6 +81,7 @@ pub fn roulette(depth: u32, throughput: Vec3, rng: &mut SampleRng) -> Option<(f3
 /// ends here.
 #[allow(clippy::too_many_arguments)]
 pub fn sample_bounce<R: Recorder>(
+    scene: &crate::scene::Scene,
     material: &crate::scene::Material,
     albedo: Vec3,
     hit: &SurfaceHit,
@@ -91,7 +92,8 @@ pub fn sample_bounce<R: Recorder>(
 ) -> Option<(Vec3, Vec3, f32)> {
     let choice = path.rng.next_f32();
     let u = path.rng.next_2d();
-    let s = sample_bsdf(material, albedo, hit.shading_normal, w_o, choice, u)?;
+    let frame = crate::render::transport::bsdf::ShadingFrame::at(scene, hit, material);
+    let s = sample_bsdf(material, albedo, frame, w_o, choice, u)?;
     // A direction into the geometric surface would leave from its far side.
     if s.w_i.dot(hit.geometric_normal) <= 0.0 {
         return None;

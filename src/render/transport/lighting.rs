@@ -10,7 +10,7 @@
 
 use crate::math::lanes::{exp2, pow, Lane, V3};
 use crate::render::transport::microfacet;
-use crate::scene::material::{Fresnel, GlossyModel};
+use crate::scene::material::{DiffuseModel, Fresnel, GlossyModel};
 use crate::scene::Light;
 use std::f32::consts::PI;
 
@@ -24,16 +24,52 @@ pub struct SurfaceLanes<L: Lane> {
     pub w_o: V3<L>,
     /// Diffuse albedo k_L (texture applied).
     pub albedo: V3<L>,
+    /// The diffuse lobe's model and parameter.
+    pub diffuse: DiffuseLanes<L>,
     /// The glossy lobe's weight k_G, and the Blinn-Phong and Phong lobes'
     /// sharpness s.
     pub glossy: V3<L>,
     pub sharpness: L,
     /// The glossy lobe's model, as `model_lane` codes it (lanes may differ).
     pub glossy_model: L,
-    /// The microfacet lobes' alpha.
+    /// The microfacet lobes' alpha, and Ward's alpha along u.
     pub roughness: L,
+    /// Ward's alpha along v.
+    pub roughness_v: L,
+    /// The surface's tangent (the direction of growing u), not necessarily
+    /// unit or orthogonal to the normal; zero where there is none. Only
+    /// Ward's lobe reads it.
+    pub tangent: V3<L>,
     /// The glossy lobe's Fresnel term.
     pub fresnel: FresnelLanes<L>,
+}
+
+/// A diffuse lobe per lane: its model (`diffuse_lane`'s code) and that
+/// model's parameter (`DiffuseModel::parameter`).
+#[derive(Clone, Copy)]
+pub struct DiffuseLanes<L: Lane> {
+    pub model: L,
+    pub param: L,
+}
+
+impl<L: Lane> DiffuseLanes<L> {
+    /// `model` in every lane.
+    #[inline(always)]
+    pub fn splat(like: L, model: DiffuseModel) -> Self {
+        DiffuseLanes { model: like.splat(diffuse_lane(model)), param: like.splat(model.parameter()) }
+    }
+}
+
+/// `model` as the number `DiffuseLanes::model` holds (Lambert is 0, the
+/// others above it).
+#[inline(always)]
+pub fn diffuse_lane(model: DiffuseModel) -> f32 {
+    match model {
+        DiffuseModel::Lambert => 0.0,
+        DiffuseModel::OrenNayar { .. } => 1.0,
+        DiffuseModel::Minnaert { .. } => 2.0,
+        DiffuseModel::Toon { .. } => 3.0,
+    }
 }
 
 /// A glossy lobe's Fresnel term per lane: which one (`fresnel_lane`'s
@@ -75,7 +111,21 @@ pub fn model_lane(model: GlossyModel) -> f32 {
         GlossyModel::Phong => 1.0,
         GlossyModel::Ggx => 2.0,
         GlossyModel::Beckmann => 3.0,
+        GlossyModel::Ward => 4.0,
     }
+}
+
+/// The alpha `SurfaceLanes::roughness` holds for `material`: Ward's alpha
+/// along u for its lobe, else the microfacet alpha.
+#[inline(always)]
+pub fn roughness_u(material: &crate::scene::Material) -> f32 {
+    if material.glossy_model == GlossyModel::Ward { material.roughness_uv.x } else { material.roughness }
+}
+
+/// The alpha `SurfaceLanes::roughness_v` holds: Ward's alpha along v.
+#[inline(always)]
+pub fn roughness_v(material: &crate::scene::Material) -> f32 {
+    material.roughness_uv.y
 }
 
 /// How one light arrives at a surface point, per lane, before visibility.
@@ -125,8 +175,9 @@ pub fn incidence<L: Lane>(light: &Light, p: V3<L>, n: V3<L>) -> IncidenceLanes<L
     IncidenceLanes { w_i, distance, incident, cos_theta: w_i.dot(n), exists }
 }
 
-/// The BSDF: Lambertian plus a glossy lobe, `f = k_L / pi + k_G lobe`, the
-/// lobe chosen per lane by `glossy_model`:
+/// The BSDF: a diffuse lobe (`diffuse`: Lambertian `k_L / pi` unless the
+/// material names another model) plus a glossy lobe, `f = f_d + k_G lobe`,
+/// the glossy lobe chosen per lane by `glossy_model`:
 ///
 /// - Blinn-Phong (CGPP listing 15.19): `N(s) max(0, n.h)^s` with `N` from
 ///   `blinn_phong_normalization`;
@@ -151,14 +202,14 @@ pub fn incidence<L: Lane>(light: &Light, p: V3<L>, n: V3<L>) -> IncidenceLanes<L
 #[inline(always)]
 pub fn bsdf<L: Lane>(s: &SurfaceLanes<L>, w_i: V3<L>) -> V3<L> {
     let like = s.sharpness;
-    let f = s.albedo.scale(like.splat(1.0 / PI));
+    let f = diffuse(s, w_i);
     let glossy = !s.glossy.is_zero();
     if !L::any(glossy) {
         return f;
     }
     let weight = glossy_weight(s, w_i);
     let mut out = f;
-    for model in [GlossyModel::BlinnPhong, GlossyModel::Phong, GlossyModel::Ggx, GlossyModel::Beckmann] {
+    for model in [GlossyModel::BlinnPhong, GlossyModel::Phong, GlossyModel::Ggx, GlossyModel::Beckmann, GlossyModel::Ward] {
         let lanes = glossy & s.glossy_model.eq(like.splat(model_lane(model)));
         if !L::any(lanes) {
             continue;
@@ -177,10 +228,66 @@ pub fn bsdf<L: Lane>(s: &SurfaceLanes<L>, w_i: V3<L>) -> V3<L> {
                 let (above, lobe) = microfacet_lobe(s, w_i, model == GlossyModel::Ggx);
                 (lanes & above, lobe)
             }
+            GlossyModel::Ward => {
+                let (above, lobe) = ward_lobe(s, w_i);
+                (lanes & above, lobe)
+            }
         };
         out = V3::select(counted, f + weight.scale(lobe), out);
     }
     out
+}
+
+/// The diffuse lobe towards `w_i`, `k_L / pi` times a factor per model,
+/// with c_i = n.w_i and c_o = n.w_o:
+///
+/// - Lambert: 1 (the same bits as `k_L / pi`; nothing else is computed
+///   when every lane is Lambertian);
+/// - Oren-Nayar (qualitative model): `A + B max(0, cos(phi_i - phi_o))
+///   sin(alpha) tan(beta)` with `A = 1 - 0.5 s^2 / (s^2 + 0.33)`,
+///   `B = 0.45 s^2 / (s^2 + 0.09)`, alpha and beta the larger and smaller
+///   angle to n, computed as `max(0, t_i.t_o) / max(c_i, c_o)` with t the
+///   directions' tangential parts; at sigma 0 it is 1 exactly;
+/// - Minnaert (normalized so that it reflects at most k_L): `(k + 1) / 2
+///   (c_i / c_o)^(k - 1)`, the cosines taken at least 1e-4;
+/// - toon: `q(c_i) / c_i`, q rounding `c_i` to the nearest of 0, 1/b, ...,
+///   1 (b bands), so that `f c_i` is flat within a band.
+#[inline(always)]
+fn diffuse<L: Lane>(s: &SurfaceLanes<L>, w_i: V3<L>) -> V3<L> {
+    let like = s.sharpness;
+    let inv_pi = like.splat(1.0 / PI);
+    let (model, param) = (s.diffuse.model, s.diffuse.param);
+    let zero = like.splat(0.0);
+    if !L::any(model.gt(zero)) {
+        return s.albedo.scale(inv_pi);
+    }
+    let one = like.splat(1.0);
+    let n = s.normal;
+    let (cos_i, cos_o) = (n.dot(w_i), n.dot(s.w_o));
+    let mut factor = inv_pi;
+    let oren_nayar = model.eq(like.splat(diffuse_lane(DiffuseModel::OrenNayar { sigma: 0.0 })));
+    if L::any(oren_nayar) {
+        let s2 = param * param;
+        let a = one - like.splat(0.5) * s2 / (s2 + like.splat(0.33));
+        let b = like.splat(0.45) * s2 / (s2 + like.splat(0.09));
+        let (t_i, t_o) = (w_i - n.scale(cos_i), s.w_o - n.scale(cos_o));
+        let t = t_i.dot(t_o).max(zero) / cos_i.max(cos_o).max(like.splat(1e-4));
+        factor = L::select(oren_nayar, inv_pi * (a + b * t), factor);
+    }
+    let minnaert = model.eq(like.splat(diffuse_lane(DiffuseModel::Minnaert { darkening: 0.0 })));
+    if L::any(minnaert) {
+        let floor = like.splat(1e-4);
+        let ratio = cos_i.max(floor) / cos_o.max(floor);
+        let m = (param + one) * like.splat(0.5) * pow(ratio, param - one);
+        factor = L::select(minnaert, inv_pi * m, factor);
+    }
+    let toon = model.eq(like.splat(diffuse_lane(DiffuseModel::Toon { bands: 1 })));
+    if L::any(toon) {
+        let q = ((cos_i.max(zero) * param + like.splat(0.5)).floor() / param).min(one);
+        let t = L::select(q.gt(zero), q / cos_i, zero);
+        factor = L::select(toon, inv_pi * t, factor);
+    }
+    s.albedo.scale(factor)
 }
 
 /// The glossy lobe's weight towards `w_i`: k_G where there is no Fresnel
@@ -269,6 +376,41 @@ fn microfacet_lobe<L: Lane>(s: &SurfaceLanes<L>, w_i: V3<L>, ggx: bool) -> (L::M
     (above, L::select(above, lobe, zero))
 }
 
+/// Ward's anisotropic lobe,
+/// `exp(-((h.t / a_u)^2 + (h.b / a_v)^2) / (h.n)^2) / (4 pi a_u a_v sqrt(cos_i cos_o))`
+/// with h = w_i + w_o (its length cancels) and (t, b, n) the frame
+/// `ward_frame` builds, and where both directions are above the surface.
+#[inline(always)]
+fn ward_lobe<L: Lane>(s: &SurfaceLanes<L>, w_i: V3<L>) -> (L::Mask, L) {
+    let zero = s.roughness.splat(0.0);
+    let n = s.normal;
+    let (cos_i, cos_o) = (n.dot(w_i), n.dot(s.w_o));
+    let above = cos_i.gt(zero) & cos_o.gt(zero);
+    let (t, b) = ward_frame(n, s.tangent);
+    let h = w_i + s.w_o;
+    let (au, av) = (s.roughness, s.roughness_v);
+    let (x, y, z) = (h.dot(t) / au, h.dot(b) / av, h.dot(n));
+    let e = -((x * x + y * y) / (z * z)) * zero.splat(std::f32::consts::LOG2_E);
+    let in_range = e.ge(zero.splat(-126.0));
+    let d = exp2(e.max(zero.splat(-126.0))) / (zero.splat(4.0 * PI) * au * av * (cos_i * cos_o).max(zero).sqrt());
+    let lobe = L::select(in_range & above, d, zero);
+    (above, lobe)
+}
+
+/// The unit tangent and bitangent of Ward's frame at unit normal `n`:
+/// `tangent` made orthogonal to n, or where that leaves nothing (no
+/// tangent, or one along n) a fixed perpendicular, `x cross n` (`y cross n`
+/// when n is near x). The bitangent is `n cross t`.
+#[inline(always)]
+pub fn ward_frame<L: Lane>(n: V3<L>, tangent: V3<L>) -> (V3<L>, V3<L>) {
+    let like = n.x;
+    let t = (tangent - n.scale(n.dot(tangent))).normalize_or_zero();
+    let near_x = n.x.max(-n.x).gt(like.splat(0.9));
+    let axis = V3::select(near_x, V3::splat(like, glam::Vec3::Y), V3::splat(like, glam::Vec3::X));
+    let t = V3::select(t.is_zero(), axis.cross(n).normalize(), t);
+    (t, n.cross(t))
+}
+
 /// `N(s) = (s + 2)(s + 4) / (8 pi (2^(-s/2) + s))`: the factor that makes
 /// the Blinn-Phong lobe `N(s) (n.h)^s` reflect exactly what arrives when
 /// seen along the normal, and less at every other angle (the horizon cuts
@@ -330,10 +472,13 @@ mod tests {
             normal: Vec3::Z.into(),
             w_o: w_o.into(),
             albedo: Vec3::ZERO.into(),
+            diffuse: DiffuseLanes::splat(0.0, DiffuseModel::Lambert),
             glossy: glossy.into(),
             sharpness: 10.0,
             glossy_model: model_lane(model),
             roughness: 0.5,
+            roughness_v: 0.5,
+            tangent: Vec3::ZERO.into(),
             fresnel: FresnelLanes::splat(0.0, Fresnel::None),
         }
     }

@@ -21,6 +21,7 @@
 //! finishes in `shade()`'s own code from there.
 
 use crate::render::transport::bsdf_sampling::cosine_lobe;
+use crate::scene::material::DiffuseModel;
 use crate::render::transport::gi;
 use crate::render::transport::gi::{GiMode, PathState};
 use crate::render::inspect::pixel_record::NoRecord;
@@ -116,9 +117,10 @@ enum SurfaceKind {
     /// Mirror or glass (`Material::has_secondary`): `shade()`'s own code
     /// finishes the path.
     Secondary,
-    /// A glossy lobe beside the diffuse one: `gi::sample_bounce`.
+    /// A glossy lobe beside the diffuse one, or a diffuse lobe that is not
+    /// Lambertian: `gi::sample_bounce`.
     Glossy,
-    /// Diffuse only: the cosine lobe, sampled eight lanes at a time.
+    /// Lambertian only: the cosine lobe, sampled eight lanes at a time.
     Lambertian,
 }
 
@@ -204,7 +206,8 @@ impl<'p> PathPool<'p> {
         // is made at its first flush.
         if self.kinds.len() != materials.len() {
             self.kinds.clear();
-            self.kinds.extend(materials.iter().map(|m| match (m.has_secondary(), m.has_glossy()) {
+            // Only the Lambertian lobe takes the eight-wide cosine bounce; other diffuse models go through `sample_bounce`.
+            self.kinds.extend(materials.iter().map(|m| match (m.has_secondary(), m.has_glossy() || m.diffuse_model != DiffuseModel::Lambert) {
                 (true, _) => SurfaceKind::Secondary,
                 (false, true) => SurfaceKind::Glossy,
                 (false, false) => SurfaceKind::Lambertian,
@@ -302,7 +305,7 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
             }
             let hit = group.hits.get(k);
             let w_o = Vec3::new(group.w_o[0][k], group.w_o[1][k], group.w_o[2][k]);
-            match gi::sample_bounce(material, group.albedo[k], &hit, w_o, self.depth, path, &mut NoRecord) {
+            match gi::sample_bounce(scene, material, group.albedo[k], &hit, w_o, self.depth, path, &mut NoRecord) {
                 Some((w_i, weight, _)) => self.go_on(group, k, w_i, weight),
                 None => self.beyond[s] = group.direct[k] + Vec3::ZERO,
             }

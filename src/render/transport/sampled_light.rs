@@ -101,6 +101,7 @@ pub fn sampled_direct<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &
         return Vec3::ZERO;
     }
     let n = hit.shading_normal;
+    let frame = crate::render::transport::bsdf::ShadingFrame::at(scene, hit, material);
     let count = settings.light_samples;
     let mis = bsdf_strategy(sh, depth);
     let mut l_o = Vec3::ZERO;
@@ -120,7 +121,7 @@ pub fn sampled_direct<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &
             if cos <= 0.0 || s.w_i.dot(hit.geometric_normal) <= 0.0 || s.radiance == Vec3::ZERO {
                 continue;
             }
-            let f = bsdf(material, albedo, n, s.w_i, w_o);
+            let f = bsdf(material, albedo, frame, s.w_i, w_o);
             if f == Vec3::ZERO {
                 continue;
             }
@@ -142,7 +143,7 @@ pub fn sampled_direct<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &
                 }
             };
             let visible = visibility > 0.0;
-            let weight = if mis { power_heuristic(count as f32 * s.pdf, bsdf_pdf(material, albedo, n, w_o, s.w_i)) } else { 1.0 };
+            let weight = if mis { power_heuristic(count as f32 * s.pdf, bsdf_pdf(material, albedo, frame, w_o, s.w_i)) } else { 1.0 };
             let contribution = if visible { s.radiance * f * (cos * weight * visibility / (s.pdf * count as f32)) } else { Vec3::ZERO };
             l_o += contribution;
             if R::ENABLED {
@@ -158,13 +159,13 @@ pub fn sampled_direct<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &
             if cos <= 0.0 || w_i.dot(hit.geometric_normal) <= 0.0 {
                 continue;
             }
-            let f = bsdf(material, albedo, n, w_i, w_o);
+            let f = bsdf(material, albedo, frame, w_i, w_o);
             let radiance = scene.miss_radiance(w_i);
             if f == Vec3::ZERO || radiance == Vec3::ZERO {
                 continue;
             }
             let visible = settings.shadows == ShadowMode::None || unblocked(sh, hit, w_i, f32::INFINITY);
-            let weight = if mis { power_heuristic(count as f32 * pdf, bsdf_pdf(material, albedo, n, w_o, w_i)) } else { 1.0 };
+            let weight = if mis { power_heuristic(count as f32 * pdf, bsdf_pdf(material, albedo, frame, w_o, w_i)) } else { 1.0 };
             let contribution = if visible { radiance * f * (cos * weight / (pdf * count as f32)) } else { Vec3::ZERO };
             l_o += contribution;
             if R::ENABLED {
@@ -189,7 +190,8 @@ fn bsdf_sampled<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &Surfac
     let Shading { scene, query, settings, .. } = *sh;
     let choice = sh.path.rng.next_f32();
     let u = sh.path.rng.next_2d();
-    let Some(s) = sample_bsdf(material, albedo, hit.shading_normal, w_o, choice, u) else { return Vec3::ZERO };
+    let frame = crate::render::transport::bsdf::ShadingFrame::at(scene, hit, material);
+    let Some(s) = sample_bsdf(material, albedo, frame, w_o, choice, u) else { return Vec3::ZERO };
     if s.w_i.dot(hit.geometric_normal) <= 0.0 {
         return Vec3::ZERO;
     }

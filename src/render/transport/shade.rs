@@ -2,7 +2,7 @@
 //! `SurfaceHit` to `shade()`. Lights, shadows, BSDF and secondary rays live
 //! here and nowhere else.
 
-use crate::render::transport::bsdf::{surface_lane, DeltaLobes};
+use crate::render::transport::bsdf::{surface_lane, DeltaLobes, ShadingFrame};
 use crate::render::transport::gi;
 use crate::render::transport::gi::GiMode;
 use crate::render::transport::lighting;
@@ -32,7 +32,7 @@ pub fn shade<Q: SceneQuery, R: Recorder>(
     let material = &scene.materials[hit.material as usize];
     let albedo = albedo_at(material, hit.uv, &hit.diff, sh.settings);
     let ambient = ambient_term(sh, || *hit, albedo);
-    let surface = surface_lane(material, albedo, hit.position, hit.shading_normal, w_o);
+    let surface = surface_lane(material, albedo, hit.position, ShadingFrame::at(scene, hit, material), w_o);
     let mut visibility = ShadowQueries { sh: &mut *sh, hit, depth, pending: PendingShadow::default() };
     let direct: Vec3 = lighting::direct_light(&scene.lights, &surface, ambient.into(), &mut visibility).into();
     after_direct(sh, hit, material, albedo, w_o, depth, direct)
@@ -187,7 +187,7 @@ fn indirect_path<Q: SceneQuery, R: Recorder>(
     depth: u32,
 ) -> Radiance {
     let Shading { settings, .. } = *sh;
-    let Some((w_i, weight, pdf)) = gi::sample_bounce(material, albedo, hit, w_o, depth, sh.path, sh.rec) else {
+    let Some((w_i, weight, pdf)) = gi::sample_bounce(sh.scene, material, albedo, hit, w_o, depth, sh.path, sh.rec) else {
         return Vec3::ZERO;
     };
     let ray = hit.spawn_ray_front(w_i, settings.shadow_bump);
@@ -233,7 +233,7 @@ fn indirect_photons<Q: SceneQuery, R: Recorder>(
         for _ in 0..gather {
             let choice = sh.path.rng.next_f32();
             let u = sh.path.rng.next_2d();
-            if let Some(s) = crate::render::transport::bsdf_sampling::sample_bsdf(material, albedo, hit.shading_normal, w_o, choice, u) {
+            if let Some(s) = crate::render::transport::bsdf_sampling::sample_bsdf(material, albedo, ShadingFrame::at(sh.scene, hit, material), w_o, choice, u) {
                 if s.w_i.dot(hit.geometric_normal) > 0.0 {
                     let ray = hit.spawn_ray_front(s.w_i, settings.shadow_bump);
                     sum += s.weight * follow(sh, &ray, depth, false, s.weight, Arrival::Gathered);

@@ -10,7 +10,7 @@
 //! gives that sample alone, which is what pixel replays run.
 
 use crate::render::transport::lighting;
-use crate::render::transport::lighting::{FresnelLanes, IncidenceLanes, LightVisibility, SurfaceLanes};
+use crate::render::transport::lighting::{DiffuseLanes, FresnelLanes, IncidenceLanes, LightVisibility, SurfaceLanes};
 use crate::render::inspect::pixel_record::NoRecord;
 use crate::render::transport::shade;
 use crate::render::transport::incidence::Incidence;
@@ -22,7 +22,7 @@ use crate::math::lanes::{mask_bits, mask_from_bits, simd_level, Lane, V3};
 use crate::math::{Radiance, Ray, Vec2, Vec3};
 use crate::scene::hit_lanes::{EyeSamples, Floats, HitLanes, TriangleHitInput};
 use crate::scene::{CameraView, Light, PrimitiveKind, Scene, SurfaceHit};
-use crate::scene::material::Fresnel;
+use crate::scene::material::{DiffuseModel, Fresnel, GlossyModel};
 use fearless_simd::{dispatch, f32x16, f32x8, Simd, SimdCombine, SimdFrom};
 
 /// Samples per batch.
@@ -391,11 +391,11 @@ pub fn direct_in_lanes<Q: SceneQuery>(
     // tame); their results are dropped. A full batch is read in place.
     let padded;
     let geometry = if n == LANES {
-        Geometry { position: &hits.position, normal: &hits.shading_normal, w_o }
+        Geometry { position: &hits.position, normal: &hits.shading_normal, w_o, tangent: ward_tangents(scene, hits, n) }
     } else {
         let pad = |v: &[Floats; 3]| v.map(|c| std::array::from_fn(|i| if i < n { c[i] } else { c[0] }));
         padded = [pad(&hits.position), pad(&hits.shading_normal), pad(w_o)];
-        Geometry { position: &padded[0], normal: &padded[1], w_o: &padded[2] }
+        Geometry { position: &padded[0], normal: &padded[1], w_o: &padded[2], tangent: ward_tangents(scene, hits, n) }
     };
     let mut albedo = [Vec3::ZERO; LANES];
     let first = &scene.materials[hits.material[0] as usize];
@@ -407,11 +407,12 @@ pub fn direct_in_lanes<Q: SceneQuery>(
         let mut sh = Shading { scene, query, settings, path: &mut paths[path_of[0]], counts: &mut *counts, rec: &mut NoRecord };
         let ambient = shade::ambient_term(&mut sh, || hits.get(0), a);
         albedo = [a; LANES];
-        MaterialLanes::Uniform { albedo: a, glossy: first.glossy, sharpness: first.sharpness, model: lighting::model_lane(first.glossy_model), roughness: first.roughness, fresnel: first.fresnel, ambient }
+        MaterialLanes::Uniform { albedo: a, diffuse: first.diffuse_model, glossy: first.glossy, sharpness: first.sharpness, model: lighting::model_lane(first.glossy_model), roughness: lighting::roughness_u(first), roughness_v: lighting::roughness_v(first), fresnel: first.fresnel, ambient }
     } else {
         // Lanes past `n` get a black material.
         let (mut albedo_lanes, mut glossy, mut sharpness, mut ambient_lanes) = ([[0.0; LANES]; 3], [[0.0; LANES]; 3], [1.0; LANES], [[0.0; LANES]; 3]);
-        let (mut model, mut roughness, mut fresnel) = ([0.0; LANES], [1.0; LANES], FresnelSoa::default());
+        let (mut model, mut roughness, mut roughness_v, mut fresnel) = ([0.0; LANES], [1.0; LANES], [1.0; LANES], FresnelSoa::default());
+        let mut diffuse = [[0.0; LANES]; 2];
         for i in 0..n {
             let material = &scene.materials[hits.material[i] as usize];
             albedo[i] = shade::albedo_at(material, Vec2::new(hits.uv[0][i], hits.uv[1][i]), &hits.diff[i], settings);
@@ -424,14 +425,32 @@ pub fn direct_in_lanes<Q: SceneQuery>(
             (ambient_lanes[0][i], ambient_lanes[1][i], ambient_lanes[2][i]) = (ambient.x, ambient.y, ambient.z);
             sharpness[i] = material.sharpness;
             model[i] = lighting::model_lane(material.glossy_model);
-            roughness[i] = material.roughness;
+            roughness[i] = lighting::roughness_u(material);
+            roughness_v[i] = lighting::roughness_v(material);
             fresnel.set(i, material.fresnel);
+            (diffuse[0][i], diffuse[1][i]) = (lighting::diffuse_lane(material.diffuse_model), material.diffuse_model.parameter());
         }
-        MaterialLanes::PerLane { albedo: albedo_lanes, glossy, sharpness, model, roughness, fresnel, ambient: ambient_lanes }
+        MaterialLanes::PerLane { albedo: albedo_lanes, diffuse, glossy, sharpness, model, roughness, roughness_v, fresnel, ambient: ambient_lanes }
     };
     let mut visibility = BatchVisibility { job, query, hits, live: ((1u32 << n) - 1) as u8, blocked, counts: &mut *counts };
     let direct = dispatch!(simd_level(), simd => direct_light8(simd, job, &geometry, &materials, &mut visibility));
     (albedo, direct)
+}
+
+/// The tangents of lanes `0..n` of `hits` whose material has Ward's lobe,
+/// as `ShadingFrame::at` gives them to one-sample shading; zero in the
+/// other lanes (and nothing is looked up when no lane has that lobe).
+fn ward_tangents(scene: &Scene, hits: &HitLanes, n: usize) -> [Floats; 3] {
+    let mut out = [[0.0; LANES]; 3];
+    let ward = |i: usize| scene.materials[hits.material[i] as usize].glossy_model == GlossyModel::Ward;
+    if !(0..n).any(ward) {
+        return out;
+    }
+    for i in (0..n).filter(|&i| ward(i)) {
+        let t = crate::scene::tangents::tangent_at(scene, &hits.get(i));
+        (out[0][i], out[1][i], out[2][i]) = (t.x, t.y, t.z);
+    }
+    out
 }
 
 /// Where the surfaces of a batch are and which way they face and are seen,
@@ -440,15 +459,18 @@ struct Geometry<'a> {
     position: &'a [Floats; 3],
     normal: &'a [Floats; 3],
     w_o: &'a [Floats; 3],
+    /// The surfaces' tangents where their lobe is Ward's (which alone
+    /// reads them), zero elsewhere.
+    tangent: [Floats; 3],
 }
 
 /// A batch's material values as `direct_light8` loads them.
 enum MaterialLanes {
     /// The same in every lane (one material without a texture).
     /// `model` is the glossy model's `lighting::model_lane` code.
-    Uniform { albedo: Vec3, glossy: Vec3, sharpness: f32, model: f32, roughness: f32, fresnel: Fresnel, ambient: Radiance },
+    Uniform { albedo: Vec3, diffuse: DiffuseModel, glossy: Vec3, sharpness: f32, model: f32, roughness: f32, roughness_v: f32, fresnel: Fresnel, ambient: Radiance },
     /// One array per coordinate (lanes may have different glossy models).
-    PerLane { albedo: [Floats; 3], glossy: [Floats; 3], sharpness: Floats, model: Floats, roughness: Floats, fresnel: FresnelSoa, ambient: [Floats; 3] },
+    PerLane { albedo: [Floats; 3], diffuse: [Floats; 2], glossy: [Floats; 3], sharpness: Floats, model: Floats, roughness: Floats, roughness_v: Floats, fresnel: FresnelSoa, ambient: [Floats; 3] },
 }
 
 /// Lanes' Fresnel terms, one array per value (`lighting::FresnelLanes`).
@@ -478,22 +500,24 @@ impl FresnelSoa {
 #[inline(always)]
 fn direct_light8<S: Simd, Q: SceneQuery>(simd: S, job: &PassJob, geometry: &Geometry, materials: &MaterialLanes, visibility: &mut BatchVisibility<Q>) -> [Radiance; LANES] {
     let like = <f32x8<S> as fearless_simd::SimdBase<S>>::splat(simd, 0.0);
-    let (albedo, glossy, sharpness, glossy_model, roughness, fresnel, start) = match materials {
-        MaterialLanes::Uniform { albedo, glossy, sharpness, model, roughness, fresnel, ambient } => (
+    let (albedo, diffuse, glossy, sharpness, glossy_model, (roughness, roughness_v), fresnel, start) = match materials {
+        MaterialLanes::Uniform { albedo, diffuse, glossy, sharpness, model, roughness, roughness_v, fresnel, ambient } => (
             V3::splat(like, *albedo),
+            DiffuseLanes::splat(like, *diffuse),
             V3::splat(like, *glossy),
             like.splat(*sharpness),
             like.splat(*model),
-            like.splat(*roughness),
+            (like.splat(*roughness), like.splat(*roughness_v)),
             FresnelLanes::splat(like, *fresnel),
             V3::splat(like, *ambient),
         ),
-        MaterialLanes::PerLane { albedo, glossy, sharpness, model, roughness, fresnel, ambient } => (
+        MaterialLanes::PerLane { albedo, diffuse, glossy, sharpness, model, roughness, roughness_v, fresnel, ambient } => (
             V3::from_soa(simd, albedo),
+            DiffuseLanes { model: f32x8::simd_from(simd, diffuse[0]), param: f32x8::simd_from(simd, diffuse[1]) },
             V3::from_soa(simd, glossy),
             f32x8::simd_from(simd, *sharpness),
             f32x8::simd_from(simd, *model),
-            f32x8::simd_from(simd, *roughness),
+            (f32x8::simd_from(simd, *roughness), f32x8::simd_from(simd, *roughness_v)),
             fresnel.load(simd),
             V3::from_soa(simd, ambient),
         ),
@@ -503,10 +527,13 @@ fn direct_light8<S: Simd, Q: SceneQuery>(simd: S, job: &PassJob, geometry: &Geom
         normal: V3::from_soa(simd, geometry.normal),
         w_o: V3::from_soa(simd, geometry.w_o),
         albedo,
+        diffuse,
         glossy,
         sharpness,
         glossy_model,
         roughness,
+        roughness_v,
+        tangent: V3::from_soa(simd, &geometry.tangent),
         fresnel,
     };
     lighting::direct_light(&job.prepared.scene.lights, &surface, start, visibility).scatter()
@@ -608,7 +635,8 @@ pub fn shade_batch_pair<Q: SceneQuery>(job: &PassJob, query: &Q, pair: [&Batch; 
         return false;
     }
     let material = &scene.materials[index as usize];
-    if material.texture.is_some() || shade::adds_after_direct(scene, settings, material) {
+    // Ward's lobe needs each lane's tangent, which pairs do not carry.
+    if material.texture.is_some() || material.glossy_model == GlossyModel::Ward || shade::adds_after_direct(scene, settings, material) {
         return false;
     }
     // `direct_in_lanes`' one-material case, for each batch: the albedo
@@ -623,7 +651,7 @@ pub fn shade_batch_pair<Q: SceneQuery>(job: &PassJob, query: &Q, pair: [&Batch; 
     if (albedo, ambient) != other {
         return false;
     }
-    let materials = MaterialLanes::Uniform { albedo, glossy: material.glossy, sharpness: material.sharpness, model: lighting::model_lane(material.glossy_model), roughness: material.roughness, fresnel: material.fresnel, ambient };
+    let materials = MaterialLanes::Uniform { albedo, diffuse: material.diffuse_model, glossy: material.glossy, sharpness: material.sharpness, model: lighting::model_lane(material.glossy_model), roughness: lighting::roughness_u(material), roughness_v: lighting::roughness_v(material), fresnel: material.fresnel, ambient };
     let mut visibility = PairVisibility { shadows: settings.shadows, blocked, counts };
     dispatch!(simd_level(), simd => direct_light16(simd, job, pair, &materials, &mut visibility, out));
     true
@@ -634,7 +662,7 @@ pub fn shade_batch_pair<Q: SceneQuery>(job: &PassJob, query: &Q, pair: [&Batch; 
 #[inline(always)]
 fn direct_light16<S: Simd, V: LightVisibility<f32x16<S>>>(simd: S, job: &PassJob, [a, b]: [&Batch; 2], materials: &MaterialLanes, visibility: &mut V, out: &mut [[Radiance; LANES]; 2]) {
     let like = <f32x16<S> as fearless_simd::SimdBase<S>>::splat(simd, 0.0);
-    let MaterialLanes::Uniform { albedo, glossy, sharpness, model, roughness, fresnel, ambient } = materials else {
+    let MaterialLanes::Uniform { albedo, diffuse, glossy, sharpness, model, roughness, roughness_v, fresnel, ambient } = materials else {
         unreachable!("pairs are one material")
     };
     let surface = SurfaceLanes {
@@ -642,10 +670,13 @@ fn direct_light16<S: Simd, V: LightVisibility<f32x16<S>>>(simd: S, job: &PassJob
         normal: join_lanes(simd, &a.hits.shading_normal, &b.hits.shading_normal),
         w_o: join_lanes(simd, &a.w_o, &b.w_o),
         albedo: V3::splat(like, *albedo),
+        diffuse: DiffuseLanes::splat(like, *diffuse),
         glossy: V3::splat(like, *glossy),
         sharpness: like.splat(*sharpness),
         glossy_model: like.splat(*model),
         roughness: like.splat(*roughness),
+        roughness_v: like.splat(*roughness_v),
+        tangent: V3::splat(like, Vec3::ZERO),
         fresnel: FresnelLanes::splat(like, *fresnel),
     };
     let l_o = lighting::direct_light(&job.prepared.scene.lights, &surface, V3::splat(like, *ambient), visibility);
@@ -916,13 +947,19 @@ mod tests {
 
     /// `scene` with a glossy lobe on every material, the models taken in
     /// turn (GGX, Beckmann, Phong, Blinn-Phong) with varied roughness and
-    /// sharpness: batches then hold one model, or several side by side.
+    /// sharpness, and the diffuse models and Fresnel terms in turns of
+    /// their own: batches then hold one model, or several side by side.
     fn with_every_glossy_model(scene: &mut crate::scene::Scene) {
-        use crate::scene::material::GlossyModel;
-        let models = [GlossyModel::Ggx, GlossyModel::Beckmann, GlossyModel::Phong, GlossyModel::BlinnPhong];
+        use crate::scene::material::{DiffuseModel, Fresnel, GlossyModel};
+        let models = [GlossyModel::Ggx, GlossyModel::Beckmann, GlossyModel::Phong, GlossyModel::BlinnPhong, GlossyModel::Ward];
+        let diffuse = [DiffuseModel::OrenNayar { sigma: 0.4 }, DiffuseModel::Lambert, DiffuseModel::Minnaert { darkening: 0.6 }, DiffuseModel::Toon { bands: 3 }, DiffuseModel::OrenNayar { sigma: 0.0 }];
+        let fresnel = [Fresnel::Schlick, Fresnel::None, Fresnel::Conductor { eta: Vec3::new(0.2, 0.9, 1.1), k: Vec3::new(3.9, 2.4, 2.2) }];
         for (k, m) in scene.materials.iter_mut().enumerate() {
+            m.diffuse_model = diffuse[k % diffuse.len()];
+            m.fresnel = fresnel[k % fresnel.len()];
             m.glossy_model = models[k % models.len()];
             m.roughness = 0.05 + 0.15 * (k % 5) as f32;
+            m.roughness_uv = crate::math::Vec2::new(m.roughness, 0.1 + 0.1 * (k % 3) as f32);
             m.sharpness = 3.0 + 20.0 * k as f32;
             if m.glossy == Vec3::ZERO {
                 m.glossy = Vec3::new(0.3, 0.5, 0.4);
@@ -956,7 +993,7 @@ mod tests {
     fn batches_equal_one_sample_shading() {
         use crate::scene::material::GlossyModel;
         let mut compared = 0;
-        let mut lit_by_model = [0usize; 4];
+        let mut lit_by_model = [0usize; 5];
         for_each_shading_case(|name, job, query| {
             assert!(batchable(job));
             let settings = job.settings;
@@ -988,7 +1025,7 @@ mod tests {
             }
         });
         assert!(compared > 3000, "only {compared} samples compared");
-        for model in [GlossyModel::Ggx, GlossyModel::Beckmann, GlossyModel::Phong, GlossyModel::BlinnPhong] {
+        for model in [GlossyModel::Ggx, GlossyModel::Beckmann, GlossyModel::Phong, GlossyModel::BlinnPhong, GlossyModel::Ward] {
             let seen = lit_by_model[lighting::model_lane(model) as usize];
             assert!(seen > 200, "only {seen} lit glossy samples of {model:?} compared");
         }
