@@ -308,9 +308,7 @@ fn cmd_render(scene_arg: &str, output: &Path, opts: &RenderOpts, stats: Option<&
     let start = Instant::now();
     let done = AtomicBool::new(false);
     let result = std::thread::scope(|s| {
-        if show_progress {
-            s.spawn(|| progress_loop(&rows_done, total_rows, &done));
-        }
+        s.spawn(|| progress_loop(&rows_done, total_rows, &done, show_progress));
         let bands = if show_progress { 32 } else { 1 };
         let r = l.pool.install(|| {
             render::render_frame_in_bands(l.renderer.as_ref(), &l.prepared, &l.settings, cancel, None, bands, Some(&rows_done))
@@ -333,21 +331,33 @@ fn cmd_render(scene_arg: &str, output: &Path, opts: &RenderOpts, stats: Option<&
     Ok(())
 }
 
-/// Prints a progress line on stderr until `done`.
-fn progress_loop(rows_done: &AtomicU64, total: u64, done: &AtomicBool) {
+/// Reports progress on stderr until `done`: on a terminal, one line
+/// redrawn in place; otherwise (a log, a batch job) a line every
+/// `LOG_PROGRESS_SECS` once the render has taken that long.
+fn progress_loop(rows_done: &AtomicU64, total: u64, done: &AtomicBool, terminal: bool) {
+    const LOG_PROGRESS_SECS: f64 = 10.0;
     let start = Instant::now();
     let mut shown = false;
+    let mut last_logged = 0.0;
     while !done.load(Ordering::Relaxed) {
         std::thread::sleep(std::time::Duration::from_millis(200));
         let d = rows_done.load(Ordering::Relaxed);
         let secs = start.elapsed().as_secs_f64();
-        if secs > 0.5 && d > 0 {
-            let eta = secs * (total as f64 / d as f64 - 1.0);
-            eprint!("\rrendering {:5.1}%  {:.1} s elapsed, about {:.0} s left   ", 100.0 * d as f64 / total as f64, secs, eta);
+        let eta = secs * (total as f64 / d.max(1) as f64 - 1.0);
+        let percent = 100.0 * d as f64 / total as f64;
+        if terminal && secs > 0.5 && d > 0 {
+            eprint!("\rrendering {percent:5.1}%  {secs:.1} s elapsed, about {eta:.0} s left   ");
             shown = true;
+        } else if !terminal && secs - last_logged >= LOG_PROGRESS_SECS {
+            last_logged = secs;
+            if d > 0 {
+                eprintln!("rendering {percent:.1}%, {secs:.0} s elapsed, about {eta:.0} s left");
+            } else {
+                eprintln!("rendering, {secs:.0} s elapsed (the first pass is not done yet)");
+            }
         }
     }
-    if shown {
+    if shown && terminal {
         eprintln!("\rrendered in {:.1} s{:40}", start.elapsed().as_secs_f64(), "");
     }
 }

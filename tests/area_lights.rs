@@ -11,7 +11,6 @@ use pinhole::math::{Radiance, Vec3};
 use pinhole::metrics::compare;
 use pinhole::render::transport::gi::GiMode;
 use pinhole::render::{PreparedScene, RenderSettings, ShadowMode};
-use pinhole::named::Named;
 use pinhole::scene::file::parse_scene;
 use pinhole::scene::Scene;
 use std::f64::consts::PI;

@@ -535,6 +535,8 @@ fn output_paths_that_alias_inputs() {
         let r = pinhole::file_identity::check_outputs(&[&path]);
         assert_eq!(r.is_err(), target_is_input, "case {case}: {} -> {r:?}", path.display());
     }
+}
+
 #[test]
 fn mutated_ply_meshes() {
     let dir = work_dir("ply");
