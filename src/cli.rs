@@ -362,6 +362,23 @@ fn progress_loop(rows_done: &AtomicU64, total: u64, done: &AtomicBool, terminal:
     }
 }
 
+/// Says every ten seconds how many of `total` passes of `what` are done,
+/// until `finished`.
+fn report_passes(what: &str, done: &std::sync::atomic::AtomicU32, total: u32, finished: &AtomicBool) {
+    let start = Instant::now();
+    let mut last = 0.0;
+    while !finished.load(Ordering::Relaxed) {
+        std::thread::sleep(std::time::Duration::from_millis(200));
+        let secs = start.elapsed().as_secs_f64();
+        if secs - last >= 10.0 {
+            last = secs;
+            let d = done.load(Ordering::Relaxed);
+            let left = if d > 0 { format!(", about {:.0} s left", secs * (total as f64 / d as f64 - 1.0)) } else { String::new() };
+            eprintln!("{what}: {d} of {total} passes, {secs:.0} s elapsed{left}");
+        }
+    }
+}
+
 fn write_json(dest: &str, j: &serde_json::Value) -> Result<(), String> {
     let text = serde_json::to_string_pretty(j).map_err(|e| e.to_string())? + "\n";
     if dest == "-" {
@@ -486,10 +503,20 @@ fn cmd_chart_methods(scene_arg: &str, output: &Path, metric: &str, reference: Op
     let source = crate::chart::ReferenceSource::choose(reference, &l.prepared, reference_spp);
     let cancel = interrupt::flag();
     let cache = crate::chart::reference::default_cache_dir();
-    let truth = l
-        .pool
-        .install(|| crate::chart::load_reference(&source, &l.prepared, w, h, cache.as_deref(), cancel, None))?
-        .ok_or("cancelled")?;
+    // A path-traced reference can take minutes: its passes are reported
+    // every ten seconds.
+    let passes = std::sync::atomic::AtomicU32::new(0);
+    let loaded = AtomicBool::new(false);
+    let truth = std::thread::scope(|s| {
+        if let crate::chart::ReferenceSource::PathTraced { spp } = source {
+            let (passes, loaded) = (&passes, &loaded);
+            s.spawn(move || report_passes("reference", passes, spp, loaded));
+        }
+        let r = l.pool.install(|| crate::chart::load_reference(&source, &l.prepared, w, h, cache.as_deref(), cancel, Some(&passes)));
+        loaded.store(true, Ordering::Relaxed);
+        r
+    })?
+    .ok_or("cancelled")?;
     eprintln!("reference: {}", truth.name);
     check_chart_outputs(output)?;
     let configs = match gi {
