@@ -32,12 +32,12 @@ for c in "${cases[@]}"; do
     counts=()
     for b in "${bins[@]}"; do
         # The frame's instructions only: collection is on inside the frame.
-        n=$(valgrind --tool=callgrind --toggle-collect='*render_frame_over' --callgrind-out-file="$out" \
+        n=$(valgrind --tool=callgrind --toggle-collect='*render_frame_with' --callgrind-out-file="$out" \
             "$b" bench "${args[@]}" --frames 1 --threads 1 2>&1 >/dev/null | sed -nE 's/.*refs: *([0-9,]+).*/\1/p' | tr -d ,)
-        # The collection starts at `render_frame_over`'s own symbol: were
+        # The collection starts at `render_frame_with`'s own symbol: were
         # the compiler to inline it, nothing would be counted.
         if [ -z "$n" ] || [ "$n" = 0 ]; then
-            echo "count_instructions.sh: no instructions counted for $b on $label: is render_frame_over still a function of its own in that binary?" >&2
+            echo "count_instructions.sh: no instructions counted for $b on $label: is render_frame_with still a function of its own in that binary?" >&2
             exit 1
         fi
         counts+=("$n")

@@ -311,7 +311,7 @@ fn cmd_render(scene_arg: &str, output: &Path, opts: &RenderOpts, stats: Option<&
         s.spawn(|| progress_loop(&rows_done, total_rows, &done, show_progress));
         let bands = if show_progress { 32 } else { 1 };
         let r = l.pool.install(|| {
-            render::render_frame_in_bands(l.renderer.as_ref(), &l.prepared, &l.settings, cancel, None, bands, Some(&rows_done))
+            render::render_frame_with(l.renderer.as_ref(), &l.prepared, &l.settings, cancel, render::FrameOptions { bands, rows_done: Some(&rows_done), ..render::FrameOptions::default() })
         });
         done.store(true, Ordering::Relaxed);
         r
@@ -400,13 +400,13 @@ fn cmd_bench(scene_arg: &str, opts: &RenderOpts, frames: u32) -> Result<(), Stri
     let mut first_ms = 0.0;
     let mut counts = RayCounts::default();
     // Each frame renders over the one before's pixels, as a viewer redraws
-    // its image (`render_frame_reusing`).
+    // its image (`FrameOptions::spare`).
     let mut spare = Vec::new();
     for i in 0..=frames {
         let start = Instant::now();
         let frame = l
             .pool
-            .install(|| render::render_frame_reusing(l.renderer.as_ref(), &l.prepared, &l.settings, cancel, std::mem::take(&mut spare)))
+            .install(|| render::render_frame_with(l.renderer.as_ref(), &l.prepared, &l.settings, cancel, render::FrameOptions { spare: std::mem::take(&mut spare), ..render::FrameOptions::default() }))
             .ok_or("the render was cancelled")?;
         let ms = start.elapsed().as_secs_f64() * 1e3;
         if i > 0 {

@@ -196,6 +196,6 @@ fn thread_count_and_row_bands_do_not_change_the_painter() {
     assert!(one == two);
     // Rendered in bands of 7 rows (as the viewer does): the same frame.
     let r = renderer_by_name("rasterize:painter").unwrap();
-    let banded = pinhole::render::render_frame_in_bands(r.as_ref(), &prepared, &s, &AtomicBool::new(false), None, 14, None).unwrap();
+    let banded = pinhole::render::render_frame_with(r.as_ref(), &prepared, &s, &AtomicBool::new(false), pinhole::render::FrameOptions { bands: 14, ..Default::default() }).unwrap();
     assert!(banded.pixels == one);
 }

@@ -53,21 +53,7 @@ impl SceneParams {
             && self.render == o.render
             && self.lights == o.lights
             && self.materials.len() == o.materials.len()
-            && self.materials.iter().zip(&o.materials).all(|(a, b)| {
-                a.name == b.name
-                    && a.lambertian == b.lambertian
-                    && a.glossy == b.glossy
-                    && a.sharpness == b.sharpness
-                    && a.glossy_model == b.glossy_model
-                    && a.roughness == b.roughness
-                    && a.roughness_uv == b.roughness_uv
-                    && a.fresnel == b.fresnel
-                    && a.diffuse_model == b.diffuse_model
-                    && a.mirror == b.mirror
-                    && a.transmission == b.transmission
-                    && a.ior == b.ior
-                    && a.emission == b.emission
-            })
+            && self.materials.iter().zip(&o.materials).all(|(a, b)| a.same_but_texels(b))
     }
 
     /// Equal except for the display-only values (exposure).

@@ -21,53 +21,41 @@ pub struct FrameResult {
     pub differing_pixels: Option<u64>,
 }
 
+/// How a caller follows and feeds a frame beyond its settings: the
+/// defaults (`FrameOptions::default()`) render it in one band per pass
+/// with nothing reported.
+pub struct FrameOptions<'a> {
+    /// Counts finished passes, for progress display.
+    pub passes_done: Option<&'a AtomicU32>,
+    /// Each pass split into this many bands of rows, so that `rows_done`
+    /// can report progress within a pass (long reference renders).
+    /// Splitting costs the rasterizers one setup per band, so frames that
+    /// are timed use one band.
+    pub bands: u32,
+    /// Counts finished rows over all passes.
+    pub rows_done: Option<&'a AtomicU64>,
+    /// Storage to render into where it fits (`Accumulator::reusing`): what a
+    /// caller that renders frame after frame (`pinhole bench`) hands back
+    /// from the frame before.
+    pub spare: Vec<Radiance>,
+}
+
+impl Default for FrameOptions<'_> {
+    fn default() -> Self {
+        FrameOptions { passes_done: None, bands: 1, rows_done: None, spare: Vec::new() }
+    }
+}
+
 /// Renders a whole frame of `settings.spp` samples. Returns `None` when
 /// `cancel` was raised. `passes_done` (if given) counts finished passes, for
 /// progress display.
-pub fn render_frame(
-    renderer: &dyn Renderer,
-    prepared: &PreparedScene,
-    settings: &RenderSettings,
-    cancel: &AtomicBool,
-    passes_done: Option<&AtomicU32>,
-) -> Option<FrameResult> {
-    render_frame_in_bands(renderer, prepared, settings, cancel, passes_done, 1, None)
+pub fn render_frame(renderer: &dyn Renderer, prepared: &PreparedScene, settings: &RenderSettings, cancel: &AtomicBool, passes_done: Option<&AtomicU32>) -> Option<FrameResult> {
+    render_frame_with(renderer, prepared, settings, cancel, FrameOptions { passes_done, ..FrameOptions::default() })
 }
 
-/// As `render_frame`, with each pass split into `bands` bands of rows so that
-/// `rows_done` can report progress within a pass (long reference renders).
-/// Splitting costs the rasterizers one setup per band, so frames that are
-/// timed use one band.
-pub fn render_frame_in_bands(
-    renderer: &dyn Renderer,
-    prepared: &PreparedScene,
-    settings: &RenderSettings,
-    cancel: &AtomicBool,
-    passes_done: Option<&AtomicU32>,
-    bands: u32,
-    rows_done: Option<&AtomicU64>,
-) -> Option<FrameResult> {
-    render_frame_over(renderer, prepared, settings, cancel, passes_done, bands, rows_done, Vec::new())
-}
-
-/// `render_frame` into `spare`'s storage where it fits
-/// (`Accumulator::reusing`): what a caller that renders frame after frame
-/// (`pinhole bench`) hands back from the frame before.
-pub fn render_frame_reusing(renderer: &dyn Renderer, prepared: &PreparedScene, settings: &RenderSettings, cancel: &AtomicBool, spare: Vec<Radiance>) -> Option<FrameResult> {
-    render_frame_over(renderer, prepared, settings, cancel, None, 1, None, spare)
-}
-
-#[allow(clippy::too_many_arguments)]
-fn render_frame_over(
-    renderer: &dyn Renderer,
-    prepared: &PreparedScene,
-    settings: &RenderSettings,
-    cancel: &AtomicBool,
-    passes_done: Option<&AtomicU32>,
-    bands: u32,
-    rows_done: Option<&AtomicU64>,
-    spare: Vec<Radiance>,
-) -> Option<FrameResult> {
+/// `render_frame` followed and fed as `options` say.
+pub fn render_frame_with(renderer: &dyn Renderer, prepared: &PreparedScene, settings: &RenderSettings, cancel: &AtomicBool, options: FrameOptions) -> Option<FrameResult> {
+    let FrameOptions { passes_done, bands, rows_done, spare } = options;
     // Sub-sampling interpolates shaded images; debug views show every pixel.
     if settings.subsample.is_on() && settings.view == crate::render::inspect::debug::View::Shaded {
         return subsample::render_subsampled(renderer, prepared, settings, cancel, passes_done);

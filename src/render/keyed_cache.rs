@@ -31,6 +31,12 @@ impl<K: PartialEq, V> KeyedCache<K, V> {
         self.id
     }
 
+    /// Whether the value held was built for `key` (`get` would not build).
+    pub fn holds(&self, key: &K) -> bool {
+        let slot = self.slot.lock().unwrap_or_else(|e| e.into_inner());
+        slot.as_ref().is_some_and(|(held, _)| held == key)
+    }
+
     /// The value for `key`: the one held when it was built for `key`, else
     /// `build(&key)`'s, which replaces it. Callers asking meanwhile wait for
     /// the build rather than building too.
@@ -95,12 +101,15 @@ mod tests {
             builds.set(builds.get() + 1);
             format!("built for {k}")
         };
+        assert!(!cache.holds(&1), "an empty cache holds nothing");
         let a = cache.get(1, build);
+        assert!(cache.holds(&1) && !cache.holds(&2));
         let b = cache.get(1, build);
         assert_eq!(builds.get(), 1);
         assert!(Arc::ptr_eq(&a, &b));
         let c = cache.get(2, build);
         assert_eq!(builds.get(), 2);
+        assert!(cache.holds(&2) && !cache.holds(&1), "one slot");
         assert_eq!(*c, "built for 2");
         // One slot: going back to the first key builds again.
         let d = cache.get(1, build);

@@ -22,7 +22,7 @@ pub mod settings_check;
 pub mod shadow;
 pub mod transport;
 
-pub use frame::{render_frame, render_frame_in_bands, render_frame_reusing, replay_pixel, FrameResult, PixelReplay};
+pub use frame::{render_frame, render_frame_with, replay_pixel, FrameOptions, FrameResult, PixelReplay};
 pub use prepared::PreparedScene;
 
 use crate::math::{Radiance, Ray, Vec2};
@@ -501,18 +501,16 @@ pub fn view_miss_without_ray(job: &PassJob) -> Option<Radiance> {
     miss_without_ray(job).or_else(|| inspect::debug::miss_color(job.settings.view))
 }
 
+/// The batched hand-off from visibility to shading, beside `resolve_sample`
+/// below (the one-sample hand-off): a rasterizer pushes the samples its
+/// visibility buffer sees and the queue lights them eight at a time. It is
+/// named here so that the hit-making layers never name `transport`.
+pub use transport::shade_queue::ShadeQueue;
+
 /// The value one sample contributes, given what it sees: `shade()` for the
 /// shaded view, a debug colour otherwise, the background on a miss.
 #[inline]
-pub fn resolve_sample<Q: SceneQuery, R: Recorder>(
-    job: &PassJob,
-    query: &Q,
-    ray: &Ray,
-    hit: Option<&SurfaceHit>,
-    pixel: u32,
-    counts: &mut RayCounts,
-    rec: &mut R,
-) -> Radiance {
+pub fn resolve_sample<Q: SceneQuery, R: Recorder>(job: &PassJob, query: &Q, ray: &Ray, hit: Option<&SurfaceHit>, pixel: u32, counts: &mut RayCounts, rec: &mut R) -> Radiance {
     if job.settings.view == inspect::debug::View::Shadowmap {
         return shadow::map::view_sample(job, ray, rec);
     }
@@ -534,29 +532,12 @@ pub fn resolve_sample<Q: SceneQuery, R: Recorder>(
 /// are known already: a rasterizer's stencil (`--shadows volume`).
 #[allow(clippy::too_many_arguments)]
 #[inline]
-pub fn resolve_counted<Q: SceneQuery, R: Recorder>(
-    job: &PassJob,
-    query: &Q,
-    ray: &Ray,
-    hit: Option<&SurfaceHit>,
-    volume: &[i32],
-    pixel: u32,
-    counts: &mut RayCounts,
-    rec: &mut R,
-) -> Radiance {
+pub fn resolve_counted<Q: SceneQuery, R: Recorder>(job: &PassJob, query: &Q, ray: &Ray, hit: Option<&SurfaceHit>, volume: &[i32], pixel: u32, counts: &mut RayCounts, rec: &mut R) -> Radiance {
     resolve_with(job, &shadow::ApproximateShadows { inner: query, maps: None, volume_counts: Some(volume) }, ray, hit, pixel, counts, rec)
 }
 
 #[inline]
-fn resolve_with<Q: SceneQuery, R: Recorder>(
-    job: &PassJob,
-    query: &Q,
-    ray: &Ray,
-    hit: Option<&SurfaceHit>,
-    pixel: u32,
-    counts: &mut RayCounts,
-    rec: &mut R,
-) -> Radiance {
+fn resolve_with<Q: SceneQuery, R: Recorder>(job: &PassJob, query: &Q, ray: &Ray, hit: Option<&SurfaceHit>, pixel: u32, counts: &mut RayCounts, rec: &mut R) -> Radiance {
     let scene = &job.prepared.scene;
     match (job.settings.view, hit) {
         (inspect::debug::View::Shaded, Some(h)) => {

@@ -153,6 +153,20 @@ pub struct Material {
 }
 
 impl Material {
+    /// Equal in every value, its textures compared by identity rather than
+    /// texel by texel: what the viewer asks each frame to learn whether a
+    /// material was edited (it never edits texels).
+    pub fn same_but_texels(&self, o: &Material) -> bool {
+        fn same_texture(a: &Option<Arc<Texture>>, b: &Option<Arc<Texture>>) -> bool {
+            match (a, b) {
+                (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+                (a, b) => a.is_none() && b.is_none(),
+            }
+        }
+        let without_texels = |m: &Material| Material { texture: None, normal_map: None, ..m.clone() };
+        same_texture(&self.texture, &o.texture) && same_texture(&self.normal_map, &o.normal_map) && without_texels(self) == without_texels(o)
+    }
+
     pub fn default_grey() -> Material {
         Material { name: DEFAULT_MATERIAL.into(), ..Material::black() }.with_lambertian(Vec3::splat(0.8))
     }

@@ -16,6 +16,7 @@ pub mod instanced;
 pub mod load;
 pub mod mesh_cache;
 pub mod mesh_file;
+pub mod normal_map;
 pub mod material;
 pub mod obj;
 pub mod placement;
@@ -63,6 +64,18 @@ impl Triangle {
     #[inline(always)]
     pub fn normal_of(v: &[Vec3; 3]) -> Vec3 {
         (v[1] - v[0]).cross(v[2] - v[0]).normalize()
+    }
+
+    /// The geometric normal of a triangle with vertices `v`, made exactly as
+    /// `geometric_normal` makes it (so that the scene can store flat
+    /// triangles' normals as a flag, `Triangles`), or `None` where it cannot
+    /// be formed: the
+    /// triangle covers no area, or its sides overflow. Mesh readers skip
+    /// such triangles and count them.
+    pub fn normal_if_not_degenerate(v: &[Vec3; 3]) -> Option<Vec3> {
+        let geo = (v[1] - v[0]).cross(v[2] - v[0]);
+        let len = geo.length();
+        (len > 0.0 && (geo / len).is_finite()).then(|| Triangle::normal_of(v))
     }
 
     /// Flat-shaded: every corner's normal is exactly (bit for bit) the
@@ -458,10 +471,17 @@ impl Scene {
             c.triangles.iter().for_each(|t| mark(t.material));
         }
         if let Some(layer) = &self.layer {
+            // A mesh shared by thousands of copies is walked once, not once
+            // per copy.
+            let mut mesh_marked = vec![false; layer.meshes.len()];
             for inst in &layer.instances {
                 match inst.material {
                     Some(m) => mark(m),
-                    None => layer.meshes[inst.mesh as usize].iter().for_each(|t| mark(t.material)),
+                    None if !mesh_marked[inst.mesh as usize] => {
+                        mesh_marked[inst.mesh as usize] = true;
+                        layer.meshes[inst.mesh as usize].iter().for_each(|t| mark(t.material));
+                    }
+                    None => {}
                 }
             }
         }

@@ -168,17 +168,11 @@ fn load_obj_unbounded(path: &Path, mode: NormalMode, textures: MtlTextures) -> R
         let material = m.material_id.map(|i| i as u32).filter(|&i| (i as usize) < materials.len()).unwrap_or(u32::MAX);
         for (f, idx) in m.indices.chunks_exact(3).enumerate() {
             let v = [pos[idx[0] as usize], pos[idx[1] as usize], pos[idx[2] as usize]];
-            let geo = (v[1] - v[0]).cross(v[2] - v[0]);
-            let len = geo.length();
             // Skip triangles whose normal cannot be formed; they cover no area.
-            if !(len > 0.0) || !(geo / len).is_finite() {
+            let Some(geo) = Triangle::normal_if_not_degenerate(&v) else {
                 degenerate += 1;
                 continue;
-            }
-            // The flat normal is made exactly as `Triangle::geometric_normal`
-            // makes it, so that the scene stores flat triangles' normals as
-            // a flag (`Triangles`).
-            let geo = Triangle::normal_of(&v);
+            };
             let corner = |k: usize| -> Vec3 {
                 if use_file_normals {
                     normals[m.normal_indices[3 * f + k] as usize].normalize_or(geo)

@@ -505,13 +505,11 @@ pub fn load_ply(path: &Path, mode: NormalMode) -> Result<LoadedMesh, String> {
     let mut degenerate = 0;
     for idx in &ply.triangles {
         let v = idx.map(|i| pos[i as usize]);
-        let geo = (v[1] - v[0]).cross(v[2] - v[0]);
-        let len = geo.length();
-        if !(len > 0.0) || !(geo / len).is_finite() {
+        // Skip triangles whose normal cannot be formed; they cover no area.
+        let Some(geo) = Triangle::normal_if_not_degenerate(&v) else {
             degenerate += 1;
             continue;
-        }
-        let geo = Triangle::normal_of(&v);
+        };
         let corner = |k: usize| -> Vec3 {
             let i = idx[k] as usize;
             match (&ply.normals, &smooth) {

@@ -311,6 +311,14 @@ struct ArrayStack {
     len: usize,
 }
 
+impl ArrayStack {
+    /// An empty stack; its entries are left uninitialised.
+    #[inline(always)]
+    fn new() -> ArrayStack {
+        ArrayStack { items: [const { std::mem::MaybeUninit::uninit() }; STACK], len: 0 }
+    }
+}
+
 impl Stack for ArrayStack {
     #[inline(always)]
     fn push(&mut self, word: u32, t: f32) {
@@ -354,14 +362,7 @@ impl<'a> BvhQuery<'a> {
     }
 
     #[inline(always)]
-    fn traverse<const ANY: bool, R: Recorder>(
-        &self,
-        ray: &Ray,
-        t_max: f32,
-        inside: bool,
-        counts: &mut RayCounts,
-        rec: &mut R,
-    ) -> Option<BestHit> {
+    fn traverse<const ANY: bool, R: Recorder>(&self, ray: &Ray, t_max: f32, inside: bool, counts: &mut RayCounts, rec: &mut R) -> Option<BestHit> {
         let bvh = &self.prepared.bvh;
         if let (Some(accel), Some(layer)) = (&self.prepared.instances, &self.prepared.scene.layer) {
             let found = if bvh.prims.is_empty() { None } else { self.traverse_flat::<ANY, R>(ray, t_max, inside, counts, rec) };
@@ -402,14 +403,7 @@ impl<'a> BvhQuery<'a> {
 
     /// The walk through the BVH over the flattened triangles and the spheres.
     #[inline(always)]
-    fn traverse_flat<const ANY: bool, R: Recorder>(
-        &self,
-        ray: &Ray,
-        t_max: f32,
-        inside: bool,
-        counts: &mut RayCounts,
-        rec: &mut R,
-    ) -> Option<BestHit> {
+    fn traverse_flat<const ANY: bool, R: Recorder>(&self, ray: &Ray, t_max: f32, inside: bool, counts: &mut RayCounts, rec: &mut R) -> Option<BestHit> {
         // Compiled once per SIMD level: the eight-lane box test is one AVX
         // instruction per step where the CPU has it.
         dispatch!(simd_level(), simd => self.traverse_flat_at::<_, ANY, R>(simd, ray, t_max, inside, counts, rec))
@@ -417,19 +411,11 @@ impl<'a> BvhQuery<'a> {
 
     /// `traverse_flat` at SIMD level `simd`, chosen by the caller.
     #[inline(always)]
-    fn traverse_flat_at<S: Simd, const ANY: bool, R: Recorder>(
-        &self,
-        simd: S,
-        ray: &Ray,
-        t_max: f32,
-        inside: bool,
-        counts: &mut RayCounts,
-        rec: &mut R,
-    ) -> Option<BestHit> {
+    fn traverse_flat_at<S: Simd, const ANY: bool, R: Recorder>(&self, simd: S, ray: &Ray, t_max: f32, inside: bool, counts: &mut RayCounts, rec: &mut R) -> Option<BestHit> {
         if self.prepared.bvh.deep {
             self.traverse_with::<_, ANY, R, _>(simd, ray, t_max, inside, counts, rec, &mut Vec::new(), None)
         } else {
-            let mut stack = ArrayStack { items: [const { std::mem::MaybeUninit::uninit() }; STACK], len: 0 };
+            let mut stack = ArrayStack::new();
             self.traverse_with::<_, ANY, R, _>(simd, ray, t_max, inside, counts, rec, &mut stack, None)
         }
     }
@@ -438,7 +424,7 @@ impl<'a> BvhQuery<'a> {
     /// far (the packets' hybrid walk hands its last rays over here).
     #[inline(always)]
     pub(super) fn closest_from_at<S: Simd>(&self, simd: S, ray: &Ray, word: u32, best: BestHit, counts: &mut RayCounts) -> BestHit {
-        let mut stack = ArrayStack { items: [const { std::mem::MaybeUninit::uninit() }; STACK], len: 0 };
+        let mut stack = ArrayStack::new();
         self.traverse_with::<_, false, NoRecord, _>(simd, ray, best.t, false, counts, &mut NoRecord, &mut stack, Some((word, best))).unwrap_or(best)
     }
 
@@ -446,7 +432,7 @@ impl<'a> BvhQuery<'a> {
     /// occluder found below it, if any.
     #[inline(always)]
     pub(super) fn occluder_from_at<S: Simd>(&self, simd: S, ray: &Ray, word: u32, t_max: f32, counts: &mut RayCounts) -> Option<BestHit> {
-        let mut stack = ArrayStack { items: [const { std::mem::MaybeUninit::uninit() }; STACK], len: 0 };
+        let mut stack = ArrayStack::new();
         self.traverse_with::<_, true, NoRecord, _>(simd, ray, t_max, false, counts, &mut NoRecord, &mut stack, Some((word, BestHit::nothing_before(t_max))))
     }
 
@@ -454,17 +440,7 @@ impl<'a> BvhQuery<'a> {
     /// Returns the winning primitive's hit.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    fn traverse_with<S: Simd, const ANY: bool, R: Recorder, St: Stack>(
-        &self,
-        simd: S,
-        ray: &Ray,
-        t_max: f32,
-        inside: bool,
-        counts: &mut RayCounts,
-        rec: &mut R,
-        stack: &mut St,
-        from: Option<(u32, BestHit)>,
-    ) -> Option<BestHit> {
+    fn traverse_with<S: Simd, const ANY: bool, R: Recorder, St: Stack>(&self, simd: S, ray: &Ray, t_max: f32, inside: bool, counts: &mut RayCounts, rec: &mut R, stack: &mut St, from: Option<(u32, BestHit)>) -> Option<BestHit> {
         let bvh = &self.prepared.bvh;
         let spheres = &self.prepared.scene.spheres;
         let r = PreparedRay::new(ray);

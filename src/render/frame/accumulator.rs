@@ -506,7 +506,7 @@ impl Accumulator {
 mod tests {
     use super::*;
     use crate::render::raytrace::bvh_renderer::BvhRayTracer;
-    use crate::render::{render_frame, render_frame_in_bands};
+    use crate::render::{render_frame, render_frame_with, FrameOptions};
     use crate::scene::builtin;
 
     fn prepared(name: &str) -> PreparedScene {
@@ -588,7 +588,7 @@ mod tests {
             let s = settings(&p, spp, View::Shaded);
             let cancel = AtomicBool::new(false);
             let whole = render_frame(&BvhRayTracer, &p, &s, &cancel, None).unwrap();
-            let banded = render_frame_in_bands(&BvhRayTracer, &p, &s, &cancel, None, 5, None).unwrap();
+            let banded = render_frame_with(&BvhRayTracer, &p, &s, &cancel, FrameOptions { bands: 5, ..FrameOptions::default() }).unwrap();
             assert_eq!(bits(&whole.pixels), bits(&banded.pixels), "spp {spp}");
             // (Ray counts may differ: packets are formed within a band.)
             assert_eq!(whole.counts.primary, banded.counts.primary);
@@ -664,7 +664,7 @@ mod tests {
                     let s = settings(&p, 1, view);
                     let fresh = render_frame(renderer.as_ref(), &p, &s, &cancel, None).unwrap();
                     let stale = vec![Radiance::new(1234.5, -7.0, 0.25); fresh.pixels.len()];
-                    let over = crate::render::render_frame_reusing(renderer.as_ref(), &p, &s, &cancel, stale).unwrap();
+                    let over = render_frame_with(renderer.as_ref(), &p, &s, &cancel, FrameOptions { spare: stale, ..FrameOptions::default() }).unwrap();
                     assert_eq!(bits(&over.pixels), bits(&fresh.pixels), "{scene}, {}, {view:?}", renderer.name());
                 }
             }
@@ -689,7 +689,7 @@ mod tests {
         let p = prepared("spheres");
         let s = settings(&p, 1, View::Shaded);
         let stale = vec![Radiance::splat(1234.5); (s.width * s.height) as usize];
-        let over = crate::render::render_frame_reusing(&SkipsFirstPixel, &p, &s, &cancel, stale).unwrap();
+        let over = render_frame_with(&SkipsFirstPixel, &p, &s, &cancel, FrameOptions { spare: stale, ..FrameOptions::default() }).unwrap();
         assert_eq!(over.pixels[0], Radiance::splat(1234.5));
     }
 
@@ -722,7 +722,7 @@ mod tests {
         let diff = render_frame(&Poisoned, &p, &s, &cancel, None).unwrap();
         assert_eq!(diff.differing_pixels, Some(expected));
         // Band by band it is the same image and count.
-        let banded = render_frame_in_bands(&Poisoned, &p, &s, &cancel, None, 4, None).unwrap();
+        let banded = render_frame_with(&Poisoned, &p, &s, &cancel, FrameOptions { bands: 4, ..FrameOptions::default() }).unwrap();
         assert_eq!(bits(&banded.pixels), bits(&diff.pixels));
         assert_eq!(banded.differing_pixels, diff.differing_pixels);
     }

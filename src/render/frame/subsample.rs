@@ -59,13 +59,7 @@ pub fn contrast(corners: [Radiance; 4]) -> f32 {
 
 /// Renders a whole sub-sampled frame of `settings.spp` passes. `None` when
 /// `cancel` was raised.
-pub fn render_subsampled(
-    renderer: &dyn Renderer,
-    prepared: &PreparedScene,
-    settings: &RenderSettings,
-    cancel: &AtomicBool,
-    passes_done: Option<&AtomicU32>,
-) -> Option<FrameResult> {
+pub fn render_subsampled(renderer: &dyn Renderer, prepared: &PreparedScene, settings: &RenderSettings, cancel: &AtomicBool, passes_done: Option<&AtomicU32>) -> Option<FrameResult> {
     let (w, h) = (settings.width, settings.height);
     let n = w as usize * h as usize;
     let spp = settings.spp.max(1);

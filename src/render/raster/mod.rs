@@ -41,7 +41,6 @@ pub mod rect;
 pub mod runs;
 pub mod scanline;
 pub mod setup;
-pub mod shade_queue;
 pub mod small;
 pub mod sphere;
 pub mod stencil;

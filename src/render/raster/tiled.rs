@@ -107,14 +107,7 @@ pub fn bin_tiles(tris: &[FixedTri], grid: &TileGrid, off: [i64; 2]) -> Vec<Vec<(
 /// Visits, triangle by triangle in bin order, the covered samples of `tile`
 /// with their screen-space weights (the same bits as `fixed::raster`).
 #[inline]
-pub fn tile_fragments<F: FnMut(&FixedTri, u32, u32, [f32; 3])>(
-    tris: &[FixedTri],
-    bin: &[(u32, RectCoverage)],
-    tile: PixelRect,
-    off: [i64; 2],
-    tested: &mut impl TestCounter,
-    mut emit: F,
-) {
+pub fn tile_fragments<F: FnMut(&FixedTri, u32, u32, [f32; 3])>(tris: &[FixedTri], bin: &[(u32, RectCoverage)], tile: PixelRect, off: [i64; 2], tested: &mut impl TestCounter, mut emit: F) {
     tile_fragment_rows(tris, bin, tile, off, tested, |ft, x0, y, bits| {
         for x in fixed::row_pixels(x0, bits) {
             emit(ft, x, y, ft.weights(x, y));
@@ -127,14 +120,7 @@ pub fn tile_fragments<F: FnMut(&FixedTri, u32, u32, [f32; 3])>(
 /// pixels `x0..x0 + 8` in that row as bits (bit k: pixel `x0 + k`), in the
 /// same order. For code that takes a row of samples at once.
 #[inline]
-pub fn tile_fragment_rows<F: FnMut(&FixedTri, u32, u32, u8)>(
-    tris: &[FixedTri],
-    bin: &[(u32, RectCoverage)],
-    tile: PixelRect,
-    off: [i64; 2],
-    tested: &mut impl TestCounter,
-    mut emit: F,
-) {
+pub fn tile_fragment_rows<F: FnMut(&FixedTri, u32, u32, u8)>(tris: &[FixedTri], bin: &[(u32, RectCoverage)], tile: PixelRect, off: [i64; 2], tested: &mut impl TestCounter, mut emit: F) {
     for &(i, class) in bin {
         let ft = &tris[i as usize];
         let r = ft.bbox.intersect(&tile);

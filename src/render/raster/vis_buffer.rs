@@ -27,9 +27,7 @@ use std::ops::Range;
 use crate::render::inspect::debug::{cost_color, View};
 use crate::render::inspect::pixel_record::{CsgABufferRecord, FragmentRecord, NoRecord, PixelTrace, Recorder};
 use crate::render::{resolve_counted, resolve_sample, view_miss_without_ray, PassJob, RayCounts, SceneQuery};
-use crate::render::transport::path_batch::PathPool;
-use crate::render::raster::shade_queue::ShadeQueue;
-use crate::render::transport::shade_batch;
+use crate::render::ShadeQueue;
 use crate::scene::hit_lanes::EyeSamples;
 use crate::render::shadow::volume::split_depth;
 use crate::render::raster::stencil::{PixelRay, StencilSetup};
@@ -134,14 +132,11 @@ pub struct VisBuffer<'j, 'a, Q: SceneQuery, R: FragmentRecorder = NoRecord> {
     /// (`stencil_lights` of them), filled after the depth pass; empty otherwise.
     stencil: Vec<i32>,
     stencil_lights: usize,
-    /// With `--gi path`, the samples whose paths wait to be followed
-    /// together; kept with the buffer (empty between regions) so that its
-    /// buffers grow once, not in every region.
-    paths: PathPool<'a>,
-    /// The visible samples waiting to be shaded (`resolve_batched`): kept
-    /// with the buffer (empty between regions), made at the first region
+    /// The visible samples waiting to be shaded (`resolve_batched`), and
+    /// with `--gi path` their paths: kept with the buffer (empty between
+    /// regions) so that its buffers grow once, made at the first region
     /// that shades in batches rather than in every region or tile.
-    queue: Option<ShadeQueue>,
+    queue: Option<ShadeQueue<'a>>,
     /// `resolve_batched`'s runs of the output streamed past the cache
     /// (ranges of slots): the rest is admitted once the region is shaded;
     /// kept like `queue`.
@@ -197,7 +192,6 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             sample: None,
             stencil: Vec::new(),
             stencil_lights: 0,
-            paths: PathPool::new(),
             queue: None,
             streamed: Vec::new(),
         }
@@ -527,7 +521,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             // Seen along the eye ray, as in the ray casters: the same differentials.
             if scene.has_textures() {
                 let mut h = with_ray_differentials(scene, &RayDifferential::eye(self.job.view, p.x, p.y), &ray, h);
-                crate::render::transport::normal_map::apply(scene, self.job.settings.texture_filter, &mut h);
+                crate::scene::normal_map::apply(scene, self.job.settings.texture_filter, &mut h);
                 Some(h)
             } else {
                 Some(h)
@@ -538,7 +532,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             Some(match scene.has_textures() {
                 true => {
                     let mut hit = with_ray_differentials(scene, &RayDifferential::eye(self.job.view, p.x, p.y), &ray, hit);
-                    crate::render::transport::normal_map::apply(scene, self.job.settings.texture_filter, &mut hit);
+                    crate::scene::normal_map::apply(scene, self.job.settings.texture_filter, &mut hit);
                     hit
                 }
                 false => hit,
@@ -548,7 +542,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             let mut hit = scene.triangle_hit(id.index(), b, t, &ray);
             if scene.has_textures() {
                 hit.diff = crate::render::raster::derivatives::screen_differentials(scene, self.job.view, id.index(), b, p.x, p.y);
-                crate::render::transport::normal_map::apply(scene, self.job.settings.texture_filter, &mut hit);
+                crate::scene::normal_map::apply(scene, self.job.settings.texture_filter, &mut hit);
             }
             Some(hit)
         };
@@ -677,7 +671,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
     /// primary sample per pixel. Every value written is admitted
     /// (`finite::admitted`) before this returns, while it is in cache.
     pub fn resolve_into(&mut self, out: &mut [Radiance], out_stride: usize, x_offset: usize) -> RayCounts {
-        if !self.forward && !self.cost_view() && self.stencil.is_empty() && shade_batch::resolved_in_batches(self.job) {
+        if !self.forward && !self.cost_view() && self.stencil.is_empty() && ShadeQueue::takes(self.job) {
             return self.resolve_batched(out, out_stride, x_offset);
         }
         let r = self.rect;
@@ -694,14 +688,13 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
     }
 
     /// `resolve_into` in early-depth mode, the visible surfaces shaded eight
-    /// at a time (`shade_batch`); empty, inactive and recorded pixels one by
+    /// at a time (`ShadeQueue`); empty, inactive and recorded pixels one by
     /// one, as `resolve` does them.
     fn resolve_batched(&mut self, out: &mut [Radiance], out_stride: usize, x_offset: usize) -> RayCounts {
         let r = self.rect;
-        let interpolation = shade_batch::build_interpolation(self.job);
         let lights = self.job.prepared.scene.lights.len();
         let mut queue = self.queue.take().unwrap_or_else(|| ShadeQueue::new(lights));
-        let mut paths = std::mem::take(&mut self.paths);
+        const LANES: usize = ShadeQueue::LANES;
         let scene = &self.job.prepared.scene;
         // A triangle seen without textures (the common case) has its hit
         // built in the batch (eight at a time), not returned and copied.
@@ -729,7 +722,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         // Plain triangles' samples gathered eight at a time, handed to the
         // queue together (a batch's counters are not touched per sample).
         let mut eight = EyeSamples::default();
-        let (mut eight_pixels, mut eight_slots) = ([0u32; shade_batch::LANES], [0usize; shade_batch::LANES]);
+        let (mut eight_pixels, mut eight_slots) = ([0u32; LANES], [0usize; LANES]);
         for (row, y) in (r.y0..r.y1).enumerate() {
             let line = row * out_stride + x_offset;
             let start = row * self.stride;
@@ -765,18 +758,15 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
                             // gathered yet and the queue's batch empty (the
                             // usual case inside a surface): the batch is
                             // filled at once, lanes wide.
-                            if plain && eight.len == 0 && col + shade_batch::LANES <= ids.len() && queue.batch().is_empty() {
-                                let run: &[PrimitiveId; shade_batch::LANES] = ids[col..col + shade_batch::LANES].try_into().unwrap();
+                            if plain && eight.len == 0 && col + LANES <= ids.len() && queue.batch_is_empty() {
+                                let run: &[PrimitiveId; LANES] = ids[col..col + LANES].try_into().unwrap();
                                 if let Some(index) = PrimitiveId::triangle_indices(run) {
                                     let x = r.x0 + col as u32;
-                                    let bary = payload[col..col + shade_batch::LANES].try_into().unwrap();
-                                    queue.batch().fill_eye_row(&index, bary, (x, y), self.job.offset, self.job.pixel_index(x, y), self.job.sample, line + col);
-                                    if queue.advance() {
-                                        queue.flush(self.job, self.query, &mut paths, &mut self.counts, out);
-                                    }
-                                    primary += shade_batch::LANES as u64;
-                                    shaded += shade_batch::LANES as u64;
-                                    col += shade_batch::LANES;
+                                    let bary = payload[col..col + LANES].try_into().unwrap();
+                                    queue.push_eye_row(self.job, self.query, &mut self.counts, out, &index, bary, (x, y), line + col);
+                                    primary += LANES as u64;
+                                    shaded += LANES as u64;
+                                    col += LANES;
                                     continue;
                                 }
                             }
@@ -789,8 +779,8 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
                                 let k = eight.len;
                                 (eight_pixels[k], eight_slots[k]) = (self.job.pixel_index(x, y), line + col);
                                 eight.push(id.index(), b1, b2, self.job.sample_position(x, y));
-                                if eight.len == shade_batch::LANES {
-                                    queue_eye_samples(self.job, self.query, &mut self.counts, &mut queue, &mut eight, &eight_pixels, &eight_slots, &mut paths, out);
+                                if eight.len == LANES {
+                                    queue.push_eye_samples(self.job, self.query, &mut self.counts, out, &mut eight, &eight_pixels, &eight_slots);
                                 }
                             } else {
                                 visible.push(col as u32);
@@ -817,33 +807,25 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
                     shaded += 1;
                     if plain && id.kind() == crate::scene::PrimitiveKind::Triangle {
                         let [b1, b2] = self.payload[i];
-                        queue.batch().push_eye_triangle(id.index(), (b1, b2), self.job.sample_position(x, y), self.job.pixel_index(x, y), self.job.sample, slot);
-                        if queue.advance() {
-                            queue.flush(self.job, self.query, &mut paths, &mut self.counts, out);
-                        }
+                        queue.push_eye_triangle(self.job, self.query, &mut self.counts, out, id.index(), (b1, b2), (x, y), slot);
                         continue;
                     }
                     match self.eye_hit(i, x, y) {
                         (ray, Some(hit)) => {
-                            queue.batch().push(interpolation, &hit, ray.dir, self.job.pixel_index(x, y), self.job.sample, slot);
-                            if queue.advance() {
-                                queue.flush(self.job, self.query, &mut paths, &mut self.counts, out);
-                            }
+                            queue.push_hit(self.job, self.query, &mut self.counts, out, &hit, ray.dir, (x, y), slot);
                         }
                         (_, None) => out[slot] = self.shade(i, x, y),
                     }
                 }
             }
         }
-        queue_eye_samples(self.job, self.query, &mut self.counts, &mut queue, &mut eight, &eight_pixels, &eight_slots, &mut paths, out);
-        queue.flush(self.job, self.query, &mut paths, &mut self.counts, out);
-        paths.follow_into(self.job, self.query, &mut self.counts, out);
+        queue.push_eye_samples(self.job, self.query, &mut self.counts, out, &mut eight, &eight_pixels, &eight_slots);
+        queue.finish(self.job, self.query, &mut self.counts, out);
         streaming::fence();
         let rows = (0..r.height() as usize).map(|row| row * out_stride + x_offset..row * out_stride + x_offset + self.stride);
         admit_rows_except(out, rows, &streamed);
         streamed.clear();
         self.streamed = streamed;
-        self.paths = paths;
         self.queue = Some(queue);
         self.counts.primary += primary;
         self.counts.fragments_shaded += shaded;
@@ -890,29 +872,6 @@ fn each_bit_twice(bits: u8) -> u8 {
     x = (x | x << 2) & 0x33;
     x = (x | x << 1) & 0x55;
     x | x << 1
-}
-
-/// Puts the eye samples `eight` (of pixel indices `pixels`, meant for
-/// `slots`) into `queue`, a whole batch at once when it starts one, and
-/// empties `eight`; flushes the queue into `out` when it fills.
-#[allow(clippy::too_many_arguments)]
-#[inline]
-fn queue_eye_samples<'p, Q: SceneQuery>(job: &PassJob<'p>, query: &Q, counts: &mut RayCounts, queue: &mut ShadeQueue, eight: &mut EyeSamples, pixels: &[u32; shade_batch::LANES], slots: &[usize; shade_batch::LANES], paths: &mut PathPool<'p>, out: &mut [Radiance]) {
-    if eight.len == shade_batch::LANES && queue.batch().is_empty() {
-        queue.batch().fill_eye_triangles(eight, pixels, job.sample, slots);
-        if queue.advance() {
-            queue.flush(job, query, paths, counts, out);
-        }
-    } else {
-        for k in 0..eight.len {
-            let p = crate::math::Vec2::new(eight.px[k], eight.py[k]);
-            queue.batch().push_eye_triangle(eight.index[k], (eight.b1[k], eight.b2[k]), p, pixels[k], job.sample, slots[k]);
-            if queue.advance() {
-                queue.flush(job, query, paths, counts, out);
-            }
-        }
-    }
-    eight.len = 0;
 }
 
 #[cfg(test)]

@@ -72,6 +72,6 @@ pub fn with_eye_differentials(job: &PassJob, p: Vec2, ray: &Ray, hit: &mut Optio
     let scene = &job.prepared.scene;
     if let Some(h) = hit.as_mut().filter(|_| scene.has_textures()) {
         *h = with_ray_differentials(scene, &RayDifferential::eye(job.view, p.x, p.y), ray, *h);
-        crate::render::transport::normal_map::apply(scene, job.settings.texture_filter, h);
+        crate::scene::normal_map::apply(scene, job.settings.texture_filter, h);
     }
 }

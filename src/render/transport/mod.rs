@@ -1,6 +1,6 @@
 //! Hits to radiance: everything that lights a surface the renderers found.
 //! `shade` is the one shading entry for a single sample and `shade_batch` the
-//! same over eight lanes; `lighting` evaluates lights; `gi` holds the
+//! same over eight lanes, `shade_queue` the rasterizers' batched hand-off; `lighting` evaluates lights; `gi` holds the
 //! indirect-light modes, `path_batch` the path pool, `photon_map` photons
 //! and `bsdf_sampling` the BSDFs' importance sampling, `microfacet` the
 //! microfacet lobes' distributions; `sampled_light` samples area lights and
@@ -15,12 +15,12 @@ pub mod incidence;
 pub mod kd_tree;
 pub mod lighting;
 pub mod microfacet;
-pub mod normal_map;
 pub mod path_batch;
 pub mod photon_map;
 pub mod sampled_light;
 pub mod sampling;
 pub mod shade;
 pub mod shade_batch;
+pub mod shade_queue;
 pub mod shading;
 pub mod shadow_packets;

@@ -534,7 +534,7 @@ impl Group {
         if normal_maps {
             for k in 0..self.len {
                 let mut h = self.hits.get(k);
-                crate::render::transport::normal_map::apply(scene, job.settings.texture_filter, &mut h);
+                crate::scene::normal_map::apply(scene, job.settings.texture_filter, &mut h);
                 self.hits.set(k, &h);
             }
         }

@@ -102,6 +102,11 @@ impl PreparedScene {
         if shot * most_stored_per_shot * PEAK_BYTES_PER_STORED <= MAX_PHOTON_MAP_BYTES {
             return Ok(());
         }
+        // A map built already passed (the viewer asks again with every
+        // frame it requests).
+        if self.photon_cache.holds(&MapKey::of(&self.scene, gi, bump)) {
+            return Ok(());
+        }
         let sources = Sources::of(&self.scene);
         if !(sources.total > 0.0 && sources.total.is_finite()) {
             return Ok(());

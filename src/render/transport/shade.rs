@@ -82,15 +82,7 @@ pub fn adds_after_direct(scene: &Scene, settings: &RenderSettings, material: &Ma
 /// reflection and refraction. `l_o` is the ambient term plus the point and
 /// directional lights' light.
 #[inline]
-pub fn after_direct<Q: SceneQuery, R: Recorder>(
-    sh: &mut Shading<Q, R>,
-    hit: &SurfaceHit,
-    material: &Material,
-    albedo: Vec3,
-    w_o: Vec3,
-    depth: u32,
-    mut l_o: Radiance,
-) -> Radiance {
+pub fn after_direct<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &SurfaceHit, material: &Material, albedo: Vec3, w_o: Vec3, depth: u32, mut l_o: Radiance) -> Radiance {
     let Shading { settings, .. } = *sh;
     if material.is_emissive() {
         l_o += sampled_light::emitted_seen(sh, hit, w_o);
@@ -178,14 +170,7 @@ impl<Q: SceneQuery, R: Recorder> LightVisibility<f32> for ShadowQueries<'_, '_, 
 
 /// Path tracing's indirect term: one direction sampled from the diffuse and
 /// glossy lobes, the radiance found along it weighted by `f cos / pdf`.
-fn indirect_path<Q: SceneQuery, R: Recorder>(
-    sh: &mut Shading<Q, R>,
-    hit: &SurfaceHit,
-    material: &Material,
-    albedo: Vec3,
-    w_o: Vec3,
-    depth: u32,
-) -> Radiance {
+fn indirect_path<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &SurfaceHit, material: &Material, albedo: Vec3, w_o: Vec3, depth: u32) -> Radiance {
     let Shading { settings, .. } = *sh;
     let Some((w_i, weight, pdf)) = gi::sample_bounce(sh.scene, material, albedo, hit, w_o, depth, sh.path, sh.rec) else {
         return Vec3::ZERO;
@@ -197,14 +182,7 @@ fn indirect_path<Q: SceneQuery, R: Recorder>(
 /// `radiance_along` with the path's throughput multiplied by `weight` for
 /// the rest of the path (Russian roulette reads it) and the ray chosen as
 /// `arrival` says, both restored afterwards.
-fn follow<Q: SceneQuery, R: Recorder>(
-    sh: &mut Shading<Q, R>,
-    ray: &Ray,
-    depth: u32,
-    inside: bool,
-    weight: Vec3,
-    arrival: Arrival,
-) -> Radiance {
+fn follow<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, ray: &Ray, depth: u32, inside: bool, weight: Vec3, arrival: Arrival) -> Radiance {
     let (before, arrived) = (sh.path.throughput, sh.path.arrival);
     sh.path.throughput *= weight;
     sh.path.arrival = arrival;
@@ -217,14 +195,7 @@ fn follow<Q: SceneQuery, R: Recorder>(
 /// Photon mapping's indirect term: the map's density estimate at diffuse
 /// surfaces, or at the first hit a final gather of sampled rays whose hits
 /// read the map.
-fn indirect_photons<Q: SceneQuery, R: Recorder>(
-    sh: &mut Shading<Q, R>,
-    hit: &SurfaceHit,
-    material: &Material,
-    albedo: Vec3,
-    w_o: Vec3,
-    depth: u32,
-) -> Radiance {
+fn indirect_photons<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &SurfaceHit, material: &Material, albedo: Vec3, w_o: Vec3, depth: u32) -> Radiance {
     let Shading { settings, .. } = *sh;
     let Some(map) = sh.path.photons else { return Vec3::ZERO };
     let gather = settings.gi.final_gather;
@@ -254,13 +225,7 @@ fn indirect_photons<Q: SceneQuery, R: Recorder>(
 
 /// Path tracing's delta lobes: one of mirror reflection and refraction,
 /// chosen in proportion to its weight, instead of both.
-fn secondary_sampled<Q: SceneQuery, R: Recorder>(
-    sh: &mut Shading<Q, R>,
-    hit: &SurfaceHit,
-    material: &Material,
-    w_o: Vec3,
-    depth: u32,
-) -> Radiance {
+fn secondary_sampled<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &SurfaceHit, material: &Material, w_o: Vec3, depth: u32) -> Radiance {
     let Shading { settings, .. } = *sh;
     let DeltaLobes { reflect_dir, reflect_weight, refract } = DeltaLobes::at(hit, material, w_o);
     let refract_weight = refract.map_or(Vec3::ZERO, |r| r.1);
@@ -311,13 +276,7 @@ pub fn shade_gouraud<Q: SceneQuery, R: Recorder>(
 }
 
 /// Perfect mirror reflection and Fresnel-weighted refraction.
-fn secondary<Q: SceneQuery, R: Recorder>(
-    sh: &mut Shading<Q, R>,
-    hit: &SurfaceHit,
-    material: &Material,
-    w_o: Vec3,
-    depth: u32,
-) -> Radiance {
+fn secondary<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &SurfaceHit, material: &Material, w_o: Vec3, depth: u32) -> Radiance {
     let Shading { settings, .. } = *sh;
     let DeltaLobes { reflect_dir, reflect_weight, refract } = DeltaLobes::at(hit, material, w_o);
     let mut result = Vec3::ZERO;
@@ -377,7 +336,7 @@ pub fn radiance_along<Q: SceneQuery, R: Recorder>(
         if let Some(rd) = rd.filter(|_| scene.has_textures()) {
             *h = differentials::with_ray_differentials(scene, rd, ray, *h);
         }
-        crate::render::transport::normal_map::apply(scene, sh.settings.texture_filter, h);
+        crate::scene::normal_map::apply(scene, sh.settings.texture_filter, h);
     }
     sh.rec.closest(hit.as_ref());
     match &hit {

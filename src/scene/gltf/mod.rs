@@ -300,13 +300,10 @@ fn mesh_triangles(
         out.reserve(triangles.len());
         for idx in triangles {
             let v = idx.map(|i| pos[i as usize]);
-            let geo = (v[1] - v[0]).cross(v[2] - v[0]);
-            let len = geo.length();
-            if !(len > 0.0) || !(geo / len).is_finite() {
+            let Some(geo) = Triangle::normal_if_not_degenerate(&v) else {
                 *degenerate += 1;
                 continue;
-            }
-            let geo = Triangle::normal_of(&v);
+            };
             let n = match &normals {
                 Some(ns) => idx.map(|i| Vec3::from(ns[i as usize]).normalize_or(geo)),
                 None => [geo; 3],

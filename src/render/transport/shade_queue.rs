@@ -1,5 +1,9 @@
 //! A band's visible samples waiting to be shaded: up to eight batches of
-//! eight (`shade_batch::Batch`). With `--shadows ray` the queued surfaces'
+//! eight (`shade_batch::Batch`). This is the rasterizers' batched hand-off
+//! to shading, as `resolve_sample` is the one-sample hand-off: they push
+//! the samples their visibility buffer sees (`push_*`) and `finish`; the
+//! queue shades them when full and, with `--gi path`, hands them on to the
+//! path pool it owns. With `--shadows ray` the queued surfaces'
 //! shadow rays are traced as one packet per light before the batches are
 //! shaded, as the ray caster does for its tiles: neighbouring samples'
 //! rays towards a light walk the BVH together instead of one by one. The
@@ -15,6 +19,9 @@ use crate::render::transport::shade_batch;
 use crate::render::transport::shade_batch::{Batch, LANES};
 use crate::render::inspect::debug::View;
 use crate::render::{PassJob, RayCounts, SceneQuery, ShadowMode};
+use crate::math::{Vec2, Vec3};
+use crate::scene::hit_lanes::EyeSamples;
+use crate::scene::SurfaceHit;
 
 /// Batches queued before their shadow packets are traced: eight batches of
 /// eight lanes fill a packet's 64 rays.
@@ -24,7 +31,7 @@ const BATCHES: usize = 8;
 /// as many as a ray caster's tile, which keeps the lanes about as full.
 const PATH_SAMPLES: usize = 64;
 
-pub struct ShadeQueue {
+pub struct ShadeQueue<'p> {
     batches: Vec<Batch>,
     /// The batch new samples go into; those before it are full.
     current: usize,
@@ -35,10 +42,17 @@ pub struct ShadeQueue {
     batch_blocked: Vec<u8>,
     /// The same for the batch after it, when the two are shaded together.
     next_blocked: Vec<u8>,
+    /// With `--gi path`, the shaded samples whose paths wait to be
+    /// followed together.
+    paths: PathPool<'p>,
 }
 
-impl ShadeQueue {
-    pub fn new(lights: usize) -> ShadeQueue {
+impl<'p> ShadeQueue<'p> {
+    /// Samples a batch holds: a row of this many covered samples can fill
+    /// an empty batch at once (`push_eye_row`).
+    pub const LANES: usize = LANES;
+
+    pub fn new(lights: usize) -> ShadeQueue<'p> {
         ShadeQueue {
             batches: (0..BATCHES).map(|_| Batch::new()).collect(),
             current: 0,
@@ -46,27 +60,93 @@ impl ShadeQueue {
             queue_blocked: vec![0; lights],
             batch_blocked: vec![0; lights],
             next_blocked: vec![0; lights],
+            paths: PathPool::new(),
         }
     }
 
-    /// The batch the next sample goes into (never full).
-    pub fn batch(&mut self) -> &mut Batch {
-        &mut self.batches[self.current]
+    /// Whether `job`'s samples may go through a queue at all: the shaded
+    /// view and the debug views that only colour what is hit.
+    pub fn takes(job: &PassJob) -> bool {
+        shade_batch::resolved_in_batches(job)
     }
 
-    /// Call after each sample put in `batch()`: moves on when that batch is
-    /// full, and returns whether the whole queue is (then `flush` it).
-    pub fn advance(&mut self) -> bool {
+    /// Whether the batch the next sample goes into is empty, so that
+    /// `push_eye_row` may fill it.
+    pub fn batch_is_empty(&self) -> bool {
+        self.batches[self.current].is_empty()
+    }
+
+    /// Queues the eye samples of `LANES` pixels in a row from pixel (x, y)
+    /// on, which see the scene triangles `index` at barycentrics `bary`;
+    /// their results go to `out[slot..slot + LANES]`. The batch must be
+    /// empty (`batch_is_empty`).
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    pub fn push_eye_row<Q: SceneQuery>(&mut self, job: &PassJob<'p>, query: &Q, counts: &mut RayCounts, out: &mut [Radiance], index: &[u32; LANES], bary: &[[f32; 2]; LANES], (x, y): (u32, u32), slot: usize) {
+        self.batches[self.current].fill_eye_row(index, bary, (x, y), job.offset, job.pixel_index(x, y), job.sample, slot);
+        self.advance(job, query, counts, out);
+    }
+
+    /// Queues pixel (x, y)'s eye sample, which sees scene triangle `index`
+    /// at barycentrics (b1, b2); its result goes to `out[slot]`.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    pub fn push_eye_triangle<Q: SceneQuery>(&mut self, job: &PassJob<'p>, query: &Q, counts: &mut RayCounts, out: &mut [Radiance], index: u32, b: (f32, f32), (x, y): (u32, u32), slot: usize) {
+        self.batches[self.current].push_eye_triangle(index, b, job.sample_position(x, y), job.pixel_index(x, y), job.sample, slot);
+        self.advance(job, query, counts, out);
+    }
+
+    /// Queues pixel (x, y)'s sample, whose eye ray along `dir` found `hit`;
+    /// its result goes to `out[slot]`.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    pub fn push_hit<Q: SceneQuery>(&mut self, job: &PassJob<'p>, query: &Q, counts: &mut RayCounts, out: &mut [Radiance], hit: &SurfaceHit, dir: Vec3, (x, y): (u32, u32), slot: usize) {
+        self.batches[self.current].push(shade_batch::build_interpolation(job), hit, dir, job.pixel_index(x, y), job.sample, slot);
+        self.advance(job, query, counts, out);
+    }
+
+    /// Queues the eye samples `eight` (of pixel indices `pixels`, meant for
+    /// `slots`), a whole batch at once when it starts one, and empties
+    /// `eight`.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    pub fn push_eye_samples<Q: SceneQuery>(&mut self, job: &PassJob<'p>, query: &Q, counts: &mut RayCounts, out: &mut [Radiance], eight: &mut EyeSamples, pixels: &[u32; LANES], slots: &[usize; LANES]) {
+        if eight.len == LANES && self.batch_is_empty() {
+            self.batches[self.current].fill_eye_triangles(eight, pixels, job.sample, slots);
+            self.advance(job, query, counts, out);
+        } else {
+            for k in 0..eight.len {
+                let p = Vec2::new(eight.px[k], eight.py[k]);
+                self.batches[self.current].push_eye_triangle(eight.index[k], (eight.b1[k], eight.b2[k]), p, pixels[k], job.sample, slots[k]);
+                self.advance(job, query, counts, out);
+            }
+        }
+        eight.len = 0;
+    }
+
+    /// Shades everything still queued and follows every waiting path:
+    /// every pushed sample's result is in `out` when this returns.
+    pub fn finish<Q: SceneQuery>(&mut self, job: &PassJob<'p>, query: &Q, counts: &mut RayCounts, out: &mut [Radiance]) {
+        self.flush(job, query, counts, out);
+        self.paths.follow_into(job, query, counts, out);
+    }
+
+    /// Call after each sample put in the current batch: moves on when that
+    /// batch is full, and shades the whole queue when it is full.
+    #[inline(always)]
+    fn advance<Q: SceneQuery>(&mut self, job: &PassJob<'p>, query: &Q, counts: &mut RayCounts, out: &mut [Radiance]) {
         if self.batches[self.current].is_full() {
             self.current += 1;
+            if self.current == BATCHES {
+                self.flush(job, query, counts, out);
+            }
         }
-        self.current == BATCHES
     }
 
     /// Shades every queued sample into `out` at its slot (with `--gi
-    /// path`, puts it into `paths`, followed once they are `PATH_SAMPLES`)
-    /// and empties the queue.
-    pub fn flush<'p, Q: SceneQuery>(&mut self, job: &PassJob<'p>, query: &Q, paths: &mut PathPool<'p>, counts: &mut RayCounts, out: &mut [Radiance]) {
+    /// path`, puts it into the path pool, followed once it holds
+    /// `PATH_SAMPLES`) and empties the queue.
+    fn flush<Q: SceneQuery>(&mut self, job: &PassJob<'p>, query: &Q, counts: &mut RayCounts, out: &mut [Radiance]) {
         let queued = if self.current < BATCHES && !self.batches[self.current].is_empty() { self.current + 1 } else { self.current };
         self.current = 0;
         if queued == 0 {
@@ -103,9 +183,9 @@ impl ShadeQueue {
                 unpack(b, batch, &mut self.batch_blocked);
             }
             let blocked = unpack.is_some().then_some(&self.batch_blocked[..]);
-            path_batch::start_paths(job, query, batch, blocked, &batch.slots[..batch.len()], counts, paths);
-            if paths.len() >= PATH_SAMPLES {
-                paths.follow_into(job, query, counts, out);
+            path_batch::start_paths(job, query, batch, blocked, &batch.slots[..batch.len()], counts, &mut self.paths);
+            if self.paths.len() >= PATH_SAMPLES {
+                self.paths.follow_into(job, query, counts, out);
             }
             batch.clear();
         }
@@ -141,7 +221,6 @@ mod tests {
                 settings.gi.mode = gi;
                 let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: glam::Vec2::splat(0.5), sample: 1, photons: None, active: None, rows: 0..h, cancel: &cancel };
                 let mut queue = ShadeQueue::new(prepared.scene.lights.len());
-                let mut paths = PathPool::new();
                 let mut out = vec![Radiance::splat(-1.0); (w * h) as usize];
                 let mut expected = vec![None; (w * h) as usize];
                 for (x, y) in (0..h).flat_map(|y| (0..w).map(move |x| (x, y))) {
@@ -150,13 +229,9 @@ mod tests {
                     let Some(hit) = query.closest(&ray, view.far_t(p.x, p.y), false, &mut RayCounts::default(), &mut NoRecord) else { continue };
                     let pixel = job.pixel_index(x, y);
                     expected[pixel as usize] = Some(resolve_sample(&job, &query, &ray, Some(&hit), pixel, &mut RayCounts::default(), &mut NoRecord));
-                    queue.batch().push(settings.interpolation, &hit, ray.dir, pixel, job.sample, pixel as usize);
-                    if queue.advance() {
-                        queue.flush(&job, &query, &mut paths, &mut RayCounts::default(), &mut out);
-                    }
+                    queue.push_hit(&job, &query, &mut RayCounts::default(), &mut out, &hit, ray.dir, (x, y), pixel as usize);
                 }
-                queue.flush(&job, &query, &mut paths, &mut RayCounts::default(), &mut out);
-                paths.follow_into(&job, &query, &mut RayCounts::default(), &mut out);
+                queue.finish(&job, &query, &mut RayCounts::default(), &mut out);
                 for (i, e) in expected.iter().enumerate() {
                     if let Some(e) = e {
                         assert_eq!(out[i].to_array().map(f32::to_bits), e.to_array().map(f32::to_bits), "{name} {shadows:?} {gi:?} pixel {i}");
