@@ -225,6 +225,25 @@ pub struct ObjectInfo {
     pub triangles: std::ops::Range<usize>,
 }
 
+/// A named part of an object (a glTF node's mesh): its flattened triangles,
+/// or one of its object's copies in the instance layer.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NamedPart {
+    /// Index into `Scene::objects`.
+    pub object: u32,
+    pub what: PartOf,
+    pub name: String,
+}
+
+/// Where a named part's triangles are.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PartOf {
+    /// A range of `Scene::triangles`.
+    Triangles(std::ops::Range<usize>),
+    /// The object's copy with this `InstanceInfo::index`.
+    Copy(u32),
+}
+
 /// One copy made by a mesh object's `instances` list: where its triangles
 /// lie in `Scene::triangles`, and the sphere around them that rasterizers
 /// cull it by.
@@ -319,6 +338,9 @@ pub struct Scene {
     /// Cameras a loaded file offers by name (a glTF's), for `--camera` and
     /// the viewer's camera list; `camera` is the one in use.
     pub named_cameras: Vec<(String, Camera)>,
+    /// Names of the parts of objects read from other formats (a glTF's
+    /// node and mesh), for the inspector.
+    pub parts: Vec<NamedPart>,
     /// The emissive triangles and spheres, gathered by `refresh_emitters`
     /// (after loading, and whenever materials or geometry change).
     pub emitters: std::sync::Arc<emitters::Emitters>,
@@ -598,6 +620,18 @@ impl Scene {
         let index = index as usize;
         let k = self.instances.partition_point(|i| i.triangles.end <= index);
         self.instances.get(k).filter(|i| i.triangles.contains(&index))
+    }
+
+    /// The name of the part (a glTF node and mesh) triangle `index` belongs to, if it has one.
+    pub fn part_name(&self, index: u32) -> Option<&str> {
+        if self.parts.is_empty() {
+            return None;
+        }
+        let found = match self.instance_of_triangle(index) {
+            Some(copy) => self.parts.iter().find(|p| p.object == copy.object && p.what == PartOf::Copy(copy.index)),
+            None => self.parts.iter().find(|p| matches!(&p.what, PartOf::Triangles(r) if r.contains(&(index as usize)))),
+        };
+        found.map(|p| p.name.as_str())
     }
 
     /// A copy's name: its object's name and its position in the object's list.

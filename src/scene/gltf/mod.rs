@@ -18,7 +18,7 @@ use crate::math::{Vec2, Vec3};
 use crate::scene::assets::read_asset;
 use crate::scene::instanced::{Layered, MeshCopy};
 use crate::scene::placement::Placement;
-use crate::scene::{Camera, Fov, Light, ObjectInfo, Scene, Triangle};
+use crate::scene::{Camera, Fov, Light, NamedPart, ObjectInfo, PartOf, Scene, Triangle};
 use glam::Mat4;
 use std::path::Path;
 use std::sync::Arc;
@@ -194,14 +194,21 @@ fn add_gltf_unnamed(scene: &mut Scene, path: &Path, placement: &Placement, objec
     // Meshes: flattened when one node uses them, shared when several do.
     let first = scene.triangles.len();
     let mut degenerate = 0;
+    let mut copy_index = 0u32;
+    let quoted = |name: Option<&str>| name.map(|n| format!(" \"{}\"", n.chars().take(60).collect::<String>())).unwrap_or_default();
+    let node_names: Vec<Option<&str>> = doc.nodes().map(|n| n.name()).collect();
     for mesh in doc.meshes() {
         let placed = &uses[mesh.index()];
         if placed.is_empty() {
             continue;
         }
+        let part_name = |node: usize| {
+            format!("glTF node {node}{}, mesh {}{}", quoted(node_names.get(node).copied().flatten()), mesh.index(), quoted(mesh.name()))
+        };
         let local = mesh_triangles(&mesh, &buffers, first_material, fallback, &double_sided, object, &mut degenerate, &mut parts.ignored)?;
         if placed.len() == 1 {
             let p = Placement::from_matrix(placed[0].0);
+            let start = scene.triangles.len();
             for t in local {
                 let t = p.apply(t);
                 if !t.v.iter().all(|v| v.abs().max_element() <= MAX_COORDINATE) {
@@ -209,17 +216,20 @@ fn add_gltf_unnamed(scene: &mut Scene, path: &Path, placement: &Placement, objec
                 }
                 scene.triangles.push(t);
             }
+            scene.parts.push(NamedPart { object, what: PartOf::Triangles(start..scene.triangles.len()), name: part_name(placed[0].1) });
         } else if !local.is_empty() {
             let (lo, hi) = local.iter().flat_map(|t| t.v).fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), v| (lo.min(v), hi.max(v)));
             let mut copies = Vec::new();
-            for (k, (world, node)) in placed.iter().enumerate() {
+            for (world, node) in placed.iter() {
                 for c in 0..8 {
                     let corner = Vec3::new(if c & 1 == 0 { lo.x } else { hi.x }, if c & 2 == 0 { lo.y } else { hi.y }, if c & 4 == 0 { lo.z } else { hi.z });
                     if !(world.transform_point3(corner).abs().max_element() <= MAX_COORDINATE) {
                         return Err(format!("mesh {} placed by node {node}: a vertex lands out of range (coordinates must be between -{MAX_COORDINATE:e} and {MAX_COORDINATE:e})", mesh.index()));
                     }
                 }
-                copies.push(MeshCopy { placement: Some(Placement::from_matrix(*world)), material: None, index: Some(k as u32) });
+                copies.push(MeshCopy { placement: Some(Placement::from_matrix(*world)), material: None, index: Some(copy_index) });
+                scene.parts.push(NamedPart { object, what: PartOf::Copy(copy_index), name: part_name(*node) });
+                copy_index += 1;
             }
             layered.objects.push((object, Arc::new(local), copies));
         }
