@@ -1,7 +1,8 @@
 //! glTF materials and textures: a metallic-roughness material renders as
 //! the TOML material written by hand from the model's formulas (with and
 //! without textures, whose blue channel scales metalness and green
-//! roughness), an emissive texture scales emission, samplers set the wrap
+//! roughness), an emissive texture scales emission, a normal texture is
+//! read as data and bends normals, samplers set the wrap
 //! modes and cap the filter, and the Khronos BoxTextured sample puts each
 //! texel where its uvs say, checked against a ray cast written here.
 
@@ -266,6 +267,33 @@ fn emissive_texture_scales_emission_seen_and_sampled() {
     let (a, b) = (render(&gltf, "raytrace", &settings), render(&toml, "raytrace", &settings));
     assert!(floor_pixels(&b) > 0.0, "the floor is lit by the emitter");
     assert!(relative_rmse(&a, &b) < 0.01, "the sampled emitter's light: rmse/mean {}", relative_rmse(&a, &b));
+}
+
+#[test]
+fn normal_texture_is_linear_data_that_bends_the_shading_normal() {
+    let dir = work_dir("normal");
+    let material = r#"{"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1.0], "metallicFactor": 0.0}, "normalTexture": {"index": 0}}"#;
+    let with = |rgb: [u8; 3]| format!(r#", "textures": [{{"source": 0}}], "images": [{{"uri": "{}"}}]"#, png_uri(rgb));
+    write_sphere(&dir, r#"{"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1.0], "metallicFactor": 0.0}}"#, "");
+    let (plain, _) = pair(&dir, "lambertian = [1.0, 1.0, 1.0]");
+    assert!(plain.materials.iter().all(|m| m.normal_map.is_none()));
+    // (128, 128, 255) read as data is (0.502, 0.502, 1): straight out, within
+    // a quarter of a degree. Read as sRGB it would lean by 30 degrees.
+    write_sphere(&dir, material, &with([128, 128, 255]));
+    let (flat, _) = pair(&dir, "lambertian = [1.0, 1.0, 1.0]");
+    assert!(flat.materials.iter().any(|m| m.normal_map.is_some()));
+    // A texel leaning 35 degrees along u.
+    write_sphere(&dir, material, &with([201, 128, 232]));
+    let (tilted, _) = pair(&dir, "lambertian = [1.0, 1.0, 1.0]");
+    let settings = RenderSettings::for_scene(&plain);
+    for renderer in ["raytrace", "rasterize"] {
+        let base = render(&plain, renderer, &settings);
+        let e_flat = relative_rmse(&render(&flat, renderer, &settings), &base);
+        let e_tilted = relative_rmse(&render(&tilted, renderer, &settings), &base);
+        eprintln!("normal texture ({renderer}): flat {e_flat:.5}, tilted {e_tilted:.5}");
+        assert!(e_flat < 0.01, "{renderer}: a flat normal texture changes the image by {e_flat:.5}");
+        assert!(e_tilted > 0.05, "{renderer}: a tilted normal texture changes the image by only {e_tilted:.5}");
+    }
 }
 
 #[test]
