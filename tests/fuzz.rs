@@ -50,6 +50,9 @@ const REGRESSIONS: &[(&str, &str)] = &[
     ("gltf", "{\"asset\": {\"version\": \"2.0\"}, \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 2}}]}]}"),
     ("gltf", "{\"asset\": {\"version\": \"2.0\"}, \"buffers\": [{\"byteLength\": 4, \"uri\": \"../../../etc/passwd\"}]}"),
     ("gltf", "glTF\x02\0\0\0\x40\0\0\0\x20\0\0\0JSON{\"asset\": {\"version\": \"2.0\"}}"),
+    // Vertex colours: fewer than the positions, and a colour of 2.
+    ("gltf", "{\"asset\": {\"version\": \"2.0\"}, \"scenes\": [{\"nodes\": [0]}], \"nodes\": [{\"mesh\": 0}], \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0, \"COLOR_0\": 1}}]}], \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 3, \"type\": \"VEC3\", \"min\": [0, 0, 0], \"max\": [1, 1, 0]}, {\"bufferView\": 0, \"componentType\": 5126, \"count\": 2, \"type\": \"VEC3\"}], \"bufferViews\": [{\"buffer\": 0, \"byteLength\": 36}], \"buffers\": [{\"byteLength\": 36, \"uri\": \"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA\"}]}"),
+    ("gltf", "{\"asset\": {\"version\": \"2.0\"}, \"scenes\": [{\"nodes\": [0]}], \"nodes\": [{\"mesh\": 0}], \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0, \"COLOR_0\": 1}}]}], \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 3, \"type\": \"VEC3\", \"min\": [0, 0, 0], \"max\": [1, 1, 0]}, {\"bufferView\": 1, \"componentType\": 5126, \"count\": 3, \"type\": \"VEC3\"}], \"bufferViews\": [{\"buffer\": 0, \"byteLength\": 36}, {\"buffer\": 0, \"byteLength\": 36}], \"buffers\": [{\"byteLength\": 36, \"uri\": \"data:application/octet-stream;base64,AAAAQAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA\"}]}"),
     // Textures: every slot naming a missing texture, an image in a view past
     // its buffer read as metallic-roughness, normal and emissive data with a
     // mirrored, nearest sampler.
@@ -584,7 +587,7 @@ fn mutated_gltf_files() {
     let dir = work_dir("gltf");
     let mut rng = seed(5);
     let samples = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/gltf");
-    let corpus: Vec<Vec<u8>> = ["Box.gltf", "Cameras.gltf", "BoxTextured.gltf"].iter().map(|f| std::fs::read(samples.join(f)).unwrap()).collect();
+    let corpus: Vec<Vec<u8>> = ["Box.gltf", "Cameras.gltf", "BoxTextured.gltf", "BoxVertexColors.gltf"].iter().map(|f| std::fs::read(samples.join(f)).unwrap()).collect();
     counted("gltf files", || {
         for _ in 0..cases() {
             let seed_bytes = rng.pick(&corpus).clone();

@@ -4,7 +4,8 @@
 //! roughness), an emissive texture scales emission, a normal texture is
 //! read as data and bends normals, samplers set the wrap
 //! modes and cap the filter, and the Khronos BoxTextured sample puts each
-//! texel where its uvs say, checked against a ray cast written here.
+//! texel where its uvs say and BoxVertexColors each colour where its
+//! vertices say, checked against ray casts written here.
 
 mod common;
 
@@ -433,4 +434,56 @@ fn the_textured_box_draws_in_every_view_the_renderers_share() {
     let b = render(&scene, "rasterize", &settings);
     let same = a.iter().zip(&b).filter(|(x, y)| (**x - **y).abs().max_element() < 1e-3).count();
     assert!(same as f32 >= 0.99 * a.len() as f32, "{same} of {} pixels agree", a.len());
+}
+
+#[test]
+fn khronos_box_vertex_colors_multiply_the_base_colour() {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/gltf/BoxVertexColors.gltf");
+    // The file's colours are its positions (a unit RGB cube): read here.
+    let json: serde_json::Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+    let buffer = unbase64(json["buffers"][0]["uri"].as_str().unwrap().split_once(",").unwrap().1);
+    let vec3_at = |o: usize| Vec3::from_array(std::array::from_fn(|k| f32::from_le_bytes(buffer[o + 4 * k..o + 4 * k + 4].try_into().unwrap())));
+    assert!((0..24).all(|i| vec3_at(72 + 12 * i) == vec3_at(72 + 576 + 12 * i)), "COLOR_0 equals POSITION");
+    let mut scene = load_scene(path.to_str().unwrap()).unwrap();
+    assert_eq!(scene.vertex_colours.len(), 12);
+    assert!(!scene.warnings.iter().any(|w| w.contains("vertex colours")), "{:?}", scene.warnings);
+    // Unlit, ambient 1: each pixel is the default grey times the colour.
+    scene.lights.clear();
+    scene.render.ambient = Vec3::ONE;
+    let grey = scene.materials[scene.triangle(0).material as usize].lambertian;
+    let (w, h) = (100u32, 80u32);
+    let settings = RenderSettings { width: w, height: h, ..RenderSettings::for_scene(&scene) };
+    let view = scene.camera.view(w, h);
+    for renderer in ["raytrace", "rasterize"] {
+        let img = render(&scene, renderer, &settings);
+        let (mut checked, mut agree, mut lo, mut hi) = (0, 0, Vec3::ONE, Vec3::ZERO);
+        for y in 0..h {
+            for x in 0..w {
+                // The ray against the box [0, 1]^3 (slabs).
+                let ray = view.eye_ray(x as f32 + 0.5, y as f32 + 0.5);
+                let (t0, t1) = ((Vec3::ZERO - ray.origin) / ray.dir, (Vec3::ONE - ray.origin) / ray.dir);
+                let (near, far) = (t0.min(t1).max_element(), t0.max(t1).min_element());
+                if !(near < far && near > 0.0) {
+                    continue;
+                }
+                let p = ray.origin + ray.dir * near;
+                // Away from the cube's edges, where a pixel may see either face.
+                let inner = p.to_array().iter().filter(|c| **c > 0.01 && **c < 0.99).count();
+                if inner < 2 {
+                    continue;
+                }
+                let expected = grey * p.clamp(Vec3::ZERO, Vec3::ONE);
+                let got = img[(x + y * w) as usize];
+                checked += 1;
+                if (got - expected).abs().max_element() < 2e-3 {
+                    agree += 1;
+                }
+                (lo, hi) = (lo.min(p), hi.max(p));
+            }
+        }
+        eprintln!("{renderer}: {agree} of {checked} pixels are the grey times their vertex colour");
+        // The colours seen span most of red and green (the face towards the camera is blue 1).
+        assert!(checked > 1000 && (hi - lo).x > 0.8 && (hi - lo).y > 0.8, "{renderer}: {checked} pixels checked, colours from {lo} to {hi}");
+        assert!(agree as f32 >= 0.99 * checked as f32, "{renderer}: {agree} of {checked} pixels");
+    }
 }

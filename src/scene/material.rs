@@ -296,6 +296,14 @@ impl Material {
     /// textures read with `filter` (lowered to `finest_filter`).
     #[inline]
     pub fn lobes(&self, uv: Vec2, f: &Footprint, filter: TextureFilter) -> PointLobes {
+        self.lobes_tinted(uv, f, filter, Vec3::ONE)
+    }
+
+    /// `lobes` at a point whose vertex colour is `tint`: it multiplies the
+    /// diffuse albedo, or under the metallic-roughness model the base
+    /// colour (so a metal's F0 too). White changes nothing, bit for bit.
+    #[inline]
+    pub fn lobes_tinted(&self, uv: Vec2, f: &Footprint, filter: TextureFilter, tint: Vec3) -> PointLobes {
         let filter = filter.at_most(self.finest_filter);
         let Some(m) = &self.metallic else {
             let albedo = match &self.texture {
@@ -305,13 +313,13 @@ impl Material {
                 }
                 None => self.lambertian,
             };
-            return PointLobes::with_albedo(self, albedo);
+            return PointLobes::with_albedo(self, albedo * tint);
         };
         let (uv, f) = self.scaled(uv, f);
         let base = match &self.texture {
             Some(t) => m.base * t.sample(uv, &f, filter, self.wrap),
             None => m.base,
-        };
+        } * tint;
         let (metallic, roughness) = match &m.map {
             Some(t) => {
                 let texel = t.sample(uv, &f, filter, self.wrap);

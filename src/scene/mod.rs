@@ -341,6 +341,10 @@ pub struct Scene {
     /// Names of the parts of objects read from other formats (a glTF's
     /// node and mesh), for the inspector.
     pub parts: Vec<NamedPart>,
+    /// Per flattened triangle, per corner: a linear colour multiplying the
+    /// material's base colour (a glTF's `COLOR_0`). Triangles past its end
+    /// have none (white); empty when no file gives colours.
+    pub vertex_colours: Vec<[Vec3; 3]>,
     /// The emissive triangles and spheres, gathered by `refresh_emitters`
     /// (after loading, and whenever materials or geometry change).
     pub emitters: std::sync::Arc<emitters::Emitters>,
@@ -620,6 +624,15 @@ impl Scene {
         let index = index as usize;
         let k = self.instances.partition_point(|i| i.triangles.end <= index);
         self.instances.get(k).filter(|i| i.triangles.contains(&index))
+    }
+
+    /// The vertex colour at a hit (white where there is none).
+    #[inline]
+    pub fn vertex_colour(&self, kind: PrimitiveKind, index: u32, b: Vec3) -> Vec3 {
+        match (kind, self.vertex_colours.get(index as usize)) {
+            (PrimitiveKind::Triangle, Some(c)) => c[0] * b.x + c[1] * b.y + c[2] * b.z,
+            _ => Vec3::ONE,
+        }
     }
 
     /// The name of the part (a glTF node and mesh) triangle `index` belongs to, if it has one.

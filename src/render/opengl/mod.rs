@@ -186,6 +186,9 @@ fn unsupported(scene: &Scene, settings: &RenderSettings) -> Result<(), String> {
     if let Some(m) = drawn.clone().find(|m| m.has_glossy() && m.glossy_model == crate::scene::material::GlossyModel::Ward) {
         return refuse(&format!("cannot draw glossy_model \"ward\" yet (material \"{}\"); use raytrace or rasterize", m.name));
     }
+    if !scene.vertex_colours.is_empty() {
+        return refuse("cannot draw vertex colours yet; use raytrace or rasterize");
+    }
     if let Some(m) = drawn.clone().find(|m| m.metallic.is_some() || m.emission_map.is_some()) {
         return refuse(&format!("cannot draw textured metallic-roughness or emission yet (material \"{}\"); use raytrace or rasterize", m.name));
     }

@@ -291,7 +291,8 @@ fn trace_photon(scene: &Scene, query: &BvhQuery, mut ray: Ray, mut power: Vec3, 
         let Some(hit) = query.closest(&ray, f32::INFINITY, inside, &mut counts, &mut NoRecord) else { break };
         let material = &scene.materials[hit.material as usize];
         // Photons have no pixel footprint: the finest level, bilinear.
-        let lobes = material.lobes(hit.uv, &crate::scene::texture::Footprint::default(), crate::scene::texture::TextureFilter::Bilinear);
+        let tint = scene.vertex_colour(hit.kind, hit.primitive, hit.barycentric);
+        let lobes = material.lobes_tinted(hit.uv, &crate::scene::texture::Footprint::default(), crate::scene::texture::TextureFilter::Bilinear, tint);
         let diffuse = lobes.albedo + if material.has_glossy() { lobes.glossy } else { Vec3::ZERO };
         if bounce > 0 && diffuse != Vec3::ZERO {
             stored.push(Photon { position: hit.position, w_i: -ray.dir, power, normal: hit.geometric_normal });

@@ -31,7 +31,8 @@ pub fn shade<Q: SceneQuery, R: Recorder>(
 ) -> Radiance {
     let Shading { scene, .. } = *sh;
     let material = &scene.materials[hit.material as usize];
-    let lobes = lobes_at(material, hit.uv, &hit.diff, sh.settings);
+    let tint = scene.vertex_colour(hit.kind, hit.primitive, hit.barycentric);
+    let lobes = lobes_at(material, hit.uv, &hit.diff, tint, sh.settings);
     let ambient = ambient_term(sh, || *hit, lobes.albedo);
     let surface = surface_lane(material, lobes, hit.position, ShadingFrame::at(scene, hit, material), w_o);
     let mut visibility = ShadowQueries { sh: &mut *sh, hit, depth, pending: PendingShadow::default() };
@@ -39,12 +40,12 @@ pub fn shade<Q: SceneQuery, R: Recorder>(
     after_direct(sh, hit, material, lobes, w_o, depth, direct)
 }
 
-/// The lobes `shade()` lights at a hit with texture coordinates `uv` and
-/// differentials `diff`: the material's textures read there with the
-/// footprint and the chosen filter.
+/// The lobes `shade()` lights at a hit with texture coordinates `uv`,
+/// differentials `diff` and vertex colour `tint`: the material's textures
+/// read there with the footprint and the chosen filter.
 #[inline]
-pub fn lobes_at(material: &Material, uv: Vec2, diff: &Differentials, settings: &RenderSettings) -> PointLobes {
-    material.lobes(uv, &diff.footprint(), settings.texture_filter)
+pub fn lobes_at(material: &Material, uv: Vec2, diff: &Differentials, tint: Vec3, settings: &RenderSettings) -> PointLobes {
+    material.lobes_tinted(uv, &diff.footprint(), settings.texture_filter, tint)
 }
 
 /// The term `shade()` starts from, before the lights: the constant ambient,

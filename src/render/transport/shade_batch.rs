@@ -399,11 +399,11 @@ pub fn direct_in_lanes<Q: SceneQuery>(
     };
     let mut lobes = [PointLobes { albedo: Vec3::ZERO, glossy: Vec3::ZERO, roughness: 1.0 }; LANES];
     let first = &scene.materials[hits.material[0] as usize];
-    let materials = if n > 0 && !first.varies_over_surface() && settings.gi.mode != GiMode::Ao && hits.material[1..n].iter().all(|&m| m == hits.material[0]) {
+    let materials = if n > 0 && !first.varies_over_surface() && scene.vertex_colours.is_empty() && settings.gi.mode != GiMode::Ao && hits.material[1..n].iter().all(|&m| m == hits.material[0]) {
         // One untextured material (the common batch): its albedo, lobes and
         // ambient term are the same in every lane, worked out once and
         // splatted, rather than written lane by lane and loaded back.
-        let l = shade::lobes_at(first, Vec2::ZERO, &hits.diff[0], settings);
+        let l = shade::lobes_at(first, Vec2::ZERO, &hits.diff[0], Vec3::ONE, settings);
         let mut sh = Shading { scene, query, settings, path: &mut paths[path_of[0]], counts: &mut *counts, rec: &mut NoRecord };
         let ambient = shade::ambient_term(&mut sh, || hits.get(0), l.albedo);
         lobes = [l; LANES];
@@ -415,7 +415,9 @@ pub fn direct_in_lanes<Q: SceneQuery>(
         let mut diffuse = [[0.0; LANES]; 2];
         for i in 0..n {
             let material = &scene.materials[hits.material[i] as usize];
-            lobes[i] = shade::lobes_at(material, Vec2::new(hits.uv[0][i], hits.uv[1][i]), &hits.diff[i], settings);
+            let b = Vec3::new(hits.barycentric[0][i], hits.barycentric[1][i], hits.barycentric[2][i]);
+            let tint = scene.vertex_colour(hits.kind[i], hits.primitive[i], b);
+            lobes[i] = shade::lobes_at(material, Vec2::new(hits.uv[0][i], hits.uv[1][i]), &hits.diff[i], tint, settings);
             let l = lobes[i];
             let mut sh = Shading { scene, query, settings, path: &mut paths[path_of[i]], counts: &mut *counts, rec: &mut NoRecord };
             let ambient = shade::ambient_term(&mut sh, || hits.get(i), l.albedo);
@@ -637,13 +639,13 @@ pub fn shade_batch_pair<Q: SceneQuery>(job: &PassJob, query: &Q, pair: [&Batch; 
     }
     let material = &scene.materials[index as usize];
     // Ward's lobe needs each lane's tangent, which pairs do not carry.
-    if material.varies_over_surface() || material.glossy_model == GlossyModel::Ward || shade::adds_after_direct(scene, settings, material) {
+    if material.varies_over_surface() || !scene.vertex_colours.is_empty() || material.glossy_model == GlossyModel::Ward || shade::adds_after_direct(scene, settings, material) {
         return false;
     }
     // `direct_in_lanes`' one-material case, for each batch: the albedo
     // and ambient term are worked out from lane 0 and must agree.
     let mut uniform = |batch: &Batch| {
-        let albedo = shade::lobes_at(material, Vec2::ZERO, &batch.hits.diff[0], settings).albedo;
+        let albedo = shade::lobes_at(material, Vec2::ZERO, &batch.hits.diff[0], Vec3::ONE, settings).albedo;
         let mut path = PathState::new(batch.pixels[0], batch.samples[0], settings.spp, &settings.gi, job.photons);
         let mut sh = Shading { scene, query, settings, path: &mut path, counts: &mut *counts, rec: &mut NoRecord };
         (albedo, shade::ambient_term(&mut sh, || batch.hits.get(0), albedo))

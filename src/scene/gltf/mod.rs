@@ -78,6 +78,16 @@ fn add_gltf_unnamed(scene: &mut Scene, path: &Path, placement: &Placement, objec
             }
         }
     }
+    // Its image sources unwrap a missing URI, view or MIME type: refused here first.
+    for (i, image) in root.images.iter().enumerate() {
+        let well_formed = match &image.buffer_view {
+            Some(view) => view.value() < root.buffer_views.len() && image.mime_type.is_some(),
+            None => image.uri.is_some(),
+        };
+        if !well_formed {
+            return Err(format!("invalid glTF at images[{i}]: an image needs a uri, or a bufferView that exists and a mimeType"));
+        }
+    }
     let doc = gltf::Document::from_json(doc.into_json()).map_err(describe)?;
     let mut parts = GltfParts::default();
 
@@ -205,10 +215,14 @@ fn add_gltf_unnamed(scene: &mut Scene, path: &Path, placement: &Placement, objec
         let part_name = |node: usize| {
             format!("glTF node {node}{}, mesh {}{}", quoted(node_names.get(node).copied().flatten()), mesh.index(), quoted(mesh.name()))
         };
-        let local = mesh_triangles(&mesh, &buffers, first_material, fallback, &double_sided, object, &mut degenerate, &mut parts.ignored)?;
+        let (local, colours) = mesh_triangles(&mesh, &buffers, first_material, fallback, &double_sided, object, &mut degenerate, &mut parts.ignored)?;
         if placed.len() == 1 {
             let p = Placement::from_matrix(placed[0].0);
             let start = scene.triangles.len();
+            if let Some(colours) = colours {
+                scene.vertex_colours.resize(start, [Vec3::ONE; 3]);
+                scene.vertex_colours.extend(colours);
+            }
             for t in local {
                 let t = p.apply(t);
                 if !t.v.iter().all(|v| v.abs().max_element() <= MAX_COORDINATE) {
@@ -218,6 +232,9 @@ fn add_gltf_unnamed(scene: &mut Scene, path: &Path, placement: &Placement, objec
             }
             scene.parts.push(NamedPart { object, what: PartOf::Triangles(start..scene.triangles.len()), name: part_name(placed[0].1) });
         } else if !local.is_empty() {
+            if colours.is_some() {
+                parts.ignored.push(format!("mesh {}: vertex colours (its nodes share it, and shared meshes have none yet)", mesh.index()));
+            }
             let (lo, hi) = local.iter().flat_map(|t| t.v).fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), v| (lo.min(v), hi.max(v)));
             let mut copies = Vec::new();
             for (world, node) in placed.iter() {
@@ -242,7 +259,8 @@ fn add_gltf_unnamed(scene: &mut Scene, path: &Path, placement: &Placement, objec
     Ok(parts)
 }
 
-/// The triangles of every primitive of `mesh`, in the mesh's own frame.
+/// The triangles of every primitive of `mesh`, in the mesh's own frame,
+/// and their corners' vertex colours when a primitive has `COLOR_0`.
 #[allow(clippy::too_many_arguments)]
 fn mesh_triangles(
     mesh: &gltf::Mesh,
@@ -253,8 +271,9 @@ fn mesh_triangles(
     object: u32,
     degenerate: &mut usize,
     ignored: &mut Vec<String>,
-) -> Result<Vec<Triangle>, String> {
+) -> Result<(Vec<Triangle>, Option<Vec<[Vec3; 3]>>), String> {
     let mut out = Vec::new();
+    let mut colours_out: Option<Vec<[Vec3; 3]>> = None;
     for prim in mesh.primitives() {
         let at = format!("mesh {} primitive {}", mesh.index(), prim.index());
         let positions = prim.get(&gltf::Semantic::Positions).ok_or(format!("{at} has no POSITION attribute"))?;
@@ -276,8 +295,25 @@ fn mesh_triangles(
                 return Err(format!("{at}: its {what} and positions differ in count"));
             }
         }
-        if prim.get(&gltf::Semantic::Colors(0)).is_some() {
-            ignored.push(format!("{at}: vertex colours"));
+        let colours: Option<Vec<Vec3>> = match prim.get(&gltf::Semantic::Colors(0)) {
+            Some(a) => {
+                let read = match a.dimensions().multiplicity() {
+                    4 => accessor::read_floats::<4>(&a, buffers).map(|c| c.into_iter().map(|[r, g, b, _]| Vec3::new(r, g, b)).collect::<Vec<_>>()),
+                    _ => accessor::read_floats::<3>(&a, buffers).map(|c| c.into_iter().map(Vec3::from).collect()),
+                };
+                let c = read.map_err(|e| format!("{at}: COLOR_0: {e}"))?;
+                if c.len() != pos.len() {
+                    return Err(format!("{at}: its COLOR_0 and positions differ in count"));
+                }
+                if let Some(k) = c.iter().position(|v| !(v.is_finite() && v.min_element() >= 0.0 && v.max_element() <= 1.0)) {
+                    return Err(format!("{at}: colour {k} of COLOR_0 (accessor {}) is not a number from 0 to 1", a.index()));
+                }
+                Some(c)
+            }
+            None => None,
+        };
+        if colours.is_some() && colours_out.is_none() {
+            colours_out = Some(vec![[Vec3::ONE; 3]; out.len()]);
         }
         if prim.morph_targets().next().is_some() {
             ignored.push(format!("{at}: morph targets"));
@@ -331,9 +367,12 @@ fn mesh_triangles(
                 None => [Vec2::ZERO; 3],
             };
             out.push(Triangle { v, n, uv, material, object, two_sided });
+            if let Some(c) = colours_out.as_mut() {
+                c.push(colours.as_ref().map_or([Vec3::ONE; 3], |cs| idx.map(|i| cs[i as usize])));
+            }
         }
     }
-    Ok(out)
+    Ok((out, colours_out))
 }
 
 /// Refuses a file whose `extensionsRequired` names an extension pinhole
