@@ -1,6 +1,6 @@
 //! A seeded mutation fuzzer over everything pinhole reads: scene TOML (the
 //! built-in scenes, mutated), OBJ/MTL pairs, PLY meshes (ASCII and binary),
-//! glTF files (the vendored samples, mutated) and image files (PNG, EXR).
+//! glTF files (the vendored samples, textured among them, mutated) and image files (PNG, EXR).
 //!
 //! Each case must end without a panic, with either an error of at most
 //! three lines and `MAX_ERROR_CHARS` characters, or a scene that renders
@@ -50,6 +50,14 @@ const REGRESSIONS: &[(&str, &str)] = &[
     ("gltf", "{\"asset\": {\"version\": \"2.0\"}, \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 2}}]}]}"),
     ("gltf", "{\"asset\": {\"version\": \"2.0\"}, \"buffers\": [{\"byteLength\": 4, \"uri\": \"../../../etc/passwd\"}]}"),
     ("gltf", "glTF\x02\0\0\0\x40\0\0\0\x20\0\0\0JSON{\"asset\": {\"version\": \"2.0\"}}"),
+    // Vertex colours: fewer than the positions, and a colour of 2.
+    ("gltf", "{\"asset\": {\"version\": \"2.0\"}, \"scenes\": [{\"nodes\": [0]}], \"nodes\": [{\"mesh\": 0}], \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0, \"COLOR_0\": 1}}]}], \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 3, \"type\": \"VEC3\", \"min\": [0, 0, 0], \"max\": [1, 1, 0]}, {\"bufferView\": 0, \"componentType\": 5126, \"count\": 2, \"type\": \"VEC3\"}], \"bufferViews\": [{\"buffer\": 0, \"byteLength\": 36}], \"buffers\": [{\"byteLength\": 36, \"uri\": \"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA\"}]}"),
+    ("gltf", "{\"asset\": {\"version\": \"2.0\"}, \"scenes\": [{\"nodes\": [0]}], \"nodes\": [{\"mesh\": 0}], \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0, \"COLOR_0\": 1}}]}], \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 3, \"type\": \"VEC3\", \"min\": [0, 0, 0], \"max\": [1, 1, 0]}, {\"bufferView\": 1, \"componentType\": 5126, \"count\": 3, \"type\": \"VEC3\"}], \"bufferViews\": [{\"buffer\": 0, \"byteLength\": 36}, {\"buffer\": 0, \"byteLength\": 36}], \"buffers\": [{\"byteLength\": 36, \"uri\": \"data:application/octet-stream;base64,AAAAQAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA\"}]}"),
+    // Textures: every slot naming a missing texture, an image in a view past
+    // its buffer read as metallic-roughness, normal and emissive data with a
+    // mirrored, nearest sampler.
+    ("gltf", "{\"asset\": {\"version\": \"2.0\"}, \"materials\": [{\"pbrMetallicRoughness\": {\"baseColorTexture\": {\"index\": 7}, \"metallicRoughnessTexture\": {\"index\": 8}}, \"normalTexture\": {\"index\": 9}, \"emissiveTexture\": {\"index\": 10}}]}"),
+    ("gltf", "{\"asset\": {\"version\": \"2.0\"}, \"scenes\": [{\"nodes\": [0]}], \"nodes\": [{\"mesh\": 0}], \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0}, \"material\": 0}]}], \"materials\": [{\"emissiveFactor\": [1, 1, 1], \"pbrMetallicRoughness\": {\"metallicRoughnessTexture\": {\"index\": 0}}, \"normalTexture\": {\"index\": 0, \"scale\": 2}, \"emissiveTexture\": {\"index\": 0}}], \"textures\": [{\"source\": 0, \"sampler\": 0}], \"samplers\": [{\"magFilter\": 9728, \"wrapS\": 33648, \"wrapT\": 33071}], \"images\": [{\"bufferView\": 1, \"mimeType\": \"image/png\"}], \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 3, \"type\": \"VEC3\", \"min\": [0, 0, 0], \"max\": [1, 1, 0]}], \"bufferViews\": [{\"buffer\": 0, \"byteLength\": 36}, {\"buffer\": 0, \"byteOffset\": 30, \"byteLength\": 4000}], \"buffers\": [{\"byteLength\": 36, \"uri\": \"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA\"}]}"),
 ];
 
 /// splitmix64: small, seeded, and the same everywhere.
@@ -579,7 +587,7 @@ fn mutated_gltf_files() {
     let dir = work_dir("gltf");
     let mut rng = seed(5);
     let samples = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/gltf");
-    let corpus: Vec<Vec<u8>> = ["Box.gltf", "Cameras.gltf"].iter().map(|f| std::fs::read(samples.join(f)).unwrap()).collect();
+    let corpus: Vec<Vec<u8>> = ["Box.gltf", "Cameras.gltf", "BoxTextured.gltf", "BoxVertexColors.gltf"].iter().map(|f| std::fs::read(samples.join(f)).unwrap()).collect();
     counted("gltf files", || {
         for _ in 0..cases() {
             let seed_bytes = rng.pick(&corpus).clone();

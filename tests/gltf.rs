@@ -243,6 +243,42 @@ fn shared_mesh_matches_baked_obj_and_is_stored_once() {
     }
 }
 
+#[test]
+fn the_inspector_names_the_gltf_node_and_mesh_of_a_hit() {
+    let dir = work_dir("parts");
+    std::fs::write(dir.join("shared.bin"), buffer()).unwrap();
+    std::fs::write(dir.join("shared.gltf"), shared_json(Some("shared.bin"))).unwrap();
+    std::fs::write(dir.join("s.toml"), format!("{HEAD}[[object]]\ntype = \"gltf\"\nfile = \"shared.gltf\"\n")).unwrap();
+    let scene = load_scene(dir.join("s.toml").to_str().unwrap()).unwrap();
+    // The floor (node 2, flattened) and the cube's two copies (nodes 0 and 1, in the layer).
+    let names: Vec<Option<&str>> = (0..scene.total_triangles() as u32).map(|i| scene.part_name(i)).collect();
+    assert_eq!(&names[..2], &[Some("glTF node 2, mesh 1 \"floor\""); 2]);
+    let mut copies: Vec<&str> = names[2..].iter().map(|n| n.expect("every copy's triangle is named")).collect();
+    assert!(copies[..12].iter().all(|n| *n == copies[0]) && copies[12..].iter().all(|n| *n == copies[12]), "{copies:?}");
+    copies.dedup();
+    copies.sort();
+    assert_eq!(copies, ["glTF node 0, mesh 0 \"cube\"", "glTF node 1, mesh 0 \"cube\""]);
+    // A replayed pixel on the floor says so, in text and JSON, in both families.
+    let settings = RenderSettings::for_scene(&scene);
+    let prepared = PreparedScene::new(scene);
+    let view = prepared.scene.camera.view(settings.width, settings.height);
+    // A floor point in front of the cubes, inside the image.
+    let p = [Vec3::new(2.5, 0.0, 2.0), Vec3::new(-2.5, 0.0, 2.0), Vec3::new(0.0, 0.0, 1.5)]
+        .into_iter()
+        .filter_map(|w| view.project(w).map(|(p, _)| p))
+        .find(|p| p.x >= 0.0 && p.y >= 0.0 && p.x < settings.width as f32 && p.y < settings.height as f32)
+        .expect("a floor point in view");
+    let (x, y) = (p.x as u32, p.y as u32);
+    for name in ["raytrace", "rasterize"] {
+        let r = pinhole::render::renderer_by_name(name).unwrap();
+        let replay = pinhole::render::replay_pixel(r.as_ref(), &prepared, &settings, x, y).unwrap();
+        let text = pinhole::render::inspect::pixel_report::to_text(name, &prepared.scene, x, y, &replay);
+        assert!(text.contains("glTF node 2, mesh 1 \"floor\""), "{name}: {text}");
+        let json = pinhole::render::inspect::pixel_report::to_json(name, &prepared.scene, x, y, &replay);
+        assert_eq!(json["samples"][0]["rays"][0]["closest"]["part"], "glTF node 2, mesh 1 \"floor\"", "{name}: {json}");
+    }
+}
+
 /// Each bad file is refused with one line naming the file and the place.
 #[test]
 fn bad_gltf_files_are_refused_with_the_file_and_place() {

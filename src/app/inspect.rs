@@ -171,7 +171,13 @@ pub fn object_name(scene: &Scene, kind: PrimitiveKind, index: u32) -> String {
         PrimitiveKind::Csg => scene.csgs.get(index as usize).map(|c| c.object),
     };
     let copy = match kind {
-        PrimitiveKind::Triangle => scene.instance_of_triangle(index).map(|i| format!(", instance {}", i.index)),
+        PrimitiveKind::Triangle => {
+            let instance = scene.instance_of_triangle(index).map(|i| format!(", instance {}", i.index));
+            match scene.part_name(index) {
+                Some(part) => Some(format!("{}, {part}", instance.unwrap_or_default())),
+                None => instance,
+            }
+        }
         PrimitiveKind::Sphere | PrimitiveKind::Csg => None,
     };
     object

@@ -213,7 +213,8 @@ impl Emitters {
                 let point = t.v[0] * b0 + t.v[1] * b1 + t.v[2] * (1.0 - b0 - b1);
                 let n = t.geometric_normal();
                 let n = if t.two_sided && u_side < 0.5 { -n } else { n };
-                (point, n, scene.materials[t.material as usize].emission)
+                let uv = t.uv[0] * b0 + t.uv[1] * b1 + t.uv[2] * (1.0 - b0 - b1);
+                (point, n, scene.materials[t.material as usize].emission_at(uv))
             }
             EmitterShape::Sphere(i) => {
                 let s = &scene.spheres[i as usize];
@@ -264,7 +265,8 @@ impl Emitters {
                     return None;
                 }
                 let pdf = pmf * d2 / (t.area() * cos_l);
-                let radiance = if facing { scene.materials[t.material as usize].emission } else { Vec3::ZERO };
+                let uv = t.uv[0] * b0 + t.uv[1] * b1 + t.uv[2] * (1.0 - b0 - b1);
+                let radiance = if facing { scene.materials[t.material as usize].emission_at(uv) } else { Vec3::ZERO };
                 let normal = if -normal.dot(w_i) > 0.0 { normal } else { -normal };
                 finite(EmitterSample { point, normal, w_i, distance, pdf, radiance, light })
             }
@@ -343,7 +345,7 @@ pub fn emitted(scene: &Scene, hit: &SurfaceHit, w_o: Vec3) -> Vec3 {
     if !material.is_emissive() || hit.back_face || hit.geometric_normal.dot(w_o) <= 0.0 {
         return Vec3::ZERO;
     }
-    material.emission
+    material.emission_at(hit.uv)
 }
 
 /// The luminance of a linear RGB colour (Rec. 709 weights).

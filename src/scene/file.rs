@@ -325,7 +325,7 @@ fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str, two_
             return Err(format!("{where_}: ior must be a finite number > 0 (at most {MAX_IOR})"));
         }
         if let Some(w) = &m.wrap {
-            mat.wrap = Wrap::parse(w).map_err(|e| format!("{where_}: wrap: {e}"))?;
+            mat.wrap = [Wrap::parse(w).map_err(|e| format!("{where_}: wrap: {e}"))?; 2];
         }
         if let Some(scale) = m.uv_scale {
             let scale = Vec2::from(scale);

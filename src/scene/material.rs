@@ -117,6 +117,64 @@ impl Fresnel {
     }
 }
 
+/// The metallic-roughness model's parameters: base colour `b`, metalness
+/// `m` and perceptual roughness `r`, each possibly varying over the
+/// surface. At a point they give a diffuse lobe `b (1 - m)` and a glossy
+/// lobe of alpha `r^2` whose Schlick Fresnel term starts at
+/// `F0 = mix(0.04, b, m)`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Metallic {
+    /// `b`, multiplied by the material's `texture` where it has one.
+    pub base: Vec3,
+    pub metallic: f32,
+    pub roughness: f32,
+    /// Linear data multiplying the factors: blue is metalness, green roughness.
+    pub map: Option<Arc<Texture>>,
+}
+
+/// F0 of dielectrics in the metallic-roughness model.
+pub const DIELECTRIC_F0: f32 = 0.04;
+
+/// What the BSDF reads of a material at one surface point, once its
+/// textures are looked up there.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointLobes {
+    /// k_L, the diffuse albedo.
+    pub albedo: Vec3,
+    /// k_G, the glossy lobe's weight (F0 under Schlick's Fresnel).
+    pub glossy: Vec3,
+    /// The microfacet alpha (not squared).
+    pub roughness: f32,
+}
+
+impl PointLobes {
+    /// A point of `material` whose lobes are its constants, with diffuse albedo `albedo`.
+    #[inline]
+    pub fn with_albedo(material: &Material, albedo: Vec3) -> PointLobes {
+        PointLobes { albedo, glossy: material.glossy, roughness: material.roughness }
+    }
+}
+
+/// What the BSDF routines accept for a point's lobes: a `PointLobes`, or a
+/// bare diffuse albedo, the other lobes then the material's constants.
+pub trait IntoLobes {
+    fn into_lobes(self, material: &Material) -> PointLobes;
+}
+
+impl IntoLobes for PointLobes {
+    #[inline(always)]
+    fn into_lobes(self, _: &Material) -> PointLobes {
+        self
+    }
+}
+
+impl IntoLobes for Vec3 {
+    #[inline(always)]
+    fn into_lobes(self, material: &Material) -> PointLobes {
+        PointLobes::with_albedo(material, self)
+    }
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
     pub name: String,
@@ -142,10 +200,22 @@ pub struct Material {
     /// Emitted radiance (W m^-2 sr^-1) from the front side (both sides when
     /// the object is two-sided): any surface with it is an area light.
     pub emission: Vec3,
-    /// Multiplies `lambertian` when present (linear values, decoded from sRGB).
+    /// Multiplies `lambertian` when present (linear values, decoded from
+    /// sRGB); with `metallic`, multiplies its base colour instead.
     pub texture: Option<Arc<Texture>>,
-    /// Addressing of the texture and normal map outside [0, 1].
-    pub wrap: Wrap,
+    /// Addressing of every texture of the material outside [0, 1]: along u
+    /// (columns) and along v (rows).
+    pub wrap: [Wrap; 2],
+    /// The finest filter the material's textures are read with: the
+    /// render's filter is lowered to it (a sampler that asks for nearest
+    /// or unmipmapped reads).
+    pub finest_filter: TextureFilter,
+    /// Lobes worked out point by point from a base colour, metalness and
+    /// roughness (the metallic-roughness model), instead of `lambertian`,
+    /// `glossy` and `roughness`.
+    pub metallic: Option<Metallic>,
+    /// Multiplies `emission` when present (linear values, decoded from sRGB).
+    pub emission_map: Option<Arc<Texture>>,
     /// Multiplies uvs before any lookup (a checker repeated n times).
     pub uv_scale: Vec2,
     /// Tangent-space normal map (linear data: 0.5, 0.5, 1 is "straight out").
@@ -163,8 +233,19 @@ impl Material {
                 (a, b) => a.is_none() && b.is_none(),
             }
         }
-        let without_texels = |m: &Material| Material { texture: None, normal_map: None, ..m.clone() };
-        same_texture(&self.texture, &o.texture) && same_texture(&self.normal_map, &o.normal_map) && without_texels(self) == without_texels(o)
+        let metallic_map = |m: &Material| m.metallic.as_ref().and_then(|m| m.map.clone());
+        let without_texels = |m: &Material| Material {
+            texture: None,
+            normal_map: None,
+            emission_map: None,
+            metallic: m.metallic.clone().map(|metallic| Metallic { map: None, ..metallic }),
+            ..m.clone()
+        };
+        same_texture(&self.texture, &o.texture)
+            && same_texture(&self.normal_map, &o.normal_map)
+            && same_texture(&self.emission_map, &o.emission_map)
+            && same_texture(&metallic_map(self), &metallic_map(o))
+            && without_texels(self) == without_texels(o)
     }
 
     pub fn default_grey() -> Material {
@@ -188,7 +269,10 @@ impl Material {
             ior: 1.5,
             emission: Vec3::ZERO,
             texture: None,
-            wrap: Wrap::Repeat,
+            wrap: [Wrap::Repeat; 2],
+            finest_filter: TextureFilter::Trilinear,
+            metallic: None,
+            emission_map: None,
             uv_scale: Vec2::ONE,
             normal_map: None,
         }
@@ -218,16 +302,73 @@ impl Material {
         (self.mirror.cmpne(Vec3::ZERO) | self.transmission.cmpne(Vec3::ZERO)).any()
     }
 
+    /// Whether the lobes are worked out point by point (a texture feeds
+    /// them, or the metallic-roughness model does) rather than read from
+    /// the constants.
+    #[inline]
+    pub fn varies_over_surface(&self) -> bool {
+        self.texture.is_some() || self.metallic.is_some()
+    }
+
     /// Diffuse albedo at a surface point with uv `uv` and footprint `f`
-    /// (texture applied, read with `filter`).
+    /// (textures applied, read with `filter`).
     #[inline]
     pub fn albedo(&self, uv: Vec2, f: &Footprint, filter: TextureFilter) -> Vec3 {
-        match &self.texture {
+        self.lobes(uv, f, filter).albedo
+    }
+
+    /// The lobes at a surface point with uv `uv` and footprint `f`, the
+    /// textures read with `filter` (lowered to `finest_filter`).
+    #[inline]
+    pub fn lobes(&self, uv: Vec2, f: &Footprint, filter: TextureFilter) -> PointLobes {
+        self.lobes_tinted(uv, f, filter, Vec3::ONE)
+    }
+
+    /// `lobes` at a point whose vertex colour is `tint`: it multiplies the
+    /// diffuse albedo, or under the metallic-roughness model the base
+    /// colour (so a metal's F0 too). White changes nothing, bit for bit.
+    #[inline]
+    pub fn lobes_tinted(&self, uv: Vec2, f: &Footprint, filter: TextureFilter, tint: Vec3) -> PointLobes {
+        let filter = filter.at_most(self.finest_filter);
+        let Some(m) = &self.metallic else {
+            let albedo = match &self.texture {
+                Some(t) => {
+                    let (uv, f) = self.scaled(uv, f);
+                    self.lambertian * t.sample(uv, &f, filter, self.wrap)
+                }
+                None => self.lambertian,
+            };
+            return PointLobes::with_albedo(self, albedo * tint);
+        };
+        let (uv, f) = self.scaled(uv, f);
+        let base = match &self.texture {
+            Some(t) => m.base * t.sample(uv, &f, filter, self.wrap),
+            None => m.base,
+        } * tint;
+        let (metallic, roughness) = match &m.map {
             Some(t) => {
-                let (uv, f) = self.scaled(uv, f);
-                self.lambertian * t.sample(uv, &f, filter, self.wrap)
+                let texel = t.sample(uv, &f, filter, self.wrap);
+                (m.metallic * texel.z, m.roughness * texel.y)
             }
-            None => self.lambertian,
+            None => (m.metallic, m.roughness),
+        };
+        PointLobes {
+            albedo: base * (1.0 - metallic),
+            glossy: Vec3::splat(DIELECTRIC_F0).lerp(base, metallic),
+            roughness: (roughness * roughness).max(MIN_ROUGHNESS),
+        }
+    }
+
+    /// Emitted radiance at `uv` (the emission map read bilinearly at its
+    /// finest level, or nearest when the sampler asks for it).
+    #[inline]
+    pub fn emission_at(&self, uv: Vec2) -> Vec3 {
+        match &self.emission_map {
+            Some(t) => {
+                let (uv, f) = self.scaled(uv, &Footprint::default());
+                self.emission * t.sample(uv, &f, TextureFilter::Bilinear.at_most(self.finest_filter), self.wrap)
+            }
+            None => self.emission,
         }
     }
 
@@ -236,7 +377,7 @@ impl Material {
     pub fn normal_map_texel(&self, uv: Vec2, f: &Footprint, filter: TextureFilter) -> Option<Vec3> {
         self.normal_map.as_ref().map(|t| {
             let (uv, f) = self.scaled(uv, f);
-            t.sample(uv, &f, filter, self.wrap)
+            t.sample(uv, &f, filter.at_most(self.finest_filter), self.wrap)
         })
     }
 

@@ -238,6 +238,25 @@ pub struct ObjectInfo {
     pub triangles: std::ops::Range<usize>,
 }
 
+/// A named part of an object (a glTF node's mesh): its flattened triangles,
+/// or one of its object's copies in the instance layer.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NamedPart {
+    /// Index into `Scene::objects`.
+    pub object: u32,
+    pub what: PartOf,
+    pub name: String,
+}
+
+/// Where a named part's triangles are.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PartOf {
+    /// A range of `Scene::triangles`.
+    Triangles(std::ops::Range<usize>),
+    /// The object's copy with this `InstanceInfo::index`.
+    Copy(u32),
+}
+
 /// One copy made by a mesh object's `instances` list: where its triangles
 /// lie in `Scene::triangles`, and the sphere around them that rasterizers
 /// cull it by.
@@ -332,6 +351,13 @@ pub struct Scene {
     /// Cameras a loaded file offers by name (a glTF's), for `--camera` and
     /// the viewer's camera list; `camera` is the one in use.
     pub named_cameras: Vec<(String, Camera)>,
+    /// Names of the parts of objects read from other formats (a glTF's
+    /// node and mesh), for the inspector.
+    pub parts: Vec<NamedPart>,
+    /// Per flattened triangle, per corner: a linear colour multiplying the
+    /// material's base colour (a glTF's `COLOR_0`). Triangles past its end
+    /// have none (white); empty when no file gives colours.
+    pub vertex_colours: Vec<[Vec3; 3]>,
     /// The emissive triangles and spheres, gathered by `refresh_emitters`
     /// (after loading, and whenever materials or geometry change).
     pub emitters: std::sync::Arc<emitters::Emitters>,
@@ -618,6 +644,27 @@ impl Scene {
         let index = index as usize;
         let k = self.instances.partition_point(|i| i.triangles.end <= index);
         self.instances.get(k).filter(|i| i.triangles.contains(&index))
+    }
+
+    /// The vertex colour at a hit (white where there is none).
+    #[inline]
+    pub fn vertex_colour(&self, kind: PrimitiveKind, index: u32, b: Vec3) -> Vec3 {
+        match (kind, self.vertex_colours.get(index as usize)) {
+            (PrimitiveKind::Triangle, Some(c)) => c[0] * b.x + c[1] * b.y + c[2] * b.z,
+            _ => Vec3::ONE,
+        }
+    }
+
+    /// The name of the part (a glTF node and mesh) triangle `index` belongs to, if it has one.
+    pub fn part_name(&self, index: u32) -> Option<&str> {
+        if self.parts.is_empty() {
+            return None;
+        }
+        let found = match self.instance_of_triangle(index) {
+            Some(copy) => self.parts.iter().find(|p| p.object == copy.object && p.what == PartOf::Copy(copy.index)),
+            None => self.parts.iter().find(|p| matches!(&p.what, PartOf::Triangles(r) if r.contains(&(index as usize)))),
+        };
+        found.map(|p| p.name.as_str())
     }
 
     /// A copy's name: its object's name and its position in the object's list.

@@ -24,12 +24,14 @@ named_enum! {
 }
 
 named_enum! {
-    /// Texture addressing outside [0, 1]: tile, or hold the edge texel.
+    /// Texture addressing outside [0, 1]: tile, hold the edge texel, or
+    /// tile with every other copy mirrored.
     #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
     pub enum Wrap ("wrap mode") {
         #[default]
         Repeat = "repeat",
         Clamp = "clamp",
+        MirroredRepeat = "mirrored-repeat",
     }
 }
 
@@ -56,11 +58,21 @@ pub struct Footprint {
     pub duv_dy: Vec2,
 }
 
-impl MipLevel {
+impl TextureFilter {
+    /// This filter, or `finest` when that reads fewer texels (a texture's
+    /// sampler may ask for nearest or unmipmapped reads).
     #[inline]
-    fn texel(&self, x: i64, y: i64, wrap: Wrap) -> Vec3 {
-        self.texel_uv(x, y, wrap, wrap)
+    pub fn at_most(self, finest: TextureFilter) -> TextureFilter {
+        let rank = |f: TextureFilter| match f {
+            TextureFilter::Nearest => 0,
+            TextureFilter::Bilinear => 1,
+            TextureFilter::Trilinear => 2,
+        };
+        if rank(finest) < rank(self) { finest } else { self }
     }
+}
+
+impl MipLevel {
 
     /// Texel `(x, y)` with the columns addressed by `wrap_u`, the rows by `wrap_v`.
     #[inline]
@@ -68,6 +80,10 @@ impl MipLevel {
         let address = |i: i64, n: i64, wrap: Wrap| match wrap {
             Wrap::Repeat => i.rem_euclid(n),
             Wrap::Clamp => i.clamp(0, n - 1),
+            Wrap::MirroredRepeat => {
+                let m = i.rem_euclid(2 * n);
+                if m < n { m } else { 2 * n - 1 - m }
+            }
         };
         let (x, y) = (address(x, self.width as i64, wrap_u), address(y, self.height as i64, wrap_v));
         self.texels[(x + y * self.width as i64) as usize]
@@ -83,15 +99,16 @@ impl MipLevel {
         (x.is_finite() && y.is_finite() && x.abs() < 1e9 && y.abs() < 1e9).then_some((x, y))
     }
 
-    pub fn nearest(&self, uv: Vec2, wrap: Wrap) -> Vec3 {
+    /// The texel `uv` falls in, columns addressed by `wrap[0]`, rows by `wrap[1]`.
+    pub fn nearest(&self, uv: Vec2, wrap: [Wrap; 2]) -> Vec3 {
         match self.position(uv) {
-            Some((x, y)) => self.texel(x.floor() as i64, y.floor() as i64, wrap),
+            Some((x, y)) => self.texel_uv(x.floor() as i64, y.floor() as i64, wrap[0], wrap[1]),
             None => Vec3::ZERO,
         }
     }
 
-    pub fn bilinear(&self, uv: Vec2, wrap: Wrap) -> Vec3 {
-        self.bilinear_uv(uv, wrap, wrap)
+    pub fn bilinear(&self, uv: Vec2, wrap: [Wrap; 2]) -> Vec3 {
+        self.bilinear_uv(uv, wrap[0], wrap[1])
     }
 
     /// `bilinear` with separate addressing of columns and rows (a
@@ -178,8 +195,9 @@ impl Texture {
         rho.log2().min(top)
     }
 
-    /// The texture at `uv` with footprint `f`, read with `filter`.
-    pub fn sample(&self, uv: Vec2, f: &Footprint, filter: TextureFilter, wrap: Wrap) -> Vec3 {
+    /// The texture at `uv` with footprint `f`, read with `filter`; `wrap`
+    /// addresses u (columns) and v (rows) outside [0, 1].
+    pub fn sample(&self, uv: Vec2, f: &Footprint, filter: TextureFilter, wrap: [Wrap; 2]) -> Vec3 {
         match filter {
             TextureFilter::Nearest => self.levels[0].nearest(uv, wrap),
             TextureFilter::Bilinear => self.levels[0].bilinear(uv, wrap),
@@ -311,15 +329,47 @@ mod tests {
         let t = Texture::new(2, 1, grey(&[0.0, 1.0]));
         let none = Footprint::default();
         // Texel centres are at u = 0.25 and 0.75.
-        assert_eq!(t.sample(Vec2::new(0.3, 0.5), &none, TextureFilter::Nearest, Wrap::Repeat), Vec3::ZERO);
-        assert_eq!(t.sample(Vec2::new(0.5, 0.5), &none, TextureFilter::Bilinear, Wrap::Repeat), Vec3::splat(0.5));
+        assert_eq!(t.sample(Vec2::new(0.3, 0.5), &none, TextureFilter::Nearest, [Wrap::Repeat; 2]), Vec3::ZERO);
+        assert_eq!(t.sample(Vec2::new(0.5, 0.5), &none, TextureFilter::Bilinear, [Wrap::Repeat; 2]), Vec3::splat(0.5));
         // Beyond the right edge: repeat blends towards texel 0, clamp holds texel 1.
-        assert_eq!(t.sample(Vec2::new(1.0, 0.5), &none, TextureFilter::Bilinear, Wrap::Repeat), Vec3::splat(0.5));
-        assert_eq!(t.sample(Vec2::new(1.0, 0.5), &none, TextureFilter::Bilinear, Wrap::Clamp), Vec3::ONE);
-        assert_eq!(t.sample(Vec2::new(-3.9, 0.5), &none, TextureFilter::Nearest, Wrap::Clamp), Vec3::ZERO);
+        assert_eq!(t.sample(Vec2::new(1.0, 0.5), &none, TextureFilter::Bilinear, [Wrap::Repeat; 2]), Vec3::splat(0.5));
+        assert_eq!(t.sample(Vec2::new(1.0, 0.5), &none, TextureFilter::Bilinear, [Wrap::Clamp; 2]), Vec3::ONE);
+        assert_eq!(t.sample(Vec2::new(-3.9, 0.5), &none, TextureFilter::Nearest, [Wrap::Clamp; 2]), Vec3::ZERO);
         // Trilinear halfway between level 0 and the 1 x 1 level (0.5).
         let half = Footprint { duv_dx: Vec2::new(2f32.sqrt() / 2.0, 0.0), duv_dy: Vec2::ZERO };
-        let v = t.sample(Vec2::new(0.75, 0.5), &half, TextureFilter::Trilinear, Wrap::Repeat);
+        let v = t.sample(Vec2::new(0.75, 0.5), &half, TextureFilter::Trilinear, [Wrap::Repeat; 2]);
         assert!((v.x - 0.75).abs() < 1e-6, "{v}");
+    }
+
+    #[test]
+    fn mirrored_repeat_and_wrap_per_axis_by_hand() {
+        // Three texels 0, 1, 2 along u; one row.
+        let t = Texture::new(3, 1, grey(&[0.0, 1.0, 2.0]));
+        let none = Footprint::default();
+        let at = |u: f32, wrap: [Wrap; 2]| t.sample(Vec2::new(u, 0.5), &none, TextureFilter::Nearest, wrap).x;
+        let mirrored = [Wrap::MirroredRepeat, Wrap::Repeat];
+        // Columns -3..6 of a mirrored row: 2 1 0 | 0 1 2 | 2 1 0.
+        let columns: Vec<f32> = (-3..6).map(|c| at((c as f32 + 0.5) / 3.0, mirrored)).collect();
+        assert_eq!(columns, vec![2.0, 1.0, 0.0, 0.0, 1.0, 2.0, 2.0, 1.0, 0.0]);
+        // Beyond the right edge: repeat starts over, clamp holds, mirror turns back.
+        assert_eq!(at(1.0 + 0.5 / 3.0, [Wrap::Repeat; 2]), 0.0);
+        assert_eq!(at(1.0 + 0.5 / 3.0, [Wrap::Clamp; 2]), 2.0);
+        assert_eq!(at(1.0 + 0.5 / 3.0, mirrored), 2.0);
+        // Rows follow wrap[1] only: a column of texels 0 (top) and 1 (bottom).
+        let c = Texture::new(1, 2, grey(&[0.0, 1.0]));
+        let row = |v: f32, wrap: [Wrap; 2]| c.sample(Vec2::new(0.5, v), &none, TextureFilter::Nearest, wrap).x;
+        // v = 1.25 is a quarter of a copy above the top: repeat reads the
+        // bottom texel again, clamp the top one.
+        assert_eq!(row(1.25, [Wrap::Clamp, Wrap::Repeat]), 1.0);
+        assert_eq!(row(1.25, [Wrap::Repeat, Wrap::Clamp]), 0.0);
+    }
+
+    #[test]
+    fn a_sampler_caps_the_filter() {
+        use TextureFilter::*;
+        assert_eq!(Trilinear.at_most(Nearest), Nearest);
+        assert_eq!(Trilinear.at_most(Bilinear), Bilinear);
+        assert_eq!(Nearest.at_most(Trilinear), Nearest);
+        assert_eq!(Bilinear.at_most(Trilinear), Bilinear);
     }
 }

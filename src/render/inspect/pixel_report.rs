@@ -41,12 +41,21 @@ fn instance_of<'s>(scene: &'s Scene, h: &SurfaceHit) -> Option<&'s crate::scene:
     }
 }
 
+/// The named part (a glTF node and mesh) a hit is on, if any.
+fn part_of(scene: &Scene, h: &SurfaceHit) -> Option<String> {
+    match h.kind {
+        PrimitiveKind::Triangle => scene.part_name(h.primitive).map(str::to_string),
+        PrimitiveKind::Sphere | PrimitiveKind::Csg => None,
+    }
+}
+
 fn hit_json(scene: &Scene, h: &SurfaceHit) -> Value {
     json!({
         "kind": kind(h.kind), "primitive": h.primitive, "object": h.object,
         "object_name": scene.objects.get(h.object as usize).map(|o| o.name.clone()),
         "instance": instance_of(scene, h).map(|i| i.index),
         "instance_name": instance_of(scene, h).map(|i| scene.instance_name(i)),
+        "part": part_of(scene, h),
         "material": scene.materials.get(h.material as usize).map(|m| m.name.clone()),
         "t": h.t, "position": v3(h.position), "barycentric": v3(h.barycentric),
         "geometric_normal": v3(h.geometric_normal), "shading_normal": v3(h.shading_normal),
@@ -261,7 +270,10 @@ pub fn to_text(renderer: &str, scene: &Scene, x: u32, y: u32, replay: &PixelRepl
             match &r.closest {
                 Some(h) => {
                     let mat = scene.materials.get(h.material as usize).map(|m| m.name.as_str()).unwrap_or("?");
-                    let instance = instance_of(scene, h).map(|i| format!(", {}", scene.instance_name(i))).unwrap_or_default();
+                    let mut instance = instance_of(scene, h).map(|i| format!(", {}", scene.instance_name(i))).unwrap_or_default();
+                    if let Some(part) = part_of(scene, h) {
+                        instance += &format!(", {part}");
+                    }
                     let _ = writeln!(
                         s,
                         "{indent}  closest: {} {} (object {}{instance}, material {mat}) at t = {:.6}\n{indent}    P = {}  n = {}  b = {}",

@@ -186,6 +186,15 @@ fn unsupported(scene: &Scene, settings: &RenderSettings) -> Result<(), String> {
     if let Some(m) = drawn.clone().find(|m| m.has_glossy() && m.glossy_model == crate::scene::material::GlossyModel::Ward) {
         return refuse(&format!("cannot draw glossy_model \"ward\" yet (material \"{}\"); use raytrace or rasterize", m.name));
     }
+    if !scene.vertex_colours.is_empty() {
+        return refuse("cannot draw vertex colours yet; use raytrace or rasterize");
+    }
+    if let Some(m) = drawn.clone().find(|m| m.metallic.is_some() || m.emission_map.is_some()) {
+        return refuse(&format!("cannot draw textured metallic-roughness or emission yet (material \"{}\"); use raytrace or rasterize", m.name));
+    }
+    if let Some(m) = drawn.clone().find(|m| m.wrap[0] != m.wrap[1] || m.wrap[0] == crate::scene::texture::Wrap::MirroredRepeat) {
+        return refuse(&format!("wraps textures the same way along u and v, by repeat or clamp only (material \"{}\"); use raytrace or rasterize", m.name));
+    }
     if let Some(m) = drawn.clone().find(|m| m.transmission != crate::math::Vec3::ZERO) {
         return refuse(&format!("cannot trace glass rays (material \"{}\")", m.name));
     }

@@ -6,7 +6,7 @@
 use crate::math::Vec3;
 use crate::render::transport::lighting;
 use crate::render::transport::lighting::SurfaceLanes;
-use crate::scene::material::GlossyModel;
+use crate::scene::material::{GlossyModel, IntoLobes, PointLobes};
 use crate::scene::tangents::tangent_at;
 use crate::scene::{Material, Scene, SurfaceHit};
 
@@ -41,24 +41,25 @@ impl ShadingFrame {
 /// lobe plus the material's glossy lobe, `f = f_d + k_G lobe`, at `frame`
 /// (a normal, or a normal and tangent).
 #[inline]
-pub fn bsdf(material: &Material, albedo: Vec3, frame: impl Into<ShadingFrame>, w_i: Vec3, w_o: Vec3) -> Vec3 {
-    let surface = surface_lane(material, albedo, Vec3::ZERO, frame.into(), w_o);
+pub fn bsdf(material: &Material, lobes: impl IntoLobes, frame: impl Into<ShadingFrame>, w_i: Vec3, w_o: Vec3) -> Vec3 {
+    let surface = surface_lane(material, lobes.into_lobes(material), Vec3::ZERO, frame.into(), w_o);
     lighting::bsdf(&surface, w_i.into()).into()
 }
 
-/// One sample's surface as the lane-generic lighting code reads it.
+/// One sample's surface as the lane-generic lighting code reads it: the
+/// material's lobes at the point (`lobes`) and its models.
 #[inline(always)]
-pub(crate) fn surface_lane(material: &Material, albedo: Vec3, position: Vec3, frame: ShadingFrame, w_o: Vec3) -> SurfaceLanes<f32> {
+pub(crate) fn surface_lane(material: &Material, lobes: PointLobes, position: Vec3, frame: ShadingFrame, w_o: Vec3) -> SurfaceLanes<f32> {
     SurfaceLanes {
         position: position.into(),
         normal: frame.n.into(),
         w_o: w_o.into(),
-        albedo: albedo.into(),
+        albedo: lobes.albedo.into(),
         diffuse: lighting::DiffuseLanes::splat(0.0, material.diffuse_model),
-        glossy: material.glossy.into(),
+        glossy: lobes.glossy.into(),
         sharpness: material.sharpness,
         glossy_model: lighting::model_lane(material.glossy_model),
-        roughness: lighting::roughness_u(material),
+        roughness: lighting::roughness_u(material, lobes.roughness),
         roughness_v: lighting::roughness_v(material),
         tangent: frame.tangent.into(),
         fresnel: lighting::FresnelLanes::splat(0.0, material.fresnel),

@@ -6,7 +6,7 @@
 
 use crate::render::transport::sampling::{blinn_phong_half, blinn_phong_pdf, cosine_hemisphere, cosine_hemisphere_lanes, cosine_hemisphere_pdf, cosine_hemisphere_pdf_lanes, from_local, from_local_lanes, luminance, reflect, tangents};
 use crate::render::transport::microfacet;
-use crate::scene::material::{DiffuseModel, GlossyModel};
+use crate::scene::material::{DiffuseModel, GlossyModel, IntoLobes, PointLobes};
 use std::f32::consts::PI;
 use crate::math::lanes::{Lane, V3};
 use crate::render::transport::bsdf::{bsdf, ShadingFrame};
@@ -27,21 +27,22 @@ pub struct BsdfSample {
 
 /// The probability of choosing the Lambertian lobe; the glossy lobe takes the rest.
 #[inline]
-fn diffuse_probability(material: &Material, albedo: Vec3) -> f32 {
-    let d = luminance(albedo).max(0.0);
-    let g = if material.has_glossy() { luminance(material.glossy).max(0.0) } else { 0.0 };
+fn diffuse_probability(material: &Material, lobes: &PointLobes) -> f32 {
+    let d = luminance(lobes.albedo).max(0.0);
+    let g = if material.has_glossy() { luminance(lobes.glossy).max(0.0) } else { 0.0 };
     if d + g > 0.0 { d / (d + g) } else { 0.0 }
 }
 
 /// The density with which `sample_bsdf` returns `w_i` at `frame` (a
-/// normal, or a normal and tangent).
-pub fn bsdf_pdf(material: &Material, albedo: Vec3, frame: impl Into<ShadingFrame>, w_o: Vec3, w_i: Vec3) -> f32 {
+/// normal, or a normal and tangent) for a point's `lobes` (or albedo).
+pub fn bsdf_pdf(material: &Material, lobes: impl IntoLobes, frame: impl Into<ShadingFrame>, w_o: Vec3, w_i: Vec3) -> f32 {
+    let lobes = lobes.into_lobes(material);
     let frame = frame.into();
     let n = frame.n;
-    let p_d = diffuse_probability(material, albedo);
+    let p_d = diffuse_probability(material, &lobes);
     let mut pdf = p_d * diffuse_pdf(material, n, w_i);
     if material.has_glossy() && p_d < 1.0 {
-        pdf += (1.0 - p_d) * glossy_pdf(material, frame, w_o, w_i);
+        pdf += (1.0 - p_d) * glossy_pdf(material, lobes.roughness, frame, w_o, w_i);
     }
     pdf
 }
@@ -79,9 +80,8 @@ fn sample_diffuse(material: &Material, n: Vec3, u: Vec2) -> Vec3 {
 /// The density with which `sample_glossy` returns `w_i` (over the whole
 /// sphere: directions below the surface have density too, and are refused
 /// by `sample_bsdf`).
-fn glossy_pdf(material: &Material, frame: ShadingFrame, w_o: Vec3, w_i: Vec3) -> f32 {
+fn glossy_pdf(material: &Material, a: f32, frame: ShadingFrame, w_o: Vec3, w_i: Vec3) -> f32 {
     let n = frame.n;
-    let a = material.roughness;
     match material.glossy_model {
         GlossyModel::BlinnPhong => blinn_phong_pdf(n, w_o, w_i, material.sharpness),
         GlossyModel::Phong => {
@@ -148,9 +148,8 @@ fn sample_ward_half(alpha: Vec2, u: Vec2) -> Vec3 {
 /// An incoming direction from the glossy lobe alone (not yet normalized,
 /// possibly below the surface); `None` where the lobe reflects nothing
 /// towards `w_o` (a microfacet lobe seen from below).
-fn sample_glossy(material: &Material, frame: ShadingFrame, w_o: Vec3, u: Vec2) -> Option<Vec3> {
+fn sample_glossy(material: &Material, a: f32, frame: ShadingFrame, w_o: Vec3, u: Vec2) -> Option<Vec3> {
     let n = frame.n;
-    let a = material.roughness;
     Some(match material.glossy_model {
         GlossyModel::BlinnPhong => reflect(w_o, from_local(blinn_phong_half(u, material.sharpness), n)),
         // The Phong lobe is the Blinn-Phong half vector's distribution laid about r.
@@ -175,11 +174,14 @@ fn sample_glossy(material: &Material, frame: ShadingFrame, w_o: Vec3, u: Vec2) -
 /// Samples an incoming direction at a surface with shading normal `n` seen
 /// from `w_o`; `choice` picks the lobe, `u` places the direction. `None` when
 /// the material reflects nothing diffusely or glossily, or the sample falls
-/// below the surface (that path ends: its light is absorbed).
-pub fn sample_bsdf(material: &Material, albedo: Vec3, frame: impl Into<ShadingFrame>, w_o: Vec3, choice: f32, u: Vec2) -> Option<BsdfSample> {
+/// below the surface (that path ends: its light is absorbed). `lobes` are
+/// the point's (or its diffuse albedo).
+pub fn sample_bsdf(material: &Material, lobes: impl IntoLobes, frame: impl Into<ShadingFrame>, w_o: Vec3, choice: f32, u: Vec2) -> Option<BsdfSample> {
+    let lobes = lobes.into_lobes(material);
+    let albedo = lobes.albedo;
     let frame = frame.into();
     let n = frame.n;
-    let p_d = diffuse_probability(material, albedo);
+    let p_d = diffuse_probability(material, &lobes);
     let has_glossy = material.has_glossy() && p_d < 1.0;
     if p_d <= 0.0 && !has_glossy {
         return None;
@@ -190,18 +192,18 @@ pub fn sample_bsdf(material: &Material, albedo: Vec3, frame: impl Into<ShadingFr
     let w_i = if choice < p_d || !has_glossy {
         sample_diffuse(material, n, u)
     } else {
-        sample_glossy(material, frame, w_o, u)?
+        sample_glossy(material, lobes.roughness, frame, w_o, u)?
     };
     if !(n.dot(w_i) > 0.0) {
         return None;
     }
     let w_i = w_i.normalize();
     let cos_i = n.dot(w_i);
-    let pdf = bsdf_pdf(material, albedo, frame, w_o, w_i);
+    let pdf = bsdf_pdf(material, lobes, frame, w_o, w_i);
     if !(pdf > 0.0 && pdf.is_finite()) {
         return None;
     }
-    let weight = bsdf(material, albedo, frame, w_i, w_o) * (cos_i / pdf);
+    let weight = bsdf(material, lobes, frame, w_i, w_o) * (cos_i / pdf);
     weight.is_finite().then_some(BsdfSample { w_i, pdf, weight })
 }
 
@@ -361,7 +363,7 @@ mod tests {
     /// normal, smooth) and below one otherwise.
     #[test]
     fn glossy_densities_integrate_to_one() {
-        let sphere_integral = |m: &Material, w_o: Vec3| integrate_sphere(800, 800, Vec3::Z, |w_i| glossy_pdf(m, Vec3::Z.into(), w_o, w_i) as f64);
+        let sphere_integral = |m: &Material, w_o: Vec3| integrate_sphere(800, 800, Vec3::Z, |w_i| glossy_pdf(m, m.roughness, Vec3::Z.into(), w_o, w_i) as f64);
         let near_normal = Vec3::new(0.3, 0.1, 0.9).normalize();
         let grazing = Vec3::new(0.95, 0.0, 0.3).normalize();
         for (model, roughness, sharpness) in [(GlossyModel::Ggx, 0.2, 0.0), (GlossyModel::Ggx, 0.7, 0.0), (GlossyModel::Phong, 0.1, 10.0), (GlossyModel::Phong, 0.1, 60.0)] {

@@ -83,7 +83,7 @@ pub fn roulette(depth: u32, throughput: Vec3, rng: &mut SampleRng) -> Option<(f3
 pub fn sample_bounce<R: Recorder>(
     scene: &crate::scene::Scene,
     material: &crate::scene::Material,
-    albedo: Vec3,
+    lobes: crate::scene::material::PointLobes,
     hit: &SurfaceHit,
     w_o: Vec3,
     depth: u32,
@@ -93,7 +93,7 @@ pub fn sample_bounce<R: Recorder>(
     let choice = path.rng.next_f32();
     let u = path.rng.next_2d();
     let frame = crate::render::transport::bsdf::ShadingFrame::at(scene, hit, material);
-    let s = sample_bsdf(material, albedo, frame, w_o, choice, u)?;
+    let s = sample_bsdf(material, lobes, frame, w_o, choice, u)?;
     // A direction into the geometric surface would leave from its far side.
     if s.w_i.dot(hit.geometric_normal) <= 0.0 {
         return None;

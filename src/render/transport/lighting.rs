@@ -115,11 +115,11 @@ pub fn model_lane(model: GlossyModel) -> f32 {
     }
 }
 
-/// The alpha `SurfaceLanes::roughness` holds for `material`: Ward's alpha
-/// along u for its lobe, else the microfacet alpha.
+/// The alpha `SurfaceLanes::roughness` holds for `material` at a point of
+/// microfacet alpha `alpha`: Ward's alpha along u for its lobe, else `alpha`.
 #[inline(always)]
-pub fn roughness_u(material: &crate::scene::Material) -> f32 {
-    if material.glossy_model == GlossyModel::Ward { material.roughness_uv.x } else { material.roughness }
+pub fn roughness_u(material: &crate::scene::Material, alpha: f32) -> f32 {
+    if material.glossy_model == GlossyModel::Ward { material.roughness_uv.x } else { alpha }
 }
 
 /// The alpha `SurfaceLanes::roughness_v` holds: Ward's alpha along v.

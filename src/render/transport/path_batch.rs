@@ -21,7 +21,7 @@
 //! finishes in `shade()`'s own code from there.
 
 use crate::render::transport::bsdf_sampling::cosine_lobe;
-use crate::scene::material::DiffuseModel;
+use crate::scene::material::{DiffuseModel, PointLobes};
 use crate::render::transport::gi;
 use crate::render::transport::gi::{GiMode, PathState};
 use crate::render::inspect::pixel_record::NoRecord;
@@ -56,8 +56,8 @@ pub fn start_paths<'p, Q: SceneQuery>(job: &PassJob<'p>, query: &Q, batch: &Batc
     assert!(batch.pending.len == 0 && batch.pending_ray_count == 0, "start_paths on a batch with hits not built (`build_pending`)");
     let settings = job.settings;
     let paths = pool.start(batch.len, |i| PathState::new(batch.pixels[i], batch.samples[i], settings.spp, &settings.gi, job.photons));
-    let (albedo, direct) = direct_in_lanes(job, query, &batch.hits, &batch.w_o, batch.len, paths, &IN_ORDER, blocked, counts);
-    pool.add(&batch.hits, &batch.w_o, slots, &albedo, &direct);
+    let (lobes, direct) = direct_in_lanes(job, query, &batch.hits, &batch.w_o, batch.len, paths, &IN_ORDER, blocked, counts);
+    pool.add(&batch.hits, &batch.w_o, slots, &lobes, &direct);
 }
 
 /// One bounce a path took, kept until the radiance found beyond it is
@@ -70,14 +70,14 @@ struct Bounce {
 }
 
 /// Up to eight surfaces that live paths stand on: lane k holds sample
-/// `sample[k]`'s hit, the unit direction back along its ray, its albedo
+/// `sample[k]`'s hit, the unit direction back along its ray, its lobes
 /// and its direct light.
 struct Group {
     len: usize,
     hits: HitLanes,
     w_o: [Floats; 3],
     sample: [usize; LANES],
-    albedo: [Vec3; LANES],
+    lobes: [PointLobes; LANES],
     direct: [Radiance; LANES],
     /// Triangle hits whose records are not built yet, and their lanes.
     pending: [TriangleHitInput; LANES],
@@ -180,7 +180,7 @@ impl<'p> PathPool<'p> {
     /// `slots.len()`) from directions `w_o`, following the `n` paths last
     /// `start`ed, with the albedo and direct light `direct_in_lanes` found
     /// there; lane k's radiance goes to `out[slots[k]]` of `follow_into`.
-    pub fn add(&mut self, hits: &HitLanes, w_o: &[Floats; 3], slots: &[usize], albedo: &[Vec3; LANES], direct: &[Radiance; LANES]) {
+    pub fn add(&mut self, hits: &HitLanes, w_o: &[Floats; 3], slots: &[usize], lobes: &[PointLobes; LANES], direct: &[Radiance; LANES]) {
         let n = slots.len();
         let first = self.slots.len();
         debug_assert_eq!(self.paths.len(), first + n, "`add` follows `start` of as many paths");
@@ -191,7 +191,7 @@ impl<'p> PathPool<'p> {
         group.hits = *hits;
         group.w_o = *w_o;
         group.sample = std::array::from_fn(|k| first + k);
-        group.albedo = *albedo;
+        group.lobes = *lobes;
         group.direct = *direct;
         self.live += 1;
     }
@@ -229,7 +229,7 @@ impl<'p> PathPool<'p> {
             let blocked = shadow_bits(job, query, groups, &mut self.packet, &mut self.blocked, counts);
             for (g, group) in groups.iter_mut().enumerate() {
                 let bits = blocked.then(|| &self.blocked[g * lights..(g + 1) * lights]);
-                (group.albedo, group.direct) = direct_in_lanes(job, query, &group.hits, &group.w_o, group.len, &mut self.paths, &group.sample, bits, counts);
+                (group.lobes, group.direct) = direct_in_lanes(job, query, &group.hits, &group.w_o, group.len, &mut self.paths, &group.sample, bits, counts);
             }
             std::mem::swap(&mut self.front, &mut self.next);
             depth += 1;
@@ -295,7 +295,7 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
                 let hit = group.hits.get(k);
                 let w_o = Vec3::new(group.w_o[0][k], group.w_o[1][k], group.w_o[2][k]);
                 let mut sh = Shading { scene, query: self.query, settings, path, counts: &mut *self.counts, rec: &mut NoRecord };
-                self.beyond[s] = shade::after_direct(&mut sh, &hit, material, group.albedo[k], w_o, self.depth, group.direct[k]);
+                self.beyond[s] = shade::after_direct(&mut sh, &hit, material, group.lobes[k], w_o, self.depth, group.direct[k]);
                 continue;
             }
             if kind == SurfaceKind::Lambertian {
@@ -305,7 +305,7 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
             }
             let hit = group.hits.get(k);
             let w_o = Vec3::new(group.w_o[0][k], group.w_o[1][k], group.w_o[2][k]);
-            match gi::sample_bounce(scene, material, group.albedo[k], &hit, w_o, self.depth, path, &mut NoRecord) {
+            match gi::sample_bounce(scene, material, group.lobes[k], &hit, w_o, self.depth, path, &mut NoRecord) {
                 Some((w_i, weight, _)) => self.go_on(group, k, w_i, weight),
                 None => self.beyond[s] = group.direct[k] + Vec3::ZERO,
             }
@@ -329,7 +329,7 @@ impl<Q: SceneQuery> DepthPass<'_, '_, '_, Q> {
             let k = m.trailing_zeros() as usize;
             m &= m - 1;
             let s = group.sample[k];
-            let albedo = group.albedo[k];
+            let albedo = group.lobes[k].albedo;
             // `sample_bsdf`'s tests for a Lambertian surface (it reflects
             // something; its sample is usable), `sample_bounce`'s (the
             // direction leaves the geometric surface's front), then the
@@ -489,7 +489,7 @@ impl Group {
             hits: HitLanes::new(),
             w_o: [[0.0; LANES]; 3],
             sample: [0; LANES],
-            albedo: [Vec3::ZERO; LANES],
+            lobes: [PointLobes { albedo: Vec3::ZERO, glossy: Vec3::ZERO, roughness: 1.0 }; LANES],
             direct: [Radiance::ZERO; LANES],
             pending: [TriangleHitInput::default(); LANES],
             pending_lanes: [0; LANES],

@@ -170,7 +170,7 @@ impl PhotonMap {
 
     /// Reflected radiance towards `w_o` at `hit` from the `k` nearest photons:
     /// the sum of `f * flux` over a disc of their radius, divided by its area.
-    pub fn radiance(&self, hit: &SurfaceHit, material: &Material, albedo: Vec3, w_o: Vec3, k: usize) -> Radiance {
+    pub fn radiance(&self, hit: &SurfaceHit, material: &Material, lobes: crate::scene::material::PointLobes, w_o: Vec3, k: usize) -> Radiance {
         NEIGHBOURS.with(|cell| {
             let mut found = cell.borrow_mut();
             self.tree.nearest_as_heap(hit.position, k.max(1), self.max_radius2, &mut found);
@@ -186,7 +186,7 @@ impl PhotonMap {
                 if p.normal.dot(hit.geometric_normal) <= 0.0 || p.w_i.dot(hit.shading_normal) <= 0.0 {
                     continue;
                 }
-                sum += bsdf(material, albedo, hit.shading_normal, p.w_i, w_o) * p.power;
+                sum += bsdf(material, lobes, hit.shading_normal, p.w_i, w_o) * p.power;
             }
             sum / (PI * r2)
         })
@@ -296,8 +296,9 @@ fn trace_photon(scene: &Scene, query: &BvhQuery, mut ray: Ray, mut power: Vec3, 
         let Some(hit) = query.closest(&ray, f32::INFINITY, inside, &mut counts, &mut NoRecord) else { break };
         let material = &scene.materials[hit.material as usize];
         // Photons have no pixel footprint: the finest level, bilinear.
-        let albedo = material.albedo(hit.uv, &crate::scene::texture::Footprint::default(), crate::scene::texture::TextureFilter::Bilinear);
-        let diffuse = albedo + if material.has_glossy() { material.glossy } else { Vec3::ZERO };
+        let tint = scene.vertex_colour(hit.kind, hit.primitive, hit.barycentric);
+        let lobes = material.lobes_tinted(hit.uv, &crate::scene::texture::Footprint::default(), crate::scene::texture::TextureFilter::Bilinear, tint);
+        let diffuse = lobes.albedo + if material.has_glossy() { lobes.glossy } else { Vec3::ZERO };
         if bounce > 0 && diffuse != Vec3::ZERO {
             stored.push(Photon { position: hit.position, w_i: -ray.dir, power, normal: hit.geometric_normal });
         }

@@ -22,6 +22,7 @@ use crate::render::transport::incidence::Incidence;
 use crate::render::transport::shading::Shading;
 use crate::render::{SceneQuery, ShadowMode};
 use crate::scene::emitters::emitted;
+use crate::scene::material::PointLobes;
 use crate::scene::{Material, SurfaceHit};
 
 /// Whether the BSDF strategy is taken at all: with MIS on, and alone when
@@ -95,9 +96,9 @@ pub fn miss_seen<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, dir: Vec3) 
 /// path's bounce) alone finds these lights: the strategy MIS is measured
 /// against. Zero where the surface reflects nothing but by delta
 /// lobes, or the scene has no such lights.
-pub fn sampled_direct<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &SurfaceHit, material: &Material, albedo: Vec3, w_o: Vec3, depth: u32) -> Radiance {
+pub fn sampled_direct<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &SurfaceHit, material: &Material, lobes: PointLobes, w_o: Vec3, depth: u32) -> Radiance {
     let Shading { scene, settings, .. } = *sh;
-    if !scene.has_sampled_lights() || (albedo == Vec3::ZERO && !material.has_glossy()) {
+    if !scene.has_sampled_lights() || (lobes.albedo == Vec3::ZERO && !material.has_glossy()) {
         return Vec3::ZERO;
     }
     let n = hit.shading_normal;
@@ -121,7 +122,7 @@ pub fn sampled_direct<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &
             if cos <= 0.0 || s.w_i.dot(hit.geometric_normal) <= 0.0 || s.radiance == Vec3::ZERO {
                 continue;
             }
-            let f = bsdf(material, albedo, frame, s.w_i, w_o);
+            let f = bsdf(material, lobes, frame, s.w_i, w_o);
             if f == Vec3::ZERO {
                 continue;
             }
@@ -143,7 +144,7 @@ pub fn sampled_direct<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &
                 }
             };
             let visible = visibility > 0.0;
-            let weight = if mis { power_heuristic(count as f32 * s.pdf, bsdf_pdf(material, albedo, frame, w_o, s.w_i)) } else { 1.0 };
+            let weight = if mis { power_heuristic(count as f32 * s.pdf, bsdf_pdf(material, lobes, frame, w_o, s.w_i)) } else { 1.0 };
             let contribution = if visible { s.radiance * f * (cos * weight * visibility / (s.pdf * count as f32)) } else { Vec3::ZERO };
             l_o += contribution;
             if R::ENABLED {
@@ -159,13 +160,13 @@ pub fn sampled_direct<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &
             if cos <= 0.0 || w_i.dot(hit.geometric_normal) <= 0.0 {
                 continue;
             }
-            let f = bsdf(material, albedo, frame, w_i, w_o);
+            let f = bsdf(material, lobes, frame, w_i, w_o);
             let radiance = scene.miss_radiance(w_i);
             if f == Vec3::ZERO || radiance == Vec3::ZERO {
                 continue;
             }
             let visible = settings.shadows == ShadowMode::None || unblocked(sh, hit, w_i, f32::INFINITY);
-            let weight = if mis { power_heuristic(count as f32 * pdf, bsdf_pdf(material, albedo, frame, w_o, w_i)) } else { 1.0 };
+            let weight = if mis { power_heuristic(count as f32 * pdf, bsdf_pdf(material, lobes, frame, w_o, w_i)) } else { 1.0 };
             let contribution = if visible { radiance * f * (cos * weight / (pdf * count as f32)) } else { Vec3::ZERO };
             l_o += contribution;
             if R::ENABLED {
@@ -178,7 +179,7 @@ pub fn sampled_direct<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &
     // does not go on (its last vertex, or no path at all).
     let extra_bsdf_ray = if count == 0 { !path_continues(sh, depth) } else { mis && settings.gi.mode != GiMode::Path };
     if extra_bsdf_ray {
-        l_o += bsdf_sampled(sh, hit, material, albedo, w_o, count);
+        l_o += bsdf_sampled(sh, hit, material, lobes, w_o, count);
     }
     l_o
 }
@@ -186,12 +187,12 @@ pub fn sampled_direct<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &
 /// MIS's BSDF strategy outside path tracing: one direction sampled from
 /// the BSDF, and the light it finds on an emitter or in the environment,
 /// weighted against the light strategy's `count` samples.
-fn bsdf_sampled<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &SurfaceHit, material: &Material, albedo: Vec3, w_o: Vec3, count: u32) -> Radiance {
+fn bsdf_sampled<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &SurfaceHit, material: &Material, lobes: PointLobes, w_o: Vec3, count: u32) -> Radiance {
     let Shading { scene, query, settings, .. } = *sh;
     let choice = sh.path.rng.next_f32();
     let u = sh.path.rng.next_2d();
     let frame = crate::render::transport::bsdf::ShadingFrame::at(scene, hit, material);
-    let Some(s) = sample_bsdf(material, albedo, frame, w_o, choice, u) else { return Vec3::ZERO };
+    let Some(s) = sample_bsdf(material, lobes, frame, w_o, choice, u) else { return Vec3::ZERO };
     if s.w_i.dot(hit.geometric_normal) <= 0.0 {
         return Vec3::ZERO;
     }

@@ -16,6 +16,7 @@ use crate::render::differentials::{self, RayDifferential};
 use crate::render::{Reflections, RenderSettings, SceneQuery, ShadowMode};
 use crate::math::lanes::V3;
 use crate::math::{Radiance, Ray, Vec2, Vec3};
+use crate::scene::material::PointLobes;
 use crate::scene::{Differentials, Material, Scene, SurfaceHit};
 #[cfg(test)]
 use std::f32::consts::PI;
@@ -30,20 +31,21 @@ pub fn shade<Q: SceneQuery, R: Recorder>(
 ) -> Radiance {
     let Shading { scene, .. } = *sh;
     let material = &scene.materials[hit.material as usize];
-    let albedo = albedo_at(material, hit.uv, &hit.diff, sh.settings);
-    let ambient = ambient_term(sh, || *hit, albedo);
-    let surface = surface_lane(material, albedo, hit.position, ShadingFrame::at(scene, hit, material), w_o);
+    let tint = scene.vertex_colour(hit.kind, hit.primitive, hit.barycentric);
+    let lobes = lobes_at(material, hit.uv, &hit.diff, tint, sh.settings);
+    let ambient = ambient_term(sh, || *hit, lobes.albedo);
+    let surface = surface_lane(material, lobes, hit.position, ShadingFrame::at(scene, hit, material), w_o);
     let mut visibility = ShadowQueries { sh: &mut *sh, hit, depth, pending: PendingShadow::default() };
     let direct: Vec3 = lighting::direct_light(&scene.lights, &surface, ambient.into(), &mut visibility).into();
-    after_direct(sh, hit, material, albedo, w_o, depth, direct)
+    after_direct(sh, hit, material, lobes, w_o, depth, direct)
 }
 
-/// The diffuse albedo `shade()` lights at a hit with texture coordinates
-/// `uv` and differentials `diff`: the material's texture read there with
-/// the footprint and the chosen filter.
+/// The lobes `shade()` lights at a hit with texture coordinates `uv`,
+/// differentials `diff` and vertex colour `tint`: the material's textures
+/// read there with the footprint and the chosen filter.
 #[inline]
-pub fn albedo_at(material: &Material, uv: Vec2, diff: &Differentials, settings: &RenderSettings) -> Vec3 {
-    material.albedo(uv, &diff.footprint(), settings.texture_filter)
+pub fn lobes_at(material: &Material, uv: Vec2, diff: &Differentials, tint: Vec3, settings: &RenderSettings) -> PointLobes {
+    material.lobes_tinted(uv, &diff.footprint(), settings.texture_filter, tint)
 }
 
 /// The term `shade()` starts from, before the lights: the constant ambient,
@@ -82,17 +84,17 @@ pub fn adds_after_direct(scene: &Scene, settings: &RenderSettings, material: &Ma
 /// reflection and refraction. `l_o` is the ambient term plus the point and
 /// directional lights' light.
 #[inline]
-pub fn after_direct<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &SurfaceHit, material: &Material, albedo: Vec3, w_o: Vec3, depth: u32, mut l_o: Radiance) -> Radiance {
+pub fn after_direct<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &SurfaceHit, material: &Material, lobes: PointLobes, w_o: Vec3, depth: u32, mut l_o: Radiance) -> Radiance {
     let Shading { settings, .. } = *sh;
     if material.is_emissive() {
         l_o += sampled_light::emitted_seen(sh, hit, w_o);
     }
-    l_o += sampled_light::sampled_direct(sh, hit, material, albedo, w_o, depth);
+    l_o += sampled_light::sampled_direct(sh, hit, material, lobes, w_o, depth);
     match settings.gi.mode {
         GiMode::Path if depth < settings.gi.max_path_depth() => {
-            l_o += indirect_path(sh, hit, material, albedo, w_o, depth);
+            l_o += indirect_path(sh, hit, material, lobes, w_o, depth);
         }
-        GiMode::Photons => l_o += indirect_photons(sh, hit, material, albedo, w_o, depth),
+        GiMode::Photons => l_o += indirect_photons(sh, hit, material, lobes, w_o, depth),
         _ => {}
     }
 
@@ -170,9 +172,9 @@ impl<Q: SceneQuery, R: Recorder> LightVisibility<f32> for ShadowQueries<'_, '_, 
 
 /// Path tracing's indirect term: one direction sampled from the diffuse and
 /// glossy lobes, the radiance found along it weighted by `f cos / pdf`.
-fn indirect_path<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &SurfaceHit, material: &Material, albedo: Vec3, w_o: Vec3, depth: u32) -> Radiance {
+fn indirect_path<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &SurfaceHit, material: &Material, lobes: PointLobes, w_o: Vec3, depth: u32) -> Radiance {
     let Shading { settings, .. } = *sh;
-    let Some((w_i, weight, pdf)) = gi::sample_bounce(sh.scene, material, albedo, hit, w_o, depth, sh.path, sh.rec) else {
+    let Some((w_i, weight, pdf)) = gi::sample_bounce(sh.scene, material, lobes, hit, w_o, depth, sh.path, sh.rec) else {
         return Vec3::ZERO;
     };
     let ray = hit.spawn_ray_front(w_i, settings.shadow_bump);
@@ -195,7 +197,7 @@ fn follow<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, ray: &Ray, depth: 
 /// Photon mapping's indirect term: the map's density estimate at diffuse
 /// surfaces, or at the first hit a final gather of sampled rays whose hits
 /// read the map.
-fn indirect_photons<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &SurfaceHit, material: &Material, albedo: Vec3, w_o: Vec3, depth: u32) -> Radiance {
+fn indirect_photons<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &SurfaceHit, material: &Material, lobes: PointLobes, w_o: Vec3, depth: u32) -> Radiance {
     let Shading { settings, .. } = *sh;
     let Some(map) = sh.path.photons else { return Vec3::ZERO };
     let gather = settings.gi.final_gather;
@@ -204,7 +206,7 @@ fn indirect_photons<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &Su
         for _ in 0..gather {
             let choice = sh.path.rng.next_f32();
             let u = sh.path.rng.next_2d();
-            if let Some(s) = crate::render::transport::bsdf_sampling::sample_bsdf(material, albedo, ShadingFrame::at(sh.scene, hit, material), w_o, choice, u) {
+            if let Some(s) = crate::render::transport::bsdf_sampling::sample_bsdf(material, lobes, ShadingFrame::at(sh.scene, hit, material), w_o, choice, u) {
                 if s.w_i.dot(hit.geometric_normal) > 0.0 {
                     let ray = hit.spawn_ray_front(s.w_i, settings.shadow_bump);
                     sum += s.weight * follow(sh, &ray, depth, false, s.weight, Arrival::Gathered);
@@ -213,10 +215,10 @@ fn indirect_photons<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &Su
         }
         return sum / gather as f32;
     }
-    if albedo == Vec3::ZERO && !material.has_glossy() {
+    if lobes.albedo == Vec3::ZERO && !material.has_glossy() {
         return Vec3::ZERO;
     }
-    let l = map.radiance(hit, material, albedo, w_o, settings.gi.photon_k as usize);
+    let l = map.radiance(hit, material, lobes, w_o, settings.gi.photon_k as usize);
     if R::ENABLED {
         sh.rec.photons(l);
     }

@@ -22,7 +22,7 @@ use crate::math::lanes::{mask_bits, mask_from_bits, simd_level, Lane, V3};
 use crate::math::{Radiance, Ray, Vec2, Vec3};
 use crate::scene::hit_lanes::{EyeSamples, Floats, HitLanes, TriangleHitInput};
 use crate::scene::{CameraView, Light, PrimitiveKind, Scene, SurfaceHit};
-use crate::scene::material::{DiffuseModel, Fresnel, GlossyModel};
+use crate::scene::material::{DiffuseModel, Fresnel, GlossyModel, PointLobes};
 use fearless_simd::{dispatch, f32x16, f32x8, Simd, SimdCombine, SimdFrom};
 
 /// Samples per batch.
@@ -339,7 +339,7 @@ pub fn shade_batch<Q: SceneQuery>(job: &PassJob, query: &Q, batch: &Batch, block
     // they would be.
     let draws = settings.gi.mode != GiMode::None || scene.has_sampled_lights();
     let mut paths: Option<[PathState; LANES]> = draws.then(|| std::array::from_fn(path));
-    let (albedo, direct) = match paths.as_mut() {
+    let (lobes, direct) = match paths.as_mut() {
         Some(paths) => direct_in_lanes(job, query, hits, &batch.w_o, n, paths, &IN_ORDER, blocked, counts),
         None => direct_in_lanes(job, query, hits, &batch.w_o, n, &mut [path(0)], &[0; LANES], blocked, counts),
     };
@@ -359,7 +359,7 @@ pub fn shade_batch<Q: SceneQuery>(job: &PassJob, query: &Q, batch: &Batch, block
         let hit = hits.get(i);
         let w_o = Vec3::new(batch.w_o[0][i], batch.w_o[1][i], batch.w_o[2][i]);
         let mut sh = Shading { scene, query, settings, path: &mut paths[i], counts: &mut *counts, rec: &mut NoRecord };
-        out[i] = shade::after_direct(&mut sh, &hit, material, albedo[i], w_o, 0, direct[i]);
+        out[i] = shade::after_direct(&mut sh, &hit, material, lobes[i], w_o, 0, direct[i]);
     }
     out
 }
@@ -384,7 +384,7 @@ pub fn direct_in_lanes<Q: SceneQuery>(
     path_of: &[usize; LANES],
     blocked: Option<&[u8]>,
     counts: &mut RayCounts,
-) -> ([Vec3; LANES], [Radiance; LANES]) {
+) -> ([PointLobes; LANES], [Radiance; LANES]) {
     let scene = &job.prepared.scene;
     let settings = job.settings;
     // Lanes past `n` repeat lane 0's geometry (so their arithmetic stays
@@ -397,17 +397,17 @@ pub fn direct_in_lanes<Q: SceneQuery>(
         padded = [pad(&hits.position), pad(&hits.shading_normal), pad(w_o)];
         Geometry { position: &padded[0], normal: &padded[1], w_o: &padded[2], tangent: ward_tangents(scene, hits, n) }
     };
-    let mut albedo = [Vec3::ZERO; LANES];
+    let mut lobes = [PointLobes { albedo: Vec3::ZERO, glossy: Vec3::ZERO, roughness: 1.0 }; LANES];
     let first = &scene.materials[hits.material[0] as usize];
-    let materials = if n > 0 && first.texture.is_none() && settings.gi.mode != GiMode::Ao && hits.material[1..n].iter().all(|&m| m == hits.material[0]) {
+    let materials = if n > 0 && !first.varies_over_surface() && scene.vertex_colours.is_empty() && settings.gi.mode != GiMode::Ao && hits.material[1..n].iter().all(|&m| m == hits.material[0]) {
         // One untextured material (the common batch): its albedo, lobes and
         // ambient term are the same in every lane, worked out once and
         // splatted, rather than written lane by lane and loaded back.
-        let a = shade::albedo_at(first, Vec2::ZERO, &hits.diff[0], settings);
+        let l = shade::lobes_at(first, Vec2::ZERO, &hits.diff[0], Vec3::ONE, settings);
         let mut sh = Shading { scene, query, settings, path: &mut paths[path_of[0]], counts: &mut *counts, rec: &mut NoRecord };
-        let ambient = shade::ambient_term(&mut sh, || hits.get(0), a);
-        albedo = [a; LANES];
-        MaterialLanes::Uniform { albedo: a, diffuse: first.diffuse_model, glossy: first.glossy, sharpness: first.sharpness, model: lighting::model_lane(first.glossy_model), roughness: lighting::roughness_u(first), roughness_v: lighting::roughness_v(first), fresnel: first.fresnel, ambient }
+        let ambient = shade::ambient_term(&mut sh, || hits.get(0), l.albedo);
+        lobes = [l; LANES];
+        MaterialLanes::Uniform { albedo: l.albedo, diffuse: first.diffuse_model, glossy: l.glossy, sharpness: first.sharpness, model: lighting::model_lane(first.glossy_model), roughness: lighting::roughness_u(first, l.roughness), roughness_v: lighting::roughness_v(first), fresnel: first.fresnel, ambient }
     } else {
         // Lanes past `n` get a black material.
         let (mut albedo_lanes, mut glossy, mut sharpness, mut ambient_lanes) = ([[0.0; LANES]; 3], [[0.0; LANES]; 3], [1.0; LANES], [[0.0; LANES]; 3]);
@@ -415,17 +415,20 @@ pub fn direct_in_lanes<Q: SceneQuery>(
         let mut diffuse = [[0.0; LANES]; 2];
         for i in 0..n {
             let material = &scene.materials[hits.material[i] as usize];
-            albedo[i] = shade::albedo_at(material, Vec2::new(hits.uv[0][i], hits.uv[1][i]), &hits.diff[i], settings);
+            let b = Vec3::new(hits.barycentric[0][i], hits.barycentric[1][i], hits.barycentric[2][i]);
+            let tint = scene.vertex_colour(hits.kind[i], hits.primitive[i], b);
+            lobes[i] = shade::lobes_at(material, Vec2::new(hits.uv[0][i], hits.uv[1][i]), &hits.diff[i], tint, settings);
+            let l = lobes[i];
             let mut sh = Shading { scene, query, settings, path: &mut paths[path_of[i]], counts: &mut *counts, rec: &mut NoRecord };
-            let ambient = shade::ambient_term(&mut sh, || hits.get(i), albedo[i]);
-            for (a, (v, g)) in [(albedo[i].x, material.glossy.x), (albedo[i].y, material.glossy.y), (albedo[i].z, material.glossy.z)].into_iter().enumerate() {
+            let ambient = shade::ambient_term(&mut sh, || hits.get(i), l.albedo);
+            for (a, (v, g)) in [(l.albedo.x, l.glossy.x), (l.albedo.y, l.glossy.y), (l.albedo.z, l.glossy.z)].into_iter().enumerate() {
                 albedo_lanes[a][i] = v;
                 glossy[a][i] = g;
             }
             (ambient_lanes[0][i], ambient_lanes[1][i], ambient_lanes[2][i]) = (ambient.x, ambient.y, ambient.z);
             sharpness[i] = material.sharpness;
             model[i] = lighting::model_lane(material.glossy_model);
-            roughness[i] = lighting::roughness_u(material);
+            roughness[i] = lighting::roughness_u(material, l.roughness);
             roughness_v[i] = lighting::roughness_v(material);
             fresnel.set(i, material.fresnel);
             (diffuse[0][i], diffuse[1][i]) = (lighting::diffuse_lane(material.diffuse_model), material.diffuse_model.parameter());
@@ -434,7 +437,7 @@ pub fn direct_in_lanes<Q: SceneQuery>(
     };
     let mut visibility = BatchVisibility { job, query, hits, live: ((1u32 << n) - 1) as u8, blocked, counts: &mut *counts };
     let direct = dispatch!(simd_level(), simd => direct_light8(simd, job, &geometry, &materials, &mut visibility));
-    (albedo, direct)
+    (lobes, direct)
 }
 
 /// The tangents of lanes `0..n` of `hits` whose material has Ward's lobe,
@@ -636,13 +639,13 @@ pub fn shade_batch_pair<Q: SceneQuery>(job: &PassJob, query: &Q, pair: [&Batch; 
     }
     let material = &scene.materials[index as usize];
     // Ward's lobe needs each lane's tangent, which pairs do not carry.
-    if material.texture.is_some() || material.glossy_model == GlossyModel::Ward || shade::adds_after_direct(scene, settings, material) {
+    if material.varies_over_surface() || !scene.vertex_colours.is_empty() || material.glossy_model == GlossyModel::Ward || shade::adds_after_direct(scene, settings, material) {
         return false;
     }
     // `direct_in_lanes`' one-material case, for each batch: the albedo
     // and ambient term are worked out from lane 0 and must agree.
     let mut uniform = |batch: &Batch| {
-        let albedo = shade::albedo_at(material, Vec2::ZERO, &batch.hits.diff[0], settings);
+        let albedo = shade::lobes_at(material, Vec2::ZERO, &batch.hits.diff[0], Vec3::ONE, settings).albedo;
         let mut path = PathState::new(batch.pixels[0], batch.samples[0], settings.spp, &settings.gi, job.photons);
         let mut sh = Shading { scene, query, settings, path: &mut path, counts: &mut *counts, rec: &mut NoRecord };
         (albedo, shade::ambient_term(&mut sh, || batch.hits.get(0), albedo))
@@ -651,7 +654,7 @@ pub fn shade_batch_pair<Q: SceneQuery>(job: &PassJob, query: &Q, pair: [&Batch; 
     if (albedo, ambient) != other {
         return false;
     }
-    let materials = MaterialLanes::Uniform { albedo, diffuse: material.diffuse_model, glossy: material.glossy, sharpness: material.sharpness, model: lighting::model_lane(material.glossy_model), roughness: lighting::roughness_u(material), roughness_v: lighting::roughness_v(material), fresnel: material.fresnel, ambient };
+    let materials = MaterialLanes::Uniform { albedo, diffuse: material.diffuse_model, glossy: material.glossy, sharpness: material.sharpness, model: lighting::model_lane(material.glossy_model), roughness: lighting::roughness_u(material, material.roughness), roughness_v: lighting::roughness_v(material), fresnel: material.fresnel, ambient };
     let mut visibility = PairVisibility { shadows: settings.shadows, blocked, counts };
     dispatch!(simd_level(), simd => direct_light16(simd, job, pair, &materials, &mut visibility, out));
     true

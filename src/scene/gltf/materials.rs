@@ -1,35 +1,37 @@
 //! glTF metallic-roughness materials as pinhole materials, and their
-//! base-colour textures decoded.
+//! textures decoded.
 //!
 //! A base colour `b`, metallic `m` and roughness `r` become a Lambertian
 //! lobe `b (1 - m)` plus a GGX lobe with alpha `r^2` whose Schlick Fresnel
-//! term starts at `F0 = mix(0.04, b, m)`. The base-colour texture
-//! multiplies the Lambertian lobe. The emissive factor (times
-//! `KHR_materials_emissive_strength`) is the emitted radiance.
+//! term starts at `F0 = mix(0.04, b, m)`. With a base-colour or
+//! metallic-roughness texture the lobes are worked out point by point
+//! (`Material::metallic`): the base-colour texture multiplies `b`, the
+//! metallic-roughness texture's blue channel `m` and its green channel `r`.
+//! The emissive factor (times `KHR_materials_emissive_strength`, times the
+//! emissive texture) is the emitted radiance; the normal texture bends the
+//! shading normal in the frame the uvs give.
 
 use crate::input::{InputKind, MAX_LIGHT};
 use crate::math::Vec3;
-use crate::scene::material::{Fresnel, GlossyModel, MIN_ROUGHNESS};
-use crate::scene::texture::{decode_texture, Encoding, Texture, Wrap};
+use crate::scene::material::{Fresnel, GlossyModel, Metallic, DIELECTRIC_F0, MIN_ROUGHNESS};
+use crate::scene::texture::{decode_texture, Encoding, Texture, TextureFilter, Wrap};
 use crate::scene::Material;
 use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
 
-/// F0 of dielectrics in the metallic-roughness model.
-const DIELECTRIC_F0: f32 = 0.04;
-
-/// Decodes each image once, however many materials use it.
+/// Decodes each image once per encoding, however many materials use it.
 pub struct Images<'a> {
     pub folder: &'a Path,
     pub buffers: &'a [Vec<u8>],
-    pub decoded: HashMap<usize, Arc<Texture>>,
+    pub decoded: HashMap<(usize, bool), Arc<Texture>>,
 }
 
 impl Images<'_> {
-    fn get(&mut self, image: &gltf::Image) -> Result<Arc<Texture>, String> {
+    fn get(&mut self, image: &gltf::Image, encoding: Encoding) -> Result<Arc<Texture>, String> {
         let i = image.index();
-        if let Some(t) = self.decoded.get(&i) {
+        let key = (i, encoding == Encoding::Srgb);
+        if let Some(t) = self.decoded.get(&key) {
             return Ok(Arc::clone(t));
         }
         let what = format!("image {i}");
@@ -41,9 +43,32 @@ impl Images<'_> {
             }
             gltf::image::Source::Uri { uri, .. } => super::source::read_uri(uri, self.folder, &what, InputKind::Image)?,
         };
-        let texture = Arc::new(decode_texture(bytes, &what, Encoding::Srgb)?);
-        self.decoded.insert(i, Arc::clone(&texture));
+        let texture = Arc::new(decode_texture(bytes, &what, encoding)?);
+        self.decoded.insert(key, Arc::clone(&texture));
         Ok(texture)
+    }
+}
+
+/// A sampler's wrap mode as pinhole's.
+fn wrap(mode: gltf::texture::WrappingMode) -> Wrap {
+    match mode {
+        gltf::texture::WrappingMode::ClampToEdge => Wrap::Clamp,
+        gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
+        gltf::texture::WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
+    }
+}
+
+/// The finest of pinhole's filters a sampler allows: a NEAREST
+/// magnification filter reads single texels, a minification filter
+/// without mipmaps reads level 0 only; unset filters allow everything.
+pub fn finest_filter(sampler: &gltf::texture::Sampler) -> TextureFilter {
+    use gltf::texture::{MagFilter, MinFilter};
+    let blends = sampler.mag_filter() != Some(MagFilter::Nearest);
+    let mipmapped = !matches!(sampler.min_filter(), Some(MinFilter::Nearest | MinFilter::Linear));
+    match (blends, mipmapped) {
+        (false, _) => TextureFilter::Nearest,
+        (true, false) => TextureFilter::Bilinear,
+        (true, true) => TextureFilter::Trilinear,
     }
 }
 
@@ -72,31 +97,55 @@ pub fn convert(m: &gltf::Material, name: String, images: &mut Images, ignored: &
     if !(mat.emission.is_finite() && mat.emission.min_element() >= 0.0 && mat.emission.max_element() <= MAX_LIGHT) {
         return Err(format!("{at}: emissiveFactor times emissiveStrength must be finite, not negative and at most {MAX_LIGHT:e}"));
     }
-    if let Some(info) = pbr.base_color_texture() {
-        if info.tex_coord() != 0 {
-            ignored.push(format!("{at}: a base-colour texture on uv set {}", info.tex_coord()));
-        } else {
-            let texture = info.texture();
-            mat.texture = Some(images.get(&texture.source()).map_err(|e| format!("{at}: baseColorTexture: {e}"))?);
-            mat.wrap = match texture.sampler().wrap_s() {
-                gltf::texture::WrappingMode::ClampToEdge => Wrap::Clamp,
-                gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
-                gltf::texture::WrappingMode::MirroredRepeat => {
-                    ignored.push(format!("{at}: mirrored-repeat wrapping (drawn as repeat)"));
-                    Wrap::Repeat
-                }
-            };
+
+    // The textures pinhole reads, each with its uv set and sampler; the
+    // material has one sampler, the first texture's.
+    let normal = m.normal_texture();
+    let emissive = m.emissive_texture();
+    let slots: [(&str, Option<(gltf::Texture, u32)>); 4] = [
+        ("baseColorTexture", pbr.base_color_texture().map(|i| (i.texture(), i.tex_coord()))),
+        ("metallicRoughnessTexture", pbr.metallic_roughness_texture().map(|i| (i.texture(), i.tex_coord()))),
+        ("normalTexture", normal.as_ref().map(|i| (i.texture(), i.tex_coord()))),
+        ("emissiveTexture", emissive.as_ref().map(|i| (i.texture(), i.tex_coord()))),
+    ];
+    let mut sampler: Option<(usize, [Wrap; 2], TextureFilter)> = None;
+    let mut read = [None, None, None, None];
+    for (k, (what, slot)) in slots.into_iter().enumerate() {
+        let Some((texture, set)) = slot else { continue };
+        if set != 0 {
+            ignored.push(format!("{at}: its {what} on uv set {set}"));
+            continue;
         }
+        let s = texture.sampler();
+        let this = ([wrap(s.wrap_s()), wrap(s.wrap_t())], finest_filter(&s));
+        match sampler {
+            None => sampler = Some((texture.index(), this.0, this.1)),
+            Some((first, w, f)) if (w, f) != this => {
+                ignored.push(format!("{at}: the sampler of its {what} (texture {} is read with texture {first}'s)", texture.index()))
+            }
+            Some(_) => {}
+        }
+        let encoding = if matches!(k, 1 | 2) { Encoding::Linear } else { Encoding::Srgb };
+        read[k] = Some(images.get(&texture.source(), encoding).map_err(|e| format!("{at}: {what}: {e}"))?);
     }
-    for (what, present) in [
-        ("metallic-roughness texture", pbr.metallic_roughness_texture().is_some()),
-        ("normal texture", m.normal_texture().is_some()),
-        ("occlusion texture", m.occlusion_texture().is_some()),
-        ("emissive texture", m.emissive_texture().is_some()),
-    ] {
-        if present {
-            ignored.push(format!("{at}: its {what}"));
-        }
+    if let Some((_, w, f)) = sampler {
+        mat.wrap = w;
+        mat.finest_filter = f;
+    }
+    let [base_map, metallic_map, normal_map, emission_map] = read;
+    if base_map.is_some() || metallic_map.is_some() {
+        mat.metallic = Some(Metallic { base, metallic, roughness, map: metallic_map });
+    }
+    mat.texture = base_map;
+    mat.normal_map = normal_map;
+    if mat.is_emissive() {
+        mat.emission_map = emission_map;
+    }
+    if normal.as_ref().is_some_and(|n| n.scale() != 1.0) {
+        ignored.push(format!("{at}: its normal texture's scale (drawn at 1)"));
+    }
+    if m.occlusion_texture().is_some() {
+        ignored.push(format!("{at}: its occlusion texture"));
     }
     match m.alpha_mode() {
         gltf::material::AlphaMode::Opaque => {}

@@ -18,7 +18,7 @@ use crate::math::{Vec2, Vec3};
 use crate::scene::assets::read_asset;
 use crate::scene::instanced::{Layered, MeshCopy};
 use crate::scene::placement::Placement;
-use crate::scene::{Camera, Fov, Light, ObjectInfo, Scene, Triangle};
+use crate::scene::{Camera, Fov, Light, NamedPart, ObjectInfo, PartOf, Scene, Triangle};
 use glam::Mat4;
 use std::path::Path;
 use std::sync::Arc;
@@ -76,6 +76,16 @@ fn add_gltf_unnamed(scene: &mut Scene, path: &Path, placement: &Placement, objec
             if let Some(i) = position.filter(|i| i.value() >= root.accessors.len()) {
                 return Err(format!("invalid glTF at meshes[{m}].primitives[{p}].attributes[\"POSITION\"]: accessor {} does not exist", i.value()));
             }
+        }
+    }
+    // Its image sources unwrap a missing URI, view or MIME type: refused here first.
+    for (i, image) in root.images.iter().enumerate() {
+        let well_formed = match &image.buffer_view {
+            Some(view) => view.value() < root.buffer_views.len() && image.mime_type.is_some(),
+            None => image.uri.is_some(),
+        };
+        if !well_formed {
+            return Err(format!("invalid glTF at images[{i}]: an image needs a uri, or a bufferView that exists and a mimeType"));
         }
     }
     let doc = gltf::Document::from_json(doc.into_json()).map_err(describe)?;
@@ -194,14 +204,25 @@ fn add_gltf_unnamed(scene: &mut Scene, path: &Path, placement: &Placement, objec
     // Meshes: flattened when one node uses them, shared when several do.
     let first = scene.triangles.len();
     let mut degenerate = 0;
+    let mut copy_index = 0u32;
+    let quoted = |name: Option<&str>| name.map(|n| format!(" \"{}\"", n.chars().take(60).collect::<String>())).unwrap_or_default();
+    let node_names: Vec<Option<&str>> = doc.nodes().map(|n| n.name()).collect();
     for mesh in doc.meshes() {
         let placed = &uses[mesh.index()];
         if placed.is_empty() {
             continue;
         }
-        let local = mesh_triangles(&mesh, &buffers, first_material, fallback, &double_sided, object, &mut degenerate, &mut parts.ignored)?;
+        let part_name = |node: usize| {
+            format!("glTF node {node}{}, mesh {}{}", quoted(node_names.get(node).copied().flatten()), mesh.index(), quoted(mesh.name()))
+        };
+        let (local, colours) = mesh_triangles(&mesh, &buffers, first_material, fallback, &double_sided, object, &mut degenerate, &mut parts.ignored)?;
         if placed.len() == 1 {
             let p = Placement::from_matrix(placed[0].0);
+            let start = scene.triangles.len();
+            if let Some(colours) = colours {
+                scene.vertex_colours.resize(start, [Vec3::ONE; 3]);
+                scene.vertex_colours.extend(colours);
+            }
             for t in local {
                 let t = p.apply(t);
                 if !t.v.iter().all(|v| v.abs().max_element() <= MAX_COORDINATE) {
@@ -209,17 +230,23 @@ fn add_gltf_unnamed(scene: &mut Scene, path: &Path, placement: &Placement, objec
                 }
                 scene.triangles.push(t);
             }
+            scene.parts.push(NamedPart { object, what: PartOf::Triangles(start..scene.triangles.len()), name: part_name(placed[0].1) });
         } else if !local.is_empty() {
+            if colours.is_some() {
+                parts.ignored.push(format!("mesh {}: vertex colours (its nodes share it, and shared meshes have none yet)", mesh.index()));
+            }
             let (lo, hi) = local.iter().flat_map(|t| t.v).fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), v| (lo.min(v), hi.max(v)));
             let mut copies = Vec::new();
-            for (k, (world, node)) in placed.iter().enumerate() {
+            for (world, node) in placed.iter() {
                 for c in 0..8 {
                     let corner = Vec3::new(if c & 1 == 0 { lo.x } else { hi.x }, if c & 2 == 0 { lo.y } else { hi.y }, if c & 4 == 0 { lo.z } else { hi.z });
                     if !(world.transform_point3(corner).abs().max_element() <= MAX_COORDINATE) {
                         return Err(format!("mesh {} placed by node {node}: a vertex lands out of range (coordinates must be between -{MAX_COORDINATE:e} and {MAX_COORDINATE:e})", mesh.index()));
                     }
                 }
-                copies.push(MeshCopy { placement: Some(Placement::from_matrix(*world)), material: None, index: Some(k as u32) });
+                copies.push(MeshCopy { placement: Some(Placement::from_matrix(*world)), material: None, index: Some(copy_index) });
+                scene.parts.push(NamedPart { object, what: PartOf::Copy(copy_index), name: part_name(*node) });
+                copy_index += 1;
             }
             layered.objects.push((object, Arc::new(local), copies));
         }
@@ -232,7 +259,8 @@ fn add_gltf_unnamed(scene: &mut Scene, path: &Path, placement: &Placement, objec
     Ok(parts)
 }
 
-/// The triangles of every primitive of `mesh`, in the mesh's own frame.
+/// The triangles of every primitive of `mesh`, in the mesh's own frame,
+/// and their corners' vertex colours when a primitive has `COLOR_0`.
 #[allow(clippy::too_many_arguments)]
 fn mesh_triangles(
     mesh: &gltf::Mesh,
@@ -243,8 +271,9 @@ fn mesh_triangles(
     object: u32,
     degenerate: &mut usize,
     ignored: &mut Vec<String>,
-) -> Result<Vec<Triangle>, String> {
+) -> Result<(Vec<Triangle>, Option<Vec<[Vec3; 3]>>), String> {
     let mut out = Vec::new();
+    let mut colours_out: Option<Vec<[Vec3; 3]>> = None;
     for prim in mesh.primitives() {
         let at = format!("mesh {} primitive {}", mesh.index(), prim.index());
         let positions = prim.get(&gltf::Semantic::Positions).ok_or(format!("{at} has no POSITION attribute"))?;
@@ -266,8 +295,25 @@ fn mesh_triangles(
                 return Err(format!("{at}: its {what} and positions differ in count"));
             }
         }
-        if prim.get(&gltf::Semantic::Colors(0)).is_some() {
-            ignored.push(format!("{at}: vertex colours"));
+        let colours: Option<Vec<Vec3>> = match prim.get(&gltf::Semantic::Colors(0)) {
+            Some(a) => {
+                let read = match a.dimensions().multiplicity() {
+                    4 => accessor::read_floats::<4>(&a, buffers).map(|c| c.into_iter().map(|[r, g, b, _]| Vec3::new(r, g, b)).collect::<Vec<_>>()),
+                    _ => accessor::read_floats::<3>(&a, buffers).map(|c| c.into_iter().map(Vec3::from).collect()),
+                };
+                let c = read.map_err(|e| format!("{at}: COLOR_0: {e}"))?;
+                if c.len() != pos.len() {
+                    return Err(format!("{at}: its COLOR_0 and positions differ in count"));
+                }
+                if let Some(k) = c.iter().position(|v| !(v.is_finite() && v.min_element() >= 0.0 && v.max_element() <= 1.0)) {
+                    return Err(format!("{at}: colour {k} of COLOR_0 (accessor {}) is not a number from 0 to 1", a.index()));
+                }
+                Some(c)
+            }
+            None => None,
+        };
+        if colours.is_some() && colours_out.is_none() {
+            colours_out = Some(vec![[Vec3::ONE; 3]; out.len()]);
         }
         if prim.morph_targets().next().is_some() {
             ignored.push(format!("{at}: morph targets"));
@@ -318,9 +364,12 @@ fn mesh_triangles(
                 None => [Vec2::ZERO; 3],
             };
             out.push(Triangle { v, n, uv, material, object, two_sided });
+            if let Some(c) = colours_out.as_mut() {
+                c.push(colours.as_ref().map_or([Vec3::ONE; 3], |cs| idx.map(|i| cs[i as usize])));
+            }
         }
     }
-    Ok(out)
+    Ok((out, colours_out))
 }
 
 /// Refuses a file whose `extensionsRequired` names an extension pinhole
