@@ -180,12 +180,19 @@ mod tests {
     }
 
     #[test]
-    fn opengl_refuses_the_environment_as_a_light_in_one_sentence() {
+    fn opengl_lights_with_the_environment_without_shadows_and_says_so() {
         let sc = scene("sky");
         assert!(sc.environment.as_ref().is_some_and(|e| e.is_light()));
+        let gl = renderer_by_name("opengl").unwrap();
+        // Asked for maps, it refuses in one sentence.
         let s = RenderSettings { shadows: ShadowMode::Map, mis: false, ..RenderSettings::for_scene(&sc) };
-        let e = admit(renderer_by_name("opengl").unwrap().as_ref(), &sc, &s).unwrap_err();
-        assert_eq!(e, "the opengl renderer cannot light the scene with the [environment] yet; use raytrace or rasterize");
+        let e = admit(gl.as_ref(), &sc, &s).unwrap_err();
+        assert_eq!(e, "the opengl renderer lights the scene with the [environment] without shadows (it casts no rays, and no shadow map holds the sky's), so with --shadows none only");
+        // Asked for rays and MIS (the defaults), it draws no shadows and light sampling alone.
+        let asked = RenderSettings::for_scene(&sc);
+        let a = admit(gl.as_ref(), &sc, &asked).unwrap();
+        assert_eq!(a.settings, RenderSettings { shadows: ShadowMode::None, mis: false, ..asked });
+        assert!(a.notices.len() == 1 && a.notices[0].ends_with("(--shadows none --mis off)") && !a.notices[0].contains('\n'), "{:?}", a.notices);
     }
 
     #[test]

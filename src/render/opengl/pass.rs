@@ -27,6 +27,8 @@ pub struct State {
     /// The area lights and their pattern of points (`scene_data::area_lights`).
     area_light_buffer: glow::Buffer,
     area_point_buffer: glow::Buffer,
+    /// The environment light's directions (`scene_data::environment_light`).
+    environment_buffer: glow::Buffer,
     /// The uploaded geometry: its fingerprint, triangle runs, sphere count.
     uploaded: Option<(u64, Vec<scene_data::Run>, usize)>,
     /// The two-level layer's shared meshes (`scene_data::layer_geometry`)
@@ -133,6 +135,7 @@ impl State {
                 light_buffer: gl.create_buffer()?,
                 area_light_buffer: gl.create_buffer()?,
                 area_point_buffer: gl.create_buffer()?,
+                environment_buffer: gl.create_buffer()?,
                 uploaded: None,
                 layer_array,
                 layer_buffer,
@@ -373,6 +376,16 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Opt
             gl.bind_buffer_base(glow::SHADER_STORAGE_BUFFER, 10, Some(state.area_light_buffer));
             gl.bind_buffer_base(glow::SHADER_STORAGE_BUFFER, 11, Some(state.area_point_buffer));
         }
+        let sky_lit = scene.environment.as_ref().is_some_and(|e| e.is_light());
+        if sky_lit {
+            // The count first, then the directions.
+            let directions = scene_data::environment_light(scene, job.settings.light_samples, job.sample, job.settings.gi.seed);
+            let mut data = vec![(directions.len() / 8) as f32, 0.0, 0.0, 0.0];
+            data.extend_from_slice(&directions);
+            gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(state.environment_buffer));
+            gl.buffer_data_u8_slice(glow::SHADER_STORAGE_BUFFER, bytemuck::cast_slice(&data), glow::DYNAMIC_DRAW);
+            gl.bind_buffer_base(glow::SHADER_STORAGE_BUFFER, 12, Some(state.environment_buffer));
+        }
         gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(state.material_buffer));
         gl.buffer_data_u8_slice(glow::SHADER_STORAGE_BUFFER, bytemuck::cast_slice(&scene_data::materials(scene)), glow::DYNAMIC_DRAW);
         gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(state.light_buffer));
@@ -432,9 +445,10 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Opt
             (u.1.clone(), u.2)
         };
         let defines = format!(
-            "{}{}{}{}",
+            "{}{}{}{}{}",
             if mapped { "#define SHADOW_MAP 1\n" } else { "" },
             if area_lit { "#define AREA_LIGHTS 1\n" } else { "" },
+            if sky_lit { "#define ENVIRONMENT_LIGHT 1\n" } else { "" },
             if samples > 1 { "#define MSAA 1\n" } else { "" },
             if views { "#define VIEWS 1\n" } else { "" }
         );

@@ -194,6 +194,32 @@ pub fn area_lights(scene: &Scene, first_faces: &[i32], light_samples: u32, pass:
     (lights, flat)
 }
 
+/// The `[environment]` as the fragment shaders light with it, for a pass:
+/// `AREA_POINTS_PER_SAMPLE * light_samples` directions (at most
+/// `MAX_AREA_POINTS`) importance-sampled from the map's distribution
+/// (`EnvironmentLight::sample`) at an R2 low-discrepancy sequence shifted
+/// per pass by a hash of (pass, seed); two vec4 each, (unit direction, 0)
+/// and (radiance over the direction's density and the count, 0). Empty
+/// without an environment light.
+pub fn environment_light(scene: &Scene, light_samples: u32, pass: u32, seed: u64) -> Vec<f32> {
+    let Some(light) = scene.environment.as_ref().and_then(|e| e.light.as_deref()) else { return Vec::new() };
+    let count = light_samples.saturating_mul(AREA_POINTS_PER_SAMPLE).clamp(1, MAX_AREA_POINTS);
+    let shift = crate::render::transport::sampling::hashed_unit_pair(0xE4F1_0000_0000 | pass as u64, seed);
+    const A1: f64 = 0.754_877_666_246_692_7;
+    const A2: f64 = 0.569_840_290_998_053_3;
+    let mut out = Vec::with_capacity(count as usize * 8);
+    for k in 0..count {
+        let u = crate::math::Vec2::new(((k as f64 * A1 + shift.x as f64).fract()) as f32, ((k as f64 * A2 + shift.y as f64).fract()) as f32);
+        let Some((w, pdf)) = light.sample(u) else { continue };
+        let v = scene.miss_radiance(w) / (pdf * count as f32);
+        if !v.is_finite() || v == crate::math::Vec3::ZERO {
+            continue;
+        }
+        out.extend_from_slice(&[w.x, w.y, w.z, 0.0, v.x, v.y, v.z, 0.0]);
+    }
+    out
+}
+
 /// The unit cube's 12 triangles as 36 corners, for the spheres' bounding boxes.
 pub fn cube_corners() -> Vec<f32> {
     const FACES: [[usize; 4]; 6] = [[0, 1, 3, 2], [4, 6, 7, 5], [0, 4, 5, 1], [2, 3, 7, 6], [0, 2, 6, 4], [1, 5, 7, 3]];

@@ -611,6 +611,27 @@ vec3 area_direct(vec3 p, vec3 n, vec3 g, vec3 w_o, uint m, vec3 albedo) {
 }
 #endif
 
+#ifdef ENVIRONMENT_LIGHT
+// The [environment] as a light: directions importance-sampled from its map
+// (`scene_data::environment_light`) after their count, (unit direction, 0)
+// and (radiance over density and count, 0) each, weighted as light samples
+// without MIS are. Unshadowed: GL casts no rays, and no map holds the
+// sky's shadows.
+layout(std430, binding = 12) readonly buffer EnvironmentSamples { vec4 environment_samples[]; };
+
+vec3 environment_direct(vec3 n, vec3 g, vec3 w_o, uint m, vec3 albedo) {
+    vec3 l_o = vec3(0.0);
+    int count = int(environment_samples[0].x);
+    for (int k = 0; k < count; k++) {
+        vec3 w_i = environment_samples[1 + 2 * k].xyz;
+        float cos_theta = dot(n, w_i);
+        if (cos_theta <= 0.0 || dot(w_i, g) <= 0.0) continue;
+        l_o += environment_samples[2 + 2 * k].xyz * bsdf(n, w_i, w_o, cos_theta, m, albedo) * cos_theta;
+    }
+    return l_o;
+}
+#endif
+
 vec3 shade(vec3 p, vec3 n, vec3 g, vec3 w_o, uint m, vec3 albedo) {
     vec3 l_o = albedo * ambient;
     for (int i = 0; i < light_count; i++) {
@@ -637,6 +658,9 @@ vec3 shade(vec3 p, vec3 n, vec3 g, vec3 w_o, uint m, vec3 albedo) {
     }
 #ifdef AREA_LIGHTS
     l_o += area_direct(p, n, g, w_o, m, albedo);
+#endif
+#ifdef ENVIRONMENT_LIGHT
+    l_o += environment_direct(n, g, w_o, m, albedo);
 #endif
     vec3 mirror = materials[6u * m + 2u].xyz;
     if (mirror_env && mirror != vec3(0.0)) {
