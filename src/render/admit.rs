@@ -158,9 +158,41 @@ mod tests {
         let idle = RenderSettings { shadows: ShadowMode::Ray, shadow_filter: ShadowFilter::Pcf, ..asked };
         let notes = admit(renderer_by_name("raytrace").unwrap().as_ref(), &sc, &idle).unwrap().caveats;
         assert!(notes.len() == 1 && notes[0].contains("changes nothing"), "{notes:?}");
-        // OpenGL refuses lights it cannot sample, in one sentence.
-        let e = admit(renderer_by_name("opengl").unwrap().as_ref(), &sc, &RenderSettings::for_scene(&sc)).unwrap_err();
-        assert!(e.contains("area lights") && !e.contains('\n'), "{e}");
+        // OpenGL draws area lights by light sampling alone and shadow maps,
+        // and says so in one sentence; without light samples it refuses.
+        let gl = renderer_by_name("opengl").unwrap();
+        let asked = RenderSettings::for_scene(&sc);
+        assert!(asked.mis && asked.shadows == ShadowMode::Ray);
+        let a = admit(gl.as_ref(), &sc, &asked).unwrap();
+        assert_eq!(a.settings, RenderSettings { shadows: ShadowMode::Map, mis: false, ..asked.clone() });
+        assert_eq!(a.notices.len(), 1);
+        assert!(a.notices[0].contains("(--shadows map --mis off)") && !a.notices[0].contains('\n'), "{:?}", a.notices);
+        let mapped = RenderSettings { shadows: ShadowMode::Map, ..asked.clone() };
+        let a = admit(gl.as_ref(), &sc, &mapped).unwrap();
+        assert_eq!(a.settings, RenderSettings { mis: false, ..mapped.clone() });
+        assert!(a.notices.len() == 1 && a.notices[0].ends_with("light sampling alone (--mis off)"), "{:?}", a.notices);
+        let e = admit(gl.as_ref(), &sc, &RenderSettings { light_samples: 0, ..mapped }).unwrap_err();
+        assert!(e.contains("--light-samples 0") && !e.contains('\n'), "{e}");
+        // Without area lights, --mis stays as asked.
+        let spheres = scene("spheres");
+        let a = admit(gl.as_ref(), &spheres, &RenderSettings::for_scene(&spheres)).unwrap();
+        assert!(a.settings.mis);
+    }
+
+    #[test]
+    fn opengl_lights_with_the_environment_without_shadows_and_says_so() {
+        let sc = scene("sky");
+        assert!(sc.environment.as_ref().is_some_and(|e| e.is_light()));
+        let gl = renderer_by_name("opengl").unwrap();
+        // Asked for maps, it refuses in one sentence.
+        let s = RenderSettings { shadows: ShadowMode::Map, mis: false, ..RenderSettings::for_scene(&sc) };
+        let e = admit(gl.as_ref(), &sc, &s).unwrap_err();
+        assert_eq!(e, "the opengl renderer lights the scene with the [environment] without shadows (it casts no rays, and no shadow map holds the sky's), so with --shadows none only");
+        // Asked for rays and MIS (the defaults), it draws no shadows and light sampling alone.
+        let asked = RenderSettings::for_scene(&sc);
+        let a = admit(gl.as_ref(), &sc, &asked).unwrap();
+        assert_eq!(a.settings, RenderSettings { shadows: ShadowMode::None, mis: false, ..asked });
+        assert!(a.notices.len() == 1 && a.notices[0].ends_with("(--shadows none --mis off)") && !a.notices[0].contains('\n'), "{:?}", a.notices);
     }
 
     #[test]

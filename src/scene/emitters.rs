@@ -231,6 +231,44 @@ impl Emitters {
         (lum > 0.0 && flux.is_finite() && point.is_finite()).then_some((point, normal, flux))
     }
 
+    /// A point on the emitters for a fixed pattern of light samples, not
+    /// seen from any shading point: the primitive chosen by `u_choose` in
+    /// proportion to power, the point uniform on it by `u` (on the whole
+    /// surface of a sphere). Returns the point, its unit normal, whether
+    /// both sides emit, the area light it belongs to and the emitted
+    /// radiance divided by the density of the point in area measure (the
+    /// choice included): a shading point at distance `d` gets
+    /// `value * cos_surface * cos_light / d^2` from it.
+    pub fn area_sample(&self, scene: &Scene, u_choose: f32, u: Vec2) -> Option<(Vec3, Vec3, bool, u32, Vec3)> {
+        if self.shapes.is_empty() {
+            return None;
+        }
+        let k = self.cdf.partition_point(|&c| c <= u_choose).min(self.shapes.len() - 1);
+        let pmf = self.pmf[k];
+        if !(pmf > 0.0) {
+            return None;
+        }
+        let (point, normal, two_sided, area, emission) = match self.shapes[k] {
+            EmitterShape::Triangle(i) => {
+                let t = scene.triangles.at(i as usize);
+                let r = u.x.sqrt();
+                let (b0, b1) = (1.0 - r, u.y * r);
+                let point = t.v[0] * b0 + t.v[1] * b1 + t.v[2] * (1.0 - b0 - b1);
+                (point, t.geometric_normal(), t.two_sided, t.area(), scene.materials[t.material as usize].emission)
+            }
+            EmitterShape::Sphere(i) => {
+                let s = &scene.spheres[i as usize];
+                let z = 1.0 - 2.0 * u.x;
+                let r = (1.0 - z * z).max(0.0).sqrt();
+                let phi = 2.0 * PI * u.y;
+                let n = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+                (s.center + n * s.radius, n, false, 4.0 * PI * s.radius * s.radius, scene.materials[s.material as usize].emission)
+            }
+        };
+        let value = emission * (area / pmf);
+        (value.is_finite() && point.is_finite() && normal.is_finite()).then_some((point, normal, two_sided, self.light_of[k], value))
+    }
+
     /// A point on an emitter, seen from `p`: the emitter chosen by `u_choose`
     /// in proportion to power, the point placed on it by `u`. `None` where
     /// there are no emitters or the point is degenerate (on the emitter).

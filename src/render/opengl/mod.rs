@@ -82,20 +82,38 @@ impl Renderer for OpenGl {
         unsupported(scene, settings)
     }
 
-    /// Shadow rays it cannot cast: shadow maps in the shaded view, else no shadows.
+    /// Shadow rays it cannot cast: shadow maps in the shaded view, else no
+    /// shadows. BSDF-sampled rays it cannot cast either: area lights and the
+    /// environment by light sampling alone (`--mis off`), tried after the
+    /// shadows alone.
     fn substitutes(&self, settings: &RenderSettings) -> Vec<Substitute> {
-        if settings.shadows != ShadowMode::Ray {
-            return Vec::new();
+        let mut out = Vec::new();
+        if settings.shadows == ShadowMode::Ray {
+            let with = |shadows, notice: String| Substitute { settings: RenderSettings { shadows, ..settings.clone() }, notice };
+            if settings.view != debug::View::Shaded {
+                let notice = format!("opengl cannot trace shadow rays, which the {} view does not show; drawing no shadows (--shadows none)", settings.view.name());
+                out.push(with(ShadowMode::None, notice));
+            } else {
+                out.push(with(ShadowMode::Map, "opengl cannot trace shadow rays; drawing shadow maps instead (--shadows map)".into()));
+                out.push(with(ShadowMode::None, "opengl cannot trace shadow rays, and shadow maps cannot draw this scene; drawing no shadows instead (--shadows none)".into()));
+            }
         }
-        let with = |shadows, notice: String| Substitute { settings: RenderSettings { shadows, ..settings.clone() }, notice };
-        if settings.view != debug::View::Shaded {
-            let notice = format!("opengl cannot trace shadow rays, which the {} view does not show; drawing no shadows (--shadows none)", settings.view.name());
-            return vec![with(ShadowMode::None, notice)];
+        if settings.mis {
+            const NO_MIS: &str = "opengl cannot trace the BSDF-sampled rays that MIS weighs against light samples; lighting by light sampling alone";
+            let no_mis = |s: &RenderSettings, notice: String| Substitute { settings: RenderSettings { mis: false, ..s.clone() }, notice };
+            let mut all = vec![no_mis(settings, format!("{NO_MIS} (--mis off)"))];
+            for sub in &out {
+                let flag = format!("--shadows {}", sub.settings.shadows.name());
+                let (why, what) = match sub.settings.shadows {
+                    ShadowMode::Map => ("", "shadow maps"),
+                    _ => (" (and shadow maps cannot draw this scene)", "no shadows"),
+                };
+                let notice = format!("opengl cannot trace shadow rays{why}, nor the BSDF-sampled rays that MIS weighs against light samples; drawing {what} and lighting by light sampling alone ({flag} --mis off)");
+                all.push(no_mis(&sub.settings, notice));
+            }
+            out.extend(all);
         }
-        vec![
-            with(ShadowMode::Map, "opengl cannot trace shadow rays; drawing shadow maps instead (--shadows map)".into()),
-            with(ShadowMode::None, "opengl cannot trace shadow rays, and shadow maps cannot draw this scene; drawing no shadows instead (--shadows none)".into()),
-        ]
+        out
     }
 
     /// The copies are instanced in GL; its shadow pass draws `Scene::triangles` only.
@@ -171,14 +189,21 @@ fn unsupported(scene: &Scene, settings: &RenderSettings) -> Result<(), String> {
     if settings.interpolation == Interpolation::Gouraud {
         return refuse("supports --interpolation phong|flat only");
     }
-    // Its shaders sum point and directional lights; lights with extent are
-    // sampled by the CPU renderers' shared shading only.
-    if let Some(light) = scene.emitters.lights.first() {
-        let name = scene.objects.get(light.object as usize).map_or_else(|| format!("object {}", light.object), |o| o.name.clone());
-        return refuse(&format!("cannot sample area lights yet ({name} emits light); use raytrace or rasterize"));
-    }
-    if scene.environment.as_ref().is_some_and(|e| e.is_light()) {
-        return refuse("cannot light the scene with the [environment] yet; use raytrace or rasterize");
+    // Area lights and the environment are summed over fixed patterns of
+    // light samples (`scene_data::area_lights`, `environment_light`): there
+    // is no BSDF-sampled ray to weigh them against, and no light sample at
+    // all with --light-samples 0. The environment's light is unshadowed.
+    let sky = scene.environment.as_ref().is_some_and(|e| e.is_light());
+    if (sky || !scene.emitters.is_empty()) && settings.view == debug::View::Shaded {
+        if settings.light_samples == 0 {
+            return refuse("lights area lights and the [environment] by light samples only, not --light-samples 0");
+        }
+        if settings.mis {
+            return refuse("lights area lights and the [environment] by light samples alone (it traces no BSDF-sampled rays), not with --mis on");
+        }
+        if sky && settings.shadows != ShadowMode::None {
+            return refuse("lights the scene with the [environment] without shadows (it casts no rays, and no shadow map holds the sky's), so with --shadows none only");
+        }
     }
     // Only materials something is drawn with: one merely named in the file asks nothing.
     let in_use = scene.materials_in_use();

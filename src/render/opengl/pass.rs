@@ -24,6 +24,11 @@ pub struct State {
     sphere_buffer: glow::Buffer,
     material_buffer: glow::Buffer,
     light_buffer: glow::Buffer,
+    /// The area lights and their pattern of points (`scene_data::area_lights`).
+    area_light_buffer: glow::Buffer,
+    area_point_buffer: glow::Buffer,
+    /// The environment light's directions (`scene_data::environment_light`).
+    environment_buffer: glow::Buffer,
     /// The uploaded geometry: its fingerprint, triangle runs, sphere count.
     uploaded: Option<(u64, Vec<scene_data::Run>, usize)>,
     /// The two-level layer's shared meshes (`scene_data::layer_geometry`)
@@ -128,6 +133,9 @@ impl State {
                 sphere_buffer: gl.create_buffer()?,
                 material_buffer: gl.create_buffer()?,
                 light_buffer: gl.create_buffer()?,
+                area_light_buffer: gl.create_buffer()?,
+                area_point_buffer: gl.create_buffer()?,
+                environment_buffer: gl.create_buffer()?,
                 uploaded: None,
                 layer_array,
                 layer_buffer,
@@ -282,6 +290,14 @@ unsafe fn uniforms(gl: &glow::Context, program: glow::Program, job: &PassJob, en
         let a = scene.render.ambient;
         gl.uniform_3_f32(at("ambient").as_ref(), a.x, a.y, a.z);
         gl.uniform_1_i32(at("light_count").as_ref(), scene.lights.len() as i32);
+        gl.uniform_1_i32(at("area_light_count").as_ref(), scene.emitters.lights.len() as i32);
+        let filter = match job.settings.shadow_filter {
+            crate::render::shadow::ShadowFilter::None => 0,
+            crate::render::shadow::ShadowFilter::Pcf => 1,
+            crate::render::shadow::ShadowFilter::Pcss => 2,
+        };
+        gl.uniform_1_i32(at("shadow_filter").as_ref(), filter);
+        gl.uniform_1_f32(at("pcf_radius").as_ref(), job.settings.pcf_radius);
         gl.uniform_1_i32(at("flat_shading").as_ref(), (job.settings.interpolation == Interpolation::Flat) as i32);
         gl.uniform_1_i32(at("y_down").as_ref(), (job.settings.msaa > 1) as i32);
         let bg = scene.render.background;
@@ -343,13 +359,33 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Opt
         let environment = scene.environment.as_ref().map_or((0, 0), |e| state.textures.handle(&e.texture));
         gl.bind_buffer_base(glow::SHADER_STORAGE_BUFFER, 2, Some(state.sphere_buffer));
         let mapped = job.settings.shadows == ShadowMode::Map;
-        let first_faces = if mapped {
+        let (first_faces, first_area_faces) = if mapped {
             let runs = state.uploaded.as_ref().map(|u| u.1.clone()).unwrap_or_default();
             let key = state.uploaded.as_ref().map_or(0, |u| u.0);
             state.maps.draw(gl, g.clip_control, scene, key, &runs, job.settings.shadow_map_size, state.vertex_array, state.cube_array)?
         } else {
-            Vec::new()
+            (Vec::new(), Vec::new())
         };
+        let area_lit = !scene.emitters.is_empty();
+        if area_lit {
+            let (lights, points) = scene_data::area_lights(scene, &first_area_faces, job.settings.light_samples, job.sample, job.settings.gi.seed);
+            gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(state.area_light_buffer));
+            gl.buffer_data_u8_slice(glow::SHADER_STORAGE_BUFFER, bytemuck::cast_slice(&lights), glow::DYNAMIC_DRAW);
+            gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(state.area_point_buffer));
+            gl.buffer_data_u8_slice(glow::SHADER_STORAGE_BUFFER, bytemuck::cast_slice(&points), glow::DYNAMIC_DRAW);
+            gl.bind_buffer_base(glow::SHADER_STORAGE_BUFFER, 10, Some(state.area_light_buffer));
+            gl.bind_buffer_base(glow::SHADER_STORAGE_BUFFER, 11, Some(state.area_point_buffer));
+        }
+        let sky_lit = scene.environment.as_ref().is_some_and(|e| e.is_light());
+        if sky_lit {
+            // The count first, then the directions.
+            let directions = scene_data::environment_light(scene, job.settings.light_samples, job.sample, job.settings.gi.seed);
+            let mut data = vec![(directions.len() / 8) as f32, 0.0, 0.0, 0.0];
+            data.extend_from_slice(&directions);
+            gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(state.environment_buffer));
+            gl.buffer_data_u8_slice(glow::SHADER_STORAGE_BUFFER, bytemuck::cast_slice(&data), glow::DYNAMIC_DRAW);
+            gl.bind_buffer_base(glow::SHADER_STORAGE_BUFFER, 12, Some(state.environment_buffer));
+        }
         gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(state.material_buffer));
         gl.buffer_data_u8_slice(glow::SHADER_STORAGE_BUFFER, bytemuck::cast_slice(&scene_data::materials(scene)), glow::DYNAMIC_DRAW);
         gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(state.light_buffer));
@@ -409,8 +445,10 @@ pub fn render(g: &mut Gl<State>, job: &PassJob, out: &mut [Radiance], probe: Opt
             (u.1.clone(), u.2)
         };
         let defines = format!(
-            "{}{}{}",
+            "{}{}{}{}{}",
             if mapped { "#define SHADOW_MAP 1\n" } else { "" },
+            if area_lit { "#define AREA_LIGHTS 1\n" } else { "" },
+            if sky_lit { "#define ENVIRONMENT_LIGHT 1\n" } else { "" },
             if samples > 1 { "#define MSAA 1\n" } else { "" },
             if views { "#define VIEWS 1\n" } else { "" }
         );

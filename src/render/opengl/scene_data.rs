@@ -14,7 +14,7 @@ pub struct Geometry {
     pub vertices: Vec<f32>,
     /// Consecutive triangles with the same sidedness and material: (first triangle, count, two-sided, material).
     pub runs: Vec<Run>,
-    /// Per sphere: (centre, radius), (material bits, 0, 0, 0).
+    /// Per sphere: (centre, radius), (material bits, object bits, 0, 0).
     pub spheres: Vec<f32>,
 }
 
@@ -57,7 +57,7 @@ pub fn geometry(scene: &Scene) -> Geometry {
     }
     let mut spheres = Vec::with_capacity(scene.spheres.len() * 8);
     for s in &scene.spheres {
-        spheres.extend_from_slice(&[s.center.x, s.center.y, s.center.z, s.radius, f32::from_bits(s.material), 0.0, 0.0, 0.0]);
+        spheres.extend_from_slice(&[s.center.x, s.center.y, s.center.z, s.radius, f32::from_bits(s.material), f32::from_bits(s.object), 0.0, 0.0]);
     }
     Geometry { vertices, runs, spheres }
 }
@@ -89,12 +89,13 @@ pub fn fingerprint(scene: &Scene) -> u64 {
             mix(x.to_bits());
         }
         mix(s.material);
+        mix(s.object);
     }
     h
 }
 
 /// Per material: (k_L, glossy model), (k_G, sharpness), (k_M, roughness),
-/// (eta, Fresnel term), (k, diffuse model), (diffuse parameter, 0, 0, 0);
+/// (eta, Fresnel term), (k, diffuse model), (diffuse parameter, emission);
 /// the models and the Fresnel term as `lighting::model_lane`,
 /// `diffuse_lane` and `fresnel_lane` code them.
 pub const MATERIAL_FLOATS: usize = 24;
@@ -112,7 +113,7 @@ pub fn materials(scene: &Scene) -> Vec<f32> {
         let fresnel = crate::render::transport::lighting::fresnel_lane(m.fresnel);
         let diffuse = crate::render::transport::lighting::diffuse_lane(m.diffuse_model);
         out.extend_from_slice(&[eta.x, eta.y, eta.z, fresnel, k.x, k.y, k.z, diffuse]);
-        out.extend_from_slice(&[m.diffuse_model.parameter(), 0.0, 0.0, 0.0]);
+        out.extend_from_slice(&[m.diffuse_model.parameter(), m.emission.x, m.emission.y, m.emission.z]);
     }
     if out.is_empty() {
         out.resize(MATERIAL_FLOATS, 0.0);
@@ -136,6 +137,85 @@ pub fn lights(scene: &Scene, first_faces: &[i32]) -> Vec<f32> {
     }
     if out.is_empty() {
         out.resize(8, 0.0);
+    }
+    out
+}
+
+/// Points per light sample of the fixed pattern that lights area lights
+/// (`area_lights`), and the most points in all.
+pub const AREA_POINTS_PER_SAMPLE: u32 = 64;
+pub const MAX_AREA_POINTS: u32 = 4096;
+
+/// The area lights as the fragment shaders light them, for a pass: per
+/// area light (`Scene::emitters.lights`) two vec4, (centre, first face of
+/// its shadow cube map or -1) and (radius, first point, point count, 0);
+/// and the points of a fixed pattern over the emitters, three vec4 each,
+/// (position, both sides emit), (unit normal, 0), (radiance over the
+/// point's area density and the point count, 0), grouped by light.
+///
+/// The pattern: `AREA_POINTS_PER_SAMPLE * light_samples` points (at most
+/// `MAX_AREA_POINTS`), each emitter chosen in proportion to its power by a
+/// stratified number and the point placed on it by a 2D low-discrepancy
+/// sequence (R2), the whole pattern shifted per pass by a hash of (pass,
+/// seed), so the passes of a frame sample different points. It is the
+/// same for every pixel of the pass: GL has no per-pixel stream of random
+/// numbers matching the CPU renderers'.
+pub fn area_lights(scene: &Scene, first_faces: &[i32], light_samples: u32, pass: u32, seed: u64) -> (Vec<f32>, Vec<f32>) {
+    let emitters = &scene.emitters;
+    let count = light_samples.saturating_mul(AREA_POINTS_PER_SAMPLE).clamp(1, MAX_AREA_POINTS);
+    let shift = crate::render::transport::sampling::hashed_unit_pair(0xA4EA_0000_0000 | pass as u64, seed);
+    let shift_choose = crate::render::transport::sampling::hashed_unit_pair(0xA4EA_0001_0000_0000 | pass as u64, seed).x;
+    // R2: the plastic number's powers as the two axes' steps.
+    const A1: f64 = 0.754_877_666_246_692_7;
+    const A2: f64 = 0.569_840_290_998_053_3;
+    let mut points: Vec<(u32, [f32; 12])> = Vec::with_capacity(count as usize);
+    for k in 0..count {
+        let u_choose = ((k as f32 + shift_choose) / count as f32).min(0.999_999_94);
+        let u = crate::math::Vec2::new(((k as f64 * A1 + shift.x as f64).fract()) as f32, ((k as f64 * A2 + shift.y as f64).fract()) as f32);
+        let Some((p, n, two_sided, light, value)) = emitters.area_sample(scene, u_choose, u) else { continue };
+        let v = value / count as f32;
+        points.push((light, [p.x, p.y, p.z, two_sided as u32 as f32, n.x, n.y, n.z, 0.0, v.x, v.y, v.z, 0.0]));
+    }
+    points.sort_by_key(|(light, _)| *light);
+    let mut lights = Vec::with_capacity(emitters.lights.len().max(1) * 8);
+    for (i, l) in emitters.lights.iter().enumerate() {
+        let first = points.partition_point(|(light, _)| (*light as usize) < i);
+        let end = points.partition_point(|(light, _)| (*light as usize) <= i);
+        let face = first_faces.get(i).copied().unwrap_or(-1) as f32;
+        lights.extend_from_slice(&[l.centre.x, l.centre.y, l.centre.z, face, l.radius, first as f32, (end - first) as f32, 0.0]);
+    }
+    if lights.is_empty() {
+        lights.resize(8, 0.0);
+    }
+    let mut flat: Vec<f32> = points.iter().flat_map(|(_, v)| *v).collect();
+    if flat.is_empty() {
+        flat.resize(12, 0.0);
+    }
+    (lights, flat)
+}
+
+/// The `[environment]` as the fragment shaders light with it, for a pass:
+/// `AREA_POINTS_PER_SAMPLE * light_samples` directions (at most
+/// `MAX_AREA_POINTS`) importance-sampled from the map's distribution
+/// (`EnvironmentLight::sample`) at an R2 low-discrepancy sequence shifted
+/// per pass by a hash of (pass, seed); two vec4 each, (unit direction, 0)
+/// and (radiance over the direction's density and the count, 0). Empty
+/// without an environment light.
+pub fn environment_light(scene: &Scene, light_samples: u32, pass: u32, seed: u64) -> Vec<f32> {
+    let Some(light) = scene.environment.as_ref().and_then(|e| e.light.as_deref()) else { return Vec::new() };
+    let count = light_samples.saturating_mul(AREA_POINTS_PER_SAMPLE).clamp(1, MAX_AREA_POINTS);
+    let shift = crate::render::transport::sampling::hashed_unit_pair(0xE4F1_0000_0000 | pass as u64, seed);
+    const A1: f64 = 0.754_877_666_246_692_7;
+    const A2: f64 = 0.569_840_290_998_053_3;
+    let mut out = Vec::with_capacity(count as usize * 8);
+    for k in 0..count {
+        let u = crate::math::Vec2::new(((k as f64 * A1 + shift.x as f64).fract()) as f32, ((k as f64 * A2 + shift.y as f64).fract()) as f32);
+        let Some((w, pdf)) = light.sample(u) else { continue };
+        let v = scene.miss_radiance(w) / (pdf * count as f32);
+        if !v.is_finite() || v == crate::math::Vec3::ZERO {
+            continue;
+        }
+        out.extend_from_slice(&[w.x, w.y, w.z, 0.0, v.x, v.y, v.z, 0.0]);
     }
     out
 }

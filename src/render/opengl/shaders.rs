@@ -293,6 +293,113 @@ bool shadowed(int light, vec3 p, vec3 g, vec3 w_i) {
 }
 #endif
 
+#ifdef AREA_LIGHTS
+// Per area light: (centre, first face of its cube map or -1), (radius,
+// first point, point count, 0); per point of the pattern: (position, both
+// sides emit), (unit normal, 0), (radiance over density and count, 0).
+layout(std430, binding = 10) readonly buffer AreaLights { vec4 area_lights[]; };
+layout(std430, binding = 11) readonly buffer AreaPoints { vec4 area_points[]; };
+uniform int area_light_count;
+#ifdef SHADOW_MAP
+// --shadow-filter: 0 none, 1 pcf, 2 pcss; --pcf-radius in texels.
+uniform int shadow_filter;
+uniform float pcf_radius;
+const int MAX_TAPS_PER_SIDE = 9;
+
+// The taps around a point in one face of an area light's cube map, as
+// `shadow::map::Taps` reads them: the texel `offset` texels from `centre`
+// (clamped to the face), lit unless the point lies farther than its
+// stored distance by more than the bias (which grows with the offset by
+// the slope).
+struct Taps { int face; vec2 centre; float dist; float texel_w; float tan_n; };
+
+bool tap(Taps t, vec2 offset, out float stored) {
+    float last = map_size - 1.0;
+    int x = int(clamp(t.centre.x + offset.x, 0.0, last));
+    int y = int(clamp(t.centre.y + offset.y, 0.0, last));
+    stored = texelFetch(shadow_maps, ivec3(x, int(map_size) - 1 - y, t.face), 0).r;
+    float tolerance = t.texel_w * (map_bias * (1.0 + t.tan_n) + length(offset) * t.tan_n);
+    return !(t.dist - stored > tolerance);
+}
+
+// Taps::offsets: every texel within `radius` while that is at most
+// MAX_TAPS_PER_SIDE per side, else a regular grid of that many.
+int tap_half_count(float radius) {
+    return min(int(ceil(max(radius, 0.0))), MAX_TAPS_PER_SIDE / 2);
+}
+
+float lit_fraction(Taps t, float radius) {
+    int k = tap_half_count(radius);
+    float step = k > 0 ? radius / float(k) : 0.0;
+    int lit = 0;
+    int total = 0;
+    float stored;
+    for (int j = -k; j <= k; j++) {
+        for (int i = -k; i <= k; i++) {
+            if (tap(t, vec2(float(i), float(j)) * step, stored)) lit++;
+            total++;
+        }
+    }
+    return float(lit) / float(total);
+}
+
+// The mean stored distance of the blockers within `radius`; -1 when none.
+float mean_blocker_distance(Taps t, float radius) {
+    int k = tap_half_count(radius);
+    float step = k > 0 ? radius / float(k) : 0.0;
+    float sum = 0.0;
+    int count = 0;
+    float stored;
+    for (int j = -k; j <= k; j++) {
+        for (int i = -k; i <= k; i++) {
+            if (!tap(t, vec2(float(i), float(j)) * step, stored)) {
+                sum += stored;
+                count++;
+            }
+        }
+    }
+    return count > 0 ? sum / float(count) : -1.0;
+}
+
+// ShadowMaps::area_light_visibility: the fraction of area light `light`
+// that the point sees, by its cube map read as --shadow-filter says.
+float area_visibility(int light, vec3 p, vec3 g) {
+    vec4 a = area_lights[2 * light];
+    int first = int(a.w);
+    if (first < 0) return 1.0;
+    vec3 to_light = a.xyz - p;
+    float to_length = length(to_light);
+    vec3 w_i = to_length > 0.0 ? to_light / to_length : vec3(0.0);
+    vec3 v = p - a.xyz;
+    float dist = length(v);
+    if (!(dist > 0.0)) return 1.0;
+    int face = first + cube_face(v);
+    vec4 fa = faces[5 * face];
+    vec4 fb = faces[5 * face + 1];
+    mat3 w2c = transpose(mat3(faces[5 * face + 2].xyz, faces[5 * face + 3].xyz, faces[5 * face + 4].xyz));
+    vec3 c = w2c * (p - fa.xyz);
+    if (!(c.z < 0.0)) return 1.0;
+    float inv = 1.0 / -c.z;
+    vec2 centre = vec2((c.x * inv / fa.w + 1.0) * 0.5 * map_size, (1.0 - c.y * inv / fb.x) * 0.5 * map_size);
+    float cos_n = clamp(abs(dot(g, w_i)), 1e-6, 1.0);
+    float tan_n = slope_bias ? min(sqrt(max(1.0 - cos_n * cos_n, 0.0)) / cos_n, MAX_SLOPE) : 0.0;
+    Taps t = Taps(face, centre, dist, 2.0 * -c.z / map_size, tan_n);
+    if (shadow_filter == 0) return lit_fraction(t, 0.0);
+    if (shadow_filter == 1) return lit_fraction(t, pcf_radius);
+    // PCSS: the light as a disc of equal area, the blocker search in the
+    // cone from the point to the light from a quarter of the way, then the
+    // penumbra's width by similar triangles.
+    float radius = area_lights[2 * light + 1].x * sqrt(2.0 / PI);
+    float near_d = 0.25 * dist;
+    float search = min(radius * (dist - near_d) / (dist * near_d), 0.6) * map_size * 0.5;
+    float blocker = mean_blocker_distance(t, search);
+    if (blocker < 0.0) return 1.0;
+    float penumbra = radius * (dist - blocker) / (blocker * dist) * map_size * 0.5;
+    return lit_fraction(t, min(penumbra, map_size * 0.25));
+}
+#endif
+#endif
+
 #ifdef VIEWS
 // The surface each fragment saw, for the debug views and pixel readback
 // (`views`): position and 1, shading normal and back-face flag, geometric
@@ -423,7 +530,9 @@ vec3 glossy_weight(vec3 glossy, vec4 eta, vec3 k, float c) {
     return glossy * vec3(conductor_fresnel(c, eta.x, k.x), conductor_fresnel(c, eta.y, k.y), conductor_fresnel(c, eta.z, k.z));
 }
 
-vec3 shade(vec3 p, vec3 n, vec3 g, vec3 w_o, uint m, vec3 albedo) {
+// lighting::bsdf: material m's BSDF for light from w_i seen from w_o, at a
+// surface of shading normal n (cos_theta = n . w_i > 0).
+vec3 bsdf(vec3 n, vec3 w_i, vec3 w_o, float cos_theta, uint m, vec3 albedo) {
     vec3 glossy = materials[6u * m + 1u].xyz;
     float s = materials[6u * m + 1u].w;
     float model = materials[6u * m].w;
@@ -431,6 +540,99 @@ vec3 shade(vec3 p, vec3 n, vec3 g, vec3 w_o, uint m, vec3 albedo) {
     vec4 fresnel = materials[6u * m + 3u];
     vec4 conductor_k = materials[6u * m + 4u];
     float diffuse_param = materials[6u * m + 5u].x;
+    vec3 f = albedo * diffuse_factor(conductor_k.w, diffuse_param, n, w_i, w_o);
+    if (glossy != vec3(0.0)) {
+        vec3 w_h = normalize_or_zero(w_i + w_o);
+        vec3 weight = glossy_weight(glossy, fresnel, conductor_k.xyz, dot(w_i, w_h));
+        if (model == 0.0) {
+            float c = max(dot(n, w_h), 0.0);
+            if (s * (1.0 - c) < 20.7) {
+                f += weight * ((s + 2.0) * (s + 4.0) / (8.0 * PI * (exp2(max(-0.5 * s, -126.0)) + s)) * pow(c, s));
+            }
+        } else if (model == 1.0) {
+            vec3 r = (2.0 * dot(n, w_o)) * n - w_o;
+            float c = max(dot(r, w_i), 0.0);
+            if (s * (1.0 - c) < 20.7) {
+                f += weight * ((s + 2.0) * (0.5 / PI) * pow(c, s));
+            }
+        } else {
+            float cos_o = dot(n, w_o);
+            if (cos_o > 0.0) {
+                bool ggx = model == 2.0;
+                float d = microfacet_d(dot(n, w_h), alpha, ggx);
+                float g2 = smith_g1(cos_theta, dot(w_i, w_h), alpha, ggx) * smith_g1(cos_o, dot(w_o, w_h), alpha, ggx);
+                f += weight * (d * g2 / (4.0 * cos_theta * cos_o));
+            }
+        }
+    }
+    return f;
+}
+
+// The emission of material m seen from the front (emitters::emitted).
+vec3 emitted(uint m, bool back) {
+    return back ? vec3(0.0) : materials[6u * m + 5u].yzw;
+}
+
+#ifdef AREA_LIGHTS
+// Direct light from the area lights: the fixed pattern of points over the
+// emitters (`scene_data::area_lights`), each weighted as a light sample of
+// `sampled_light::sampled_direct` is without MIS (radiance, BSDF and both
+// cosines over the squared distance and the point's density), and each
+// light's sum multiplied by the visibility its shadow map gives.
+vec3 area_direct(vec3 p, vec3 n, vec3 g, vec3 w_o, uint m, vec3 albedo) {
+    vec3 l_o = vec3(0.0);
+    for (int i = 0; i < area_light_count; i++) {
+        vec4 b = area_lights[2 * i + 1];
+        int first = int(b.y);
+        int count = int(b.z);
+        vec3 sum = vec3(0.0);
+        for (int k = first; k < first + count; k++) {
+            vec4 q = area_points[3 * k];
+            vec3 normal = area_points[3 * k + 1].xyz;
+            vec3 value = area_points[3 * k + 2].xyz;
+            vec3 offset = q.xyz - p;
+            float d2 = dot(offset, offset);
+            float d = sqrt(d2);
+            if (!(d > 0.0)) continue;
+            vec3 w_i = offset / d;
+            float cos_l = -dot(normal, w_i);
+            if (q.w != 0.0) cos_l = abs(cos_l);
+            if (!(cos_l > 1e-7)) continue;
+            float cos_theta = dot(n, w_i);
+            if (cos_theta <= 0.0 || dot(w_i, g) <= 0.0) continue;
+            sum += value * bsdf(n, w_i, w_o, cos_theta, m, albedo) * (cos_theta * cos_l / d2);
+        }
+#ifdef SHADOW_MAP
+        if (sum != vec3(0.0)) sum *= area_visibility(i, p, g);
+#endif
+        l_o += sum;
+    }
+    return l_o;
+}
+#endif
+
+#ifdef ENVIRONMENT_LIGHT
+// The [environment] as a light: directions importance-sampled from its map
+// (`scene_data::environment_light`) after their count, (unit direction, 0)
+// and (radiance over density and count, 0) each, weighted as light samples
+// without MIS are. Unshadowed: GL casts no rays, and no map holds the
+// sky's shadows.
+layout(std430, binding = 12) readonly buffer EnvironmentSamples { vec4 environment_samples[]; };
+
+vec3 environment_direct(vec3 n, vec3 g, vec3 w_o, uint m, vec3 albedo) {
+    vec3 l_o = vec3(0.0);
+    int count = int(environment_samples[0].x);
+    for (int k = 0; k < count; k++) {
+        vec3 w_i = environment_samples[1 + 2 * k].xyz;
+        float cos_theta = dot(n, w_i);
+        if (cos_theta <= 0.0 || dot(w_i, g) <= 0.0) continue;
+        l_o += environment_samples[2 + 2 * k].xyz * bsdf(n, w_i, w_o, cos_theta, m, albedo) * cos_theta;
+    }
+    return l_o;
+}
+#endif
+
+vec3 shade(vec3 p, vec3 n, vec3 g, vec3 w_o, uint m, vec3 albedo) {
     vec3 l_o = albedo * ambient;
     for (int i = 0; i < light_count; i++) {
         vec4 a = lights[2 * i];
@@ -452,33 +654,14 @@ vec3 shade(vec3 p, vec3 n, vec3 g, vec3 w_o, uint m, vec3 albedo) {
 #ifdef SHADOW_MAP
         if (shadowed(i, p, g, w_i)) continue;
 #endif
-        vec3 f = albedo * diffuse_factor(conductor_k.w, diffuse_param, n, w_i, w_o);
-        if (glossy != vec3(0.0)) {
-            vec3 w_h = normalize_or_zero(w_i + w_o);
-            vec3 weight = glossy_weight(glossy, fresnel, conductor_k.xyz, dot(w_i, w_h));
-            if (model == 0.0) {
-                float c = max(dot(n, w_h), 0.0);
-                if (s * (1.0 - c) < 20.7) {
-                    f += weight * ((s + 2.0) * (s + 4.0) / (8.0 * PI * (exp2(max(-0.5 * s, -126.0)) + s)) * pow(c, s));
-                }
-            } else if (model == 1.0) {
-                vec3 r = (2.0 * dot(n, w_o)) * n - w_o;
-                float c = max(dot(r, w_i), 0.0);
-                if (s * (1.0 - c) < 20.7) {
-                    f += weight * ((s + 2.0) * (0.5 / PI) * pow(c, s));
-                }
-            } else {
-                float cos_o = dot(n, w_o);
-                if (cos_o > 0.0) {
-                    bool ggx = model == 2.0;
-                    float d = microfacet_d(dot(n, w_h), alpha, ggx);
-                    float g2 = smith_g1(cos_theta, dot(w_i, w_h), alpha, ggx) * smith_g1(cos_o, dot(w_o, w_h), alpha, ggx);
-                    f += weight * (d * g2 / (4.0 * cos_theta * cos_o));
-                }
-            }
-        }
-        l_o += (incident * f) * cos_theta;
+        l_o += (incident * bsdf(n, w_i, w_o, cos_theta, m, albedo)) * cos_theta;
     }
+#ifdef AREA_LIGHTS
+    l_o += area_direct(p, n, g, w_o, m, albedo);
+#endif
+#ifdef ENVIRONMENT_LIGHT
+    l_o += environment_direct(n, g, w_o, m, albedo);
+#endif
     vec3 mirror = materials[6u * m + 2u].xyz;
     if (mirror_env && mirror != vec3(0.0)) {
         float cos_o = clamp(dot(w_o, g), -1.0, 1.0);
@@ -658,7 +841,7 @@ void main() {
 #endif
     if (flat_shading) n = g;
     vec3 albedo = albedo_at(v_material, v_uv, duv_dx, duv_dy);
-    colour = vec4(shade(v_position, n, g, -dir, v_material, albedo), 1.0);
+    colour = vec4(shade(v_position, n, g, -dir, v_material, albedo) + emitted(v_material, back), 1.0);
 }
 "#
     )
@@ -746,7 +929,7 @@ void main() {
     write_surface(p, n, back, g, vec3(0.0), uv, 1u, uint(v_sphere));
 #endif
     gl_FragDepth = clamp(near_plane * (far_plane - w) / ((far_plane - near_plane) * w), 0.0, 1.0);
-    colour = vec4(shade(p, n, g, -dir, m, albedo_at(m, uv, duv[0], duv[1])), 1.0);
+    colour = vec4(shade(p, n, g, -dir, m, albedo_at(m, uv, duv[0], duv[1])) + emitted(m, back), 1.0);
 }
 "#
     )
@@ -824,6 +1007,8 @@ uniform vec2 half_extent;
 uniform bool ortho;
 uniform float near_plane;
 uniform vec2 depth_range;
+// An area light's own object (-1: none), left out of its map.
+uniform int skip_object;
 flat out int v_sphere;
 void main() {
     vec4 s = spheres[gl_InstanceID].centre_radius;
@@ -834,6 +1019,8 @@ void main() {
     } else {
         gl_Position = vec4(c.x / half_extent.x, c.y / half_extent.y, near_plane, d);
     }
+    // Every corner outside the clip volume on the same side: nothing is drawn.
+    if (int(spheres[gl_InstanceID].material.y) == skip_object) gl_Position = vec4(2.0, 2.0, 0.5, 1.0);
     v_sphere = gl_InstanceID;
 }
 "#;
@@ -1186,7 +1373,7 @@ void main() {
     float depth = dot(p - eye, -camera_to_world[2]);
     gl_FragDepth = clamp(near_plane * (far_plane - depth) / ((far_plane - near_plane) * depth), 0.0, 1.0);
     // CSG hits carry no footprint: the finest texture level.
-    colour = vec4(shade(p, n, g, -ray_dir, m, albedo_at(m, uv, vec2(0.0), vec2(0.0))), 1.0);
+    colour = vec4(shade(p, n, g, -ray_dir, m, albedo_at(m, uv, vec2(0.0), vec2(0.0))) + emitted(m, back), 1.0);
 }
 "#
     )

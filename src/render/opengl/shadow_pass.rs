@@ -4,14 +4,23 @@
 //! the casters per directional light) into the layers of an R32F texture
 //! array, storing what the CPU maps store (distance from the light, or depth
 //! along its direction). One-sided triangles are drawn only where they face
-//! away from the light, as the CPU maps draw them. The fragment shaders look
-//! the maps up as `ShadowMaps::occluder` does (`shaders`, `shadowed`).
+//! away from the light, as the CPU maps draw them. Each area light gets a
+//! cube map from its centre without its own surfaces, as the CPU draws it
+//! (`shadow_map::cube_views`). The fragment shaders look the maps up as
+//! `ShadowMaps::occluder` and `ShadowMaps::area_light_visibility` do
+//! (`shaders`, `shadowed` and `area_visibility`).
 
 use crate::render::opengl::shaders::{self, compile};
-use crate::render::shadow::map::light_views;
+use crate::render::shadow::map::{cube_views, light_views};
 use crate::render::RenderSettings;
 use crate::scene::{CameraView, Light, Scene};
 use glow::HasContext;
+
+/// The key of the maps drawn and each light's and area light's first face.
+type Drawn = (u64, Vec<Light>, Vec<(u32, crate::math::Vec3)>, u32, FirstFaces);
+
+/// Each light's first face (-1: no map), then each area light's.
+pub type FirstFaces = (Vec<i32>, Vec<i32>);
 
 pub struct ShadowPass {
     triangles: glow::Program,
@@ -20,9 +29,10 @@ pub struct ShadowPass {
     face_buffer: glow::Buffer,
     /// The texture array and its depth buffer: (size, layers).
     storage: Option<(u32, u32, glow::Texture, glow::Renderbuffer)>,
-    /// What the maps in `storage` were drawn for: geometry, lights, size;
-    /// and each light's first face.
-    drawn: Option<(u64, Vec<Light>, u32, Vec<i32>)>,
+    /// What the maps in `storage` were drawn for: geometry, lights, area
+    /// lights (object and centre), size; and each light's and each area
+    /// light's first face.
+    drawn: Option<Drawn>,
 }
 
 impl ShadowPass {
@@ -39,8 +49,9 @@ impl ShadowPass {
         }
     }
 
-    /// Draws the maps unless those of the same geometry (`key`), lights and
-    /// size are there; returns each light's first face (-1: no map).
+    /// Draws the maps unless those of the same geometry (`key`), lights,
+    /// area lights and size are there; returns each light's and each area
+    /// light's first face (-1: no map).
     #[allow(clippy::too_many_arguments)]
     pub unsafe fn draw(
         &mut self,
@@ -52,20 +63,47 @@ impl ShadowPass {
         size: u32,
         vertex_array: glow::VertexArray,
         cube_array: glow::VertexArray,
-    ) -> Result<Vec<i32>, String> {
-        if let Some((k, lights, s, first)) = &self.drawn {
-            if *k == key && *lights == scene.lights && *s == size {
+    ) -> Result<FirstFaces, String> {
+        let areas: Vec<(u32, crate::math::Vec3)> = scene.emitters.lights.iter().map(|l| (l.object, l.centre)).collect();
+        if let Some((k, lights, a, s, first)) = &self.drawn {
+            if *k == key && *lights == scene.lights && *a == areas && *s == size {
                 return Ok(first.clone());
             }
         }
-        let mut faces: Vec<(CameraView, bool)> = Vec::new();
+        // (camera, orthographic, the object whose surfaces are left out)
+        let mut faces: Vec<(CameraView, bool, Option<u32>)> = Vec::new();
         let mut first = Vec::new();
         for light in &scene.lights {
             let views = light_views(scene, light, size);
             first.push(if views.is_empty() { -1 } else { faces.len() as i32 });
             let ortho = matches!(light, Light::Directional { .. });
-            faces.extend(views.into_iter().map(|v| (v, ortho)));
+            faces.extend(views.into_iter().map(|v| (v, ortho, None)));
         }
+        let mut first_area = Vec::new();
+        for &(object, centre) in &areas {
+            let views = cube_views(scene, centre, size);
+            first_area.push(if views.len() == 6 { faces.len() as i32 } else { -1 });
+            if views.len() == 6 {
+                faces.extend(views.into_iter().map(|v| (v, false, Some(object))));
+            }
+        }
+        // Per area light's object: the runs' triangles without that object's.
+        let without = |object: u32| -> Vec<(u32, u32, bool)> {
+            let mut out: Vec<(u32, u32, bool)> = Vec::new();
+            for run in runs {
+                for i in run.first..run.first + run.count {
+                    if scene.triangles.at(i as usize).object == object {
+                        continue;
+                    }
+                    match out.last_mut() {
+                        Some(last) if last.0 + last.1 == i && last.2 == run.two_sided => last.1 += 1,
+                        _ => out.push((i, 1, run.two_sided)),
+                    }
+                }
+            }
+            out
+        };
+        let all: Vec<(u32, u32, bool)> = runs.iter().map(|r| (r.first, r.count, r.two_sided)).collect();
         unsafe {
             let layers = (faces.len() as u32).max(1);
             if self.storage.is_none_or(|(s, l, _, _)| (s, l) != (size, layers)) {
@@ -84,7 +122,7 @@ impl ShadowPass {
             let (_, _, texture, depth) = self.storage.expect("allocated above");
             // Per face: (eye, half_x), (half_y, ortho, 0, 0), the rows of world-to-camera.
             let mut data = Vec::with_capacity(faces.len().max(1) * 20);
-            for (v, ortho) in &faces {
+            for (v, ortho, _) in &faces {
                 let c = v.camera_to_world;
                 data.extend_from_slice(&[v.eye.x, v.eye.y, v.eye.z, v.half_x, v.half_y, *ortho as u32 as f32, 0.0, 0.0]);
                 for axis in [c.x_axis, c.y_axis, c.z_axis] {
@@ -107,7 +145,8 @@ impl ShadowPass {
             gl.depth_mask(true);
             gl.front_face(glow::CCW);
             let bounds = scene.bounds();
-            for (i, (view, ortho)) in faces.iter().enumerate() {
+            let mut skipped: Option<(u32, Vec<(u32, u32, bool)>)> = None;
+            for (i, (view, ortho, skip)) in faces.iter().enumerate() {
                 gl.framebuffer_texture_layer(glow::FRAMEBUFFER, glow::COLOR_ATTACHMENT0, Some(texture), 0, i as i32);
                 let status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
                 if status != glow::FRAMEBUFFER_COMPLETE {
@@ -138,10 +177,20 @@ impl ShadowPass {
                     gl.uniform_1_f32(at("near_plane").as_ref(), if *ortho { 1.0 } else { view.near });
                     gl.uniform_2_f32(at("depth_range").as_ref(), range.0, range.1);
                     gl.uniform_1_f32(at("map_size").as_ref(), size as f32);
+                    gl.uniform_1_i32(at("skip_object").as_ref(), skip.map_or(-1, |o| o as i32));
                 }
+                let drawn_runs = match skip {
+                    None => &all,
+                    Some(o) => {
+                        if skipped.as_ref().is_none_or(|(so, _)| so != o) {
+                            skipped = Some((*o, without(*o)));
+                        }
+                        &skipped.as_ref().expect("made above").1
+                    }
+                };
                 gl.use_program(Some(self.triangles));
                 gl.bind_vertex_array(Some(vertex_array));
-                for &crate::render::opengl::scene_data::Run { first: start, count, two_sided, .. } in runs {
+                for &(start, count, two_sided) in drawn_runs {
                     if two_sided {
                         gl.disable(glow::CULL_FACE);
                     } else {
@@ -164,7 +213,8 @@ impl ShadowPass {
             gl.bind_vertex_array(None);
             gl.bind_framebuffer(glow::FRAMEBUFFER, None);
         }
-        self.drawn = Some((key, scene.lights.clone(), size, first.clone()));
+        let first = (first, first_area);
+        self.drawn = Some((key, scene.lights.clone(), areas, size, first.clone()));
         Ok(first)
     }
 
