@@ -82,11 +82,12 @@ fn agreement(a: &[Radiance], b: &[Radiance]) -> (f64, usize) {
 /// The scenes the agreement test draws at `W` x `H`: every built-in one
 /// (`textures` with its mirror by --reflections env), `forest-100` and
 /// `forest-1`; `forest` has a test of its own.
-/// Every built-in scene GL draws: all but those lit by area lights, which
-/// it refuses (`admit`'s tests check that it says so).
+/// Every built-in scene GL draws: all but those lit by area lights and
+/// those under classic lighting, which it refuses (`admit`'s tests and
+/// `tests/classic_lighting.rs` check that it says so).
 fn agreement_scenes() -> Vec<&'static str> {
     let mut names = pinhole::scene::builtin::names();
-    names.retain(|n| scene(n).emitters.is_empty());
+    names.retain(|n| scene(n).emitters.is_empty() && scene(n).render.lighting == pinhole::scene::Lighting::Physical);
     names.extend(pinhole::scene::builtin::large_names().into_iter().filter(|n| *n != "forest"));
     names
 }

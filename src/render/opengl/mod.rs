@@ -180,6 +180,9 @@ fn unsupported(scene: &Scene, settings: &RenderSettings) -> Result<(), String> {
     if scene.environment.as_ref().is_some_and(|e| e.is_light()) {
         return refuse("cannot light the scene with the [environment] yet; use raytrace or rasterize");
     }
+    if scene.render.lighting == crate::scene::Lighting::Classic {
+        return refuse("cannot shade [render] lighting = \"classic\" (its shader has the physical model only); use raytrace or rasterize");
+    }
     // Only materials something is drawn with: one merely named in the file asks nothing.
     let in_use = scene.materials_in_use();
     let mut drawn = scene.materials.iter().zip(in_use).filter(|(_, used)| *used).map(|(m, _)| m);
