@@ -468,3 +468,29 @@ fn opengl_in_the_viewer_draws_what_render_frame_draws() {
     let background = h.state().scene().render.background;
     assert!(img.iter().filter(|p| **p != background).count() > img.len() / 10, "the teapot is drawn");
 }
+
+#[test]
+fn the_lobe_plot_opens_with_the_directional_albedo() {
+    let mut h = harness(small_scene("spheres"));
+    h.get_by_label("Materials").click();
+    h.step();
+    h.step();
+    h.get_by_label("red lobe plot").click_accesskit();
+    h.step();
+    h.step();
+    // The albedo printed is the plot module's integral for the red material
+    // at the default angle, and a Lambertian-plus-glossy lobe reflects
+    // between its diffuse albedo's share and 1.
+    let red = h.state().params().materials.iter().find(|m| m.name == "red").unwrap().clone();
+    let a = pinhole::app::panels::bsdf_plot::directional_albedo(&red, 45.0);
+    let text = format!("red directional albedo: {:.4} {:.4} {:.4}", a.x, a.y, a.z);
+    h.get_by_label(&text);
+    assert!(a.x > 0.8 && a.x < 1.0, "{a}");
+    // Another incident angle, another albedo (the glossy lobe loses light at grazing).
+    h.get_by_role_and_label(egui::accesskit::Role::Slider, "red incident angle").set_value_accesskit(85.0);
+    h.step();
+    h.step();
+    let b = pinhole::app::panels::bsdf_plot::directional_albedo(&red, 85.0);
+    assert!(b.x < a.x, "{b} at 85 degrees, {a} at 45");
+    h.get_by_label(&format!("red directional albedo: {:.4} {:.4} {:.4}", b.x, b.y, b.z));
+}

@@ -83,13 +83,16 @@ fn agreement(a: &[Radiance], b: &[Radiance]) -> (f64, usize) {
 /// The scenes the agreement test draws at `W` x `H`: every built-in one
 /// (`textures` with its mirror by --reflections env), `forest-100` and
 /// `forest-1`; `forest` has a test of its own.
-/// Every built-in scene GL draws, but those lit by area lights: GL lights
-/// them by a fixed pattern of light samples, the CPU renderers by random
-/// ones, so their pixels differ by design (the area lights' shadows are
-/// compared on their own, `area_light_shadow_filters_in_gl_agree_with_the_cpu_maps`).
+/// Every built-in scene GL draws, but those lit by area lights and those
+/// under classic lighting. GL lights area-lit scenes by a fixed pattern of
+/// light samples, the CPU renderers by random ones, so their pixels differ
+/// by design (the area lights' shadows are compared on their own,
+/// `area_light_shadow_filters_in_gl_agree_with_the_cpu_maps`); classic
+/// lighting it refuses (`admit`'s tests and `tests/classic_lighting.rs`
+/// check that it says so).
 fn agreement_scenes() -> Vec<&'static str> {
     let mut names = pinhole::scene::builtin::names();
-    names.retain(|n| scene(n).emitters.is_empty());
+    names.retain(|n| scene(n).emitters.is_empty() && scene(n).render.lighting == pinhole::scene::Lighting::Physical);
     names.extend(pinhole::scene::builtin::large_names().into_iter().filter(|n| *n != "forest"));
     names
 }

@@ -384,7 +384,11 @@ impl PinholeApp {
             self.settings.apply_configuration(&c.renderer, &c.settings);
             // The configuration replaces a gallery case's knobs: they are the user's now.
             self.gallery = None;
-            self.message = Some(format!("applied {}", c.label));
+            self.message = Some(match c.glossy_model {
+                // The model sweep's edit is of the materials, not the settings.
+                Some(m) => format!("applied {}'s settings; its glossy model is an edit of the materials: choose {} in the Materials panel", c.label, crate::chart::glossy_models::name(m)),
+                None => format!("applied {}", c.label),
+            });
         }
         if let Some(c) = req.set_b {
             let mut b = self.settings.clone();

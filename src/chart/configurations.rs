@@ -13,6 +13,8 @@ use crate::render::shadow::ShadowFilter;
 use crate::render::raster::DEFAULT_RASTERIZE;
 use crate::render::Reflections;
 use crate::scene::texture::TextureFilter;
+use crate::chart::glossy_models;
+use crate::scene::material::GlossyModel;
 use crate::scene::Scene;
 
 /// One point of the methods sweep.
@@ -24,11 +26,30 @@ pub struct Configuration {
     pub group: &'static str,
     pub renderer: String,
     pub settings: RenderSettings,
+    /// The glossy model every glossy material is drawn with instead of its
+    /// own (`glossy_models::switched`): an edit of the scene's materials, not
+    /// a render setting, so the model sweep can set models side by side.
+    pub glossy_model: Option<GlossyModel>,
 }
 
 impl Configuration {
     pub fn new(group: &'static str, renderer: &str, settings: RenderSettings) -> Configuration {
-        Configuration { label: describe(renderer, &settings), group, renderer: renderer.to_string(), settings }
+        Configuration { label: describe(renderer, &settings), group, renderer: renderer.to_string(), settings, glossy_model: None }
+    }
+
+    /// The configuration drawn with every glossy lobe switched to `model`.
+    pub fn with_glossy_model(group: &'static str, renderer: &str, settings: RenderSettings, model: GlossyModel) -> Configuration {
+        let label = format!("{} glossy_model {}", describe(renderer, &settings), glossy_models::name(model));
+        Configuration { label, group, renderer: renderer.to_string(), settings, glossy_model: Some(model) }
+    }
+
+    /// The scene this configuration draws: `scene` itself, or a copy with
+    /// its glossy lobes switched.
+    pub fn scene<'s>(&self, scene: &'s Scene) -> std::borrow::Cow<'s, Scene> {
+        match self.glossy_model {
+            None => std::borrow::Cow::Borrowed(scene),
+            Some(model) => std::borrow::Cow::Owned(glossy_models::switched(scene, model)),
+        }
     }
 }
 
@@ -118,8 +139,9 @@ pub fn describe(renderer: &str, s: &RenderSettings) -> String {
 /// (`render::admit` accepts them with nothing substituted: a substitute
 /// would be measured under a label that does not say what was drawn).
 pub fn accepted(scene: &Scene, config: &Configuration) -> bool {
+    let scene = config.scene(scene);
     crate::render::renderer_by_name(&config.renderer)
-        .and_then(|r| crate::render::admit::admit(r.as_ref(), scene, &config.settings))
+        .and_then(|r| crate::render::admit::admit(r.as_ref(), &scene, &config.settings))
         .is_ok_and(|a| a.notices.is_empty() && a.settings == config.settings)
 }
 
@@ -279,6 +301,15 @@ pub fn method_configurations(scene: &Scene, base: &RenderSettings) -> Vec<Config
         s.gi.mode = GiMode::Path;
         s.spp = 16;
     }));
+    // Glossy models side by side: every glossy lobe drawn by each model in
+    // turn, its parameter matched to the lobe's width, so each model's cost
+    // sits beside its error against the scene's own model's truth.
+    if glossy_models::has_glossy(scene) {
+        for model in glossy_models::SWEPT {
+            out.push(Configuration::with_glossy_model("glossy model", ray, plain.clone(), model));
+        }
+    }
+
     // What the scene cannot be drawn with (CSG objects under the painter or
     // shadow maps, the copies' two-level layer under shadow maps, maps too
     // big for memory...) is not measured: its image would be refused, not wrong.
@@ -289,6 +320,30 @@ pub fn method_configurations(scene: &Scene, base: &RenderSettings) -> Vec<Config
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_model_sweep_lists_every_glossy_model_where_there_is_a_glossy_lobe() {
+        let scene = crate::scene::builtin::load_builtin("spheres").unwrap().unwrap();
+        let base = RenderSettings { width: 40, height: 30, ..RenderSettings::for_scene(&scene) };
+        let configs = method_configurations(&scene, &base);
+        let models: Vec<GlossyModel> = configs.iter().filter(|c| c.group == "glossy model").filter_map(|c| c.glossy_model).collect();
+        assert_eq!(models, glossy_models::SWEPT.to_vec());
+        for c in configs.iter().filter(|c| c.group == "glossy model") {
+            let m = c.glossy_model.unwrap();
+            assert!(c.label.ends_with(&format!("glossy_model {}", glossy_models::name(m))), "{}", c.label);
+            // The edit reaches the scene the configuration draws.
+            assert!(c.scene(&scene).materials.iter().filter(|m| m.has_glossy()).all(|g| g.glossy_model == m));
+        }
+        assert!(configs.iter().filter(|c| c.group != "glossy model").all(|c| c.glossy_model.is_none()));
+        // No glossy lobe, no model sweep.
+        let mut plain = scene.clone();
+        plain.materials.iter_mut().for_each(|m| m.glossy = crate::math::Vec3::ZERO);
+        assert!(method_configurations(&plain, &RenderSettings::for_scene(&plain)).iter().all(|c| c.group != "glossy model"));
+        // Classic lighting has raw forms of the power lobes only: the sweep keeps those.
+        let classic = crate::scene::builtin::load_builtin("cgfs-spheres").unwrap().unwrap();
+        let kept: Vec<GlossyModel> = method_configurations(&classic, &RenderSettings::for_scene(&classic)).iter().filter_map(|c| c.glossy_model).collect();
+        assert_eq!(kept, vec![GlossyModel::BlinnPhong, GlossyModel::Phong]);
+    }
 
     #[test]
     fn labels_name_the_knobs_that_differ_and_are_unique() {

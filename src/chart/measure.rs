@@ -59,6 +59,15 @@ pub fn measure(prepared: &PreparedScene, config: &Configuration, reference: &Ref
         return Err(format!("{} renders {}x{} but the reference is {}x{}", config.label, s.width, s.height, reference.width, reference.height));
     }
     let renderer = render::renderer_by_name(&config.renderer)?;
+    // A configuration that edits the scene (the model sweep) draws its own copy.
+    let edited;
+    let prepared = match config.glossy_model {
+        None => prepared,
+        Some(_) => {
+            edited = PreparedScene::new(config.scene(&prepared.scene).into_owned());
+            &edited
+        }
+    };
     render::frame::build_shadow_maps(prepared, s);
     render::frame::build_photon_map(prepared, s);
     let mut best = f64::INFINITY;

@@ -3,6 +3,7 @@
 //! the trade-off as a chart (PNG) and a table (CSV).
 //!
 //! - `configurations`: what the methods sweep measures on a scene;
+//! - `glossy_models`: the model sweep's edit, every glossy lobe in one model;
 //! - `reference`: the truth (an EXR, or a cached path-traced image);
 //! - `measure`: timing and error of one configuration, the Pareto front, CSV;
 //! - `spp_sweep`: the older sweep over samples per pixel;
@@ -11,6 +12,7 @@
 
 pub mod configurations;
 pub mod gi_sweep;
+pub mod glossy_models;
 pub mod measure;
 pub mod plot;
 pub mod reference;

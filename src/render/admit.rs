@@ -97,7 +97,33 @@ fn check(renderer: &dyn Renderer, scene: &Scene, settings: &RenderSettings) -> R
         shadow_map::check_memory(scene, settings.shadow_map_size)?;
     }
     layer_support::check(renderer, scene, settings)?;
+    classic_lighting(scene, settings)?;
     renderer.check(scene, settings)
+}
+
+/// What no renderer draws under `[render] lighting = "classic"`: traced or
+/// mapped indirect light (the book's model has its ambient term instead),
+/// lobes the book has no raw form of, and a `reflective` above 1 (it would
+/// weigh the local colour by a negative number).
+fn classic_lighting(scene: &Scene, settings: &RenderSettings) -> Result<(), String> {
+    use crate::render::transport::gi::GiMode;
+    use crate::scene::material::GlossyModel;
+    if scene.render.lighting != crate::scene::Lighting::Classic {
+        return Ok(());
+    }
+    if matches!(settings.gi.mode, GiMode::Path | GiMode::Photons) {
+        return Err(format!("--gi {} traces physical light, which [render] lighting = \"classic\" does not describe; use --gi none or ao", settings.gi.mode.name()));
+    }
+    let in_use = scene.materials_in_use();
+    let mut drawn = scene.materials.iter().zip(in_use).filter(|(_, used)| *used).map(|(m, _)| m);
+    if let Some(m) = drawn.clone().find(|m| m.has_glossy() && !matches!(m.glossy_model, GlossyModel::BlinnPhong | GlossyModel::Phong)) {
+        let name = GlossyModel::NAMES.iter().find(|(_, g)| *g == m.glossy_model).map_or("?", |(n, _)| n);
+        return Err(format!("[render] lighting = \"classic\" has a raw form of the phong and blinn-phong lobes only, not glossy_model \"{name}\" (material \"{}\")", m.name));
+    }
+    if let Some(m) = drawn.find(|m| m.mirror.max_element() > 1.0) {
+        return Err(format!("[render] lighting = \"classic\" reads mirror as the book's reflective, from 0 to 1, and material \"{}\" has mirror {}", m.name, m.mirror));
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -20,6 +20,7 @@ const SCENES: &[(&str, &str)] = &[
     ("cornell-box", include_str!("../../assets/scenes/cornell-box.toml")),
     ("soft-shadows", include_str!("../../assets/scenes/soft-shadows.toml")),
     ("sky", include_str!("../../assets/scenes/sky.toml")),
+    ("cgfs-spheres", include_str!("../../assets/scenes/cgfs-spheres.toml")),
 ];
 
 /// The stress gallery's scenes (`gallery::cases`), each built to provoke

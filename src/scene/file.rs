@@ -8,7 +8,7 @@ use crate::scene::texture::{load_texture_as, Encoding, Wrap};
 use crate::scene::material::{DiffuseModel, Fresnel, GlossyModel, MIN_ROUGHNESS};
 use crate::scene::instanced::{build_layer, Layered, MeshCopy};
 use crate::scene::placement::Placement;
-use crate::scene::{Camera, Fov, InstanceInfo, Light, Material, ObjectInfo, RenderDefaults, Scene, Sphere, Triangle};
+use crate::scene::{Camera, Fov, InstanceInfo, Light, Lighting, Material, ObjectInfo, RenderDefaults, Scene, Sphere, Triangle};
 use crate::input::{MAX_COORDINATE, MAX_LIGHT, MAX_VALUE};
 use crate::math::{Vec2, Vec3};
 
@@ -64,6 +64,7 @@ struct RenderDesc {
     background: Option<F3>,
     ambient: Option<F3>,
     exposure: Option<f32>,
+    lighting: Option<String>,
     reference: Option<String>,
 }
 
@@ -267,6 +268,11 @@ fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str, two_
             background: color(r.background, d.background, MAX_VALUE, &where_, "render.background")?,
             ambient: color(r.ambient, d.ambient, MAX_VALUE, &where_, "render.ambient")?,
             exposure: r.exposure.unwrap_or(d.exposure),
+            lighting: match r.lighting.as_deref() {
+                None => d.lighting,
+                Some(name) => Lighting::parse(name)
+                    .ok_or_else(|| format!("{where_}: render.lighting = \"{name}\" is not a lighting model (expected \"physical\" or \"classic\")"))?,
+            },
             reference: r.reference.as_ref().map(|f| base.join(f)),
         };
         if !(scene.render.exposure.is_finite() && scene.render.exposure >= 0.0 && scene.render.exposure <= MAX_VALUE) {

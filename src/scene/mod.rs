@@ -296,6 +296,42 @@ impl InstanceInfo {
     }
 }
 
+/// How a scene's lights and lobes are read (`[render] lighting`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Lighting {
+    /// Radiometric: a point light's `power` falls off as `1 / (4 pi d^2)`,
+    /// lobes are normalized, `mirror` adds its reflection.
+    #[default]
+    Physical,
+    /// Computer Graphics from Scratch's model: a light's `power` or
+    /// `irradiance` is an intensity that does not fall off with distance,
+    /// the diffuse lobe reflects `k_L cos` (no `1 / pi`), the glossy lobe is
+    /// the raw power `k_G c^s` (no normalization, no cosine), and `mirror`
+    /// is the book's `reflective` r: the colour is `(1 - r) local + r
+    /// reflected` (the local colour alone where the recursion stops).
+    Classic,
+}
+
+impl Lighting {
+    /// The names a scene file gives the models.
+    pub const NAMES: [&'static str; 2] = ["physical", "classic"];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Lighting::Physical => "physical",
+            Lighting::Classic => "classic",
+        }
+    }
+
+    pub fn parse(name: &str) -> Option<Lighting> {
+        match name {
+            "physical" => Some(Lighting::Physical),
+            "classic" => Some(Lighting::Classic),
+            _ => None,
+        }
+    }
+}
+
 /// Image and display settings from `[render]`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderDefaults {
@@ -304,6 +340,9 @@ pub struct RenderDefaults {
     pub background: Vec3,
     pub ambient: Vec3,
     pub exposure: f32,
+    /// How lights and lobes are read: physically, or as Computer Graphics
+    /// from Scratch's classic model.
+    pub lighting: Lighting,
     /// A ground-truth image (linear EXR of this size) that charts measure
     /// error against; the path is resolved against the scene file's folder.
     pub reference: Option<std::path::PathBuf>,
@@ -317,6 +356,7 @@ impl Default for RenderDefaults {
             background: Vec3::new(0.0, 0.0, 0.1),
             ambient: Vec3::ZERO,
             exposure: 1.0,
+            lighting: Lighting::Physical,
             reference: None,
         }
     }

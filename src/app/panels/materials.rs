@@ -2,7 +2,8 @@
 //! model and its parameter, k_G with the glossy model and its parameters
 //! (sharpness on a logarithmic slider, the book's advice; roughness; Ward's
 //! two alphas) and the Fresnel term, mirror, transmission, ior and emission
-//! (a colour and a strength: an emissive material is an area light).
+//! (a colour and a strength: an emissive material is an area light), and
+//! a polar plot of the lobe with its directional albedo (`bsdf_plot`).
 
 use eframe::egui;
 use crate::app::panels::{color_edit, section};
@@ -26,6 +27,7 @@ pub fn show(ui: &mut egui::Ui, open: &mut bool, materials: &mut [Material]) {
                         ui.add(egui::DragValue::new(&mut m.ior).range(1.0..=3.0).speed(0.01)).labelled_by(l.id);
                     });
                     emission_edit(ui, m);
+                    crate::app::panels::bsdf_plot::show(ui, m);
                     if m.texture.is_some() {
                         ui.label("textured: k_L multiplies the texture");
                     }

@@ -6,6 +6,7 @@
 //! per frame. The status bar and the inspector ask nothing more.
 
 use eframe::egui;
+pub mod bsdf_plot;
 pub mod camera;
 pub mod compare;
 pub mod inspector;

@@ -205,6 +205,9 @@ fn unsupported(scene: &Scene, settings: &RenderSettings) -> Result<(), String> {
             return refuse("lights the scene with the [environment] without shadows (it casts no rays, and no shadow map holds the sky's), so with --shadows none only");
         }
     }
+    if scene.render.lighting == crate::scene::Lighting::Classic {
+        return refuse("cannot shade [render] lighting = \"classic\" (its shader has the physical model only); use raytrace or rasterize");
+    }
     // Only materials something is drawn with: one merely named in the file asks nothing.
     let in_use = scene.materials_in_use();
     let mut drawn = scene.materials.iter().zip(in_use).filter(|(_, used)| *used).map(|(m, _)| m);

@@ -11,7 +11,7 @@
 use crate::math::lanes::{exp2, pow, Lane, V3};
 use crate::render::transport::microfacet;
 use crate::scene::material::{DiffuseModel, Fresnel, GlossyModel};
-use crate::scene::Light;
+use crate::scene::{Light, Lighting};
 use std::f32::consts::PI;
 
 /// What the BSDF and the lights need of a surface, per lane.
@@ -423,6 +423,40 @@ pub fn blinn_phong_normalization<L: Lane>(s: L) -> L {
     (s + s.splat(2.0)) * (s + s.splat(4.0)) / (s.splat(8.0 * PI) * (exp2(half) + s))
 }
 
+/// A light's intensity under `Lighting::Classic`: its `power` or
+/// `irradiance` as given, whatever the distance.
+#[inline(always)]
+pub fn classic_intensity(light: &Light) -> glam::Vec3 {
+    match *light {
+        Light::Point { power, .. } => power,
+        Light::Directional { irradiance, .. } => irradiance,
+    }
+}
+
+/// What a surface reflects of a light of intensity 1 towards the viewer
+/// under `Lighting::Classic` (Computer Graphics from Scratch, ch. 3): the
+/// diffuse lobe's `f_d pi cos_i` (Lambert: `k_L cos_i`, no `1 / pi`) plus
+/// the glossy lobe's raw power `k_G c^s`, with c = r.w_i for Phong (r the
+/// mirror direction of the viewer; the book's R.V) and c = n.h for
+/// Blinn-Phong, neither normalized nor multiplied by the cosine. `cos_i` is
+/// `n.w_i`; lights behind the surface are never asked for.
+#[inline(always)]
+pub fn classic_reflection<L: Lane>(s: &SurfaceLanes<L>, w_i: V3<L>, cos_i: L) -> V3<L> {
+    let like = s.sharpness;
+    let zero = like.splat(0.0);
+    let diffuse = if L::any(s.diffuse.model.gt(zero)) { diffuse(s, w_i).scale(like.splat(PI) * cos_i) } else { s.albedo.scale(cos_i) };
+    let glossy = !s.glossy.is_zero();
+    if !L::any(glossy) {
+        return diffuse;
+    }
+    let phong = s.glossy_model.eq(like.splat(model_lane(GlossyModel::Phong)));
+    let r = s.normal.scale(like.splat(2.0) * s.normal.dot(s.w_o)) - s.w_o;
+    let w_h = (w_i + s.w_o).normalize_or_zero();
+    let c = L::select(phong, r.dot(w_i), s.normal.dot(w_h));
+    let (counted, lobe) = power_lobe(glossy, s.sharpness, c, || like.splat(1.0));
+    V3::select(counted, diffuse + glossy_weight(s, w_i).scale(lobe), diffuse)
+}
+
 /// Answers, per light, whether it is visible from the surface, and hears
 /// what it contributed (for the pixel recorder).
 pub trait LightVisibility<L: Lane> {
@@ -436,15 +470,20 @@ pub trait LightVisibility<L: Lane> {
 }
 
 /// `start` (the ambient or indirect term) plus every light's
-/// `incident * f * cos`, in the order of `lights`, where visible.
+/// `incident * f * cos`, in the order of `lights`, where visible. Under
+/// `Lighting::Classic` a light's incident value is its intensity at any
+/// distance and its term is `classic_reflection` instead.
 #[inline(always)]
-pub fn direct_light<L: Lane, V: LightVisibility<L>>(lights: &[Light], s: &SurfaceLanes<L>, start: V3<L>, vis: &mut V) -> V3<L> {
+pub fn direct_light<L: Lane, V: LightVisibility<L>>(lights: &[Light], lighting: Lighting, s: &SurfaceLanes<L>, start: V3<L>, vis: &mut V) -> V3<L> {
     let zero = V3::splat(s.sharpness, glam::Vec3::ZERO);
     let mut l_o = start;
     for (index, light) in lights.iter().enumerate() {
-        let inc = incidence(light, s.position, s.normal);
+        let mut inc = incidence(light, s.position, s.normal);
         if !L::any(inc.exists) {
             continue;
+        }
+        if lighting == Lighting::Classic {
+            inc.incident = V3::splat(s.sharpness, classic_intensity(light));
         }
         let lit = inc.illuminates();
         if !L::any(lit) {
@@ -452,8 +491,17 @@ pub fn direct_light<L: Lane, V: LightVisibility<L>>(lights: &[Light], s: &Surfac
             continue;
         }
         let visible = vis.visible(index, &inc, lit);
-        let f = bsdf(s, inc.w_i);
-        let contribution = (inc.incident * f).scale(inc.cos_theta);
+        let (f, contribution) = match lighting {
+            Lighting::Physical => {
+                let f = bsdf(s, inc.w_i);
+                (f, (inc.incident * f).scale(inc.cos_theta))
+            }
+            Lighting::Classic => {
+                let r = classic_reflection(s, inc.w_i, inc.cos_theta);
+                // Reported as the factor on the light's intensity.
+                (r, inc.incident * r)
+            }
+        };
         let counted = lit & visible;
         l_o = V3::select(counted, l_o + contribution, l_o);
         vis.reflected(index, &inc, lit, V3::select(lit, f, zero), V3::select(counted, contribution, zero));

@@ -17,7 +17,7 @@ use crate::render::{Reflections, RenderSettings, SceneQuery, ShadowMode};
 use crate::math::lanes::V3;
 use crate::math::{Radiance, Ray, Vec2, Vec3};
 use crate::scene::material::PointLobes;
-use crate::scene::{Differentials, Material, Scene, SurfaceHit};
+use crate::scene::{Differentials, Lighting, Material, Scene, SurfaceHit};
 #[cfg(test)]
 use std::f32::consts::PI;
 
@@ -36,7 +36,7 @@ pub fn shade<Q: SceneQuery, R: Recorder>(
     let ambient = ambient_term(sh, || *hit, lobes.albedo);
     let surface = surface_lane(material, lobes, hit.position, ShadingFrame::at(scene, hit, material), w_o);
     let mut visibility = ShadowQueries { sh: &mut *sh, hit, depth, pending: PendingShadow::default() };
-    let direct: Vec3 = lighting::direct_light(&scene.lights, &surface, ambient.into(), &mut visibility).into();
+    let direct: Vec3 = lighting::direct_light(&scene.lights, scene.render.lighting, &surface, ambient.into(), &mut visibility).into();
     after_direct(sh, hit, material, lobes, w_o, depth, direct)
 }
 
@@ -82,7 +82,10 @@ pub fn adds_after_direct(scene: &Scene, settings: &RenderSettings, material: &Ma
 /// order: the surface's own emission, direct light from area lights and
 /// the environment, traced or mapped indirect light, then mirror
 /// reflection and refraction. `l_o` is the ambient term plus the point and
-/// directional lights' light.
+/// directional lights' light. Under `Lighting::Classic` a mirror blends:
+/// what came before it is weighed by `1 - mirror` while the recursion
+/// goes on, and kept whole where it stops (`--max-depth`), as the book's
+/// tracer returns its local colour there.
 #[inline]
 pub fn after_direct<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &SurfaceHit, material: &Material, lobes: PointLobes, w_o: Vec3, depth: u32, mut l_o: Radiance) -> Radiance {
     let Shading { settings, .. } = *sh;
@@ -104,6 +107,11 @@ pub fn after_direct<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &Su
                 l_o += secondary_sampled(sh, hit, material, w_o, depth);
             }
         } else if depth < settings.max_depth {
+            if sh.scene.render.lighting == Lighting::Classic {
+                // The book's `reflective` r: (1 - r) local + r reflected
+                // (`secondary` weighs the reflection by r).
+                l_o *= Vec3::ONE - material.mirror;
+            }
             l_o += secondary(sh, hit, material, w_o, depth);
         }
     }

@@ -539,7 +539,7 @@ fn direct_light8<S: Simd, Q: SceneQuery>(simd: S, job: &PassJob, geometry: &Geom
         tangent: V3::from_soa(simd, &geometry.tangent),
         fresnel,
     };
-    lighting::direct_light(&job.prepared.scene.lights, &surface, start, visibility).scatter()
+    lighting::direct_light(&job.prepared.scene.lights, job.prepared.scene.render.lighting, &surface, start, visibility).scatter()
 }
 
 /// Colours each of `batches` (hits built) in a debug view that colours
@@ -682,7 +682,7 @@ fn direct_light16<S: Simd, V: LightVisibility<f32x16<S>>>(simd: S, job: &PassJob
         tangent: V3::splat(like, Vec3::ZERO),
         fresnel: FresnelLanes::splat(like, *fresnel),
     };
-    let l_o = lighting::direct_light(&job.prepared.scene.lights, &surface, V3::splat(like, *ambient), visibility);
+    let l_o = lighting::direct_light(&job.prepared.scene.lights, job.prepared.scene.render.lighting, &surface, V3::splat(like, *ambient), visibility);
     let (x, y, z): ([f32; 16], [f32; 16], [f32; 16]) = (l_o.x.into(), l_o.y.into(), l_o.z.into());
     // A plain loop: `array::map` over `from_fn` was left as a call that
     // passed the lanes through the stack several times.
