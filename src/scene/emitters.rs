@@ -12,6 +12,45 @@ use crate::scene::{PrimitiveId, PrimitiveKind, Scene, SurfaceHit};
 use std::collections::HashMap;
 use std::f32::consts::PI;
 
+/// A point uniform on one emissive primitive, with what the samplers read
+/// there.
+struct UniformPoint {
+    point: Vec3,
+    /// The primitive's outward unit normal at `point` (a triangle's
+    /// geometric normal).
+    normal: Vec3,
+    /// Triangles: whether both sides emit, and the uvs at `point`.
+    two_sided: bool,
+    uv: Option<Vec2>,
+    area: f32,
+    material: u32,
+}
+
+impl UniformPoint {
+    /// The point `u` places uniformly on `shape`: by the square-root warp on
+    /// a triangle, over the whole surface of a sphere.
+    fn on(scene: &Scene, shape: EmitterShape, u: Vec2) -> UniformPoint {
+        match shape {
+            EmitterShape::Triangle(i) => {
+                let t = scene.triangles.at(i as usize);
+                let r = u.x.sqrt();
+                let (b0, b1) = (1.0 - r, u.y * r);
+                let point = t.v[0] * b0 + t.v[1] * b1 + t.v[2] * (1.0 - b0 - b1);
+                let uv = t.uv[0] * b0 + t.uv[1] * b1 + t.uv[2] * (1.0 - b0 - b1);
+                UniformPoint { point, normal: t.geometric_normal(), two_sided: t.two_sided, uv: Some(uv), area: t.area(), material: t.material }
+            }
+            EmitterShape::Sphere(i) => {
+                let s = &scene.spheres[i as usize];
+                let z = 1.0 - 2.0 * u.x;
+                let r = (1.0 - z * z).max(0.0).sqrt();
+                let phi = 2.0 * PI * u.y;
+                let n = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+                UniformPoint { point: s.center + n * s.radius, normal: n, two_sided: false, uv: None, area: 4.0 * PI * s.radius * s.radius, material: s.material }
+            }
+        }
+    }
+}
+
 /// One emissive primitive.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum EmitterShape {
@@ -205,27 +244,15 @@ impl Emitters {
             return None;
         }
         let k = self.cdf.partition_point(|&c| c <= u_choose).min(self.shapes.len() - 1);
-        let (point, normal, emission) = match self.shapes[k] {
-            EmitterShape::Triangle(i) => {
-                let t = scene.triangles.at(i as usize);
-                let r = u.x.sqrt();
-                let (b0, b1) = (1.0 - r, u.y * r);
-                let point = t.v[0] * b0 + t.v[1] * b1 + t.v[2] * (1.0 - b0 - b1);
-                let n = t.geometric_normal();
-                let n = if t.two_sided && u_side < 0.5 { -n } else { n };
-                let uv = t.uv[0] * b0 + t.uv[1] * b1 + t.uv[2] * (1.0 - b0 - b1);
-                (point, n, scene.materials[t.material as usize].emission_at(uv))
-            }
-            EmitterShape::Sphere(i) => {
-                let s = &scene.spheres[i as usize];
-                // Uniform on the sphere.
-                let z = 1.0 - 2.0 * u.x;
-                let r = (1.0 - z * z).max(0.0).sqrt();
-                let phi = 2.0 * PI * u.y;
-                let n = Vec3::new(r * phi.cos(), r * phi.sin(), z);
-                (s.center + n * s.radius, n, scene.materials[s.material as usize].emission)
-            }
+        let at = UniformPoint::on(scene, self.shapes[k], u);
+        let normal = if at.two_sided && u_side < 0.5 { -at.normal } else { at.normal };
+        let material = &scene.materials[at.material as usize];
+        // Only a triangle's point has uvs to read an emission map at.
+        let emission = match at.uv {
+            Some(uv) => material.emission_at(uv),
+            None => material.emission,
         };
+        let point = at.point;
         let lum = luminance(emission);
         let flux = emission * (self.total_power() / lum);
         (lum > 0.0 && flux.is_finite() && point.is_finite()).then_some((point, normal, flux))
@@ -248,23 +275,8 @@ impl Emitters {
         if !(pmf > 0.0) {
             return None;
         }
-        let (point, normal, two_sided, area, emission) = match self.shapes[k] {
-            EmitterShape::Triangle(i) => {
-                let t = scene.triangles.at(i as usize);
-                let r = u.x.sqrt();
-                let (b0, b1) = (1.0 - r, u.y * r);
-                let point = t.v[0] * b0 + t.v[1] * b1 + t.v[2] * (1.0 - b0 - b1);
-                (point, t.geometric_normal(), t.two_sided, t.area(), scene.materials[t.material as usize].emission)
-            }
-            EmitterShape::Sphere(i) => {
-                let s = &scene.spheres[i as usize];
-                let z = 1.0 - 2.0 * u.x;
-                let r = (1.0 - z * z).max(0.0).sqrt();
-                let phi = 2.0 * PI * u.y;
-                let n = Vec3::new(r * phi.cos(), r * phi.sin(), z);
-                (s.center + n * s.radius, n, false, 4.0 * PI * s.radius * s.radius, scene.materials[s.material as usize].emission)
-            }
-        };
+        let UniformPoint { point, normal, two_sided, area, material, .. } = UniformPoint::on(scene, self.shapes[k], u);
+        let emission = scene.materials[material as usize].emission;
         let value = emission * (area / pmf);
         (value.is_finite() && point.is_finite() && normal.is_finite()).then_some((point, normal, two_sided, self.light_of[k], value))
     }
