@@ -12,13 +12,7 @@ use pinhole::metrics::compare;
 use pinhole::render::transport::gi::GiMode;
 use pinhole::render::{PreparedScene, RenderSettings, ShadowMode};
 use pinhole::scene::file::parse_scene;
-use pinhole::scene::Scene;
-use std::f64::consts::PI;
 use std::path::Path;
-
-fn scene_from(text: &str) -> Scene {
-    parse_scene(text, "test.toml", Path::new(env!("CARGO_MANIFEST_DIR")), "test").unwrap()
-}
 
 fn direct_settings(prepared: &PreparedScene, spp: u32, light_samples: u32) -> RenderSettings {
     let mut s = RenderSettings::for_scene(&prepared.scene);
@@ -31,44 +25,6 @@ fn direct_settings(prepared: &PreparedScene, spp: u32, light_samples: u32) -> Re
 
 fn mean(img: &[Radiance]) -> Vec3 {
     img.iter().fold(Vec3::ZERO, |a, p| a + *p) / img.len() as f32
-}
-
-/// The form factor from a point to a rectangle `x` by `y` in a plane
-/// parallel to the point's at distance `h`, with one corner straight above
-/// the point (Howell's catalogue, configuration B-3; Cohen and Wallace).
-fn corner_form_factor(x: f64, y: f64, h: f64) -> f64 {
-    let (a, b) = (x / h, y / h);
-    let (ra, rb) = ((1.0 + a * a).sqrt(), (1.0 + b * b).sqrt());
-    (a / ra * (b / ra).atan() + b / rb * (a / rb).atan()) / (2.0 * PI)
-}
-
-/// A floor of albedo 0.5 under a light, seen straight from above at
-/// (`x`, `z`) through a narrow camera that sits below the light.
-fn floor_under(light: &str, x: f32, z: f32) -> Scene {
-    scene_from(&format!(
-        r#"
-[camera]
-eye = [{x}, 0.4, {ez}]
-target = [{x}, 0.0, {z}]
-fov_y_deg = 0.5
-[render]
-width = 4
-height = 4
-ambient = [0.0, 0.0, 0.0]
-background = [0.0, 0.0, 0.0]
-[materials.lamp]
-lambertian = [0.0, 0.0, 0.0]
-emission = [2.0, 2.0, 2.0]
-[materials.floor]
-lambertian = [0.5, 0.5, 0.5]
-{light}
-[[object]]
-type = "quad"
-vertices = [[-8.0, 0.0, 8.0], [8.0, 0.0, 8.0], [8.0, 0.0, -8.0], [-8.0, 0.0, -8.0]]
-material = "floor"
-"#,
-        ez = z + 0.1
-    ))
 }
 
 /// A Lambertian floor's radiance is albedo / pi times the irradiance, and a

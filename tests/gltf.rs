@@ -112,17 +112,6 @@ fn copies() -> [(Vec3, Quat, Vec3); 2] {
 }
 const PARENT: [f32; 3] = [0.0, 0.1, 0.2];
 
-fn base64(bytes: &[u8]) -> String {
-    const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut s = String::new();
-    for c in bytes.chunks(3) {
-        let n = (c[0] as u32) << 16 | (*c.get(1).unwrap_or(&0) as u32) << 8 | *c.get(2).unwrap_or(&0) as u32;
-        for k in 0..4 {
-            s.push(if k <= c.len() { A[(n >> (18 - 6 * k) & 63) as usize] as char } else { '=' });
-        }
-    }
-    s
-}
 
 /// The shared-mesh glTF's binary buffer: cube positions, floor positions,
 /// cube indices, floor indices.
@@ -214,7 +203,7 @@ fn shared_mesh_matches_baked_obj_and_is_stored_once() {
     std::fs::write(dir.join("floor.obj"), floor).unwrap();
     std::fs::write(dir.join("shared.bin"), buffer()).unwrap();
     std::fs::write(dir.join("shared.gltf"), shared_json(Some("shared.bin"))).unwrap();
-    std::fs::write(dir.join("embedded.gltf"), shared_json(Some(&format!("data:application/octet-stream;base64,{}", base64(&buffer()))))).unwrap();
+    std::fs::write(dir.join("embedded.gltf"), shared_json(Some(&format!("data:application/octet-stream;base64,{}", common::base64(&buffer()))))).unwrap();
     std::fs::write(dir.join("shared.glb"), glb(&shared_json(None), &buffer())).unwrap();
     std::fs::write(
         dir.join("obj.toml"),

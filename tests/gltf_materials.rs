@@ -28,17 +28,6 @@ fn render(scene: &Scene, renderer: &str, settings: &RenderSettings) -> Vec<Vec3>
     common::render(renderer, &PreparedScene::new(scene.clone()), settings)
 }
 
-fn base64(bytes: &[u8]) -> String {
-    const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut s = String::new();
-    for c in bytes.chunks(3) {
-        let n = (c[0] as u32) << 16 | (*c.get(1).unwrap_or(&0) as u32) << 8 | *c.get(2).unwrap_or(&0) as u32;
-        for k in 0..4 {
-            s.push(if k <= c.len() { A[(n >> (18 - 6 * k) & 63) as usize] as char } else { '=' });
-        }
-    }
-    s
-}
 
 fn unbase64(s: &str) -> Vec<u8> {
     let value = |c: u8| match c {
@@ -64,7 +53,7 @@ fn png_uri(rgb: [u8; 3]) -> String {
     let img = image::RgbImage::from_pixel(2, 2, image::Rgb(rgb));
     let mut bytes = std::io::Cursor::new(Vec::new());
     img.write_to(&mut bytes, image::ImageFormat::Png).unwrap();
-    format!("data:image/png;base64,{}", base64(bytes.get_ref()))
+    format!("data:image/png;base64,{}", common::base64(bytes.get_ref()))
 }
 
 /// A UV sphere of radius 1 at the origin: positions (= normals) and
@@ -130,7 +119,7 @@ fn write_sphere(dir: &Path, material: &str, extra: &str) {
         uvl = idx_at - uv_at,
         il = bin.len() - idx_at,
         bl = bin.len(),
-        b64 = base64(&bin),
+        b64 = common::base64(&bin),
     );
     std::fs::write(dir.join("sphere.gltf"), json).unwrap();
     let mut obj = String::new();

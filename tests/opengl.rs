@@ -20,6 +20,9 @@ use pinhole::render::{render_frame, renderer_by_name, Interpolation, PreparedSce
 use pinhole::scene::Scene;
 use std::sync::atomic::AtomicBool;
 
+mod common;
+use common::{corner_form_factor, floor_under};
+
 const W: u32 = 200;
 const H: u32 = 125;
 
@@ -579,44 +582,6 @@ fn area_light_shadow_filters_in_gl_agree_with_the_cpu_maps() {
     assert!(agree < 0.99, "PCSS against PCF still agrees on {:.2}%", agree * 100.0);
 }
 
-/// The form factor from a point to a rectangle `x` by `y` in a plane
-/// parallel to the point's at distance `h`, one corner straight above the
-/// point (Howell's catalogue, configuration B-3).
-fn corner_form_factor(x: f64, y: f64, h: f64) -> f64 {
-    let (a, b) = (x / h, y / h);
-    let (ra, rb) = ((1.0 + a * a).sqrt(), (1.0 + b * b).sqrt());
-    (a / ra * (b / ra).atan() + b / rb * (a / rb).atan()) / (2.0 * std::f64::consts::PI)
-}
-
-/// A floor of albedo 0.5 under `light` (emission 2), seen straight from
-/// above at (`x`, `z`) through a narrow camera below the light.
-fn floor_under(light: &str, x: f32, z: f32) -> Scene {
-    let text = format!(
-        r#"
-[camera]
-eye = [{x}, 0.4, {ez}]
-target = [{x}, 0.0, {z}]
-fov_y_deg = 0.5
-[render]
-width = 4
-height = 4
-ambient = [0.0, 0.0, 0.0]
-background = [0.0, 0.0, 0.0]
-[materials.lamp]
-lambertian = [0.0, 0.0, 0.0]
-emission = [2.0, 2.0, 2.0]
-[materials.floor]
-lambertian = [0.5, 0.5, 0.5]
-{light}
-[[object]]
-type = "quad"
-vertices = [[-8.0, 0.0, 8.0], [8.0, 0.0, 8.0], [8.0, 0.0, -8.0], [-8.0, 0.0, -8.0]]
-material = "floor"
-"#,
-        ez = z + 0.1
-    );
-    pinhole::scene::file::parse_scene(&text, "test.toml", std::path::Path::new(env!("CARGO_MANIFEST_DIR")), "test").unwrap()
-}
 
 #[test]
 fn gl_area_lights_give_the_closed_form_irradiance() {

@@ -233,6 +233,18 @@ impl Emitters {
         self.lights.iter().map(|l| l.power).sum()
     }
 
+    /// The primitive `u_choose` picks in proportion to power (by inverting
+    /// the running sum of powers) and the probability of that pick. `None`
+    /// where there are no emitters or the pick has no power.
+    fn choose(&self, u_choose: f32) -> Option<(usize, f32)> {
+        if self.shapes.is_empty() {
+            return None;
+        }
+        let k = self.cdf.partition_point(|&c| c <= u_choose).min(self.shapes.len() - 1);
+        let pmf = self.pmf[k];
+        (pmf > 0.0).then_some((k, pmf))
+    }
+
     /// Where a photon leaves the emitters: a primitive chosen by `u_choose`
     /// in proportion to power, a point uniform on it by `u`, on the side
     /// `u_side` picks for a two-sided triangle. Returns the point, the unit
@@ -240,10 +252,7 @@ impl Emitters {
     /// (before dividing by the photons shot): with a cosine-distributed
     /// direction, `L_e * total_power / luminance(L_e)`.
     pub fn sample_emission(&self, scene: &Scene, u_choose: f32, u: Vec2, u_side: f32) -> Option<(Vec3, Vec3, Vec3)> {
-        if self.shapes.is_empty() {
-            return None;
-        }
-        let k = self.cdf.partition_point(|&c| c <= u_choose).min(self.shapes.len() - 1);
+        let (k, _) = self.choose(u_choose)?;
         let at = UniformPoint::on(scene, self.shapes[k], u);
         let normal = if at.two_sided && u_side < 0.5 { -at.normal } else { at.normal };
         let material = &scene.materials[at.material as usize];
@@ -267,14 +276,7 @@ impl Emitters {
     /// choice included): a shading point at distance `d` gets
     /// `value * cos_surface * cos_light / d^2` from it.
     pub fn area_sample(&self, scene: &Scene, u_choose: f32, u: Vec2) -> Option<(Vec3, Vec3, bool, u32, Vec3)> {
-        if self.shapes.is_empty() {
-            return None;
-        }
-        let k = self.cdf.partition_point(|&c| c <= u_choose).min(self.shapes.len() - 1);
-        let pmf = self.pmf[k];
-        if !(pmf > 0.0) {
-            return None;
-        }
+        let (k, pmf) = self.choose(u_choose)?;
         let UniformPoint { point, normal, two_sided, area, material, .. } = UniformPoint::on(scene, self.shapes[k], u);
         let emission = scene.materials[material as usize].emission;
         let value = emission * (area / pmf);
@@ -285,14 +287,7 @@ impl Emitters {
     /// in proportion to power, the point placed on it by `u`. `None` where
     /// there are no emitters or the point is degenerate (on the emitter).
     pub fn sample(&self, scene: &Scene, p: Vec3, u_choose: f32, u: Vec2) -> Option<EmitterSample> {
-        if self.shapes.is_empty() {
-            return None;
-        }
-        let k = self.cdf.partition_point(|&c| c <= u_choose).min(self.shapes.len() - 1);
-        let pmf = self.pmf[k];
-        if !(pmf > 0.0) {
-            return None;
-        }
+        let (k, pmf) = self.choose(u_choose)?;
         let light = self.light_of[k];
         match self.shapes[k] {
             EmitterShape::Triangle(i) => {
