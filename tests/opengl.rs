@@ -195,6 +195,49 @@ fn each_reflection_model_agrees_with_the_ray_caster() {
     assert!(fraction < 0.99, "Lambert passes for Oren-Nayar on {:.2}% of pixels", fraction * 100.0);
 }
 
+/// Ward's anisotropic lobe in the shader against the ray caster: on
+/// spheres (the tangent along the latitude), on meshes with uvs (the
+/// tangents from the uvs) and on triangles without (the fixed
+/// perpendicular).
+/// GL drawing the lobe turned by a quarter (alphas swapped) must not pass.
+#[test]
+fn ward_agrees_with_the_ray_caster() {
+    use pinhole::scene::material::GlossyModel;
+    let Some(_) = driver() else { return };
+    let gl = renderer_by_name("opengl").unwrap();
+    let reference_renderer = renderer_by_name("raytrace:bvh").unwrap();
+    let ward = |name: &str, au: f32, av: f32| {
+        let mut sc = scene(name);
+        for m in &mut sc.materials {
+            m.glossy_model = GlossyModel::Ward;
+            m.roughness_uv = glam::Vec2::new(au, av);
+            m.glossy = Vec3::splat(0.5);
+            // GL traces no mirror rays: the lobe alone is compared.
+            m.mirror = Vec3::ZERO;
+            m.transmission = Vec3::ZERO;
+        }
+        // The uvs' tangents, as a scene file naming Ward would have built them.
+        sc.tangents = pinhole::scene::tangents::build_tangents(&sc);
+        PreparedScene::new(sc)
+    };
+    for name in ["spheres", "textures", "teapot"] {
+        let prepared = ward(name, 0.08, 0.4);
+        let s = settings(&prepared.scene);
+        if let Err(e) = gl.check(&prepared.scene, &s) {
+            panic!("{name}: refused: {e}");
+        }
+        let (a, b) = (render(gl.as_ref(), &prepared, &s), render(reference_renderer.as_ref(), &prepared, &s));
+        assert!(a.iter().all(|p| p.is_finite()), "{name}: a pixel is not finite");
+        let (fraction, wrong) = agreement(&a, &b);
+        eprintln!("{name} ward: {:.3}% agree ({wrong} pixels differ)", fraction * 100.0);
+        assert!(fraction >= 0.99, "{name} ward: only {:.3}% of pixels within 1e-3", fraction * 100.0);
+    }
+    let (along, across) = (ward("spheres", 0.08, 0.4), ward("spheres", 0.4, 0.08));
+    let s = settings(&along.scene);
+    let (fraction, _) = agreement(&render(gl.as_ref(), &across, &s), &render(reference_renderer.as_ref(), &along, &s));
+    assert!(fraction < 0.99, "the lobe turned by a quarter passes on {:.2}% of pixels", fraction * 100.0);
+}
+
 #[test]
 fn the_forest_of_ten_thousand_copies_agrees_with_brute_force() {
     // 10,000 bunny copies (694 M triangles, never flattened): one mesh in

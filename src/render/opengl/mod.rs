@@ -211,9 +211,6 @@ fn unsupported(scene: &Scene, settings: &RenderSettings) -> Result<(), String> {
     // Only materials something is drawn with: one merely named in the file asks nothing.
     let in_use = scene.materials_in_use();
     let mut drawn = scene.materials.iter().zip(in_use).filter(|(_, used)| *used).map(|(m, _)| m);
-    if let Some(m) = drawn.clone().find(|m| m.has_glossy() && m.glossy_model == crate::scene::material::GlossyModel::Ward) {
-        return refuse(&format!("cannot draw glossy_model \"ward\" yet (material \"{}\"); use raytrace or rasterize", m.name));
-    }
     if !scene.vertex_colours.is_empty() {
         return refuse("cannot draw vertex colours yet; use raytrace or rasterize");
     }

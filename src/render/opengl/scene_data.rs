@@ -95,10 +95,11 @@ pub fn fingerprint(scene: &Scene) -> u64 {
 }
 
 /// Per material: (k_L, glossy model), (k_G, sharpness), (k_M, roughness),
-/// (eta, Fresnel term), (k, diffuse model), (diffuse parameter, emission);
+/// (eta, Fresnel term), (k, diffuse model), (diffuse parameter, emission),
+/// (Ward's alpha u and alpha v, 0, 0);
 /// the models and the Fresnel term as `lighting::model_lane`,
 /// `diffuse_lane` and `fresnel_lane` code them.
-pub const MATERIAL_FLOATS: usize = 24;
+pub const MATERIAL_FLOATS: usize = 28;
 
 pub fn materials(scene: &Scene) -> Vec<f32> {
     let mut out = Vec::with_capacity(scene.materials.len().max(1) * MATERIAL_FLOATS);
@@ -114,6 +115,7 @@ pub fn materials(scene: &Scene) -> Vec<f32> {
         let diffuse = crate::render::transport::lighting::diffuse_lane(m.diffuse_model);
         out.extend_from_slice(&[eta.x, eta.y, eta.z, fresnel, k.x, k.y, k.z, diffuse]);
         out.extend_from_slice(&[m.diffuse_model.parameter(), m.emission.x, m.emission.y, m.emission.z]);
+        out.extend_from_slice(&[m.roughness_uv.x, m.roughness_uv.y, 0.0, 0.0]);
     }
     if out.is_empty() {
         out.resize(MATERIAL_FLOATS, 0.0);

@@ -52,9 +52,10 @@ uniform vec3 ambient;
 uniform int light_count;
 uniform bool y_down;
 
-// Per material six vec4: (k_L, glossy model), (k_G, sharpness), (k_M,
-// roughness), (eta, Fresnel term), (k, diffuse model), (diffuse parameter);
-// the glossy model 0 = Blinn-Phong, 1 = Phong, 2 = GGX, 3 = Beckmann.
+// Per material seven vec4: (k_L, glossy model), (k_G, sharpness), (k_M,
+// roughness), (eta, Fresnel term), (k, diffuse model), (diffuse parameter,
+// emission), (Ward's alpha u, alpha v, 0, 0); the glossy model 0 =
+// Blinn-Phong, 1 = Phong, 2 = GGX, 3 = Beckmann, 4 = Ward.
 layout(std430, binding = 0) readonly buffer Materials { vec4 materials[]; };
 // Per light: (position or direction, 0 = point | 1 = directional), (power or irradiance, 0).
 layout(std430, binding = 1) readonly buffer Lights { vec4 lights[]; };
@@ -206,7 +207,7 @@ vec3 sample_texture(ivec2 t, vec2 uv, vec2 duv_dx, vec2 duv_dy) {
 }
 
 vec3 albedo_at(uint m, vec2 uv, vec2 duv_dx, vec2 duv_dy) {
-    vec3 k = materials[6u * m].xyz;
+    vec3 k = materials[7u * m].xyz;
     if (!has_albedo_map) return k;
     return k * sample_texture(albedo_map, uv, duv_dx, duv_dy);
 }
@@ -530,16 +531,26 @@ vec3 glossy_weight(vec3 glossy, vec4 eta, vec3 k, float c) {
     return glossy * vec3(conductor_fresnel(c, eta.x, k.x), conductor_fresnel(c, eta.y, k.y), conductor_fresnel(c, eta.z, k.z));
 }
 
+// lighting::ward_frame: the unit tangent t made orthogonal to n, or where
+// that leaves nothing a fixed perpendicular (x cross n, or y cross n when n
+// is near x); the bitangent is n cross t.
+void ward_frame(vec3 n, vec3 tangent, out vec3 t, out vec3 b) {
+    t = normalize_or_zero(tangent - n * dot(n, tangent));
+    if (t == vec3(0.0)) t = normalize(cross(abs(n.x) > 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0), n));
+    b = cross(n, t);
+}
+
 // lighting::bsdf: material m's BSDF for light from w_i seen from w_o, at a
-// surface of shading normal n (cos_theta = n . w_i > 0).
-vec3 bsdf(vec3 n, vec3 w_i, vec3 w_o, float cos_theta, uint m, vec3 albedo) {
-    vec3 glossy = materials[6u * m + 1u].xyz;
-    float s = materials[6u * m + 1u].w;
-    float model = materials[6u * m].w;
-    float alpha = materials[6u * m + 2u].w;
-    vec4 fresnel = materials[6u * m + 3u];
-    vec4 conductor_k = materials[6u * m + 4u];
-    float diffuse_param = materials[6u * m + 5u].x;
+// surface of shading normal n and tangent `tangent` (read by Ward's lobe
+// only; cos_theta = n . w_i > 0).
+vec3 bsdf(vec3 n, vec3 tangent, vec3 w_i, vec3 w_o, float cos_theta, uint m, vec3 albedo) {
+    vec3 glossy = materials[7u * m + 1u].xyz;
+    float s = materials[7u * m + 1u].w;
+    float model = materials[7u * m].w;
+    float alpha = materials[7u * m + 2u].w;
+    vec4 fresnel = materials[7u * m + 3u];
+    vec4 conductor_k = materials[7u * m + 4u];
+    float diffuse_param = materials[7u * m + 5u].x;
     vec3 f = albedo * diffuse_factor(conductor_k.w, diffuse_param, n, w_i, w_o);
     if (glossy != vec3(0.0)) {
         vec3 w_h = normalize_or_zero(w_i + w_o);
@@ -554,6 +565,24 @@ vec3 bsdf(vec3 n, vec3 w_i, vec3 w_o, float cos_theta, uint m, vec3 albedo) {
             float c = max(dot(r, w_i), 0.0);
             if (s * (1.0 - c) < 20.7) {
                 f += weight * ((s + 2.0) * (0.5 / PI) * pow(c, s));
+            }
+        } else if (model == 4.0) {
+            // lighting::ward_lobe: exp(-((h.t / a_u)^2 + (h.b / a_v)^2) / (h.n)^2)
+            // over 4 pi a_u a_v sqrt(cos_i cos_o), with h = w_i + w_o unnormalized.
+            float cos_o = dot(n, w_o);
+            if (cos_o > 0.0) {
+                vec2 a = materials[7u * m + 6u].xy;
+                vec3 t;
+                vec3 b;
+                ward_frame(n, tangent, t, b);
+                vec3 h = w_i + w_o;
+                float x = dot(h, t) / a.x;
+                float y = dot(h, b) / a.y;
+                float z = dot(h, n);
+                float e = -((x * x + y * y) / (z * z)) * 1.44269504088896340736;
+                if (e >= -126.0) {
+                    f += weight * (exp2(e) / (4.0 * PI * a.x * a.y * sqrt(max(cos_theta * cos_o, 0.0))));
+                }
             }
         } else {
             float cos_o = dot(n, w_o);
@@ -570,7 +599,7 @@ vec3 bsdf(vec3 n, vec3 w_i, vec3 w_o, float cos_theta, uint m, vec3 albedo) {
 
 // The emission of material m seen from the front (emitters::emitted).
 vec3 emitted(uint m, bool back) {
-    return back ? vec3(0.0) : materials[6u * m + 5u].yzw;
+    return back ? vec3(0.0) : materials[7u * m + 5u].yzw;
 }
 
 #ifdef AREA_LIGHTS
@@ -579,7 +608,7 @@ vec3 emitted(uint m, bool back) {
 // `sampled_light::sampled_direct` is without MIS (radiance, BSDF and both
 // cosines over the squared distance and the point's density), and each
 // light's sum multiplied by the visibility its shadow map gives.
-vec3 area_direct(vec3 p, vec3 n, vec3 g, vec3 w_o, uint m, vec3 albedo) {
+vec3 area_direct(vec3 p, vec3 n, vec3 t, vec3 g, vec3 w_o, uint m, vec3 albedo) {
     vec3 l_o = vec3(0.0);
     for (int i = 0; i < area_light_count; i++) {
         vec4 b = area_lights[2 * i + 1];
@@ -600,7 +629,7 @@ vec3 area_direct(vec3 p, vec3 n, vec3 g, vec3 w_o, uint m, vec3 albedo) {
             if (!(cos_l > 1e-7)) continue;
             float cos_theta = dot(n, w_i);
             if (cos_theta <= 0.0 || dot(w_i, g) <= 0.0) continue;
-            sum += value * bsdf(n, w_i, w_o, cos_theta, m, albedo) * (cos_theta * cos_l / d2);
+            sum += value * bsdf(n, t, w_i, w_o, cos_theta, m, albedo) * (cos_theta * cos_l / d2);
         }
 #ifdef SHADOW_MAP
         if (sum != vec3(0.0)) sum *= area_visibility(i, p, g);
@@ -619,20 +648,20 @@ vec3 area_direct(vec3 p, vec3 n, vec3 g, vec3 w_o, uint m, vec3 albedo) {
 // sky's shadows.
 layout(std430, binding = 12) readonly buffer EnvironmentSamples { vec4 environment_samples[]; };
 
-vec3 environment_direct(vec3 n, vec3 g, vec3 w_o, uint m, vec3 albedo) {
+vec3 environment_direct(vec3 n, vec3 t, vec3 g, vec3 w_o, uint m, vec3 albedo) {
     vec3 l_o = vec3(0.0);
     int count = int(environment_samples[0].x);
     for (int k = 0; k < count; k++) {
         vec3 w_i = environment_samples[1 + 2 * k].xyz;
         float cos_theta = dot(n, w_i);
         if (cos_theta <= 0.0 || dot(w_i, g) <= 0.0) continue;
-        l_o += environment_samples[2 + 2 * k].xyz * bsdf(n, w_i, w_o, cos_theta, m, albedo) * cos_theta;
+        l_o += environment_samples[2 + 2 * k].xyz * bsdf(n, t, w_i, w_o, cos_theta, m, albedo) * cos_theta;
     }
     return l_o;
 }
 #endif
 
-vec3 shade(vec3 p, vec3 n, vec3 g, vec3 w_o, uint m, vec3 albedo) {
+vec3 shade(vec3 p, vec3 n, vec3 t, vec3 g, vec3 w_o, uint m, vec3 albedo) {
     vec3 l_o = albedo * ambient;
     for (int i = 0; i < light_count; i++) {
         vec4 a = lights[2 * i];
@@ -654,15 +683,15 @@ vec3 shade(vec3 p, vec3 n, vec3 g, vec3 w_o, uint m, vec3 albedo) {
 #ifdef SHADOW_MAP
         if (shadowed(i, p, g, w_i)) continue;
 #endif
-        l_o += (incident * bsdf(n, w_i, w_o, cos_theta, m, albedo)) * cos_theta;
+        l_o += (incident * bsdf(n, t, w_i, w_o, cos_theta, m, albedo)) * cos_theta;
     }
 #ifdef AREA_LIGHTS
-    l_o += area_direct(p, n, g, w_o, m, albedo);
+    l_o += area_direct(p, n, t, g, w_o, m, albedo);
 #endif
 #ifdef ENVIRONMENT_LIGHT
-    l_o += environment_direct(n, g, w_o, m, albedo);
+    l_o += environment_direct(n, t, g, w_o, m, albedo);
 #endif
-    vec3 mirror = materials[6u * m + 2u].xyz;
+    vec3 mirror = materials[7u * m + 2u].xyz;
     if (mirror_env && mirror != vec3(0.0)) {
         float cos_o = clamp(dot(w_o, g), -1.0, 1.0);
         l_o += mirror * miss_radiance(normalize(2.0 * cos_o * g - w_o));
@@ -841,7 +870,7 @@ void main() {
 #endif
     if (flat_shading) n = g;
     vec3 albedo = albedo_at(v_material, v_uv, duv_dx, duv_dy);
-    colour = vec4(shade(v_position, n, g, -dir, v_material, albedo) + emitted(v_material, back), 1.0);
+    colour = vec4(shade(v_position, n, v_tangent, g, -dir, v_material, albedo) + emitted(v_material, back), 1.0);
 }
 "#
     )
@@ -929,7 +958,7 @@ void main() {
     write_surface(p, n, back, g, vec3(0.0), uv, 1u, uint(v_sphere));
 #endif
     gl_FragDepth = clamp(near_plane * (far_plane - w) / ((far_plane - near_plane) * w), 0.0, 1.0);
-    colour = vec4(shade(p, n, g, -dir, m, albedo_at(m, uv, duv[0], duv[1])) + emitted(m, back), 1.0);
+    colour = vec4(shade(p, n, vec3(o.z, 0.0, -o.x), g, -dir, m, albedo_at(m, uv, duv[0], duv[1])) + emitted(m, back), 1.0);
 }
 "#
     )
@@ -1373,7 +1402,7 @@ void main() {
     float depth = dot(p - eye, -camera_to_world[2]);
     gl_FragDepth = clamp(near_plane * (far_plane - depth) / ((far_plane - near_plane) * depth), 0.0, 1.0);
     // CSG hits carry no footprint: the finest texture level.
-    colour = vec4(shade(p, n, g, -ray_dir, m, albedo_at(m, uv, vec2(0.0), vec2(0.0))) + emitted(m, back), 1.0);
+    colour = vec4(shade(p, n, vec3(0.0), g, -ray_dir, m, albedo_at(m, uv, vec2(0.0), vec2(0.0))) + emitted(m, back), 1.0);
 }
 "#
     )
