@@ -93,3 +93,42 @@ fn bad_display_options_are_one_sentence() {
     }
     assert!(!p.exists(), "no image is written");
 }
+
+#[test]
+fn false_colour_shows_each_pixels_stop_through_viridis() {
+    // The shaded EXR's luminance, log2, placed on the 16-stop scale from
+    // 2^-10 to 2^6 and looked up in viridis's nine published points: the
+    // false-colour PNG shows that colour (within one 8-bit step, the frame
+    // holds it as linear values the sRGB curve encodes back).
+    const VIRIDIS: [[f32; 3]; 9] = [
+        [68.0, 1.0, 84.0],
+        [71.0, 44.0, 122.0],
+        [59.0, 81.0, 139.0],
+        [44.0, 113.0, 142.0],
+        [33.0, 144.0, 141.0],
+        [39.0, 173.0, 129.0],
+        [92.0, 200.0, 99.0],
+        [170.0, 220.0, 50.0],
+        [253.0, 231.0, 37.0],
+    ];
+    let (exr, png) = (tmp("fc.exr"), tmp("fc.png"));
+    render(&exr, &[]);
+    render(&png, &["--view", "false-colour"]);
+    let linear = image::open(&exr).unwrap().into_rgb32f();
+    let shown = image::open(&png).unwrap().into_rgb8();
+    let mut stops_seen = std::collections::BTreeSet::new();
+    for (x, y, p) in linear.enumerate_pixels() {
+        let l = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+        let stop = if l > 0.0 { l.log2().clamp(-10.0, 6.0) } else { -10.0 };
+        stops_seen.insert(stop.round() as i32);
+        let t = (stop + 10.0) / 16.0 * 8.0;
+        let i = (t.floor() as usize).min(7);
+        let f = t - i as f32;
+        for k in 0..3 {
+            let want = VIRIDIS[i][k] * (1.0 - f) + VIRIDIS[i + 1][k] * f;
+            let got = shown.get_pixel(x, y)[k] as f32;
+            assert!((got - want).abs() <= 1.5, "({x}, {y}) channel {k}: {got} vs {want} at stop {stop}");
+        }
+    }
+    assert!(stops_seen.len() >= 3, "the scene spans several stops: {stops_seen:?}");
+}

@@ -12,6 +12,7 @@
 //! This module reads nothing but `math`; `image_io`, `render` and the viewer
 //! call it.
 
+pub mod false_colour;
 pub mod tonemap;
 pub mod transfer;
 
