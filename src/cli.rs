@@ -244,7 +244,7 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
 
 fn stats_json(l: &Loaded, render_ms: f64, counts: &RayCounts, spp: u32) -> serde_json::Value {
     let per_frame = |v: u64| v / spp.max(1) as u64 * spp.max(1) as u64;
-    json!({
+    let mut j = json!({
         "renderer": l.renderer.name(),
         "scene": l.prepared.scene.name,
         "width": l.settings.width,
@@ -284,7 +284,12 @@ fn stats_json(l: &Loaded, render_ms: f64, counts: &RayCounts, spp: u32) -> serde
         "gi": l.settings.gi.mode.name(),
         "seed": l.settings.gi.seed,
         "photons": (l.settings.gi.mode == render::transport::gi::GiMode::Photons).then(|| l.prepared.photon_map(&l.settings.gi, l.settings.shadow_bump).len()),
-    })
+    });
+    // The display transform the 8-bit image went through (an EXR is linear).
+    j["tonemap"] = json!(l.settings.display.tonemap.name());
+    j["exposure_ev"] = json!(l.settings.display.exposure_ev);
+    j["gamma"] = json!(l.settings.display.gamma.name());
+    j
 }
 
 fn cmd_render(scene_arg: &str, output: &Path, opts: &RenderOpts, stats: Option<&str>) -> Result<(), String> {
@@ -321,7 +326,7 @@ fn cmd_render(scene_arg: &str, output: &Path, opts: &RenderOpts, stats: Option<&
     if let Some(n) = frame.differing_pixels {
         eprintln!("{n} of {} pixels differ from raytrace:brute", frame.pixels.len());
     }
-    crate::image_io::save_image(output, frame.width, frame.height, &frame.pixels, l.prepared.scene.render.exposure)?;
+    crate::image_io::save_image_displayed(output, frame.width, frame.height, &frame.pixels, l.prepared.scene.render.exposure, &l.settings.display)?;
     if let Some(dest) = stats {
         let mut j = stats_json(&l, render_ms, &frame.counts, l.settings.spp);
         // After the frame and its image: the run's peak (null where unknown).

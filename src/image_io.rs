@@ -2,23 +2,19 @@
 //! the core everything is linear radiance. Files are written atomically
 //! (a temporary file in the same directory, then a rename).
 
+use crate::display::{DisplaySettings, Gamma, ToneMap};
 use crate::math::{Radiance, Vec3};
 use std::path::{Path, PathBuf};
 
 /// sRGB transfer function (IEC 61966-2-1) of a linear value in [0, 1].
 pub fn linear_to_srgb(c: f32) -> f32 {
-    if c <= 0.003_130_8 { 12.92 * c } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 }
+    crate::display::transfer::srgb(c)
 }
 
 /// One pixel as displayed: exposure `d` (CGPP's display constant), clamp,
 /// then sRGB encoding (or plain scaling when `gamma` is off), 8 bits.
 pub fn display_pixel(c: Radiance, exposure: f32, gamma: bool) -> [u8; 3] {
-    let encode = |v: f32| {
-        let v = if v.is_finite() { (v * exposure).clamp(0.0, 1.0) } else { 0.0 };
-        let v = if gamma { linear_to_srgb(v) } else { v };
-        (v * 255.0 + 0.5) as u8
-    };
-    [encode(c.x), encode(c.y), encode(c.z)]
+    crate::display::display_rgb8(c, exposure, ToneMap::Standard, if gamma { Gamma::Srgb } else { Gamma::Off })
 }
 
 /// The whole image as 8-bit RGB, row-major.
@@ -29,11 +25,19 @@ pub fn to_rgb8(pixels: &[Radiance], exposure: f32, gamma: bool) -> Vec<u8> {
 /// Writes `pixels` (width x height, linear) by the extension of `path`:
 /// `.png` (sRGB 8-bit with exposure), `.exr` (linear f32), `.ppm` (ASCII, sRGB 8-bit).
 pub fn save_image(path: &Path, width: u32, height: u32, pixels: &[Radiance], exposure: f32) -> Result<(), String> {
+    save_image_displayed(path, width, height, pixels, exposure, &DisplaySettings::default())
+}
+
+/// As `save_image`, the 8-bit types through `display` (exposure in stops on
+/// top of the linear `exposure`, tone map, transfer curve); `.exr` stays
+/// linear, untouched by either.
+pub fn save_image_displayed(path: &Path, width: u32, height: u32, pixels: &[Radiance], exposure: f32, display: &DisplaySettings) -> Result<(), String> {
     let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).unwrap_or_default();
+    let rgb8 = || crate::display::image_rgb8(pixels, display.scale(exposure), display.tonemap, display.gamma);
     let bytes = match ext.as_str() {
-        "png" => encode_png(width, height, &to_rgb8(pixels, exposure, true))?,
+        "png" => encode_png(width, height, &rgb8())?,
         "exr" => encode_exr(width, height, pixels)?,
-        "ppm" => encode_ppm(width, height, &to_rgb8(pixels, exposure, true)),
+        "ppm" => encode_ppm(width, height, &rgb8()),
         _ => return Err(format!("{}: unknown image type (use .png, .exr or .ppm)", path.display())),
     };
     write_atomic(path, &bytes)

@@ -6,6 +6,7 @@
 
 pub mod chart;
 pub mod cli;
+pub mod display;
 pub mod env_overrides;
 pub mod file_identity;
 pub mod gallery;

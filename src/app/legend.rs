@@ -35,6 +35,7 @@ pub fn title(view: &str) -> Option<String> {
         "diff" => "diff: this renderer minus raytrace:brute".into(),
         "shadowmap" => "shadowmap: a light's depth map".into(),
         "mip" => "mip: texture level read per pixel".into(),
+        "false-colour" => "false colour: luminance in stops".into(),
         other => format!("view: {other}"),
     })
 }
@@ -160,6 +161,13 @@ pub fn show(viewed: &Viewed, hover: Option<(u32, u32)>, camera: &Camera, ctx: &e
                         let ticks: Vec<(f32, String)> = (0..=MIP_SCALE as u32).step_by(2).map(|l| (l as f32 / MIP_SCALE, format!("{l}"))).collect();
                         bar(ui, |t| mip_color(t * MIP_SCALE), &ticks);
                         small(ui, "nearest and bilinear read level 0 only; dark grey: no texture; no hit: black");
+                    }
+                    "false-colour" => {
+                        use crate::display::false_colour::{viridis, MAX_STOP, MIN_STOP};
+                        small(ui, "log2 of the linear luminance (stop 0 = luminance 1) through viridis; black and NaN take the bottom colour");
+                        let span = MAX_STOP - MIN_STOP;
+                        let ticks: Vec<(f32, String)> = (MIN_STOP as i32..=MAX_STOP as i32).step_by(4).map(|s| ((s as f32 - MIN_STOP) / span, format!("{s:+}"))).collect();
+                        bar(ui, |t| Vec3::from(viridis(t)), &ticks);
                     }
                     "uv" => small(ui, "an 8 × 8 checker in (u, v): straight in perspective-correct interpolation, bent in affine"),
                     "diff" => {

@@ -5,7 +5,6 @@
 //! waits on it: it sends requests over a channel, raises the cancel flag, and
 //! reads the latest published image under a short lock.
 
-use crate::image_io;
 use crate::math::Radiance;
 use crate::render::inspect::debug::View;
 use crate::render::frame::Accumulator;
@@ -75,6 +74,24 @@ pub struct Request {
     pub gamma: bool,
     /// The camera is moving: show a coarse preview first.
     pub interactive: bool,
+}
+
+impl Request {
+    /// The image on show as displayed: the scene's exposure and the display
+    /// settings (stops, tone map, curve; no curve with gamma off).
+    pub fn encode(&self, linear: &[Radiance]) -> Vec<u8> {
+        let d = &self.settings.display;
+        let gamma = if self.gamma { d.gamma } else { crate::display::Gamma::Off };
+        crate::display::image_rgb8(linear, d.scale(self.params.render.exposure), d.tonemap, gamma)
+    }
+}
+
+/// Render settings equal but for the display transform (a change there
+/// re-encodes the image on show, it renders nothing).
+fn same_but_display(a: &RenderSettings, b: &RenderSettings) -> bool {
+    let mut a = a.clone();
+    a.display = b.display;
+    a == *b
 }
 
 /// The inspector asks for one pixel replayed (`render::replay_pixel`) with
@@ -395,12 +412,12 @@ impl WorkerLoop {
         if let Some(f) = self.frame.as_mut() {
             if f.req.scene_id == req.scene_id
                 && f.req.renderer == req.renderer
-                && f.req.settings == req.settings
+                && same_but_display(&f.req.settings, &req.settings)
                 && f.req.params.same_but_display(&req.params)
             {
                 f.req = Request { interactive: f.req.interactive, ..req };
                 let mut out = self.shared.output.lock().unwrap();
-                out.rgb8 = image_io::to_rgb8(&out.linear, f.req.params.render.exposure, f.req.gamma);
+                out.rgb8 = f.req.encode(&out.linear);
                 out.generation = f.req.generation;
                 out.version += 1;
                 drop(out);
@@ -412,11 +429,11 @@ impl WorkerLoop {
             let out = self.shared.output.lock().unwrap();
             out.complete && self.frame.is_none() && out.scene_id == req.scene_id
         } && self.last_req.as_ref().is_some_and(|l| {
-            l.renderer == req.renderer && l.settings == req.settings && l.params.same_but_display(&req.params)
+            l.renderer == req.renderer && same_but_display(&l.settings, &req.settings) && l.params.same_but_display(&req.params)
         });
         if display_only {
             let mut out = self.shared.output.lock().unwrap();
-            out.rgb8 = image_io::to_rgb8(&out.linear, req.params.render.exposure, req.gamma);
+            out.rgb8 = req.encode(&out.linear);
             out.generation = req.generation;
             out.version += 1;
             drop(out);
@@ -569,7 +586,7 @@ impl WorkerLoop {
             f.first_image = true;
             let req = &f.req;
             let mut out = self.shared.output.lock().unwrap();
-            out.rgb8 = image_io::to_rgb8(&big, req.params.render.exposure, req.gamma);
+            out.rgb8 = req.encode(&big);
             out.linear = big;
             out.width = w;
             out.height = h;
@@ -631,7 +648,7 @@ impl WorkerLoop {
         f.pass_counts += band.counts;
         let rows = band.rows.clone();
         let display = f.frame.mean_rows(rows.clone());
-        let rgb = image_io::to_rgb8(&display, f.req.params.render.exposure, f.req.gamma);
+        let rgb = f.req.encode(&display);
         let pass_ms = f.pass_started.elapsed().as_secs_f64() * 1e3;
         self.ms_per_row = if band.pass_done { pass_ms / height as f64 } else { band_ms / rows.len() as f64 };
         let complete = f.frame.is_complete();
@@ -645,7 +662,7 @@ impl WorkerLoop {
         // diff view it is the difference image).
         let finished = if complete {
             let result = f.frame.finish();
-            let rgb8 = image_io::to_rgb8(&result.pixels, f.req.params.render.exposure, f.req.gamma);
+            let rgb8 = f.req.encode(&result.pixels);
             self.last_req = Some(f.req);
             Some((result, rgb8))
         } else {
@@ -699,7 +716,7 @@ impl WorkerLoop {
     /// Shows a frame rendered whole (not band by band) as complete.
     fn publish_whole(&mut self, f: Frame, frame: render::FrameResult) {
         let elapsed_ms = f.started.elapsed().as_secs_f64() * 1e3;
-        let rgb8 = image_io::to_rgb8(&frame.pixels, f.req.params.render.exposure, f.req.gamma);
+        let rgb8 = f.req.encode(&frame.pixels);
         let mut out = self.shared.output.lock().unwrap();
         out.error = None;
         out.width = frame.width;

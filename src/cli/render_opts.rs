@@ -137,6 +137,16 @@ pub struct RenderOpts {
     /// --shadow-filter pcf: the filter's radius in shadow-map texels.
     #[arg(long = "pcf-radius", default_value_t = defaults().pcf_radius, value_name = "R")]
     pub pcf_radius: f32,
+    /// Display (PNG and the viewer; EXR stays linear): exposure in stops, the
+    /// scale 2^EV multiplies the scene's `[render] exposure`.
+    #[arg(long, default_value_t = defaults().display.exposure_ev, value_name = "EV", allow_negative_numbers = true)]
+    pub exposure: f32,
+    /// Display tone map after the exposure: standard | reinhard | aces | agx | khronos-neutral.
+    #[arg(long, default_value_t = defaults().display.tonemap.name().to_string(), value_name = "MAP")]
+    pub tonemap: String,
+    /// Display transfer curve: srgb | 2.2 | off.
+    #[arg(long, default_value_t = defaults().display.gamma.name().to_string(), value_name = "srgb|2.2|off")]
+    pub gamma: String,
 }
 
 impl RenderOpts {
@@ -154,6 +164,9 @@ impl RenderOpts {
         s.light_samples = self.light_samples;
         s.shadow_filter = render::shadow::ShadowFilter::parse(&self.shadow_filter).map_err(|e| format!("--shadow-filter: {e}"))?;
         s.pcf_radius = self.pcf_radius;
+        s.display.exposure_ev = self.exposure;
+        s.display.tonemap = crate::display::ToneMap::parse(&self.tonemap).map_err(|e| format!("--tonemap: {e}"))?;
+        s.display.gamma = crate::display::Gamma::parse(&self.gamma).map_err(|e| format!("--gamma: {e}"))?;
         s.mis = match self.mis.as_str() {
             "on" => true,
             "off" => false,

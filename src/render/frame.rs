@@ -98,7 +98,7 @@ pub fn build_shadow_maps(prepared: &PreparedScene, settings: &RenderSettings) {
 /// The photon map the passes read, built (once, in parallel) before them,
 /// when the settings ask for photon mapping on the shaded view.
 pub fn build_photon_map(prepared: &PreparedScene, settings: &RenderSettings) -> Option<std::sync::Arc<crate::render::transport::photon_map::PhotonMap>> {
-    (settings.gi.mode == crate::render::transport::gi::GiMode::Photons && matches!(settings.view, crate::render::inspect::debug::View::Shaded | crate::render::inspect::debug::View::Diff))
+    (settings.gi.mode == crate::render::transport::gi::GiMode::Photons && matches!(settings.view, crate::render::inspect::debug::View::Shaded | crate::render::inspect::debug::View::Diff | crate::render::inspect::debug::View::FalseColour))
         .then(|| prepared.photon_map(&settings.gi, settings.shadow_bump))
 }
 
@@ -117,9 +117,11 @@ pub fn replay_pixel(renderer: &dyn Renderer, prepared: &PreparedScene, settings:
     }
     // The wireframe view is the shaded frame with lines over it: the samples
     // are shaded, and a pixel under a line takes the line's colour.
+    // So is the false-colour view, mapped once the pixel's value is final.
     let wireframe = settings.view == crate::render::inspect::debug::View::Wireframe;
+    let false_colour = settings.view == crate::render::inspect::debug::View::FalseColour;
     let shaded = RenderSettings { view: crate::render::inspect::debug::View::Shaded, ..settings.clone() };
-    let settings = if wireframe { &shaded } else { settings };
+    let settings = if wireframe || false_colour { &shaded } else { settings };
     build_shadow_maps(prepared, settings);
     let photons = build_photon_map(prepared, settings);
     let view = prepared.scene.camera.view(settings.width, settings.height);
@@ -149,6 +151,9 @@ pub fn replay_pixel(renderer: &dyn Renderer, prepared: &PreparedScene, settings:
     let mut radiance = if adaptive.is_some() { mean(sum, samples.len() as u32) } else { final_value(sum, spp) };
     if wireframe && crate::render::inspect::wireframe::line_mask(&prepared.scene, &view, settings.lines)[(x + y * settings.width) as usize] {
         radiance = crate::render::inspect::wireframe::LINE_COLOR;
+    }
+    if false_colour {
+        radiance = crate::display::false_colour::false_colour_linear(radiance);
     }
     Ok(PixelReplay { samples, radiance })
 }

@@ -165,6 +165,9 @@ pub struct RenderSettings {
     pub shadow_filter: shadow::ShadowFilter,
     /// `--shadow-filter pcf`: the filter's radius in texels of the map.
     pub pcf_radius: f32,
+    /// How the image is shown (exposure in stops, tone map, transfer
+    /// curve): read by the viewer and 8-bit outputs only, never by a renderer.
+    pub display: crate::display::DisplaySettings,
 }
 
 /// The most `RenderSettings::light_samples` a front end accepts.
@@ -205,6 +208,7 @@ impl Default for RenderSettings {
             mis: true,
             shadow_filter: shadow::ShadowFilter::None,
             pcf_radius: 1.5,
+            display: crate::display::DisplaySettings::default(),
         }
     }
 }

@@ -89,6 +89,9 @@ pub fn check(s: &RenderSettings) -> Result<(), SettingProblem> {
             refuse!("--subsample-contrast", "subsample.contrast", |s| s.subsample = RenderSettings::default().subsample, "{c} must be a contrast >= 0 (e.g. 0.3)");
         }
     }
+    if let Err(problem) = s.display.check() {
+        refuse!("--exposure", "display.exposure_ev", |s| s.display.exposure_ev = RenderSettings::default().display.exposure_ev, "{problem}");
+    }
     let gi = &s.gi;
     if let Some(b) = gi.bounces {
         if b > crate::render::transport::gi::MAX_BOUNCES {

@@ -1,12 +1,13 @@
 //! Shading section (the debug view is in the top bar): shadows (none / ray / map / volume, the map's filter) and the ray bump,
 //! light samples and MIS for area lights and the sky,
-//! samples per pixel, secondary depth, ambient, background, exposure and
-//! gamma on/off; the rasterizers' knobs (MSAA, early depth, affine, depth
+//! samples per pixel, secondary depth, ambient, background, exposure, the
+//! display transform (exposure in stops, tone map, gamma on/off and its curve); the rasterizers' knobs (MSAA, early depth, affine, depth
 //! buffer format) and the wireframe view's line algorithm.
 
 use eframe::egui;
 use crate::app::panels::{color_edit, section};
 use crate::app::settings_store::ViewerSettings;
+use crate::display::{Gamma, ToneMap};
 use crate::render::transport::gi::{GiMode, GiSettings, MAX_BOUNCES};
 use crate::render::raster::clip::ClipMode;
 use crate::render::raster::depth_format::DepthFormat;
@@ -103,7 +104,25 @@ pub fn show(ui: &mut egui::Ui, settings: &mut ViewerSettings, look: &mut RenderD
             let l = ui.label("exposure");
             ui.add(egui::Slider::new(&mut r.exposure, 0.01..=100.0).logarithmic(true)).labelled_by(l.id);
         });
-        ui.checkbox(gamma, "gamma (sRGB encode)");
+        // The display transform (`crate::display`): stops on top of the
+        // scene's exposure, a tone map, the transfer curve (gamma off: none).
+        ui.horizontal(|ui| {
+            let l = ui.label("exposure (stops)");
+            ui.add(egui::Slider::new(&mut s.display.exposure_ev, -10.0..=10.0).step_by(0.1)).labelled_by(l.id);
+        });
+        egui::ComboBox::from_label("tone map").selected_text(s.display.tonemap.name()).show_ui(ui, |ui| {
+            for t in ToneMap::ALL {
+                ui.selectable_value(&mut s.display.tonemap, t, t.name());
+            }
+        });
+        ui.horizontal(|ui| {
+            ui.checkbox(gamma, "gamma");
+            egui::ComboBox::from_label("transfer curve").selected_text(s.display.gamma.name()).show_ui(ui, |ui| {
+                for g in Gamma::ALL.into_iter().filter(|g| *g != Gamma::Off) {
+                    ui.selectable_value(&mut s.display.gamma, g, g.name());
+                }
+            });
+        });
         ui.horizontal(|ui| {
             ui.label("interpolation");
             for m in Interpolation::ALL {

@@ -150,6 +150,9 @@ pub struct Accumulator {
     /// the first band) are painted over the average.
     wireframe: Option<LineAlgorithm>,
     lines: Option<Vec<bool>>,
+    /// False-colour view: the passes are shaded; the average is shown as
+    /// its log2 luminance through the colour map (`display::false_colour`).
+    false_colour: bool,
     /// With more than one sample, what a band's pass renders before it is
     /// added to `sum`: kept from band to band, since a fresh buffer per
     /// band costs its allocation, zeroing and page faults every pass.
@@ -163,6 +166,14 @@ fn zeros(n: usize) -> Vec<Radiance> {
     let mut v = Vec::with_capacity(n);
     v.par_extend(rayon::iter::repeat_n(Radiance::ZERO, n));
     v
+}
+
+/// The false-colour view of shaded pixels: each becomes the linear colour
+/// whose sRGB encoding is the colour map's colour for its stop.
+fn false_colour_in_place(pixels: &mut [Radiance]) {
+    for c in pixels {
+        *c = crate::display::false_colour::false_colour_linear(*c);
+    }
 }
 
 impl Accumulator {
@@ -180,7 +191,8 @@ impl Accumulator {
     pub fn reusing(settings: &RenderSettings, spare: Vec<Radiance>) -> Accumulator {
         let diff = settings.view == View::Diff;
         let wireframe = (settings.view == View::Wireframe).then_some(settings.lines);
-        let shaded = diff || wireframe.is_some();
+        let false_colour = settings.view == View::FalseColour;
+        let shaded = diff || wireframe.is_some() || false_colour;
         let settings = if shaded { RenderSettings { view: View::Shaded, ..settings.clone() } } else { settings.clone() };
         let n = settings.width as usize * settings.height as usize;
         Accumulator {
@@ -195,6 +207,7 @@ impl Accumulator {
             photons: None,
             wireframe,
             lines: None,
+            false_colour,
             pass_buffer: Vec::new(),
             adaptive: settings.adaptive.filter(|_| settings.spp > 1).map(|target| Adaptive {
                 target,
@@ -441,6 +454,9 @@ impl Accumulator {
                 wireframe::draw_over(&mut out[at..], &lines[y as usize * w..(y as usize + 1) * w]);
             }
         }
+        if self.false_colour {
+            false_colour_in_place(&mut out);
+        }
         out
     }
 
@@ -490,6 +506,9 @@ impl Accumulator {
         };
         if let Some(lines) = &self.lines {
             wireframe::draw_over(&mut mine, lines);
+        }
+        if self.false_colour {
+            false_colour_in_place(&mut mine);
         }
         let (pixels, differing_pixels) = match self.reference {
             Some(reference) => {

@@ -55,6 +55,9 @@ named_enum! {
         /// The mip level each sample's texture lookup reads (`mip_color`),
         /// dark grey where the surface has no texture.
         Mip = "mip",
+        /// The shaded image's log2 luminance (stops) through the viridis
+        /// colour map (`display::false_colour`), legend in stops.
+        FalseColour = "false-colour",
     }
 }
 
@@ -121,7 +124,7 @@ pub fn surface_color(view: View, camera: &CameraView, h: &SurfaceHit) -> Radianc
         // The shadow map view is drawn by `shadow_map::view_sample`.
         // The wireframe view is the shaded image with lines drawn after the frame.
         // The mip view needs the scene's textures (`mip_view`).
-        View::Shaded | View::Raydir | View::Cost | View::Diff | View::Shadowmap | View::Wireframe | View::Mip => Vec3::ZERO,
+        View::Shaded | View::Raydir | View::Cost | View::Diff | View::Shadowmap | View::Wireframe | View::Mip | View::FalseColour => Vec3::ZERO,
         View::Barycentric => h.barycentric,
         View::Depth => Vec3::splat(depth_value(camera, (h.position - camera.eye).length())),
         View::Zbuffer => Vec3::splat(zbuffer_value(camera, camera.view_depth(h.position).max(camera.near))),
@@ -149,7 +152,7 @@ pub fn surface_color(view: View, camera: &CameraView, h: &SurfaceHit) -> Radianc
 pub fn miss_color(view: View) -> Option<Radiance> {
     match view {
         View::Barycentric | View::Depth | View::Zbuffer | View::Normal | View::GeometricNormal | View::Id | View::TriangleId | View::MaterialId | View::Uv => Some(Vec3::ZERO),
-        View::Shaded | View::Raydir | View::Cost | View::Diff | View::Shadowmap | View::Wireframe | View::Mip => None,
+        View::Shaded | View::Raydir | View::Cost | View::Diff | View::Shadowmap | View::Wireframe | View::Mip | View::FalseColour => None,
     }
 }
 
