@@ -15,6 +15,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::Instant;
 
 mod interrupt;
+mod part_opts;
 mod render_opts;
 mod usage_error;
 use render_opts::RenderOpts;
@@ -42,7 +43,20 @@ enum Command {
         output: PathBuf,
         #[command(flatten)]
         opts: RenderOpts,
+        #[command(flatten)]
+        part: part_opts::PartOpts,
         /// Write run statistics as JSON (`-` for stdout).
+        #[arg(long, value_name = "FILE")]
+        stats: Option<String>,
+    },
+    /// Assemble partial renders (--tile, --sample-range) into the whole frame.
+    Merge {
+        /// The parts (.exr files written by `render --tile` or `--sample-range`).
+        #[arg(required = true, value_name = "PART.exr")]
+        parts: Vec<PathBuf>,
+        #[arg(short = 'o', long = "output", value_name = "OUT")]
+        output: PathBuf,
+        /// Write the whole render's statistics as JSON (`-` for stdout).
         #[arg(long, value_name = "FILE")]
         stats: Option<String>,
     },
@@ -161,7 +175,8 @@ pub fn run() -> Result<Outcome, String> {
     }
     let ran = match cli.command {
         None => return Ok(Outcome::OpenViewer { scene: cli.scene, screenshot: cli.screenshot }),
-        Some(Command::Render { scene, output, opts, stats }) => cmd_render(&scene, &output, &opts, stats.as_deref()),
+        Some(Command::Render { scene, output, opts, part, stats }) => cmd_render(&scene, &output, &opts, &part, stats.as_deref()),
+        Some(Command::Merge { parts, output, stats }) => cmd_merge(&parts, &output, stats.as_deref()),
         Some(Command::Bench { scene, opts, frames }) => cmd_bench(&scene, &opts, frames),
         Some(Command::Compare { a, b, json }) => cmd_compare(&a, &b, json),
         Some(Command::Pixel { scene, x, y, opts, json }) => cmd_pixel(&scene, x, y, &opts, json),
@@ -292,10 +307,13 @@ fn stats_json(l: &Loaded, render_ms: f64, counts: &RayCounts, spp: u32) -> serde
     j
 }
 
-fn cmd_render(scene_arg: &str, output: &Path, opts: &RenderOpts, stats: Option<&str>) -> Result<(), String> {
+fn cmd_render(scene_arg: &str, output: &Path, opts: &RenderOpts, part_opts: &part_opts::PartOpts, stats: Option<&str>) -> Result<(), String> {
     let ext = output.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).unwrap_or_default();
     if !["png", "exr", "ppm"].contains(&ext.as_str()) {
         return Err(format!("{}: unknown image type (use .png, .exr or .ppm)", output.display()));
+    }
+    if part_opts.is_partial() && ext != "exr" {
+        return Err(format!("{}: a part for pinhole merge (--tile, --sample-range) is written as .exr", output.display()));
     }
     crate::image_io::check_writable(output)?;
     if let Some(dest) = stats.filter(|d| *d != "-") {
@@ -306,9 +324,14 @@ fn cmd_render(scene_arg: &str, output: &Path, opts: &RenderOpts, stats: Option<&
     let l = load(scene_arg, opts)?;
     // Now that every input is read: none of them may be an output.
     crate::file_identity::check_outputs(&outputs)?;
+    let part = part_opts.part(&l.settings)?;
     let cancel = interrupt::flag();
     let rows_done = AtomicU64::new(0);
-    let total_rows = l.settings.height as u64 * l.settings.spp as u64;
+    let total_rows = match &part {
+        Some(p) => p.height() as u64 * p.passes.len() as u64,
+        None => l.settings.height as u64 * l.settings.spp as u64,
+    };
+    let started_unix_ms = unix_ms();
     let show_progress = std::io::stderr().is_terminal();
     let start = Instant::now();
     let done = AtomicBool::new(false);
@@ -316,7 +339,7 @@ fn cmd_render(scene_arg: &str, output: &Path, opts: &RenderOpts, stats: Option<&
         s.spawn(|| progress_loop(&rows_done, total_rows, &done, show_progress));
         let bands = if show_progress { 32 } else { 1 };
         let r = l.pool.install(|| {
-            render::render_frame_with(l.renderer.as_ref(), &l.prepared, &l.settings, cancel, render::FrameOptions { bands, rows_done: Some(&rows_done), ..render::FrameOptions::default() })
+            render::render_frame_with(l.renderer.as_ref(), &l.prepared, &l.settings, cancel, render::FrameOptions { bands, rows_done: Some(&rows_done), part: part.clone(), ..render::FrameOptions::default() })
         });
         done.store(true, Ordering::Relaxed);
         r
@@ -326,12 +349,63 @@ fn cmd_render(scene_arg: &str, output: &Path, opts: &RenderOpts, stats: Option<&
     if let Some(n) = frame.differing_pixels {
         eprintln!("{n} of {} pixels differ from raytrace:brute", frame.pixels.len());
     }
-    crate::image_io::save_image_displayed(output, frame.width, frame.height, &frame.pixels, l.prepared.scene.render.exposure, &l.settings.display)?;
+    let mut j = stats_json(&l, render_ms, &frame.counts, l.settings.spp);
+    j["tile"] = json!(part_opts.tile.map(|t| format!("{}/{}", t.index, t.count)));
+    j["sample_range"] = json!(part.as_ref().filter(|_| part_opts.sample_range.is_some()).map(|p| format!("{}..{}", p.passes.start, p.passes.end)));
+    j["crop"] = json!(part_opts.crop.map(|c| c.0));
+    if part_opts.is_partial() {
+        let p = part.as_ref().expect("a partial render has a part");
+        j["started_unix_ms"] = json!(started_unix_ms);
+        j["finished_unix_ms"] = json!(unix_ms());
+        j["peak_rss_bytes"] = json!(peak_rss_bytes());
+        let record = crate::part_file::PartRecord {
+            version: env!("CARGO_PKG_VERSION").to_string(),
+            scene: l.prepared.scene.name.clone(),
+            scene_hash: crate::part_file::scene_hash(&l.prepared.scene.name, &crate::file_identity::inputs_read())?,
+            renderer: l.renderer.name().to_string(),
+            settings: serde_json::to_value(&l.settings).map_err(|e| e.to_string())?,
+            frame_width: l.settings.width,
+            frame_height: l.settings.height,
+            spp: l.settings.spp.max(1),
+            region: [p.x.start, p.y.start, p.x.end, p.y.end],
+            passes: [p.passes.start, p.passes.end],
+            tile: part_opts.tile.map(|t| [t.index, t.count]),
+            stats: j.clone(),
+        };
+        crate::image_io::write_atomic(output, &crate::part_file::encode(&record, &frame.pixels)?)?;
+    } else {
+        crate::image_io::save_image_displayed(output, frame.width, frame.height, &frame.pixels, l.prepared.scene.render.exposure, &l.settings.display)?;
+    }
     if let Some(dest) = stats {
-        let mut j = stats_json(&l, render_ms, &frame.counts, l.settings.spp);
         // After the frame and its image: the run's peak (null where unknown).
         j["peak_rss_bytes"] = json!(peak_rss_bytes());
         write_json(dest, &j)?;
+    }
+    Ok(())
+}
+
+/// Now as milliseconds since the Unix epoch (parts' start and end times,
+/// from which a merge tells the wall-clock time of the whole).
+fn unix_ms() -> f64 {
+    std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0.0, |d| d.as_secs_f64() * 1e3)
+}
+
+fn cmd_merge(paths: &[PathBuf], output: &Path, stats: Option<&str>) -> Result<(), String> {
+    if output.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() != Some("exr") {
+        return Err(format!("{}: the merged frame is written as .exr (linear, like the parts)", output.display()));
+    }
+    crate::image_io::check_writable(output)?;
+    if let Some(dest) = stats.filter(|d| *d != "-") {
+        crate::image_io::check_writable(Path::new(dest))?;
+    }
+    let parts = paths.iter().map(|p| crate::part_file::read(p).map(|f| (p.clone(), f))).collect::<Result<Vec<_>, String>>()?;
+    // Every part is read: none of them may be written over.
+    let outputs: Vec<&Path> = std::iter::once(output).chain(stats.filter(|d| *d != "-").map(Path::new)).collect();
+    crate::file_identity::check_outputs(&outputs)?;
+    let merged = crate::part_merge::merge(&parts)?;
+    crate::image_io::save_image(output, merged.width, merged.height, &merged.pixels, 1.0)?;
+    if let Some(dest) = stats {
+        write_json(dest, &merged.stats)?;
     }
     Ok(())
 }

@@ -59,6 +59,11 @@ pub fn record_input(path: &Path, metadata: &std::fs::Metadata) {
     list.push(entry);
 }
 
+/// The resolved paths of every file read so far, in the order first read.
+pub fn inputs_read() -> Vec<PathBuf> {
+    INPUTS_READ.lock().unwrap_or_else(|e| e.into_inner()).iter().map(|r| r.resolved.clone()).collect()
+}
+
 /// Where writing `path` would land: the resolved path of the file (links
 /// followed; for a file not made yet, its resolved folder joined with its
 /// name) and the file's identity if it exists. `None` for special files

@@ -15,6 +15,8 @@ pub mod input;
 pub mod math;
 pub mod metrics;
 pub mod named;
+pub mod part_file;
+pub mod part_merge;
 pub mod render;
 pub mod scene;
 pub mod app;

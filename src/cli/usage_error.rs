@@ -27,9 +27,11 @@ pub fn one_sentence(e: &clap::Error, cmd: &clap::Command) -> String {
                 Some(valid) => Some(format!("one of {valid}")),
                 None => find_arg(cmd, &token).and_then(accepted_values),
             };
-            return match accepted {
-                Some(a) => format!("{name}: \"{value}\" is not {a}"),
-                None => format!("{name}: \"{value}\" is not a valid value"),
+            return match (accepted, std::error::Error::source(e)) {
+                (Some(a), _) => format!("{name}: \"{value}\" is not {a}"),
+                // A value parser of its own says why in its error.
+                (None, Some(reason)) => format!("{name} {value}: {reason}"),
+                (None, None) => format!("{name}: \"{value}\" is not a valid value"),
             };
         }
     }

@@ -2,7 +2,10 @@
 //! completion, `replay_pixel` replays one of its pixels sample by sample.
 
 mod accumulator;
+pub mod part;
 pub mod subsample;
+
+pub use part::FramePart;
 
 pub use subsample::Subsample;
 pub use accumulator::{add_sample, admitted, final_value, mean, relative_error, wants_more, Accumulator, Band, ADAPTIVE_MIN_SAMPLES};
@@ -19,6 +22,10 @@ pub struct FrameResult {
     pub counts: RayCounts,
     /// The diff view: how many pixels differ from the reference.
     pub differing_pixels: Option<u64>,
+    /// `None`: the pixels are final values. `Some(passes)`: a part of the
+    /// frame's sample passes, whose pixels are their samples' sums (what a
+    /// merge adds up before it divides by the frame's samples per pixel).
+    pub summed_passes: Option<std::ops::Range<u32>>,
 }
 
 /// How a caller follows and feeds a frame beyond its settings: the
@@ -38,12 +45,41 @@ pub struct FrameOptions<'a> {
     /// caller that renders frame after frame (`pinhole bench`) hands back
     /// from the frame before.
     pub spare: Vec<Radiance>,
+    /// Only this part of the frame (a crop, a tile, a sample range); the
+    /// result is the part's size. `None`: the whole frame.
+    pub part: Option<FramePart>,
 }
 
 impl Default for FrameOptions<'_> {
     fn default() -> Self {
-        FrameOptions { passes_done: None, bands: 1, rows_done: None, spare: Vec::new() }
+        FrameOptions { passes_done: None, bands: 1, rows_done: None, spare: Vec::new(), part: None }
     }
+}
+
+/// Why a part of the frame cannot be rendered alone with `settings`, if
+/// it cannot: a range of the passes needs every pixel's samples to be
+/// independent of the others' and of the passes before.
+pub fn check_part(part: &FramePart, settings: &RenderSettings) -> Result<(), String> {
+    part.check(settings)?;
+    if !part.all_passes(settings) {
+        use crate::render::inspect::debug::View;
+        if settings.adaptive.is_some() {
+            return Err("--sample-range cannot split --adaptive sampling, whose later samples depend on the earlier ones".into());
+        }
+        if settings.subsample.is_on() && settings.view == View::Shaded {
+            return Err("--sample-range cannot split a --subsample frame, which interpolates every pass over the whole image".into());
+        }
+        if matches!(settings.view, View::Diff | View::Wireframe) {
+            return Err(format!("--sample-range cannot split the {} view, which is drawn over the finished average", settings.view.name()));
+        }
+    }
+    Ok(())
+}
+
+/// The rectangle `part` of a whole frame's `pixels` (width `width`).
+fn cut(pixels: &[Radiance], width: u32, part: &FramePart) -> Vec<Radiance> {
+    let w = width as usize;
+    part.y.clone().flat_map(|y| &pixels[y as usize * w + part.x.start as usize..y as usize * w + part.x.end as usize]).copied().collect()
 }
 
 /// Renders a whole frame of `settings.spp` samples. Returns `None` when
@@ -55,21 +91,38 @@ pub fn render_frame(renderer: &dyn Renderer, prepared: &PreparedScene, settings:
 
 /// `render_frame` followed and fed as `options` say.
 pub fn render_frame_with(renderer: &dyn Renderer, prepared: &PreparedScene, settings: &RenderSettings, cancel: &AtomicBool, options: FrameOptions) -> Option<FrameResult> {
-    let FrameOptions { passes_done, bands, rows_done, spare } = options;
+    let FrameOptions { passes_done, bands, rows_done, spare, part } = options;
+    let part = part.filter(|p| *p != FramePart::whole(settings));
+    // The part is cut from the whole frame's rows: every column of them is
+    // rendered (renderers take bands of whole rows).
+    let cut_part = |mut frame: FrameResult| {
+        if let Some(p) = &part {
+            frame.pixels = cut(&frame.pixels, frame.width, p);
+            frame.width = p.width();
+            frame.height = p.height();
+        }
+        frame
+    };
     // Sub-sampling interpolates shaded images; debug views show every pixel.
+    // Its grid spans the whole frame, so a part of it is cut from the whole.
     if settings.subsample.is_on() && settings.view == crate::render::inspect::debug::View::Shaded {
-        return subsample::render_subsampled(renderer, prepared, settings, cancel, passes_done);
+        assert!(part.as_ref().is_none_or(|p| p.all_passes(settings)), "check_part refuses sample ranges of a sub-sampled frame");
+        return subsample::render_subsampled(renderer, prepared, settings, cancel, passes_done).map(cut_part);
     }
     let mut frame = Accumulator::reusing(settings, spare);
+    if let Some(p) = &part {
+        frame.limit_to(p.y.clone(), p.passes.clone());
+    }
     // Without a count of passes to report, a renderer that renders a few
     // rows as cheaply as many takes the frame chunk by chunk.
     if let (None, Some(rows)) = (passes_done, renderer.chunk_rows())
         && frame.renders_in_chunks()
     {
         frame.render_in_chunks(renderer, prepared, rows, cancel, rows_done)?;
-        return Some(frame.finish());
+        return Some(cut_part(frame.finish()));
     }
-    let band_rows = settings.height.div_ceil(bands.clamp(1, settings.height.max(1)));
+    let rows = part.as_ref().map_or(settings.height, |p| p.height());
+    let band_rows = rows.div_ceil(bands.clamp(1, rows.max(1)));
     while !frame.is_complete() {
         let band = frame.render_band(renderer, prepared, band_rows, cancel)?;
         if let Some(done) = rows_done {
@@ -79,7 +132,7 @@ pub fn render_frame_with(renderer: &dyn Renderer, prepared: &PreparedScene, sett
             done.fetch_add(1, Ordering::Relaxed);
         }
     }
-    Some(frame.finish())
+    Some(cut_part(frame.finish()))
 }
 
 /// Builds the shadow maps `settings` look up (`--shadows map`, the shadow-map

@@ -22,7 +22,7 @@ pub mod settings_check;
 pub mod shadow;
 pub mod transport;
 
-pub use frame::{render_frame, render_frame_with, replay_pixel, FrameOptions, FrameResult, PixelReplay};
+pub use frame::{render_frame, render_frame_with, replay_pixel, FrameOptions, FramePart, FrameResult, PixelReplay};
 pub use prepared::PreparedScene;
 
 use crate::math::{Radiance, Ray, Vec2};

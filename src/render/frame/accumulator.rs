@@ -157,6 +157,10 @@ pub struct Accumulator {
     /// added to `sum`: kept from band to band, since a fresh buffer per
     /// band costs its allocation, zeroing and page faults every pass.
     pass_buffer: Vec<Radiance>,
+    /// The rows and passes rendered (`limit_to`; the whole frame by default):
+    /// the sums hold the whole frame's pixels, touched only there.
+    rows: Range<u32>,
+    passes: Range<u32>,
 }
 
 /// `n` zero radiances, written by every thread of the pool: a frame's sum
@@ -209,6 +213,8 @@ impl Accumulator {
             lines: None,
             false_colour,
             pass_buffer: Vec::new(),
+            rows: 0..settings.height,
+            passes: 0..settings.spp.max(1),
             adaptive: settings.adaptive.filter(|_| settings.spp > 1).map(|target| Adaptive {
                 target,
                 samples: vec![0; n],
@@ -217,6 +223,18 @@ impl Accumulator {
             }),
             settings,
         }
+    }
+
+    /// Renders only `rows` and sample passes `passes` (within the frame's),
+    /// with the sample indices, offsets and seeds of the whole frame there.
+    /// Panics once rendering began.
+    pub fn limit_to(&mut self, rows: Range<u32>, passes: Range<u32>) {
+        assert!(self.pass == self.passes.start && self.row == self.rows.start, "limit_to after rendering began");
+        assert!(rows.end <= self.settings.height && passes.end <= self.spp && !passes.is_empty(), "limit_to outside the frame");
+        self.row = rows.start;
+        self.pass = passes.start;
+        self.rows = rows;
+        self.passes = passes;
     }
 
     pub fn width(&self) -> u32 {
@@ -243,7 +261,7 @@ impl Accumulator {
 
     /// Every sample of every pixel is in.
     pub fn is_complete(&self) -> bool {
-        self.pass >= self.spp || self.adaptive.as_ref().is_some_and(|a| a.settled)
+        self.pass >= self.passes.end || self.adaptive.as_ref().is_some_and(|a| a.settled)
     }
 
     /// Samples taken over the whole frame so far.
@@ -266,10 +284,10 @@ impl Accumulator {
     pub fn render_band(&mut self, renderer: &dyn Renderer, prepared: &PreparedScene, max_rows: u32, cancel: &AtomicBool) -> Option<Band> {
         assert!(!self.is_complete(), "render_band on a complete frame");
         let (width, height) = (self.settings.width, self.settings.height);
-        if self.pass == 0 && self.row == 0 {
+        if self.pass == self.passes.start && self.row == self.rows.start {
             self.prepare_frame(prepared);
         }
-        let rows = self.row..(self.row + max_rows.max(1)).min(height);
+        let rows = self.row..(self.row + max_rows.max(1)).min(self.rows.end);
         let mut counts = RayCounts::default();
         if !rows.is_empty() && width > 0 {
             let view = prepared.scene.camera.view(width, height);
@@ -333,14 +351,16 @@ impl Accumulator {
         self.counts += counts;
         let pass = self.pass;
         self.row = rows.end;
-        let pass_done = self.row >= height;
+        let pass_done = self.row >= self.rows.end;
         if pass_done {
-            self.row = 0;
+            self.row = self.rows.start;
             self.pass += 1;
             let (sum, sum_sq, spp) = (&self.sum, &self.sum_sq, self.spp);
+            let w = width as usize;
+            let span = self.rows.start as usize * w..self.rows.end as usize * w;
             if let Some(a) = self.adaptive.as_mut() {
                 let mut any = false;
-                for i in 0..a.active.len() {
+                for i in span {
                     a.active[i] = a.active[i] && wants_more(sum[i], sum_sq[i], a.samples[i], spp, a.target);
                     any |= a.active[i];
                 }
@@ -366,7 +386,7 @@ impl Accumulator {
     /// work per pass beside the renderer's (the diff view's reference, the
     /// wireframe's lines).
     pub fn renders_in_chunks(&self) -> bool {
-        self.spp > 1 && self.pass == 0 && self.row == 0 && self.adaptive.is_none() && self.reference.is_none() && self.wireframe.is_none()
+        self.spp > 1 && self.pass == self.passes.start && self.row == self.rows.start && self.adaptive.is_none() && self.reference.is_none() && self.wireframe.is_none()
     }
 
     /// Renders the whole frame chunk by chunk: chunks of `chunk_rows` rows
@@ -384,27 +404,28 @@ impl Accumulator {
         let (settings, photons) = (&self.settings, self.photons.as_deref());
         let chunk_rows = chunk_rows.max(1);
         let chunk = (chunk_rows * width).max(1) as usize;
-        let counts = self
-            .sum
+        let (first_row, rows_end, passes_range) = (self.rows.start, self.rows.end, self.passes.clone());
+        let span = first_row as usize * width as usize..self.rows.end as usize * width as usize;
+        let counts = self.sum[span.clone()]
             .par_chunks_mut(chunk)
-            .zip(self.sum_sq.par_chunks_mut(chunk))
+            .zip(self.sum_sq[span].par_chunks_mut(chunk))
             .enumerate()
             // One pass buffer per rayon job, not per chunk: a fresh one of
             // this size is mapped memory whose every page faults in.
             .map_init(Vec::new, |pass_buffers, (k, (sum, sum_sq))| {
-                let rows = k as u32 * chunk_rows..((k as u32 + 1) * chunk_rows).min(height);
+                let rows = first_row + k as u32 * chunk_rows..(first_row + (k as u32 + 1) * chunk_rows).min(rows_end);
                 // Up to `passes_at_once` passes rendered in one call (a ray
                 // caster traces a pixel's samples of them together), then
                 // added in pass order.
-                let group = renderer.passes_at_once().clamp(1, spp) as usize;
+                let group = renderer.passes_at_once().clamp(1, passes_range.len() as u32) as usize;
                 pass_buffers.clear();
                 pass_buffers.resize(group * sum.len(), Radiance::ZERO);
                 let mut counts = RayCounts::default();
-                for first in (0..spp).step_by(group) {
+                for first in passes_range.clone().step_by(group) {
                     if cancel.load(Ordering::Relaxed) {
                         break;
                     }
-                    let passes = first..(first + group as u32).min(spp);
+                    let passes = first..(first + group as u32).min(passes_range.end);
                     let jobs: Vec<PassJob> = passes
                         .clone()
                         .map(|pass| PassJob { prepared, view: &view, settings, offset: sample_offset(pass, spp, settings.gi.seed), sample: pass, photons, active: None, rows: rows.clone(), cancel })
@@ -428,8 +449,11 @@ impl Accumulator {
             return None;
         }
         self.counts += counts;
-        self.row_passes.fill(spp);
-        self.pass = spp;
+        let passes = self.passes.len() as u32;
+        for y in self.rows.clone() {
+            self.row_passes[y as usize] = passes;
+        }
+        self.pass = self.passes.end;
         Some(())
     }
 
@@ -492,6 +516,11 @@ impl Accumulator {
     /// the reference with its count of differing pixels.
     pub fn finish(self) -> FrameResult {
         let spp = self.spp;
+        // Some of the passes only: their sums, for a merge to add up.
+        if self.passes != (0..spp) {
+            let summed = Some(self.passes.clone());
+            return FrameResult { width: self.settings.width, height: self.settings.height, pixels: self.sum, counts: self.counts, differing_pixels: None, summed_passes: summed };
+        }
         let average = |mut sum: Vec<Radiance>| {
             if spp > 1 {
                 for s in &mut sum {
@@ -517,7 +546,7 @@ impl Accumulator {
             }
             None => (mine, None),
         };
-        FrameResult { width: self.settings.width, height: self.settings.height, pixels, counts: self.counts, differing_pixels }
+        FrameResult { width: self.settings.width, height: self.settings.height, pixels, counts: self.counts, differing_pixels, summed_passes: None }
     }
 }
 

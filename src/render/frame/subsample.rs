@@ -131,7 +131,7 @@ pub fn render_subsampled(renderer: &dyn Renderer, prepared: &PreparedScene, sett
     for s in &mut sum {
         *s = final_value(*s, spp);
     }
-    Some(FrameResult { width: w, height: h, pixels: sum, counts, differing_pixels: None })
+    Some(FrameResult { width: w, height: h, pixels: sum, counts, differing_pixels: None, summed_passes: None })
 }
 
 /// Calls `f` with each grid cell's column and row span (inclusive corners).
