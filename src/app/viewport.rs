@@ -142,7 +142,7 @@ pub fn show(ui: &mut egui::Ui, viewed: &Viewed, edited: Edited) -> ViewportReque
             let depth = view.view_depth(*position);
             if depth > view.near {
                 let q = to_px(p);
-                *position = view.eye + view.camera_to_world * (view.camera_dir(q.x, q.y) * depth);
+                *position = view.point_at_depth(q.x, q.y, depth);
             }
         }
     } else if delta != egui::Vec2::ZERO && !split_drag {

@@ -44,6 +44,10 @@ pub struct RenderOpts {
     /// flat | gouraud | phong: how shading varies across a triangle.
     #[arg(long, default_value_t = defaults().interpolation.name().to_string())]
     pub interpolation: String,
+    /// Mirror and glass recursion limit: reflected and refracted rays followed
+    /// from one eye ray (0: none; the scene's or the default when absent).
+    #[arg(long = "max-depth", value_name = "N")]
+    pub max_depth: Option<u32>,
     /// Worker threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
@@ -173,6 +177,7 @@ impl RenderOpts {
             other => return Err(format!("--mis {other} is neither on nor off")),
         };
         s.spp = self.spp;
+        s.max_depth = self.max_depth.unwrap_or(s.max_depth);
         s.width = self.width.unwrap_or(s.width);
         s.height = self.height.unwrap_or(s.height);
         s.clip = render::raster::clip::ClipMode::parse(&self.clip).map_err(|e| format!("--clip: {e}"))?;
@@ -216,5 +221,36 @@ impl RenderOpts {
         gi.photon_k = self.photon_k.unwrap_or(gi.photon_k);
         gi.final_gather = self.final_gather.unwrap_or(gi.final_gather);
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Line {
+        #[command(flatten)]
+        opts: RenderOpts,
+    }
+
+    fn settings_of(args: &[&str]) -> Result<RenderSettings, String> {
+        let line = Line::try_parse_from(std::iter::once("pinhole").chain(args.iter().copied())).map_err(|e| e.to_string())?;
+        let scene = crate::scene::builtin::load_builtin("spheres").unwrap().unwrap();
+        let mut s = RenderSettings { width: 48, height: 32, ..RenderSettings::for_scene(&scene) };
+        line.opts.write_into(&mut s)?;
+        Ok(s)
+    }
+
+    /// `--max-depth` sets `RenderSettings::max_depth`, the one recursion
+    /// limit the renderers and the viewer's slider read, within its bound.
+    #[test]
+    fn max_depth_sets_the_recursion_limit_and_is_bounded() {
+        assert_eq!(settings_of(&[]).unwrap().max_depth, RenderSettings::default().max_depth);
+        let (none, four) = (settings_of(&["--max-depth", "0"]).unwrap(), settings_of(&["--max-depth", "4"]).unwrap());
+        assert_eq!((none.max_depth, four.max_depth), (0, 4));
+        let e = settings_of(&["--max-depth", "17"]).unwrap_err();
+        assert!(e.contains("--max-depth 17") && e.contains("16"), "{e}");
     }
 }

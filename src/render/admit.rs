@@ -100,6 +100,7 @@ fn check(renderer: &dyn Renderer, scene: &Scene, settings: &RenderSettings) -> R
         shadow_map::check_memory(scene, settings.shadow_map_size)?;
     }
     layer_support::check(renderer, scene, settings)?;
+    renderer.check_camera(&scene.camera)?;
     classic_lighting(scene, settings)?;
     renderer.check(scene, settings)
 }

@@ -8,6 +8,7 @@
 //! both arrive at the same numbers up to rounding.
 
 use crate::math::{Ray, Vec2, Vec3};
+use crate::scene::camera::Projection;
 use crate::scene::{CameraView, Differentials, PrimitiveKind, Scene, SurfaceHit};
 
 /// d(origin)/dx, d(origin)/dy, d(direction)/dx, d(direction)/dy of a ray,
@@ -26,8 +27,28 @@ impl RayDifferential {
     /// `2 half_x / width` along the camera's x per pixel (and `-2 half_y /
     /// height` along y), the origin on the near plane by `near` times that,
     /// and the unit direction by the derivative of normalization.
+    /// Orthographic rays move sideways and keep their direction; the
+    /// projections that bend lines take the difference between the rays
+    /// half a pixel either side.
     pub fn eye(view: &CameraView, px: f32, py: f32) -> RayDifferential {
         let m = view.camera_to_world;
+        match view.projection {
+            Projection::Perspective => {}
+            Projection::Orthographic { .. } => {
+                return RayDifferential {
+                    do_dx: m * Vec3::new(2.0 * view.half_x / view.width as f32, 0.0, 0.0),
+                    do_dy: m * Vec3::new(0.0, -2.0 * view.half_y / view.height as f32, 0.0),
+                    dd_dx: Vec3::ZERO,
+                    dd_dy: Vec3::ZERO,
+                }
+            }
+            Projection::Fisheye | Projection::Cylindrical => {
+                let across = |a: Ray, b: Ray| (b.origin - a.origin, b.dir - a.dir);
+                let (do_dx, dd_dx) = across(view.eye_ray(px - 0.5, py), view.eye_ray(px + 0.5, py));
+                let (do_dy, dd_dy) = across(view.eye_ray(px, py - 0.5), view.eye_ray(px, py + 0.5));
+                return RayDifferential { do_dx, do_dy, dd_dx, dd_dy };
+            }
+        }
         let d = m * view.camera_dir(px, py);
         let step_x = m * Vec3::new(2.0 * view.half_x / view.width as f32, 0.0, 0.0);
         let step_y = m * Vec3::new(0.0, -2.0 * view.half_y / view.height as f32, 0.0);

@@ -7,6 +7,7 @@
 
 pub mod accel;
 pub mod admit;
+pub mod camera_support;
 pub mod differentials;
 pub mod finite;
 pub mod frame;
@@ -372,6 +373,27 @@ impl PassJob<'_> {
     pub fn sample_position(&self, x: u32, y: u32) -> Vec2 {
         Vec2::new(x as f32 + self.offset.x, y as f32 + self.offset.y)
     }
+
+    /// This pass's eye ray in pixel `(x, y)` and the ray parameter of the
+    /// far plane: through its `sample_position`, and with a thin lens from
+    /// the point of the lens that `lens_sample` draws for the sample.
+    #[inline]
+    pub fn eye_ray(&self, x: u32, y: u32) -> (Ray, f32) {
+        let p = self.sample_position(x, y);
+        if self.view.aperture == 0.0 {
+            return (self.view.eye_ray(p.x, p.y), self.view.far_t(p.x, p.y));
+        }
+        self.view.eye_ray_through_lens(p.x, p.y, lens_sample(self.pixel_index(x, y), self.sample, self.settings.gi.seed))
+    }
+}
+
+/// Where on the unit disk sample `sample` of pixel `pixel` crosses a thin
+/// lens: a pure function of (pixel, sample index, seed), on a stream of
+/// its own so that it draws nothing from the shading's numbers.
+pub fn lens_sample(pixel: u32, sample: u32, seed: u64) -> Vec2 {
+    const LENS_STREAM: u64 = 0x1E45_0000_0000_0000;
+    let u = transport::sampling::hashed_unit_pair(pixel as u64 | (sample as u64) << 32, seed ^ LENS_STREAM);
+    transport::sampling::concentric_disk(u)
 }
 
 /// A rendering method: `raytrace:brute`, `raytrace:bvh`, `rasterize:...`.
@@ -418,6 +440,13 @@ pub trait Renderer: Sync + Send {
     /// `admit::admit`, with no driver loaded.
     fn check(&self, scene: &crate::scene::Scene, settings: &RenderSettings) -> Result<(), String> {
         accel::csg::check(scene, settings)
+    }
+
+    /// Whether this renderer draws through `camera`: one sentence saying
+    /// why not. By default a rasterizer's answer (`camera_support`); the
+    /// ray casters draw every camera.
+    fn check_camera(&self, camera: &crate::scene::Camera) -> Result<(), String> {
+        camera_support::check_rasterized(self.name(), camera)
     }
 
     /// What this renderer draws instead of `settings` when `check` refuses

@@ -15,6 +15,9 @@ pub const MAX_GATHER: u32 = 4096;
 /// The widest PCF filter, in texels.
 pub const MAX_PCF_RADIUS: f32 = 64.0;
 
+/// The deepest mirror and glass recursion (`--max-depth`, the viewer's slider).
+pub const MAX_MIRROR_DEPTH: u32 = 16;
+
 /// One setting out of its range.
 #[derive(Clone, Debug)]
 pub struct SettingProblem {
@@ -55,6 +58,9 @@ pub fn check(s: &RenderSettings) -> Result<(), SettingProblem> {
             let reset: fn(&mut RenderSettings) = if field == "width" { |s| s.width = RenderSettings::default().width } else { |s| s.height = RenderSettings::default().height };
             refuse!(flag, field, reset, "{v} is not between 1 and {}", crate::input::MAX_IMAGE_SIDE);
         }
+    }
+    if s.max_depth > MAX_MIRROR_DEPTH {
+        refuse!("--max-depth", "max_depth", |s| s.max_depth = RenderSettings::default().max_depth, "{} is not a number from 0 to {MAX_MIRROR_DEPTH}", s.max_depth);
     }
     if s.light_samples > crate::render::MAX_LIGHT_SAMPLES {
         refuse!("--light-samples", "light_samples", |s| s.light_samples = RenderSettings::default().light_samples,

@@ -6,6 +6,9 @@
 //! the ray tracer, just as the rasterizer's near-plane clip removes it.
 
 pub mod control;
+pub mod projection;
+
+pub use projection::Projection;
 
 use crate::math::lanes::{Lane, V3};
 use crate::math::{Mat3, Ray, Vec2, Vec3};
@@ -32,7 +35,15 @@ pub struct Camera {
     pub fov: Fov,
     pub near: f32,
     pub far: f32,
+    pub projection: Projection,
+    /// Thin lens radius in world units (0: a pinhole, everything sharp).
+    pub aperture: f32,
+    /// Distance along the view axis of the plane in focus (with an aperture).
+    pub focus_distance: f32,
 }
+
+/// Where the plane in focus lies when a scene gives no `focus_distance`.
+pub const DEFAULT_FOCUS_DISTANCE: f32 = 1.0;
 
 impl Default for Camera {
     fn default() -> Self {
@@ -43,6 +54,9 @@ impl Default for Camera {
             fov: Fov::Y(60.0),
             near: 0.1,
             far: 100.0,
+            projection: Projection::Perspective,
+            aperture: 0.0,
+            focus_distance: DEFAULT_FOCUS_DISTANCE,
         }
     }
 }
@@ -68,11 +82,27 @@ impl Camera {
         if forward.normalize().cross(crate::math::rescale_direction(self.up)).length_squared() < 1e-12 {
             return Err("camera.up is parallel to the view direction (or zero)".into());
         }
-        let deg = match self.fov {
-            Fov::X(d) | Fov::Y(d) => d,
+        let (deg, horizontal) = match self.fov {
+            Fov::X(d) => (d, true),
+            Fov::Y(d) => (d, false),
         };
-        if !((MIN_FOV_DEG..=MAX_FOV_DEG).contains(&deg)) {
-            return Err(format!("camera field of view {deg} is not between {MIN_FOV_DEG} and {MAX_FOV_DEG} degrees"));
+        let max = self.projection.max_fov_deg(horizontal);
+        if !((MIN_FOV_DEG..=max).contains(&deg)) {
+            return Err(format!("camera field of view {deg} is not between {MIN_FOV_DEG} and {max} degrees"));
+        }
+        if let Projection::Orthographic { height } = self.projection {
+            if !(height > 0.0 && height <= 2.0 * MAX_COORDINATE) {
+                return Err(format!("camera.height is {height}; an orthographic view must be more than 0 and at most {:e} world units high", 2.0 * MAX_COORDINATE));
+            }
+        }
+        if !(self.aperture >= 0.0 && self.aperture <= MAX_COORDINATE) {
+            return Err(format!("camera.aperture is {}; the lens radius must be at least 0 (0 is a pinhole) and at most {MAX_COORDINATE:e}", self.aperture));
+        }
+        if !(self.focus_distance > 0.0 && self.focus_distance <= MAX_COORDINATE) {
+            return Err(format!("camera.focus_distance is {}; the plane in focus must lie more than 0 and at most {MAX_COORDINATE:e} in front of the eye", self.focus_distance));
+        }
+        if self.aperture > 0.0 && self.projection != Projection::Perspective {
+            return Err(format!("camera.aperture is {}, but a thin lens is modelled for the perspective projection only, not \"{}\"", self.aperture, self.projection.name()));
         }
         if !(self.near > 0.0 && self.near < self.far && self.far.is_finite()) {
             return Err(format!(
@@ -103,6 +133,12 @@ pub struct CameraView {
     pub half_y: f32,
     pub near: f32,
     pub far: f32,
+    /// What `half_x` and `half_y` measure, and how image positions become
+    /// directions.
+    pub projection: Projection,
+    /// Thin lens radius (0: a pinhole) and the distance of the plane in focus.
+    pub aperture: f32,
+    pub focus_distance: f32,
 }
 
 impl CameraView {
@@ -112,15 +148,10 @@ impl CameraView {
         let up = right.cross(forward);
         let camera_to_world = Mat3::from_cols(right, up, -forward);
         let aspect = width as f32 / height as f32;
-        let (half_x, half_y) = match camera.fov {
-            Fov::X(deg) => {
-                let hx = (deg.to_radians() * 0.5).tan();
-                (hx, hx / aspect)
-            }
-            Fov::Y(deg) => {
-                let hy = (deg.to_radians() * 0.5).tan();
-                (hy * aspect, hy)
-            }
+        let (half_x, half_y) = match (camera.projection, camera.fov) {
+            (Projection::Orthographic { height }, _) => (0.5 * height * aspect, 0.5 * height),
+            (p, Fov::X(deg)) => p.half_extents(deg, true, aspect),
+            (p, Fov::Y(deg)) => p.half_extents(deg, false, aspect),
         };
         CameraView {
             width,
@@ -132,21 +163,48 @@ impl CameraView {
             half_y,
             near: camera.near,
             far: camera.far,
+            projection: camera.projection,
+            aperture: camera.aperture,
+            focus_distance: camera.focus_distance,
         }
     }
 
-    /// Camera-space direction (z = -1) through the image position `(px, py)`
-    /// in pixels (pixel centres are at +0.5).
-    pub fn camera_dir(&self, px: f32, py: f32) -> Vec3 {
-        let sx = (2.0 * px / self.width as f32 - 1.0) * self.half_x;
-        let sy = (1.0 - 2.0 * py / self.height as f32) * self.half_y;
-        Vec3::new(sx, sy, -1.0)
+    /// Whether every eye ray leaves the eye itself through a plane image:
+    /// perspective with no lens, the camera the rasterizers and the ray
+    /// casters' packets (`eye_ray_lanes`) are written for.
+    pub fn is_pinhole(&self) -> bool {
+        self.projection == Projection::Perspective && self.aperture == 0.0
     }
 
-    /// The eye ray through image position `(px, py)`, starting on the near plane.
+    /// The image position `(px, py)` in pixels scaled to the half extents.
+    #[inline]
+    fn scaled(&self, px: f32, py: f32) -> (f32, f32) {
+        let sx = (2.0 * px / self.width as f32 - 1.0) * self.half_x;
+        let sy = (1.0 - 2.0 * py / self.height as f32) * self.half_y;
+        (sx, sy)
+    }
+
+    /// Camera-space direction through the image position `(px, py)` in
+    /// pixels (pixel centres are at +0.5): for the perspective projection
+    /// the point of the image plane at z = -1.
+    pub fn camera_dir(&self, px: f32, py: f32) -> Vec3 {
+        let (sx, sy) = self.scaled(px, py);
+        self.projection.direction(sx, sy)
+    }
+
+    /// The eye ray through image position `(px, py)`, starting on the near
+    /// plane (the near sphere of a fisheye, the near cylinder of a
+    /// panorama; orthographic rays start on the near plane beside the axis).
     pub fn eye_ray(&self, px: f32, py: f32) -> Ray {
         let d = self.camera_dir(px, py);
-        let origin = self.eye + self.camera_to_world * (d * self.near);
+        let start = match self.projection {
+            Projection::Orthographic { .. } => {
+                let (sx, sy) = self.scaled(px, py);
+                Vec3::new(sx, sy, -self.near)
+            }
+            _ => d * self.near,
+        };
+        let origin = self.eye + self.camera_to_world * start;
         Ray::new(origin, (self.camera_to_world * d).normalize())
     }
 
@@ -155,7 +213,28 @@ impl CameraView {
         (self.far - self.near) * self.camera_dir(px, py).length()
     }
 
-    /// `camera_dir` for lanes of image positions, with its arithmetic in
+    /// The eye ray through `(px, py)` leaving the thin lens at the point
+    /// `lens` of the unit disk (scaled by the aperture), with the ray
+    /// parameter of the far plane. Every ray through one image position
+    /// meets the others on the plane in focus, at the point the pinhole's
+    /// ray meets it. With no aperture it is `eye_ray` and `far_t` exactly.
+    pub fn eye_ray_through_lens(&self, px: f32, py: f32, lens: Vec2) -> (Ray, f32) {
+        if self.aperture == 0.0 {
+            return (self.eye_ray(px, py), self.far_t(px, py));
+        }
+        let focus = self.camera_dir(px, py) * self.focus_distance;
+        let on_lens = Vec3::new(lens.x * self.aperture, lens.y * self.aperture, 0.0);
+        let d = focus - on_lens;
+        // The line leaves the lens (depth 0) and reaches the plane in focus at
+        // depth `focus_distance`: depths along it are linear in the parameter.
+        let per_depth = 1.0 / self.focus_distance;
+        let start = on_lens + d * (self.near * per_depth);
+        let ray = Ray::new(self.eye + self.camera_to_world * start, (self.camera_to_world * d).normalize());
+        (ray, (self.far - self.near) * per_depth * d.length())
+    }
+
+    /// `camera_dir` of the perspective projection (`is_pinhole` cameras
+    /// only) for lanes of image positions, with its arithmetic in
     /// the same order (glam's), so a tile's eye rays made eight at a time
     /// are bit for bit the ones `eye_ray` makes for a pixel replay (a test
     /// holds them to it). The one-pixel functions above stay in glam's form,
@@ -201,21 +280,39 @@ impl CameraView {
 
     /// Projects a camera-space point with z < 0 to image position (pixels) .
     pub fn project_camera(&self, c: Vec3) -> Vec2 {
-        let inv = 1.0 / -c.z;
-        Vec2::new(
-            (c.x * inv / self.half_x + 1.0) * 0.5 * self.width as f32,
-            (1.0 - c.y * inv / self.half_y) * 0.5 * self.height as f32,
-        )
+        if self.projection == Projection::Perspective {
+            let inv = 1.0 / -c.z;
+            return Vec2::new(
+                (c.x * inv / self.half_x + 1.0) * 0.5 * self.width as f32,
+                (1.0 - c.y * inv / self.half_y) * 0.5 * self.height as f32,
+            );
+        }
+        let (sx, sy) = self.projection.image_of(c);
+        Vec2::new((sx / self.half_x + 1.0) * 0.5 * self.width as f32, (1.0 - sy / self.half_y) * 0.5 * self.height as f32)
     }
 
     /// Projects a world point to image position and view depth; `None` when
-    /// the point is not in front of the near plane.
+    /// the point is not beyond the near plane (sphere, cylinder).
     pub fn project(&self, world: Vec3) -> Option<(Vec2, f32)> {
         let c = self.to_camera(world);
-        if -c.z < self.near {
+        if !self.projection.beyond_near(c, self.near) {
             return None;
         }
         Some((self.project_camera(c), -c.z))
+    }
+
+    /// The world point at view depth `depth` seen at image position `(px, py)`.
+    pub fn point_at_depth(&self, px: f32, py: f32, depth: f32) -> Vec3 {
+        match self.projection {
+            Projection::Orthographic { .. } => {
+                let (sx, sy) = self.scaled(px, py);
+                self.eye + self.camera_to_world * Vec3::new(sx, sy, -depth)
+            }
+            _ => {
+                let d = self.camera_dir(px, py);
+                self.eye + self.camera_to_world * (d * (depth / -d.z))
+            }
+        }
     }
 
     /// Unit world-space view direction (camera -z).
@@ -321,6 +418,7 @@ mod tests {
             fov: Fov::Y(40.0),
             near: 0.05,
             far: 50.0,
+            ..Camera::default()
         };
         let v = cam.view(640, 360);
         for &(px, py) in &[(0.5, 0.5), (320.0, 180.0), (600.25, 17.75), (12.0, 359.0)] {

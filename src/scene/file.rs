@@ -8,6 +8,7 @@ use crate::scene::texture::{load_texture_as, Encoding, Wrap};
 use crate::scene::material::{DiffuseModel, Fresnel, GlossyModel, MIN_ROUGHNESS};
 use crate::scene::instanced::{build_layer, Layered, MeshCopy};
 use crate::scene::placement::Placement;
+use crate::scene::camera::Projection;
 use crate::scene::{Camera, Fov, InstanceInfo, Light, Lighting, Material, ObjectInfo, RenderDefaults, Scene, Sphere, Triangle};
 use crate::input::{MAX_COORDINATE, MAX_LIGHT, MAX_VALUE};
 use crate::math::{Vec2, Vec3};
@@ -54,6 +55,10 @@ struct CameraDesc {
     fov_x_deg: Option<f32>,
     near: Option<f32>,
     far: Option<f32>,
+    projection: Option<String>,
+    height: Option<f32>,
+    aperture: Option<f32>,
+    focus_distance: Option<f32>,
 }
 
 #[derive(Deserialize)]
@@ -214,6 +219,29 @@ pub enum TwoLevel {
     Never,
 }
 
+/// The `[camera]` table's projection: its name, and `height` for the
+/// orthographic one (which alone takes it).
+fn camera_projection(c: &CameraDesc) -> Result<Projection, String> {
+    let name = c.projection.as_deref().unwrap_or("perspective");
+    let projection = match name {
+        "perspective" => Projection::Perspective,
+        "fisheye" => Projection::Fisheye,
+        "cylindrical" => Projection::Cylindrical,
+        "orthographic" if c.fov_x_deg.is_some() || c.fov_y_deg.is_some() => {
+            return Err("camera.projection = \"orthographic\" is sized by camera.height and takes no field of view (fov_x_deg, fov_y_deg)".to_string())
+        }
+        "orthographic" => match c.height {
+            Some(height) => return Ok(Projection::Orthographic { height }),
+            None => return Err("camera.projection = \"orthographic\" needs camera.height, the view's height in world units".to_string()),
+        },
+        other => return Err(format!("camera.projection = \"{other}\" is not one of {}", Projection::NAMES.join(", "))),
+    };
+    if let Some(h) = c.height {
+        return Err(format!("camera.height = {h} sizes an orthographic view, and camera.projection is \"{name}\" (its field of view sizes it)"));
+    }
+    Ok(projection)
+}
+
 /// Most triangles made by copies that are flattened (`TwoLevel::Auto`):
 /// beyond it a scene holds its copies as shared meshes and placements.
 pub const FLATTEN_LIMIT: usize = 2_000_000;
@@ -240,6 +268,7 @@ fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str, two_
             (None, None) => Fov::Y(60.0),
         };
         let d = Camera::default();
+        let projection = camera_projection(c).map_err(|e| format!("{where_}: {e}"))?;
         scene.camera = Camera {
             eye: c.eye.map(Vec3::from).unwrap_or(d.eye),
             target: c.target.map(Vec3::from).unwrap_or(d.target),
@@ -247,6 +276,9 @@ fn parse_scene_unbounded(text: &str, origin: &str, base: &Path, name: &str, two_
             fov,
             near: c.near.unwrap_or(d.near),
             far: c.far.unwrap_or(d.far),
+            projection,
+            aperture: c.aperture.unwrap_or(d.aperture),
+            focus_distance: c.focus_distance.unwrap_or(d.focus_distance),
         };
         scene.camera.validate().map_err(|e| format!("{where_}: {e}"))?;
     }

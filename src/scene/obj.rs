@@ -233,6 +233,7 @@ pub fn frame_camera(scene: &mut Scene, lo: Vec3, hi: Vec3) {
         fov: Fov::Y(fov_y),
         near: ((distance - radius) * 0.5).max(distance * 1e-3),
         far: (distance + radius) * 2.0,
+        ..Camera::default()
     };
     let light_pos = center + Vec3::new(0.5 * distance, 1.5 * distance, 1.2 * distance);
     let d2 = (light_pos - center).length_squared();

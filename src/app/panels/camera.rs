@@ -1,8 +1,10 @@
 //! Camera section: the file's named cameras (a glTF's), eye, target, up,
-//! field of view (x or y), near, far, resolution scale; reset and frame-all.
+//! projection (with the field of view, x or y, or an orthographic height),
+//! thin lens, near, far, resolution scale; reset and frame-all.
 
 use eframe::egui;
 use crate::app::panels::{section, vec3_edit, Requests};
+use crate::scene::camera::Projection;
 use crate::scene::{Camera, Fov};
 
 /// `scene_size`: the scene's image size, which `res_scale` scales;
@@ -26,10 +28,12 @@ pub fn show(ui: &mut egui::Ui, open: &mut bool, cam: &mut Camera, res_scale: &mu
         moved |= vec3_edit(ui, "eye", &mut cam.eye, 0.01);
         moved |= vec3_edit(ui, "target", &mut cam.target, 0.01);
         vec3_edit(ui, "up", &mut cam.up, 0.01);
+        moved |= projection_edit(ui, cam);
         ui.horizontal(|ui| {
             let (mut deg, mut horizontal) = crate::scene::camera::control::fov_parts(cam.fov);
             ui.label("fov");
-            let mut c = ui.add(egui::DragValue::new(&mut deg).range(1.0..=179.0).speed(0.2).suffix("°")).changed();
+            let max = cam.projection.max_fov_deg(horizontal).min(359.0);
+            let mut c = ui.add(egui::DragValue::new(&mut deg).range(1.0..=max).speed(0.2).suffix("°")).changed();
             c |= ui.radio_value(&mut horizontal, false, "y").changed();
             c |= ui.radio_value(&mut horizontal, true, "x").changed();
             if c {
@@ -58,6 +62,47 @@ pub fn show(ui: &mut egui::Ui, open: &mut bool, cam: &mut Camera, res_scale: &mu
         ui.label(egui::RichText::new("orbit: left drag · pan: middle or shift drag · dolly: wheel · fly: WASD/QE").small());
     });
     requests
+}
+
+/// The projection's choice, an orthographic view's height and the thin
+/// lens (aperture, focus distance); whether any changed. Only values the
+/// camera accepts (`Camera::validate`) can be chosen: a lens is offered
+/// with the perspective projection alone.
+fn projection_edit(ui: &mut egui::Ui, cam: &mut Camera) -> bool {
+    let mut changed = false;
+    ui.horizontal(|ui| {
+        ui.label("projection");
+        let before = cam.projection;
+        egui::ComboBox::from_id_salt("camera projection").selected_text(cam.projection.name()).show_ui(ui, |ui| {
+            let height = 2.0 * (cam.target - cam.eye).length() * 0.577;
+            for p in [Projection::Perspective, Projection::Orthographic { height: height.max(1e-3) }, Projection::Fisheye, Projection::Cylindrical] {
+                ui.selectable_value(&mut cam.projection, p, p.name());
+            }
+        });
+        if std::mem::discriminant(&before) == std::mem::discriminant(&cam.projection) {
+            cam.projection = before;
+        } else {
+            changed = true;
+            cam.aperture = 0.0;
+            let (deg, horizontal) = crate::scene::camera::control::fov_parts(cam.fov);
+            if deg > cam.projection.max_fov_deg(horizontal) {
+                cam.fov = Fov::Y(60.0);
+            }
+        }
+        if let Projection::Orthographic { height } = &mut cam.projection {
+            ui.label("height");
+            changed |= ui.add(egui::DragValue::new(height).range(1e-3..=1e6).speed(0.01)).changed();
+        }
+    });
+    if cam.projection == Projection::Perspective {
+        ui.horizontal(|ui| {
+            ui.label("aperture");
+            changed |= ui.add(egui::DragValue::new(&mut cam.aperture).range(0.0..=10.0).speed(0.001).max_decimals(4)).changed();
+            ui.label("focus");
+            changed |= ui.add(egui::DragValue::new(&mut cam.focus_distance).range(1e-3..=1e6).speed(0.01)).changed();
+        });
+    }
+    changed
 }
 
 /// `width` x `height` times `scale`, rounded, at least one pixel each way.

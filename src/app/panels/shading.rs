@@ -95,7 +95,7 @@ pub fn show(ui: &mut egui::Ui, settings: &mut ViewerSettings, look: &mut RenderD
         });
         ui.horizontal(|ui| {
             let l = ui.label("max depth");
-            ui.add(egui::Slider::new(&mut s.max_depth, 0..=16)).labelled_by(l.id);
+            ui.add(egui::Slider::new(&mut s.max_depth, 0..=crate::render::settings_check::MAX_MIRROR_DEPTH)).labelled_by(l.id);
         });
         let r = look;
         color_edit(ui, "ambient", &mut r.ambient, 1.0);

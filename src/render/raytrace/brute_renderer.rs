@@ -27,6 +27,11 @@ impl Renderer for BruteForce {
         true
     }
 
+    /// Every eye ray is made from the camera itself (`PassJob::eye_ray`).
+    fn check_camera(&self, _camera: &crate::scene::Camera) -> Result<(), String> {
+        Ok(())
+    }
+
     fn trace_pixel(&self, job: &PassJob, x: u32, y: u32, rec: &mut PixelTrace) -> Option<Radiance> {
         Some(cast_pixel(job, &BruteQuery(job.prepared), x, y, &mut RayCounts::default(), rec))
     }

@@ -49,6 +49,11 @@ impl Renderer for BvhRayTracer {
         true
     }
 
+    /// Every eye ray is made from the camera itself (`PassJob::eye_ray`).
+    fn check_camera(&self, _camera: &crate::scene::Camera) -> Result<(), String> {
+        Ok(())
+    }
+
     fn passes_at_once(&self) -> u32 {
         crate::render::accel::packet::MAX_PASSES as u32
     }

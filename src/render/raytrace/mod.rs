@@ -46,8 +46,7 @@ pub fn cast_pass<Q: SceneQuery>(job: &PassJob, query: &Q, out: &mut [Radiance]) 
 #[inline]
 pub fn cast_pixel<Q: SceneQuery, R: Recorder>(job: &PassJob, query: &Q, x: u32, y: u32, counts: &mut RayCounts, rec: &mut R) -> Radiance {
     let p = job.sample_position(x, y);
-    let ray = job.view.eye_ray(p.x, p.y);
-    let t_max = job.view.far_t(p.x, p.y);
+    let (ray, t_max) = job.eye_ray(x, y);
     counts.primary += 1;
     rec.ray(&ray, t_max, 0);
     let work_before = counts.nodes + counts.tests;

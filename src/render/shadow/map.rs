@@ -467,7 +467,7 @@ pub fn light_views(scene: &Scene, light: &Light, size: u32) -> Vec<CameraView> {
             let up = if forward.y.abs() < 0.9 { Vec3::Y } else { Vec3::Z };
             let (clo, chi) = caster_bounds(scene).unwrap_or((lo, hi));
             let centre = (clo + chi) * 0.5;
-            let cam = Camera { eye: centre, target: centre + forward, up, fov: Fov::Y(90.0), near: 1.0, far: 2.0 };
+            let cam = Camera { eye: centre, target: centre + forward, up, fov: Fov::Y(90.0), near: 1.0, far: 2.0, ..Camera::default() };
             let mut v = CameraView::new(&cam, size, size);
             // The rectangle: the casters' box projected across the light, plus a
             // texel of margin so silhouettes on its edge are not cut.
@@ -508,7 +508,7 @@ pub fn cube_views(scene: &Scene, position: Vec3, size: u32) -> Vec<CameraView> {
     ];
     axes.iter()
         .map(|&(forward, up)| {
-            let cam = Camera { eye: position, target: position + forward, up, fov: Fov::Y(90.0), near, far: f32::MAX };
+            let cam = Camera { eye: position, target: position + forward, up, fov: Fov::Y(90.0), near, far: f32::MAX, ..Camera::default() };
             let mut v = CameraView::new(&cam, size, size);
             // Exactly 90 degrees: faces meet edge to edge.
             v.half_x = 1.0;

@@ -493,6 +493,19 @@ pub fn uniform_disk(u: Vec2) -> Vec2 {
     Vec2::new(r * phi.cos(), r * phi.sin())
 }
 
+/// Uniform on the unit disk by Shirley and Chiu's concentric map: the
+/// unit square's nested squares go to nested circles, so strata of the
+/// square stay compact on the disk (a lens's samples).
+#[inline]
+pub fn concentric_disk(u: Vec2) -> Vec2 {
+    let (a, b) = (2.0 * u.x - 1.0, 2.0 * u.y - 1.0);
+    if a == 0.0 && b == 0.0 {
+        return Vec2::ZERO;
+    }
+    let (r, phi) = if a.abs() > b.abs() { (a, 0.25 * PI * (b / a)) } else { (b, 0.5 * PI - 0.25 * PI * (a / b)) };
+    Vec2::new(r * phi.cos(), r * phi.sin())
+}
+
 /// Luminance weights of linear sRGB (Rec. 709), for choosing between lobes
 /// and for Russian roulette.
 #[inline]

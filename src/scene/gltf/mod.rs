@@ -151,26 +151,27 @@ fn add_gltf_unnamed(scene: &mut Scene, path: &Path, placement: &Placement, objec
             uses[mesh.index()].push((world, i));
         }
         if let Some(camera) = node.camera() {
-            match camera.projection() {
+            let cam_name = camera.name().or(node.name()).map(str::to_string).unwrap_or_else(|| format!("camera {}", camera.index()));
+            let eye = world.transform_point3(Vec3::ZERO);
+            let forward = world.transform_vector3(-Vec3::Z).normalize_or_zero();
+            let placed = Camera { eye, target: eye + forward, up: world.transform_vector3(Vec3::Y).normalize_or_zero(), ..Camera::default() };
+            let (c, aspect) = match camera.projection() {
                 gltf::camera::Projection::Perspective(p) => {
-                    let cam_name = camera.name().or(node.name()).map(str::to_string).unwrap_or_else(|| format!("camera {}", camera.index()));
-                    let eye = world.transform_point3(Vec3::ZERO);
-                    let forward = world.transform_vector3(-Vec3::Z).normalize_or_zero();
-                    let c = Camera {
-                        eye,
-                        target: eye + forward,
-                        up: world.transform_vector3(Vec3::Y).normalize_or_zero(),
-                        fov: Fov::Y(p.yfov().to_degrees()),
-                        near: p.znear(),
-                        far: p.zfar().unwrap_or(p.znear() * 1e6),
-                    };
-                    c.validate().map_err(|e| format!("camera {} (node {i}): {e}", camera.index()))?;
-                    parts.cameras.push(NamedCamera { name: cam_name, camera: c, aspect: p.aspect_ratio() });
+                    (Camera { fov: Fov::Y(p.yfov().to_degrees()), near: p.znear(), far: p.zfar().unwrap_or(p.znear() * 1e6), ..placed }, p.aspect_ratio())
                 }
-                gltf::camera::Projection::Orthographic(_) => {
-                    parts.ignored.push(format!("orthographic camera {} (pinhole has no orthographic projection yet)", camera.index()))
+                // xmag and ymag are half the view's width and height; the
+                // image's own aspect ratio sizes its width, as it does a
+                // perspective camera's.
+                gltf::camera::Projection::Orthographic(o) => {
+                    let projection = crate::scene::camera::Projection::Orthographic { height: 2.0 * o.ymag() };
+                    let aspect = (o.ymag() != 0.0).then(|| o.xmag() / o.ymag()).filter(|a| a.is_finite() && *a > 0.0);
+                    // glTF lets an orthographic znear be 0; eye rays start on the near plane, so it becomes a sliver.
+                    let near = if o.znear() > 0.0 { o.znear() } else { 1e-4 * o.zfar().abs().max(1e-3) };
+                    (Camera { projection, near, far: o.zfar(), ..placed }, aspect)
                 }
-            }
+            };
+            c.validate().map_err(|e| format!("camera {} (node {i}): {e}", camera.index()))?;
+            parts.cameras.push(NamedCamera { name: cam_name, camera: c, aspect });
         }
         if let Some(light) = node.light() {
             let colour = Vec3::from(light.color()) * light.intensity();
