@@ -89,6 +89,8 @@ fn khronos_cameras_offers_its_perspective_and_orthographic_cameras() {
     assert_eq!(names, ["camera 0", "camera 1"]);
     // xmag = ymag = 1: a view two units high.
     assert_eq!(scene.named_cameras.iter().find(|(n, _)| n == "camera 1").unwrap().1.projection, pinhole::scene::camera::Projection::Orthographic { height: 2.0 });
+    // By default the perspective camera, though the orthographic one's node comes first.
+    assert_eq!(scene.camera.projection, pinhole::scene::camera::Projection::Perspective);
     assert_eq!(scene.camera.eye, Vec3::new(0.5, 0.5, 3.0));
     assert!((scene.camera.target - Vec3::new(0.5, 0.5, 2.0)).length() < 1e-6);
     assert_eq!((scene.render.width, scene.render.height), (800, 800), "aspectRatio 1 makes a square image");

@@ -425,7 +425,9 @@ pub fn frame_bare_gltf(path: &Path, camera: Option<&str>) -> Result<Scene, Strin
             let names: Vec<String> = parts.cameras.iter().map(|c| format!("\"{}\"", c.name)).collect();
             format!("{name}: no camera is named \"{wanted}\" (its cameras: {})", if names.is_empty() { "none".into() } else { names.join(", ") })
         })?),
-        None => parts.cameras.first(),
+        // The first perspective camera: the view the asset's author framed
+        // for looking at it; an orthographic one only when there is no other.
+        None => parts.cameras.iter().find(|c| c.camera.projection == crate::scene::camera::Projection::Perspective).or(parts.cameras.first()),
     };
     crate::scene::obj::frame_camera(&mut scene, lo, hi);
     let rig = std::mem::take(&mut scene.lights);
