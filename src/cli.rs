@@ -52,13 +52,18 @@ enum Command {
     /// Assemble partial renders (--tile, --sample-range) into the whole frame.
     Merge {
         /// The parts (.exr files written by `render --tile` or `--sample-range`).
-        #[arg(required = true, value_name = "PART.exr")]
+        #[arg(required_unless_present = "status", value_name = "PART.exr")]
         parts: Vec<PathBuf>,
-        #[arg(short = 'o', long = "output", value_name = "OUT")]
-        output: PathBuf,
+        /// The whole frame (.exr).
+        #[arg(short = 'o', long = "output", value_name = "OUT", required_unless_present = "status")]
+        output: Option<PathBuf>,
         /// Write the whole render's statistics as JSON (`-` for stdout).
         #[arg(long, value_name = "FILE")]
         stats: Option<String>,
+        /// Instead of merging: which parts in DIR exist, which tiles are
+        /// missing, and about how much rendering is left.
+        #[arg(long, value_name = "DIR", conflicts_with_all = ["parts", "output", "stats"])]
+        status: Option<PathBuf>,
     },
     /// Render warm frames and print timing statistics as JSON.
     Bench {
@@ -176,7 +181,9 @@ pub fn run() -> Result<Outcome, String> {
     let ran = match cli.command {
         None => return Ok(Outcome::OpenViewer { scene: cli.scene, screenshot: cli.screenshot }),
         Some(Command::Render { scene, output, opts, part, stats }) => cmd_render(&scene, &output, &opts, &part, stats.as_deref()),
-        Some(Command::Merge { parts, output, stats }) => cmd_merge(&parts, &output, stats.as_deref()),
+        Some(Command::Merge { status: Some(dir), .. }) => crate::part_status::status(&dir).map(|s| print!("{s}")),
+        Some(Command::Merge { parts, output: Some(output), stats, status: None }) => cmd_merge(&parts, &output, stats.as_deref()),
+        Some(Command::Merge { output: None, .. }) => Err("pinhole merge needs -o OUT.exr (or --status DIR)".into()),
         Some(Command::Bench { scene, opts, frames }) => cmd_bench(&scene, &opts, frames),
         Some(Command::Compare { a, b, json }) => cmd_compare(&a, &b, json),
         Some(Command::Pixel { scene, x, y, opts, json }) => cmd_pixel(&scene, x, y, &opts, json),

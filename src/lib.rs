@@ -17,6 +17,7 @@ pub mod metrics;
 pub mod named;
 pub mod part_file;
 pub mod part_merge;
+pub mod part_status;
 pub mod render;
 pub mod scene;
 pub mod app;

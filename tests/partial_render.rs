@@ -246,3 +246,33 @@ fn bad_parts_are_refused_in_one_sentence() {
     one_sentence_error(&["render", "cornell-box", "-o", d.join("o.png").to_str().unwrap(), "--tile", "0/2"], "written as .exr");
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// `merge --status DIR` while a tiled render is under way: the parts there,
+/// the missing tile, an estimate of the time left, and files that are not
+/// parts of the frame named; then, with every tile, that it is complete.
+#[test]
+fn status_names_the_missing_tiles_and_the_time_left() {
+    let d = dir("status");
+    let status = || {
+        let out = ok(pinhole(&["merge", "--status", d.to_str().unwrap()]));
+        String::from_utf8(out.stdout).unwrap()
+    };
+    assert!(status().contains("no parts yet"), "{}", status());
+    let tile = |i: u32| render("cornell-gi", &["--gi", "path", "--spp", "2"], &["--tile", &format!("{i}/3")], &d.join(format!("t{i}.exr")));
+    tile(0);
+    tile(2);
+    render("spheres", &[], &["--tile", "0/2"], &d.join("other.exr"));
+    std::fs::write(d.join("junk.exr"), b"not an image").unwrap();
+    let s = status();
+    assert!(s.contains("2 parts hold 66.7% of the frame's samples"), "{s}");
+    assert!(s.contains("missing tiles: 1/3"), "{s}");
+    assert!(s.contains("s of rendering left"), "{s}");
+    assert!(s.contains("other.exr: not counted: a part of another frame"), "{s}");
+    assert!(s.contains("junk.exr: not counted"), "{s}");
+    tile(1);
+    let s = status();
+    assert!(s.contains("3 parts hold 100.0%") && s.contains("every tile of 3 is there") && s.contains("complete"), "{s}");
+    assert!(!s.contains("left"), "{s}");
+    // It writes nothing: the folder holds what it held.
+    assert_eq!(std::fs::read_dir(&d).unwrap().count(), 5);
+}

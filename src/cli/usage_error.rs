@@ -35,6 +35,13 @@ pub fn one_sentence(e: &clap::Error, cmd: &clap::Command) -> String {
             };
         }
     }
+    // A missing argument: clap lists the missing ones on the lines below
+    // its first; they belong in the sentence.
+    if e.kind() == ErrorKind::MissingRequiredArgument {
+        if let Some(missing) = text(ContextKind::InvalidArg) {
+            return format!("missing {missing}; see pinhole --help");
+        }
+    }
     // Other errors: clap's own first line is already one sentence.
     let rendered = e.render().to_string();
     let first = rendered.lines().next().unwrap_or("").trim_start_matches("error: ").trim();
@@ -102,5 +109,11 @@ mod tests {
         let s = one_sentence(&e, &cmd);
         assert_eq!(s.lines().count(), 1, "{s}");
         assert!(s.contains("--nope"), "{s}");
+    }
+
+    #[test]
+    fn a_missing_argument_is_named_in_the_sentence() {
+        let e = T::try_parse_from(["t"]).err().unwrap();
+        assert_eq!(one_sentence(&e, &T::command()), "missing <X>; see pinhole --help");
     }
 }
