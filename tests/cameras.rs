@@ -294,18 +294,6 @@ fn bad_camera_values_are_refused_naming_the_file_and_key() {
     assert!(error_of(&format!("{cam}projection = \"fisheye\"\nfov_x_deg = 400.0\n")).contains("360"));
 }
 
-fn base64(bytes: &[u8]) -> String {
-    const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut s = String::new();
-    for c in bytes.chunks(3) {
-        let n = (c[0] as u32) << 16 | (*c.get(1).unwrap_or(&0) as u32) << 8 | *c.get(2).unwrap_or(&0) as u32;
-        for k in 0..4 {
-            s.push(if k <= c.len() { A[(n >> (18 - 6 * k) & 63) as usize] as char } else { '=' });
-        }
-    }
-    s
-}
-
 #[test]
 fn a_gltf_orthographic_camera_is_used() {
     // One triangle of area 2 at z = -5, seen by an orthographic camera at
@@ -321,7 +309,7 @@ fn a_gltf_orthographic_camera_is_used() {
 "accessors": [{{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [-1, -1, -5], "max": [1, 1, -5]}}],
 "bufferViews": [{{"buffer": 0, "byteLength": 36}}],
 "buffers": [{{"byteLength": 36, "uri": "data:application/octet-stream;base64,{}"}}]}}"#,
-        base64(&bytes)
+        common::base64(&bytes)
     );
     let dir = std::env::temp_dir().join(format!("pinhole-cameras-gltf-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
