@@ -60,7 +60,13 @@ impl Environment {
     /// around the horizon and clamped at the poles.
     #[inline]
     pub fn radiance(&self, dir: Vec3) -> Vec3 {
-        let v = self.texture.levels[0].bilinear_uv(latlong_uv(dir), Wrap::Repeat, Wrap::Clamp) * self.intensity;
+        self.radiance_at(latlong_uv(dir))
+    }
+
+    /// `radiance` of the direction at point `uv` of the image.
+    #[inline]
+    pub fn radiance_at(&self, uv: Vec2) -> Vec3 {
+        let v = self.texture.levels[0].bilinear_uv(uv, Wrap::Repeat, Wrap::Clamp) * self.intensity;
         if v.is_finite() { v } else { Vec3::ZERO }
     }
 }
@@ -80,7 +86,17 @@ pub struct EnvironmentLight {
     columns: Vec<f32>,
     /// The running sum of the rows' totals (`height` entries).
     rows: Vec<f32>,
+    /// Per row, the last running sum of each block of `BLOCK` columns
+    /// (`blocks` entries a row): a column search first finds its block in
+    /// these few, then its column inside one cache line of `columns`, where
+    /// a search of the whole row walks through several lines of a table too
+    /// big for the cache.
+    block_ends: Vec<f32>,
+    blocks: usize,
 }
+
+/// Columns per block of `EnvironmentLight::block_ends`: one cache line of f32s.
+const BLOCK: usize = 16;
 
 impl EnvironmentLight {
     /// `None` when no texel has a finite, positive luminance.
@@ -118,7 +134,9 @@ impl EnvironmentLight {
             total += row;
             rows.push(total as f32);
         }
-        (total > 0.0 && total.is_finite()).then_some(EnvironmentLight { width: w, height: h, columns, rows })
+        let blocks = w.div_ceil(BLOCK);
+        let block_ends = columns.chunks(w).flat_map(|row| (0..blocks).map(|b| row[((b + 1) * BLOCK).min(w) - 1])).collect();
+        (total > 0.0 && total.is_finite()).then_some(EnvironmentLight { width: w, height: h, columns, rows, block_ends, blocks })
     }
 
     /// About the integral of the luminance over the sphere (from the
@@ -130,6 +148,13 @@ impl EnvironmentLight {
 
     /// A direction sampled by `u`, and its density in solid angle.
     pub fn sample(&self, u: Vec2) -> Option<(Vec3, f32)> {
+        self.sample_uv(u).map(|(_, dir, pdf)| (dir, pdf))
+    }
+
+    /// `sample`, with the point of the image the direction comes from (so
+    /// that its radiance is read without turning the direction back).
+    #[inline]
+    pub fn sample_uv(&self, u: Vec2) -> Option<(Vec2, Vec3, f32)> {
         let (w, h) = (self.width, self.height);
         let total = self.rows[h - 1];
         let target = u.y * total;
@@ -144,13 +169,19 @@ impl EnvironmentLight {
         // the texel's height.
         let fy = ((target - row_start) / (self.rows[y] - row_start)).clamp(0.0, 0.999_999);
         let target_x = u.x * row_total;
-        let x = row.partition_point(|&c| c <= target_x).min(w - 1);
+        // The sums rise along the row, so every column of the blocks before
+        // the first block whose end exceeds the target is at most the
+        // target: the same column as a search of the whole row.
+        let ends = &self.block_ends[y * self.blocks..(y + 1) * self.blocks];
+        let block = ends.partition_point(|&c| c <= target_x).min(self.blocks - 1);
+        let first = block * BLOCK;
+        let x = (first + row[first..(first + BLOCK).min(w)].partition_point(|&c| c <= target_x)).min(w - 1);
         let col_start = if x == 0 { 0.0 } else { row[x - 1] };
         let fx = ((target_x - col_start) / (row[x] - col_start)).clamp(0.0, 0.999_999);
         let uv = Vec2::new((x as f32 + fx) / w as f32, 1.0 - (y as f32 + fy) / h as f32);
         let dir = latlong_dir(uv);
         let pdf = self.pdf_at(x, y, dir);
-        (pdf > 0.0 && pdf.is_finite() && dir.is_finite()).then_some((dir, pdf))
+        (pdf > 0.0 && pdf.is_finite() && dir.is_finite()).then_some((uv, dir, pdf))
     }
 
     /// The density in solid angle with which `sample` returns unit `dir`.
@@ -246,5 +277,49 @@ mod tests {
         assert!(light.pdf(bright) > 10.0 * light.pdf(-bright));
         // A black image lights nothing.
         assert!(EnvironmentLight::build(&Texture::new(2, 2, vec![Vec3::ZERO; 4])).is_none());
+    }
+
+    #[test]
+    fn sampled_texels_come_up_as_often_as_their_density_says() {
+        // 8 x 4 texels of different brightness: over a fine grid of u, the
+        // fraction of samples landing in each texel is that texel's share
+        // of the density, and each sample's pdf is what `pdf` says of its
+        // direction.
+        let texels = (0..32).map(|i| Vec3::splat(1.0 + (i * 7 % 11) as f32)).collect();
+        let light = EnvironmentLight::build(&Texture::new(8, 4, texels)).unwrap();
+        let n = 512;
+        let mut counts = [0u32; 32];
+        for i in 0..n {
+            for j in 0..n {
+                let u = Vec2::new((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
+                let (uv, dir, pdf) = light.sample_uv(u).unwrap();
+                assert!((light.pdf(dir) - pdf).abs() <= 1e-3 * pdf, "{u}: {pdf} against {}", light.pdf(dir));
+                assert!((latlong_uv(dir) - uv).length() < 1e-4);
+                let (x, y) = ((uv.x * 8.0) as usize, ((1.0 - uv.y) * 4.0) as usize);
+                counts[x.min(7) + 8 * y.min(3)] += 1;
+            }
+        }
+        let total = light.rows[3];
+        for (t, &c) in counts.iter().enumerate() {
+            let row = &light.columns[(t / 8) * 8..(t / 8) * 8 + 8];
+            let expected = (row[t % 8] - if t % 8 == 0 { 0.0 } else { row[t % 8 - 1] }) / total;
+            let seen = c as f32 / (n * n) as f32;
+            assert!((seen - expected).abs() < 0.002, "texel {t}: {seen} against {expected}");
+        }
+    }
+
+    #[test]
+    fn the_block_search_finds_the_column_a_whole_row_search_finds() {
+        // 37 columns: two whole blocks of 16 and a short one of 5.
+        let texels = (0..37 * 5).map(|i| Vec3::splat(((i * 7919) % 23) as f32)).collect();
+        let light = EnvironmentLight::build(&Texture::new(37, 5, texels)).unwrap();
+        for i in 0..2000 {
+            let u = Vec2::new((i as f32 * 0.618_034).fract(), (i as f32 * 0.414_214).fract());
+            let Some((uv, _, _)) = light.sample_uv(u) else { continue };
+            let y = light.rows.partition_point(|&c| c <= u.y * light.rows[4]).min(4);
+            let row = &light.columns[y * 37..(y + 1) * 37];
+            let x = row.partition_point(|&c| c <= u.x * row[36]).min(36);
+            assert_eq!((uv.x * 37.0) as usize, x, "u = {u}");
+        }
     }
 }

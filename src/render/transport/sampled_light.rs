@@ -152,16 +152,16 @@ pub fn sampled_direct<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &
             }
         }
     }
-    if let Some(light) = scene.environment.as_ref().and_then(|e| e.light.as_deref()).filter(|_| count > 0) {
+    if let Some((env, light)) = scene.environment.as_ref().and_then(|e| Some((e, e.light.as_deref()?))).filter(|_| count > 0) {
         for _ in 0..count {
             let u = sh.path.rng.next_2d();
-            let Some((w_i, pdf)) = light.sample(u) else { continue };
+            let Some((uv, w_i, pdf)) = light.sample_uv(u) else { continue };
             let cos = n.dot(w_i);
             if cos <= 0.0 || w_i.dot(hit.geometric_normal) <= 0.0 {
                 continue;
             }
             let f = bsdf(material, lobes, frame, w_i, w_o);
-            let radiance = scene.miss_radiance(w_i);
+            let radiance = env.radiance_at(uv);
             if f == Vec3::ZERO || radiance == Vec3::ZERO {
                 continue;
             }
