@@ -244,7 +244,7 @@ pub fn method_configurations(scene: &Scene, base: &RenderSettings) -> Vec<Config
     }
 
     // Visibility: depth buffers that store less, and no depth buffer at all.
-    for format in [DepthFormat::Unorm16, DepthFormat::Unorm24, DepthFormat::Reversed] {
+    for format in [DepthFormat::Unorm16, DepthFormat::Unorm24, DepthFormat::Reversed, DepthFormat::LinearZ] {
         add("visibility", raster, with(&|s| s.depth_buffer = format));
     }
     add("visibility", "rasterize:painter", plain.clone());

@@ -30,6 +30,7 @@ const SCENES: &[(&str, &str)] = &[
 const STRESS_SCENES: &[(&str, &str)] = &[
     ("stress-painter", include_str!("../../assets/scenes/stress-painter.toml")),
     ("stress-zfight", include_str!("../../assets/scenes/stress-zfight.toml")),
+    ("stress-linear-z", include_str!("../../assets/scenes/stress-linear-z.toml")),
     ("stress-zpass", include_str!("../../assets/scenes/stress-zpass.toml")),
     ("stress-shadow", include_str!("../../assets/scenes/stress-shadow.toml")),
     ("stress-grazing", include_str!("../../assets/scenes/stress-grazing.toml")),

@@ -21,6 +21,13 @@
 //!   crowding cancel out and distant surfaces keep their separation. The key
 //!   is -d', so the shared `<` test is the GREATER test on d'.
 //!
+//! - `linear-z`: view depth z interpolated linearly in image space (as
+//!   the key -1/z), the mistake the f32 format avoids: z along a receding
+//!   triangle is not affine in image space, the straight line between its
+//!   corners' z lies beyond the surface, so a large receding triangle reads
+//!   as farther than it is and what lies just behind it shows through.
+//!   Wrong on purpose, for the lesson; spheres keep their exact ray depth.
+//!
 //! Only the variants with 2D weights (barycentric, incremental, scanline,
 //! fixed, tiled) store depth keys; naive and bbox compare exact ray
 //! parameters as the ray casters do, the painter keeps no depth buffer,
@@ -41,6 +48,8 @@ named_enum! {
         Unorm16 = "unorm16",
         /// Reversed z (1 - z/w) as f32, compared GREATER.
         Reversed = "reversed",
+        /// View z interpolated linearly in image space (wrong on purpose).
+        LinearZ = "linear-z",
     }
 }
 
@@ -61,6 +70,7 @@ impl DepthFormat {
             DepthFormat::Unorm24 => "GPU z/w in [0,1] with 2^24-1 steps, compared LESS",
             DepthFormat::Unorm16 => "GPU z/w in [0,1] with 2^16-1 steps, compared LESS: z-fights first",
             DepthFormat::Reversed => "reversed z (1 - z/w) as f32, compared GREATER",
+            DepthFormat::LinearZ => "z interpolated linearly in image space (wrong on purpose: why 1/z is stored)",
         }
     }
 
@@ -69,7 +79,7 @@ impl DepthFormat {
         match self {
             DepthFormat::Unorm24 => Some(((1u32 << 24) - 1) as f64),
             DepthFormat::Unorm16 => Some(((1u32 << 16) - 1) as f64),
-            DepthFormat::F32 | DepthFormat::Reversed => None,
+            DepthFormat::F32 | DepthFormat::Reversed | DepthFormat::LinearZ => None,
         }
     }
 }
@@ -83,7 +93,7 @@ impl DepthEncoding {
     #[inline(always)]
     pub fn key(&self, inv_z: f32) -> f32 {
         match self.format {
-            DepthFormat::F32 => -inv_z,
+            DepthFormat::F32 | DepthFormat::LinearZ => -inv_z,
             _ => self.key_slow(inv_z),
         }
     }
@@ -93,7 +103,7 @@ impl DepthEncoding {
         let (n, f) = (self.near as f64, self.far as f64);
         let inv_z = inv_z as f64;
         match self.format {
-            DepthFormat::F32 => -inv_z as f32,
+            DepthFormat::F32 | DepthFormat::LinearZ => -inv_z as f32,
             DepthFormat::Reversed => -((n * (f * inv_z - 1.0) / (f - n)) as f32),
             DepthFormat::Unorm24 | DepthFormat::Unorm16 => {
                 let steps = self.format.steps().unwrap_or(1.0);
@@ -110,7 +120,7 @@ impl DepthEncoding {
     #[inline]
     pub fn clear_key(&self) -> f32 {
         match self.format {
-            DepthFormat::F32 => -1.0 / self.far,
+            DepthFormat::F32 | DepthFormat::LinearZ => -1.0 / self.far,
             DepthFormat::Reversed => 0.0,
             DepthFormat::Unorm24 | DepthFormat::Unorm16 => self.format.steps().unwrap_or(1.0) as f32,
         }
@@ -120,7 +130,7 @@ impl DepthEncoding {
     pub fn view_depth(&self, key: f32) -> f32 {
         let (n, f) = (self.near as f64, self.far as f64);
         let inv_z = match self.format {
-            DepthFormat::F32 => return -1.0 / key,
+            DepthFormat::F32 | DepthFormat::LinearZ => return -1.0 / key,
             DepthFormat::Reversed => (-key as f64 * (f - n) / n + 1.0) / f,
             DepthFormat::Unorm24 | DepthFormat::Unorm16 => {
                 let d = key as f64 / self.format.steps().unwrap_or(1.0);

@@ -93,6 +93,14 @@ impl ScreenTri {
         self.inv_z_lanes(&l)
     }
 
+    /// View depth interpolated linearly in image space for screen-space
+    /// weights `l` (`--depth-buffer linear-z`: not the surface's depth
+    /// between the corners, which `1 / inv_z_at(l)` is).
+    #[inline]
+    pub fn linear_z_at(&self, l: [f32; 3]) -> f32 {
+        l[0] / self.inv_z[0] + l[1] / self.inv_z[1] + l[2] / self.inv_z[2]
+    }
+
     /// `inv_z_at` for lanes of weights.
     #[inline(always)]
     pub fn inv_z_lanes<L: Lane>(&self, l: &[L; 3]) -> L {
@@ -385,6 +393,17 @@ pub fn bin_rows_by_id(rects: impl Iterator<Item = (u32, PixelRect)>, rows_start:
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn linear_z_is_the_straight_line_between_the_corners_depths() {
+        // Corners at view depths 1, 10 and 10; halfway between the first
+        // two in image space, 1/z is affine: the surface's depth there is
+        // 1 / 0.55, while z drawn straight across is 5.5.
+        let st = ScreenTri::new(0, [Vec2::new(0.0, 0.0), Vec2::new(8.0, 0.0), Vec2::new(0.0, 8.0)], [1.0, 0.1, 0.1], [Vec3::X, Vec3::Y, Vec3::Z], Vec2::ZERO, 16, 16).unwrap();
+        let l = [0.5, 0.5, 0.0];
+        assert!((1.0 / st.inv_z_at(l) - 1.0 / 0.55).abs() < 1e-5);
+        assert!((st.linear_z_at(l) - 5.5).abs() < 1e-5);
+    }
     use crate::scene::{Camera, Fov};
 
     #[test]

@@ -276,7 +276,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         let i = self.index(x, y);
         self.count_work(i);
         let inv_z = st.inv_z_at(l);
-        let key = self.enc.key(inv_z);
+        let key = if self.enc.format == DepthFormat::LinearZ { self.enc.key(1.0 / st.linear_z_at(l)) } else { self.enc.key(inv_z) };
         let stored = self.depth[i];
         let passed = self.paint || key < stored;
         if passed {
