@@ -67,7 +67,7 @@ pub fn false_colour_linear(c: Radiance) -> Radiance {
 }
 
 /// The inverse of the sRGB curve.
-fn srgb_to_linear(v: f32) -> f32 {
+pub fn srgb_to_linear(v: f32) -> f32 {
     if v <= 0.04045 { v / 12.92 } else { ((v + 0.055) / 1.055).powf(2.4) }
 }
 

@@ -12,7 +12,9 @@
 //! This module reads nothing but `math`; `image_io`, `render` and the viewer
 //! call it.
 
+pub mod error_view;
 pub mod false_colour;
+pub mod histogram;
 pub mod tonemap;
 pub mod transfer;
 
