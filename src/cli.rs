@@ -81,6 +81,11 @@ enum Command {
         /// Number of timed frames (after one warm-up frame).
         #[arg(long, default_value_t = 5)]
         frames: u32,
+        /// Time the viewer's display pass instead of rendering: the display
+        /// transform (--exposure, --tonemap, --gamma), false colour and the
+        /// log-luminance histogram of one rendered frame, --frames times.
+        #[arg(long = "display-pass")]
+        display_pass: bool,
     },
     /// The debug record of one pixel, replayed exactly as the renderer computed it.
     Pixel {
@@ -192,7 +197,8 @@ pub fn run() -> Result<Outcome, String> {
         Some(Command::Merge { status: Some(dir), .. }) => crate::part_status::status(&dir).map(|s| print!("{s}")),
         Some(Command::Merge { parts, output: Some(output), stats, status: None }) => cmd_merge(&parts, &output, stats.as_deref()),
         Some(Command::Merge { output: None, .. }) => Err("pinhole merge needs -o OUT.exr (or --status DIR)".into()),
-        Some(Command::Bench { scene, opts, frames }) => cmd_bench(&scene, &opts, frames),
+        Some(Command::Bench { scene, opts, frames, display_pass: false }) => cmd_bench(&scene, &opts, frames),
+        Some(Command::Bench { scene, opts, frames, display_pass: true }) => cmd_bench_display(&scene, &opts, frames),
         Some(Command::Compare { a, b, json }) => cmd_compare(&a, &b, json),
         Some(Command::Pixel { scene, x, y, opts, json }) => cmd_pixel(&scene, x, y, &opts, json),
         Some(Command::Chart { scene, output, sweep, metric, renderers, spp_list, reference, reference_spp, peer, opts }) => match sweep.as_str() {
@@ -593,6 +599,50 @@ fn cmd_bench(scene_arg: &str, opts: &RenderOpts, frames: u32) -> Result<(), Stri
     j["prepared_bytes"] = json!(memory.prepared_bytes);
     j["bytes_per_triangle"] = json!((triangles > 0).then(|| memory.total() as f64 / triangles as f64));
     j["peak_rss_bytes"] = json!(peak_rss_bytes());
+    write_json("-", &j)
+}
+
+/// `bench --display-pass`: one frame rendered, then its display pass timed
+/// `frames` times, each step apart: the display transform to 8 bits, false
+/// colour to 8 bits, the log-luminance histogram. Prints the medians (ms).
+fn cmd_bench_display(scene_arg: &str, opts: &RenderOpts, frames: u32) -> Result<(), String> {
+    if !(1..=MAX_BENCH_FRAMES).contains(&frames) {
+        return Err(format!("--frames {frames} is not between 1 and {MAX_BENCH_FRAMES}"));
+    }
+    let l = load(scene_arg, opts)?;
+    let shaded = RenderSettings { view: View::Shaded, ..l.settings.clone() };
+    let frame = l.pool.install(|| render::render_frame(l.renderer.as_ref(), &l.prepared, &shaded, interrupt::flag(), None)).ok_or("the render was cancelled")?;
+    let d = l.settings.display;
+    let scale = d.scale(l.prepared.scene.render.exposure);
+    let time = |f: &mut dyn FnMut()| -> f64 {
+        let start = Instant::now();
+        f();
+        start.elapsed().as_secs_f64() * 1e3
+    };
+    let (mut tonemap, mut false_colour, mut histogram, mut total) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut checksum = 0u64;
+    // One untimed round first (caches, page faults), then the timed ones.
+    for i in 0..=frames {
+        let a = time(&mut || checksum += crate::display::image_rgb8(&frame.pixels, scale, d.tonemap, d.gamma).len() as u64);
+        let b = time(&mut || checksum += crate::display::false_colour::image_rgb8(&frame.pixels).len() as u64);
+        let c = time(&mut || checksum += crate::display::histogram::log_luminance(&frame.pixels)[0] as u64);
+        if i > 0 {
+            tonemap.push(a);
+            false_colour.push(b);
+            histogram.push(c);
+            total.push(a + b + c);
+        }
+    }
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let j = json!({
+        "scene": l.prepared.scene.name, "width": frame.width, "height": frame.height, "frames": frames,
+        "tonemap": d.tonemap.name(), "gamma": d.gamma.name(), "exposure_ev": d.exposure_ev,
+        "display_ms": median(total), "tonemap_ms": median(tonemap), "false_colour_ms": median(false_colour), "histogram_ms": median(histogram),
+        "budget_ms": 2.0, "checksum": checksum,
+    });
     write_json("-", &j)
 }
 

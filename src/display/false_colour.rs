@@ -78,7 +78,7 @@ pub fn legend() -> Vec<(i32, [u8; 3])> {
 
 /// A whole image in false colour, 8-bit RGB, row-major.
 pub fn image_rgb8(pixels: &[Radiance]) -> Vec<u8> {
-    pixels.iter().flat_map(|&c| false_colour_rgb8(c)).collect()
+    crate::display::encode_rgb8(pixels, false_colour_rgb8)
 }
 
 #[cfg(test)]
