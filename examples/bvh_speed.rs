@@ -180,7 +180,7 @@ fn main() {
             let settings = RenderSettings { view: view_kind, shadows, ..RenderSettings::for_scene(&prepared.scene) };
             let mut counts = RayCounts::default();
             let t = best_of(reps, || {
-                let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: Vec2::splat(0.5), sample: 0, photons: None, active: None, rows: 0..h, cancel: &cancel };
+                let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: Vec2::splat(0.5), sample: 0, photons: None, active: None, rows: 0..h, cancel: &cancel, keep_non_finite: false };
                 counts = BvhRayTracer.render_pass(&job, &mut out);
             });
             (t, counts)

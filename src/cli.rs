@@ -45,6 +45,14 @@ enum Command {
         opts: RenderOpts,
         #[command(flatten)]
         part: part_opts::PartOpts,
+        /// The error views' ground truth (linear .exr of the frame's size);
+        /// default: the scene's [render] reference.
+        #[arg(long, value_name = "FILE.exr")]
+        reference: Option<PathBuf>,
+        /// Also write these layers of raw values into the output EXR:
+        /// depth,normal,albedo,position,uv,id,material (comma-separated).
+        #[arg(long, value_name = "LIST")]
+        aov: Option<String>,
         /// Write run statistics as JSON (`-` for stdout).
         #[arg(long, value_name = "FILE")]
         stats: Option<String>,
@@ -73,6 +81,11 @@ enum Command {
         /// Number of timed frames (after one warm-up frame).
         #[arg(long, default_value_t = 5)]
         frames: u32,
+        /// Time the viewer's display pass instead of rendering: the display
+        /// transform (--exposure, --tonemap, --gamma), false colour and the
+        /// log-luminance histogram of one rendered frame, --frames times.
+        #[arg(long = "display-pass")]
+        display_pass: bool,
     },
     /// The debug record of one pixel, replayed exactly as the renderer computed it.
     Pixel {
@@ -180,11 +193,12 @@ pub fn run() -> Result<Outcome, String> {
     }
     let ran = match cli.command {
         None => return Ok(Outcome::OpenViewer { scene: cli.scene, screenshot: cli.screenshot }),
-        Some(Command::Render { scene, output, opts, part, stats }) => cmd_render(&scene, &output, &opts, &part, stats.as_deref()),
+        Some(Command::Render { scene, output, opts, part, reference, aov, stats }) => cmd_render(&scene, &output, &opts, &part, reference.as_deref(), aov.as_deref(), stats.as_deref()),
         Some(Command::Merge { status: Some(dir), .. }) => crate::part_status::status(&dir).map(|s| print!("{s}")),
         Some(Command::Merge { parts, output: Some(output), stats, status: None }) => cmd_merge(&parts, &output, stats.as_deref()),
         Some(Command::Merge { output: None, .. }) => Err("pinhole merge needs -o OUT.exr (or --status DIR)".into()),
-        Some(Command::Bench { scene, opts, frames }) => cmd_bench(&scene, &opts, frames),
+        Some(Command::Bench { scene, opts, frames, display_pass: false }) => cmd_bench(&scene, &opts, frames),
+        Some(Command::Bench { scene, opts, frames, display_pass: true }) => cmd_bench_display(&scene, &opts, frames),
         Some(Command::Compare { a, b, json }) => cmd_compare(&a, &b, json),
         Some(Command::Pixel { scene, x, y, opts, json }) => cmd_pixel(&scene, x, y, &opts, json),
         Some(Command::Chart { scene, output, sweep, metric, renderers, spp_list, reference, reference_spp, peer, opts }) => match sweep.as_str() {
@@ -306,6 +320,8 @@ fn stats_json(l: &Loaded, render_ms: f64, counts: &RayCounts, spp: u32) -> serde
         "gi": l.settings.gi.mode.name(),
         "seed": l.settings.gi.seed,
         "photons": (l.settings.gi.mode == render::transport::gi::GiMode::Photons).then(|| l.prepared.photon_map(&l.settings.gi, l.settings.shadow_bump).len()),
+        // Samples that came out NaN or infinite, zeroed before any pixel saw them.
+        "non_finite_samples": counts.non_finite,
     });
     // The display transform the 8-bit image went through (an EXR is linear).
     j["tonemap"] = json!(l.settings.display.tonemap.name());
@@ -314,10 +330,46 @@ fn stats_json(l: &Loaded, render_ms: f64, counts: &RayCounts, spp: u32) -> serde
     j
 }
 
-fn cmd_render(scene_arg: &str, output: &Path, opts: &RenderOpts, part_opts: &part_opts::PartOpts, stats: Option<&str>) -> Result<(), String> {
+/// The reference image an error view compares with: `--reference`, else
+/// the scene's `[render] reference`, read at the frame's size and cut to
+/// `part` when only a part is rendered. `None` for the other views (a
+/// `--reference` they do not read is said in a note).
+fn error_reference(l: &Loaded, given: Option<&Path>, part: Option<&render::FramePart>, tiled: bool) -> Result<Option<(PathBuf, Vec<crate::math::Radiance>)>, String> {
+    let view = l.settings.view;
+    if view.error_kind().is_none() {
+        if let Some(path) = given {
+            eprintln!("note: --reference {} is read by --view error, absolute-error and signed-error only; this render does not use it", path.display());
+        }
+        return Ok(None);
+    }
+    if tiled {
+        return Err(format!("--view {} cannot be rendered as --tile parts: its scale spans the whole image (render the tiles shaded, merge them, and compare the result)", view.name()));
+    }
+    let Some(path) = given.map(Path::to_path_buf).or_else(|| l.prepared.scene.render.reference.clone()) else {
+        return Err(format!("--view {} compares with a reference image: give --reference FILE.exr or set [render] reference in the scene", view.name()));
+    };
+    let image = crate::chart::reference::load_reference_file(&path, l.settings.width, l.settings.height)?;
+    let pixels = match part {
+        Some(p) => {
+            let w = image.width as usize;
+            p.y.clone().flat_map(|y| image.pixels[y as usize * w + p.x.start as usize..y as usize * w + p.x.end as usize].iter().copied()).collect()
+        }
+        None => image.pixels,
+    };
+    Ok(Some((path, pixels)))
+}
+
+fn cmd_render(scene_arg: &str, output: &Path, opts: &RenderOpts, part_opts: &part_opts::PartOpts, reference: Option<&Path>, aov: Option<&str>, stats: Option<&str>) -> Result<(), String> {
     let ext = output.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).unwrap_or_default();
     if !["png", "exr", "ppm"].contains(&ext.as_str()) {
         return Err(format!("{}: unknown image type (use .png, .exr or .ppm)", output.display()));
+    }
+    let aovs = aov.map(render::aov::parse_list).transpose()?.unwrap_or_default();
+    if !aovs.is_empty() && ext != "exr" {
+        return Err(format!("--aov writes named layers of an EXR, and {} is not one (use -o OUT.exr)", output.display()));
+    }
+    if !aovs.is_empty() && part_opts.is_partial() {
+        return Err("--aov cannot go with --tile or --sample-range: a part for pinhole merge holds the image alone".into());
     }
     if part_opts.is_partial() && ext != "exr" {
         return Err(format!("{}: a part for pinhole merge (--tile, --sample-range) is written as .exr", output.display()));
@@ -329,9 +381,13 @@ fn cmd_render(scene_arg: &str, output: &Path, opts: &RenderOpts, part_opts: &par
     let outputs: Vec<&Path> = std::iter::once(output).chain(stats.filter(|d| *d != "-").map(Path::new)).collect();
     crate::file_identity::check_outputs(&outputs)?;
     let l = load(scene_arg, opts)?;
+    let part = part_opts.part(&l.settings)?;
+    let truth = error_reference(&l, reference, part.as_ref(), part_opts.tile.is_some())?;
+    if let Some(notice) = render::admit::aov_notice(l.renderer.as_ref(), &aovs) {
+        eprintln!("note: {notice}");
+    }
     // Now that every input is read: none of them may be an output.
     crate::file_identity::check_outputs(&outputs)?;
-    let part = part_opts.part(&l.settings)?;
     let cancel = interrupt::flag();
     let rows_done = AtomicU64::new(0);
     let total_rows = match &part {
@@ -352,11 +408,18 @@ fn cmd_render(scene_arg: &str, output: &Path, opts: &RenderOpts, part_opts: &par
         r
     });
     let render_ms = start.elapsed().as_secs_f64() * 1e3;
-    let frame = result.ok_or("the render was cancelled")?;
+    let mut frame = result.ok_or("the render was cancelled")?;
     if let Some(n) = frame.differing_pixels {
         eprintln!("{n} of {} pixels differ from raytrace:brute", frame.pixels.len());
     }
     let mut j = stats_json(&l, render_ms, &frame.counts, l.settings.spp);
+    // The error views: the shaded frame against the reference, mapped.
+    if let (Some(kind), Some((path, truth))) = (l.settings.view.error_kind(), &truth) {
+        let (image, map) = crate::display::error_view::error_image(kind, &frame.pixels, truth);
+        frame.pixels = image;
+        j["reference"] = json!(path.display().to_string());
+        j["error_scale"] = json!(map.scale);
+    }
     j["tile"] = json!(part_opts.tile.map(|t| format!("{}/{}", t.index, t.count)));
     j["sample_range"] = json!(part.as_ref().filter(|_| part_opts.sample_range.is_some()).map(|p| format!("{}..{}", p.passes.start, p.passes.end)));
     j["crop"] = json!(part_opts.crop.map(|c| c.0));
@@ -380,6 +443,11 @@ fn cmd_render(scene_arg: &str, output: &Path, opts: &RenderOpts, part_opts: &par
             stats: j.clone(),
         };
         crate::image_io::write_atomic(output, &crate::part_file::encode(&record, &frame.pixels)?)?;
+    } else if !aovs.is_empty() {
+        let layers = l.pool.install(|| render::aov::render_aovs(&l.prepared, &l.settings, &aovs, part.as_ref()));
+        let channels: Vec<(String, Vec<f32>)> = layers.into_iter().flat_map(|layer| layer.channels).collect();
+        crate::image_io::write_atomic(output, &crate::image_io::encode_layered_exr(frame.width, frame.height, &frame.pixels, &channels)?)?;
+        j["aov"] = json!(aovs.iter().map(|a| a.name()).collect::<Vec<_>>());
     } else {
         crate::image_io::save_image_displayed(output, frame.width, frame.height, &frame.pixels, l.prepared.scene.render.exposure, &l.settings.display)?;
     }
@@ -531,6 +599,50 @@ fn cmd_bench(scene_arg: &str, opts: &RenderOpts, frames: u32) -> Result<(), Stri
     j["prepared_bytes"] = json!(memory.prepared_bytes);
     j["bytes_per_triangle"] = json!((triangles > 0).then(|| memory.total() as f64 / triangles as f64));
     j["peak_rss_bytes"] = json!(peak_rss_bytes());
+    write_json("-", &j)
+}
+
+/// `bench --display-pass`: one frame rendered, then its display pass timed
+/// `frames` times, each step apart: the display transform to 8 bits, false
+/// colour to 8 bits, the log-luminance histogram. Prints the medians (ms).
+fn cmd_bench_display(scene_arg: &str, opts: &RenderOpts, frames: u32) -> Result<(), String> {
+    if !(1..=MAX_BENCH_FRAMES).contains(&frames) {
+        return Err(format!("--frames {frames} is not between 1 and {MAX_BENCH_FRAMES}"));
+    }
+    let l = load(scene_arg, opts)?;
+    let shaded = RenderSettings { view: View::Shaded, ..l.settings.clone() };
+    let frame = l.pool.install(|| render::render_frame(l.renderer.as_ref(), &l.prepared, &shaded, interrupt::flag(), None)).ok_or("the render was cancelled")?;
+    let d = l.settings.display;
+    let scale = d.scale(l.prepared.scene.render.exposure);
+    let time = |f: &mut dyn FnMut()| -> f64 {
+        let start = Instant::now();
+        f();
+        start.elapsed().as_secs_f64() * 1e3
+    };
+    let (mut tonemap, mut false_colour, mut histogram, mut total) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut checksum = 0u64;
+    // One untimed round first (caches, page faults), then the timed ones.
+    for i in 0..=frames {
+        let a = time(&mut || checksum += crate::display::image_rgb8(&frame.pixels, scale, d.tonemap, d.gamma).len() as u64);
+        let b = time(&mut || checksum += crate::display::false_colour::image_rgb8(&frame.pixels).len() as u64);
+        let c = time(&mut || checksum += crate::display::histogram::log_luminance(&frame.pixels)[0] as u64);
+        if i > 0 {
+            tonemap.push(a);
+            false_colour.push(b);
+            histogram.push(c);
+            total.push(a + b + c);
+        }
+    }
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let j = json!({
+        "scene": l.prepared.scene.name, "width": frame.width, "height": frame.height, "frames": frames,
+        "tonemap": d.tonemap.name(), "gamma": d.gamma.name(), "exposure_ev": d.exposure_ev,
+        "display_ms": median(total), "tonemap_ms": median(tonemap), "false_colour_ms": median(false_colour), "histogram_ms": median(histogram),
+        "budget_ms": 2.0, "checksum": checksum,
+    });
     write_json("-", &j)
 }
 

@@ -60,6 +60,33 @@ fn encode_exr(width: u32, height: u32, pixels: &[Radiance]) -> Result<Vec<u8>, S
     Ok(out.into_inner())
 }
 
+/// A single-part EXR of f32 channels: the image as `R`, `G`, `B` and, beside
+/// it, `extra` named channels (`layer.channel`, e.g. `normal.X`: readers
+/// such as tev and OpenImageIO group them into layers by the prefix), each
+/// `width * height` values, row-major.
+pub fn encode_layered_exr(width: u32, height: u32, pixels: &[Radiance], extra: &[(String, Vec<f32>)]) -> Result<Vec<u8>, String> {
+    use exr::prelude::*;
+    let n = width as usize * height as usize;
+    if pixels.len() != n || extra.iter().any(|(_, v)| v.len() != n) || n == 0 {
+        return Err(format!("a layered EXR of {width}x{height} pixels was given layers of other sizes"));
+    }
+    let mut channels: Vec<AnyChannel<FlatSamples>> = ["R", "G", "B"]
+        .iter()
+        .enumerate()
+        .map(|(k, name)| AnyChannel::new(*name, FlatSamples::F32(pixels.iter().map(|c| c[k]).collect())))
+        .collect();
+    for (name, values) in extra {
+        let text = Text::new_or_none(name.as_str()).ok_or_else(|| format!("\"{name}\" cannot name an EXR channel"))?;
+        channels.push(AnyChannel::new(text, FlatSamples::F32(values.clone())));
+    }
+    let mut attributes = LayerAttributes::named("");
+    attributes.software_name = Some(Text::new_or_panic(format!("pinhole {}", env!("CARGO_PKG_VERSION"))));
+    let layer = Layer::new((width as usize, height as usize), attributes, Encoding::SMALL_LOSSLESS, AnyChannels::sort(channels.into()));
+    let mut out = std::io::Cursor::new(Vec::new());
+    Image::from_layer(layer).write().to_buffered(&mut out).map_err(|e| format!("cannot encode the layered EXR: {e}"))?;
+    Ok(out.into_inner())
+}
+
 fn encode_ppm(width: u32, height: u32, rgb8: &[u8]) -> Vec<u8> {
     // Plain (ASCII) PPM, as CGPP listing 15.6 writes it.
     let mut s = format!("P3\n{width} {height}\n255\n");

@@ -160,6 +160,7 @@ fn the_wipe_shows_two_renderers_and_measures_their_difference() {
     assert!(x1 > x0 + 10 && y1 > y0 + 10, "{:?}", (x0, y0, x1, y1));
     assert!(h.state().split().error.unwrap().region.is_some());
     assert_eq!(h.state().params().camera, camera);
+    region_statistics_are_numpys(&h, [x0, y0, x1, y1]);
 
     // X swaps A and B.
     h.key_press(egui::Key::X);
@@ -198,4 +199,33 @@ fn the_viewer_shows_a_sub_sampled_frame() {
     let (w, hgt) = app.image_size();
     let grid = |n: u32| n.div_ceil(4) + u32::from((n - 1) % 4 != 0);
     assert_eq!(app.with_output(|o| o.stats.counts.primary), (grid(w) * grid(hgt)) as u64, "{w}x{hgt}: one ray per grid pixel");
+}
+
+/// The dragged region's statistics equal numpy-style statistics (mean,
+/// population std, median of the sorted values, min, max) computed here
+/// from A's linear pixels in the same rectangle, and the bar shows them.
+fn region_statistics_are_numpys(h: &Harness<'static, PinholeApp>, region: [u32; 4]) {
+    let app = h.state();
+    let stats = app.split().region_stats.expect("statistics of the dragged region");
+    assert_eq!(stats.region, region);
+    let [x0, y0, x1, y1] = region;
+    let (w, _) = app.image_size();
+    let a = app.with_output(|o| o.linear.clone());
+    assert_eq!(stats.pixels, ((x1 - x0) * (y1 - y0)) as u64);
+    assert_eq!(stats.non_finite, 0, "a rendered frame has no non-finite values");
+    for k in 0..3 {
+        let mut v: Vec<f64> = (y0..y1).flat_map(|y| (x0..x1).map(move |x| (x, y))).map(|(x, y)| a[(y * w + x) as usize][k] as f64).collect();
+        let n = v.len() as f64;
+        let mean = v.iter().sum::<f64>() / n;
+        let std = (v.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / n).sqrt();
+        v.sort_by(f64::total_cmp);
+        let m = v.len() / 2;
+        let median = if v.len() % 2 == 1 { v[m] } else { (v[m - 1] + v[m]) / 2.0 };
+        let c = stats.channels[k].expect("finite values");
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * b.abs().max(1e-6);
+        assert!(close(c.mean, mean) && close(c.std, std) && close(c.median, median), "channel {k}: {c:?} vs mean {mean} std {std} median {median}");
+        assert_eq!((c.min as f64, c.max as f64), (v[0], v[v.len() - 1]), "channel {k}");
+    }
+    assert!(stats.channels[0].unwrap().max > stats.channels[0].unwrap().min, "the region is not flat");
+    h.get_by_label(&pinhole::app::panels::split_bar::region_text(&stats));
 }

@@ -333,7 +333,7 @@ fn settings_persist_between_runs() {
     let mut app = PinholeApp::new_for_test(small_scene("one-triangle"));
     app.settings_mut().renderer = "raytrace:brute".into();
     app.settings_mut().render.spp = 9;
-    app.settings_mut().gamma = false;
+    app.settings_mut().render.display.gamma = pinhole::display::Gamma::Off;
     app.settings_mut().panels.materials = true;
     let mut mem = Mem::default();
     app.settings().save(&mut mem);
@@ -342,7 +342,7 @@ fn settings_persist_between_runs() {
     assert_eq!(p.scene.as_deref(), Some("one-triangle"));
     assert_eq!(again.settings().renderer, "raytrace:brute");
     assert_eq!(again.settings().render.spp, 9);
-    assert!(!again.settings().gamma && again.settings().panels.materials);
+    assert!(again.settings().render.display.gamma == pinhole::display::Gamma::Off && again.settings().panels.materials);
 }
 
 #[test]

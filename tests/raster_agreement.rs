@@ -304,7 +304,7 @@ fn rows_render_as_in_the_frame(name: &str) {
         let r = raster(m);
         let full = render(&r, &prepared, &settings);
         for rows in [0..H, 37..90, 3..4, 100..H, 0..1, 60..61, 61..77, 124..H] {
-            let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: sample_offset(0, 1, 0), sample: 0, photons: None, active: None, rows: rows.clone(), cancel: &cancel };
+            let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: sample_offset(0, 1, 0), sample: 0, photons: None, active: None, rows: rows.clone(), cancel: &cancel, keep_non_finite: false };
             let mut out = vec![Radiance::ZERO; (W * rows.len() as u32) as usize];
             let counts = r.render_pass(&job, &mut out);
             assert_eq!(counts.primary, out.len() as u64);

@@ -33,7 +33,7 @@ fn order_of(prepared: &PreparedScene, settings: &RenderSettings) -> (Vec<Paint>,
     let view = prepared.scene.camera.view(settings.width, settings.height);
     let cancel = AtomicBool::new(false);
     let off = Vec2::splat(0.5);
-    let job = PassJob { prepared, view: &view, settings, offset: off, sample: 0, photons: None, active: None, rows: 0..settings.height, cancel: &cancel };
+    let job = PassJob { prepared, view: &view, settings, offset: off, sample: 0, photons: None, active: None, rows: 0..settings.height, cancel: &cancel, keep_non_finite: false };
     let fts = snap_triangles(&setup_pass(&job), off, settings.width, settings.height);
     let spheres = all_sphere_bounds(&view, &prepared.scene.spheres, off);
     draw_order(&job, &fts, &spheres)

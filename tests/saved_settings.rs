@@ -58,7 +58,8 @@ fn files_the_last_release_saved_load_with_their_values() {
     let p = ViewerSettings::load(Some(&stored(LAST_RELEASE_CHANGED))).expect("the last release's settings load");
     assert_eq!(p.scene.as_deref(), Some("spheres"));
     assert_eq!(p.renderer, "rasterize:fixed");
-    assert_eq!((p.res_scale, p.gamma), (0.5, false));
+    // The old "gamma" checkbox off: no transfer curve.
+    assert_eq!((p.res_scale, p.render.display.gamma), (0.5, pinhole::display::Gamma::Off));
     assert!(p.panels.camera && !p.panels.lights);
     let r = &p.render;
     let mut expected = RenderSettings::default();
@@ -73,6 +74,8 @@ fn files_the_last_release_saved_load_with_their_values() {
     expected.gi.bounces = Some(3);
     expected.gi.seed = 7;
     expected.texture_filter = pinhole::scene::texture::TextureFilter::Bilinear;
+    // The old checkbox's `gamma:false` is the transfer curve `off` now.
+    expected.display.gamma = pinhole::display::Gamma::Off;
     expected.reflections = Reflections::Env;
     expected.subsample = pinhole::render::frame::Subsample { step: 4, contrast: Some(0.3) };
     assert_eq!(*r, expected);

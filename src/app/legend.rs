@@ -36,6 +36,10 @@ pub fn title(view: &str) -> Option<String> {
         "shadowmap" => "shadowmap: a light's depth map".into(),
         "mip" => "mip: texture level read per pixel".into(),
         "false-colour" => "false colour: luminance in stops".into(),
+        "error" => "error: |a - b| / b against the reference".into(),
+        "absolute-error" => "absolute error: |a - b| against the reference".into(),
+        "signed-error" => "signed error: a - b against the reference".into(),
+        "nan" => "nan: pixels that took a non-finite sample".into(),
         other => format!("view: {other}"),
     })
 }
@@ -66,6 +70,18 @@ fn bar(ui: &mut egui::Ui, colour: impl Fn(f32) -> Vec3, ticks: &[(f32, String)])
             egui::Align2::CENTER_TOP
         };
         p.text(Pos2::new(x, bar.max.y + 4.0), align, text, font.clone(), Color32::from_gray(230));
+    }
+}
+
+/// An error view's tick label: percentages for relative errors below one,
+/// else a short number with its sign.
+fn error_tick(v: f32) -> String {
+    if v == 0.0 {
+        "0".into()
+    } else if v.abs() < 1e-2 || v.abs() >= 1e3 {
+        format!("{v:+.0e}")
+    } else {
+        format!("{v:+}")
     }
 }
 
@@ -168,6 +184,23 @@ pub fn show(viewed: &Viewed, hover: Option<(u32, u32)>, camera: &Camera, ctx: &e
                         let span = MAX_STOP - MIN_STOP;
                         let ticks: Vec<(f32, String)> = (MIN_STOP as i32..=MAX_STOP as i32).step_by(4).map(|s| ((s as f32 - MIN_STOP) / span, format!("{s:+}"))).collect();
                         bar(ui, |t| Vec3::from(viridis(t)), &ticks);
+                    }
+                    "error" | "absolute-error" | "signed-error" => match viewed.error {
+                        Some(crate::app::reference_view::Mapped::Against { source, map }) => {
+                            small(ui, &format!("luminance of this image (a) against {source} (b)"));
+                            let ticks: Vec<(f32, String)> = map.legend().iter().map(|(v, _)| (map.position(*v), error_tick(*v))).collect();
+                            bar(ui, |t| Vec3::from(map.colour(map.value_at(t))), &ticks);
+                            if view == "signed-error" {
+                                small(ui, "red: brighter than b, green: darker; the scale is the largest difference, rounded up");
+                            }
+                        }
+                        Some(crate::app::reference_view::Mapped::Unmapped(why)) => small(ui, &format!("showing the shaded image: {why}")),
+                        None => small(ui, "waiting for the image…"),
+                    },
+                    "nan" => {
+                        let marked = viewed.with_output(|o| o.linear.iter().filter(|c| **c == crate::render::frame::NAN_MARK).count());
+                        small(ui, "magenta: a sample of the pixel was NaN or infinite (the frame counts it as black); the rest: luminance, dimmed");
+                        ui.label(format!("pixels marked: {marked}"));
                     }
                     "uv" => small(ui, "an 8 × 8 checker in (u, v): straight in perspective-correct interpolation, bent in affine"),
                     "diff" => {

@@ -13,6 +13,8 @@ pub mod legend;
 pub mod overlay;
 pub mod open_dialog;
 pub mod panels;
+pub mod reference_view;
+pub mod region_stats;
 pub mod settings_store;
 pub mod split_view;
 pub mod state;
@@ -177,7 +179,7 @@ fn apply_env_overrides(app: &mut PinholeApp, env: &crate::env_overrides::ViewerO
         app.settings.render.view = v;
     }
     if let Some(g) = env.gamma {
-        app.settings.gamma = g;
+        app.settings.render.display.gamma = if g { crate::display::Gamma::Srgb } else { crate::display::Gamma::Off };
     }
     if let Some(m) = env.gi {
         app.settings.render.gi.mode = m;

@@ -26,9 +26,12 @@ pub struct ViewerSettings {
     pub render: RenderSettings,
     /// Image size over the scene's size.
     pub res_scale: f32,
-    /// Encode the image as sRGB for display.
-    pub gamma: bool,
     pub panels: Panels,
+    /// Older versions' "gamma" checkbox: `false` meant no transfer curve.
+    /// `load` turns it into `render.display.gamma` (the one place that
+    /// setting lives now) and it is never saved again.
+    #[serde(rename = "gamma", skip_serializing, deserialize_with = "saved_as_bool")]
+    legacy_gamma: Option<bool>,
 }
 
 /// Which side-panel sections are open.
@@ -55,8 +58,8 @@ impl Default for ViewerSettings {
             renderer: crate::render::DEFAULT_RAYTRACE.to_string(),
             render: RenderSettings::default(),
             res_scale: 1.0,
-            gamma: true,
             panels: Panels::default(),
+            legacy_gamma: None,
         }
     }
 }
@@ -126,9 +129,9 @@ impl ViewerSettings {
     /// Takes `other`'s renderer and render knobs, keeping this one's view,
     /// display, panels and scene.
     pub fn take_configuration(&mut self, other: &ViewerSettings) {
-        let keep = (self.scene.take(), self.render.view, self.res_scale, self.gamma, self.panels);
+        let keep = (self.scene.take(), self.render.view, self.render.display, self.res_scale, self.panels);
         *self = other.clone();
-        (self.scene, self.render.view, self.res_scale, self.gamma, self.panels) = keep;
+        (self.scene, self.render.view, self.render.display, self.res_scale, self.panels) = keep;
     }
 
     /// The settings saved in `storage`, in this layout or the last release's
@@ -142,12 +145,20 @@ impl ViewerSettings {
             // it has a field for and ignores the rest.
             settings.render = eframe::get_value(storage, STORAGE_KEY)?;
         }
+        if settings.legacy_gamma.take() == Some(false) {
+            settings.render.display.gamma = crate::display::Gamma::Off;
+        }
         Some(settings)
     }
 
     pub fn save(&self, storage: &mut dyn eframe::Storage) {
         eframe::set_value(storage, STORAGE_KEY, self);
     }
+}
+
+/// The old checkbox, saved as a plain `bool`.
+fn saved_as_bool<'de, D: serde::Deserializer<'de>>(de: D) -> Result<Option<bool>, D::Error> {
+    <bool as serde::Deserialize>::deserialize(de).map(Some)
 }
 
 /// A string stored as `Option<String>` (`None` for empty), the form older
@@ -198,7 +209,7 @@ mod tests {
         let s = ViewerSettings::load(Some(&mem)).unwrap();
         assert_eq!(s.scene.as_deref(), Some("spheres"));
         assert_eq!(s.renderer, "raytrace:brute");
-        assert_eq!((s.render.spp, s.render.shadows, s.gamma), (9, ShadowMode::Map, false));
+        assert_eq!((s.render.spp, s.render.shadows, s.render.display.gamma), (9, ShadowMode::Map, crate::display::Gamma::Off));
         assert_eq!(s.render.max_depth, 4);
         s.save(&mut mem);
         assert_eq!(ViewerSettings::load(Some(&mem)), Some(s));

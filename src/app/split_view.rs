@@ -51,6 +51,8 @@ pub struct SplitView {
     /// (A's version, B's version, region) the difference and error were computed for.
     measured: Option<(u64, u64, Option<[u32; 4]>)>,
     pub error: Option<SplitError>,
+    /// Statistics of A's linear values over the dragged rectangle.
+    pub region_stats: Option<crate::app::region_stats::RegionStats>,
 }
 
 impl Default for SplitView {
@@ -71,6 +73,7 @@ impl Default for SplitView {
             diff_texture: None,
             measured: None,
             error: None,
+            region_stats: None,
         }
     }
 }
@@ -109,7 +112,7 @@ impl SplitView {
         let settings = self.b_settings(a_settings, a.settings.width, a.settings.height);
         let worker = self.worker.get_or_insert_with(|| Worker::start(repaint));
         if let Some(l) = &self.last_sent {
-            if l.scene_id == scene_id && l.renderer == self.b.renderer && l.settings == settings && l.gamma == a.gamma && l.params.same_as(&a.params) && l.interactive == a.interactive {
+            if l.scene_id == scene_id && l.renderer == self.b.renderer && l.settings == settings && l.params.same_as(&a.params) && l.interactive == a.interactive {
                 return;
             }
         }
@@ -147,6 +150,12 @@ impl SplitView {
         }
     }
 
+    /// The version of B's latest image (`None` before B has one).
+    pub fn b_version(&self) -> Option<u64> {
+        let o = self.worker.as_ref()?.shared.output.lock().unwrap();
+        (o.width > 0).then_some(o.version)
+    }
+
     /// B's latest linear image, `(width, height, pixels)`.
     pub fn b_linear(&self) -> Option<(u32, u32, Vec<Radiance>)> {
         let o = self.worker.as_ref()?.shared.output.lock().unwrap();
@@ -155,7 +164,7 @@ impl SplitView {
 
     /// Copies B's newest image into its texture and, when A or B or the region
     /// changed, recomputes the difference image and the error.
-    pub fn update(&mut self, ctx: &egui::Context, a: (u32, u32, u64, &[Radiance]), exposure: f32, gamma: bool) {
+    pub fn update(&mut self, ctx: &egui::Context, a: (u32, u32, u64, &[Radiance]), exposure: f32, display: &crate::display::DisplaySettings) {
         let Some(worker) = self.worker.as_ref().filter(|_| self.enabled) else { return };
         let (b_version, bw, bh, b_linear, b_rgb) = {
             let o = worker.shared.output.lock().unwrap();
@@ -182,8 +191,9 @@ impl SplitView {
         }
         self.measured = Some(key);
         self.error = Some(split_error(a_linear, &b_linear, aw, self.region));
+        self.region_stats = self.region.map(|r| crate::app::region_stats::region_stats(a_linear, aw, r));
         let (diff, _) = crate::render::inspect::debug::diff_image(&b_linear, a_linear);
-        let rgb = crate::image_io::to_rgb8(&diff, exposure, gamma);
+        let rgb = crate::display::image_rgb8(&diff, display.scale(exposure), display.tonemap, display.gamma);
         let image = egui::ColorImage::from_rgb([aw as usize, ah as usize], &rgb);
         match &mut self.diff_texture {
             Some(t) => t.set(image, egui::TextureOptions::NEAREST),
@@ -252,7 +262,8 @@ mod tests {
 
     #[test]
     fn swapping_exchanges_the_configurations() {
-        let mut a = ViewerSettings { renderer: "raytrace:bvh".into(), ..Default::default() };
+        let mut a = ViewerSettings::default();
+        a.renderer = "raytrace:bvh".into();
         a.render.spp = 4;
         let mut split = SplitView::default();
         split.toggle(&a);

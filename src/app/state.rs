@@ -45,6 +45,8 @@ pub struct PinholeApp {
     pub(crate) camera_moving: bool,
     pub(crate) texture: Option<egui::TextureHandle>,
     pub(crate) shown_version: u64,
+    /// The error views: the frame on show mapped against its reference.
+    pub(crate) reference_view: crate::app::reference_view::ReferenceView,
     /// A problem to show in the red bar (the previous scene stays).
     pub(crate) error_bar: Option<String>,
     /// A passing note in the status bar (e.g. "saved x.png").
@@ -103,6 +105,7 @@ impl PinholeApp {
             camera_moving: false,
             texture: None,
             shown_version: 0,
+            reference_view: Default::default(),
             error_bar: None,
             message: None,
             loader: None,
@@ -252,7 +255,6 @@ impl PinholeApp {
             if last.scene_id == self.scene_id
                 && last.renderer == self.settings.renderer
                 && last.settings == settings
-                && last.gamma == self.settings.gamma
                 && last.params.same_as(&self.params)
             {
                 return;
@@ -268,7 +270,6 @@ impl PinholeApp {
             params: self.params.clone(),
             settings,
             renderer: self.settings.renderer.clone(),
-            gamma: self.settings.gamma,
             interactive: self.camera_moving,
         };
         self.worker.request(req.clone());
@@ -419,11 +420,43 @@ impl PinholeApp {
 
     /// Copies a newly published image into the texture.
     fn update_texture(&mut self, ctx: &egui::Context) {
+        if let Some(kind) = self.settings.render.view.error_kind() {
+            return self.update_error_texture(ctx, kind);
+        }
+        self.reference_view.clear();
         let out = self.worker.shared.output.lock().unwrap();
         if out.version == self.shown_version || out.width == 0 {
             return;
         }
         let image = egui::ColorImage::from_rgb([out.width as usize, out.height as usize], &out.rgb8);
+        self.shown_version = out.version;
+        drop(out);
+        self.update_texture_of_a(ctx, image);
+    }
+
+    /// An error view: A's frame (rendered shaded) mapped against B or the
+    /// scene's reference, again whenever either changes; the shaded image
+    /// while there is no reference.
+    fn update_error_texture(&mut self, ctx: &egui::Context, kind: crate::display::error_view::ErrorKind) {
+        let b_version = if self.split.enabled { self.split.b_version().unwrap_or(0) } else { 0 };
+        let out = self.worker.shared.output.lock().unwrap();
+        let key = (out.version, b_version, kind);
+        if out.width == 0 || self.reference_view.is_current(key) {
+            return;
+        }
+        let b = if b_version > 0 { self.split.b_linear() } else { None };
+        let b_label = self.split.b_label(&self.settings);
+        let reference = self.scene.render.reference.clone();
+        let rgb = self.reference_view.map(
+            key,
+            (out.width, out.height, &out.linear),
+            b,
+            &b_label,
+            reference.as_deref(),
+            &self.settings.render.display,
+            self.params.render.exposure,
+        );
+        let image = egui::ColorImage::from_rgb([out.width as usize, out.height as usize], rgb.as_deref().unwrap_or(&out.rgb8));
         self.shown_version = out.version;
         drop(out);
         self.update_texture_of_a(ctx, image);
@@ -435,8 +468,8 @@ impl PinholeApp {
             return;
         }
         let out = self.worker.shared.output.lock().unwrap();
-        let (exposure, gamma) = (self.params.render.exposure, self.settings.gamma);
-        self.split.update(ctx, (out.width, out.height, out.version, &out.linear), exposure, gamma);
+        let display = self.settings.render.display;
+        self.split.update(ctx, (out.width, out.height, out.version, &out.linear), self.params.render.exposure, &display);
     }
 
     fn update_texture_of_a(&mut self, ctx: &egui::Context, image: egui::ColorImage) {
@@ -612,7 +645,7 @@ impl PinholeApp {
                 materials: &self.params.materials,
                 renderer: &self.settings.renderer,
                 exposure: self.params.render.exposure,
-                gamma: self.settings.gamma,
+                display: self.settings.render.display,
                 frame_pixel,
             };
             crate::app::panels::inspector::show(ui, &mut self.inspect, &viewed);
@@ -622,12 +655,13 @@ impl PinholeApp {
             settings: &settings,
             renderer: &self.settings.renderer,
             exposure: self.params.render.exposure,
-            gamma: self.settings.gamma,
+            display: self.settings.render.display,
             scene: &self.scene,
             scene_id: self.scene_id,
             generation: self.generation,
             texture: self.texture.as_ref(),
             output: &self.worker.shared.output,
+            error: self.reference_view.mapped.as_ref(),
         };
         let edited = crate::app::viewport::Edited {
             camera: &mut self.params.camera,

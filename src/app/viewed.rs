@@ -12,8 +12,9 @@ pub struct Viewed<'a> {
     /// The settings the worker renders with, at the image's size.
     pub settings: &'a RenderSettings,
     pub renderer: &'a str,
+    /// The scene's exposure (a linear factor) and the display transform.
     pub exposure: f32,
-    pub gamma: bool,
+    pub display: crate::display::DisplaySettings,
     pub scene: &'a Scene,
     pub scene_id: u64,
     /// The last render request sent: a replay for it is current.
@@ -21,6 +22,8 @@ pub struct Viewed<'a> {
     pub texture: Option<&'a egui::TextureHandle>,
     /// The worker's latest output (pixel values under the cursor, counts).
     pub output: &'a Mutex<Output>,
+    /// The error views: what the image on show was compared with.
+    pub error: Option<&'a crate::app::reference_view::Mapped>,
 }
 
 impl Viewed<'_> {

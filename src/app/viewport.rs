@@ -323,7 +323,8 @@ fn hover_readout(viewed: &Viewed, hover: Option<(u32, u32)>, painter: &egui::Pai
     let exposure = viewed.exposure;
     let Some(v) = viewed.with_output(|o| (x < o.width && y < o.height && o.linear.len() == (o.width * o.height) as usize).then(|| o.linear[(x + y * o.width) as usize])) else { return };
     let meaning = crate::app::inspect::value_text(viewed.settings.view.name(), v, view, viewed.scene);
-    let d = crate::image_io::display_pixel(v, exposure, viewed.gamma);
+    let t = viewed.display;
+    let d = crate::display::display_rgb8(v, t.scale(exposure), t.tonemap, t.gamma);
     let text = if meaning.starts_with("linear") {
         format!("({x}, {y})  {meaning}  -> {d:?}")
     } else {

@@ -71,18 +71,16 @@ pub struct Request {
     pub params: SceneParams,
     pub settings: RenderSettings,
     pub renderer: String,
-    pub gamma: bool,
     /// The camera is moving: show a coarse preview first.
     pub interactive: bool,
 }
 
 impl Request {
     /// The image on show as displayed: the scene's exposure and the display
-    /// settings (stops, tone map, curve; no curve with gamma off).
+    /// settings (stops, tone map, transfer curve).
     pub fn encode(&self, linear: &[Radiance]) -> Vec<u8> {
         let d = &self.settings.display;
-        let gamma = if self.gamma { d.gamma } else { crate::display::Gamma::Off };
-        crate::display::image_rgb8(linear, d.scale(self.params.render.exposure), d.tonemap, gamma)
+        crate::display::image_rgb8(linear, d.scale(self.params.render.exposure), d.tonemap, d.gamma)
     }
 }
 
@@ -150,7 +148,7 @@ pub struct Stats {
 pub struct Output {
     pub width: u32,
     pub height: u32,
-    /// Display-encoded image (exposure, sRGB if gamma on), RGB8 row-major.
+    /// Display-encoded image (`Request::encode`), RGB8 row-major.
     pub rgb8: Vec<u8>,
     /// Linear radiance: the running average of the samples so far.
     pub linear: Vec<Radiance>,
@@ -408,7 +406,7 @@ impl WorkerLoop {
         if req.scene_id != *scene_id {
             return; // a request for a scene not loaded yet; its SetScene follows
         }
-        // Display-only change: same image, different exposure or gamma.
+        // Display-only change: same image, another display transform.
         if let Some(f) = self.frame.as_mut() {
             if f.req.scene_id == req.scene_id
                 && f.req.renderer == req.renderer

@@ -32,7 +32,8 @@ pub struct RenderOpts {
     /// Samples per pixel (stratified; 1 = the pixel centre).
     #[arg(long, default_value_t = defaults().spp)]
     pub spp: u32,
-    /// shaded | barycentric | raydir | depth | zbuffer | normal | id | uv | cost | diff | shadowmap | wireframe | mip | false-colour (see `pinhole list`)
+    /// shaded | barycentric | raydir | depth | zbuffer | normal | id | uv | cost | diff | shadowmap | wireframe | mip | false-colour |
+    /// error | absolute-error | signed-error (against --reference) | nan (see `pinhole list`)
     #[arg(long, default_value_t = defaults().view.name().to_string())]
     pub view: String,
     /// ray | map | volume | none (opengl, which casts no rays, draws ray shadows as maps)

@@ -67,7 +67,7 @@ pub fn false_colour_linear(c: Radiance) -> Radiance {
 }
 
 /// The inverse of the sRGB curve.
-fn srgb_to_linear(v: f32) -> f32 {
+pub fn srgb_to_linear(v: f32) -> f32 {
     if v <= 0.04045 { v / 12.92 } else { ((v + 0.055) / 1.055).powf(2.4) }
 }
 
@@ -78,7 +78,7 @@ pub fn legend() -> Vec<(i32, [u8; 3])> {
 
 /// A whole image in false colour, 8-bit RGB, row-major.
 pub fn image_rgb8(pixels: &[Radiance]) -> Vec<u8> {
-    pixels.iter().flat_map(|&c| false_colour_rgb8(c)).collect()
+    crate::display::encode_rgb8(pixels, false_colour_rgb8)
 }
 
 #[cfg(test)]

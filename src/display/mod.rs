@@ -12,7 +12,9 @@
 //! This module reads nothing but `math`; `image_io`, `render` and the viewer
 //! call it.
 
+pub mod error_view;
 pub mod false_colour;
+pub mod histogram;
 pub mod tonemap;
 pub mod transfer;
 
@@ -74,7 +76,22 @@ pub fn display_rgb8(c: Radiance, scale: f32, tonemap: ToneMap, gamma: Gamma) -> 
     display_rgb(c, scale, tonemap, gamma).map(|v| (v * 255.0 + 0.5) as u8)
 }
 
-/// A whole image as 8-bit RGB, row-major.
+/// A whole image as 8-bit RGB, row-major; rows of pixels in parallel (the
+/// viewer encodes every frame it shows).
 pub fn image_rgb8(pixels: &[Radiance], scale: f32, tonemap: ToneMap, gamma: Gamma) -> Vec<u8> {
-    pixels.iter().flat_map(|&c| display_rgb8(c, scale, tonemap, gamma)).collect()
+    encode_rgb8(pixels, |c| display_rgb8(c, scale, tonemap, gamma))
+}
+
+/// `encode` of every pixel into 8-bit RGB, in parallel chunks, into one
+/// buffer (no per-pixel allocation or iterator chain).
+pub fn encode_rgb8(pixels: &[Radiance], encode: impl Fn(Radiance) -> [u8; 3] + Sync) -> Vec<u8> {
+    use rayon::prelude::*;
+    const CHUNK: usize = 4096;
+    let mut out = vec![0u8; pixels.len() * 3];
+    out.par_chunks_mut(CHUNK * 3).zip(pixels.par_chunks(CHUNK)).for_each(|(out, pixels)| {
+        for (o, &c) in out.chunks_exact_mut(3).zip(pixels) {
+            o.copy_from_slice(&encode(c));
+        }
+    });
+    out
 }

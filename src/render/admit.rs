@@ -83,8 +83,9 @@ fn approximations(scene: &Scene, settings: &RenderSettings) -> Vec<String> {
     if shaded && sky && matches!(settings.shadows, ShadowMode::Map | ShadowMode::Volume) {
         notes.push(format!("--shadows {} holds no shadows of the [environment]; its light samples cast shadow rays", settings.shadows.name()));
     }
-    if settings.view == View::FalseColour && settings.display != crate::display::DisplaySettings::default() {
-        notes.push("--view false-colour holds its colour map as linear values, so --exposure, --tonemap and --gamma other than 0, standard and srgb change its colours (the legend no longer matches)".to_string());
+    let colour_map = matches!(settings.view, View::FalseColour | View::Nan) || settings.view.error_kind().is_some();
+    if colour_map && settings.display != crate::display::DisplaySettings::default() {
+        notes.push(format!("--view {} holds its colours as linear values, so --exposure, --tonemap and --gamma other than 0, standard and srgb change them (the legend no longer matches)", settings.view.name()));
     }
     if settings.shadow_filter != ShadowFilter::None && (settings.shadows != ShadowMode::Map || !area_lights) {
         notes.push(format!("--shadow-filter {} filters the shadow maps of area lights only, and this render has none; it changes nothing", settings.shadow_filter.name()));
@@ -245,4 +246,12 @@ mod tests {
         let e = admit(renderer_by_name("raytrace").unwrap().as_ref(), &big, &s).unwrap_err();
         assert!(e.starts_with("the image size 100000x"), "{e}");
     }
+}
+
+/// What `--aov` layers are for `renderer`: a notice when its own visibility
+/// is not the BVH ray caster's, which casts the layers (`render::aov`).
+pub fn aov_notice(renderer: &dyn crate::render::Renderer, aovs: &[crate::render::aov::Aov]) -> Option<String> {
+    (!aovs.is_empty() && !renderer.name().starts_with("raytrace")).then(|| {
+        format!("--aov layers are cast through the BVH at each pixel's first sample; {} finds its own surfaces, which can differ along edges", renderer.name())
+    })
 }

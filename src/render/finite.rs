@@ -25,31 +25,38 @@ pub fn admitted(sample: Radiance) -> Radiance {
     if finite { sample } else { Radiance::ZERO }
 }
 
-/// Replaces every non-finite value of `values` by black. A read-only scan
-/// in lanes: the values are rewritten only when one of them is not finite
+/// Replaces every non-finite value of `values` by black and returns how
+/// many it replaced (a frame's `non_finite` count). A read-only scan in
+/// lanes: the values are rewritten only when one of them is not finite
 /// (rarely).
-pub fn admit_all(values: &mut [Radiance]) {
-    if !crate::math::lanes::all_finite(bytemuck::cast_slice(values)) {
-        for v in values.iter_mut() {
-            *v = admitted(*v);
-        }
+pub fn admit_all(values: &mut [Radiance]) -> u64 {
+    if crate::math::lanes::all_finite(bytemuck::cast_slice(values)) {
+        return 0;
     }
+    let mut replaced = 0;
+    for v in values.iter_mut() {
+        replaced += u64::from(!v.is_finite());
+        *v = admitted(*v);
+    }
+    replaced
 }
 
 /// `admit_all` over each range of `rows` (in ascending order, apart) of
 /// `values`, except the ranges `skipped` (ascending, each within one row):
 /// values a renderer streamed past the cache, admitted before they were
 /// stored, which a scan would read back from memory.
-pub fn admit_rows_except(values: &mut [Radiance], rows: impl Iterator<Item = Range<usize>>, skipped: &[Range<usize>]) {
+pub fn admit_rows_except(values: &mut [Radiance], rows: impl Iterator<Item = Range<usize>>, skipped: &[Range<usize>]) -> u64 {
     let mut skip = skipped.iter().peekable();
+    let mut replaced = 0;
     for row in rows {
         let mut from = row.start;
         while let Some(s) = skip.next_if(|s| s.start < row.end) {
-            admit_all(&mut values[from..s.start]);
+            replaced += admit_all(&mut values[from..s.start]);
             from = s.end;
         }
-        admit_all(&mut values[from..row.end]);
+        replaced += admit_all(&mut values[from..row.end]);
     }
+    replaced
 }
 
 #[cfg(test)]
@@ -121,7 +128,7 @@ mod renderer_tests {
         for renderer in &renderers {
             assert!(renderer.admits_its_samples(), "{}", renderer.name());
             for active in [Some(&inactive[..]), None] {
-                let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: glam::Vec2::splat(0.5), sample: 0, photons: None, active, rows: 0..h, cancel: &cancel };
+                let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: glam::Vec2::splat(0.5), sample: 0, photons: None, active, rows: 0..h, cancel: &cancel, keep_non_finite: false };
                 let mut out = vec![Radiance::splat(f32::NAN); (w * h) as usize];
                 renderer.render_pass(&job, &mut out);
                 assert!(out.iter().all(|v| v.is_finite()), "{} (active: {})", renderer.name(), active.is_none());
@@ -151,7 +158,7 @@ mod renderer_tests {
         renderers.push(Box::new(BvhRayTracer));
         renderers.push(Box::new(BruteForce));
         for renderer in &renderers {
-            let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: glam::Vec2::splat(0.5), sample: 0, photons: None, active: None, rows: 0..h, cancel: &cancel };
+            let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: glam::Vec2::splat(0.5), sample: 0, photons: None, active: None, rows: 0..h, cancel: &cancel, keep_non_finite: false };
             let mut out = vec![Radiance::splat(-1.0); (w * h) as usize];
             renderer.render_pass(&job, &mut out);
             assert!(out.iter().all(|v| v.is_finite()), "{}", renderer.name());

@@ -8,7 +8,7 @@ pub mod subsample;
 pub use part::FramePart;
 
 pub use subsample::Subsample;
-pub use accumulator::{add_sample, admitted, final_value, mean, relative_error, wants_more, Accumulator, Band, ADAPTIVE_MIN_SAMPLES};
+pub use accumulator::{add_sample, admitted, final_value, mean, relative_error, wants_more, Accumulator, Band, ADAPTIVE_MIN_SAMPLES, NAN_DIM, NAN_MARK};
 
 use crate::render::{sample_offset, PassJob, PreparedScene, RayCounts, RenderSettings, Renderer};
 use crate::math::Radiance;
@@ -69,7 +69,7 @@ pub fn check_part(part: &FramePart, settings: &RenderSettings) -> Result<(), Str
         if settings.subsample.is_on() && settings.view == View::Shaded {
             return Err("--sample-range cannot split a --subsample frame, which interpolates every pass over the whole image".into());
         }
-        if matches!(settings.view, View::Diff | View::Wireframe) {
+        if settings.view != View::Shaded && settings.view.renders_shaded() {
             return Err(format!("--sample-range cannot split the {} view, which is drawn over the finished average", settings.view.name()));
         }
     }
@@ -151,7 +151,7 @@ pub fn build_shadow_maps(prepared: &PreparedScene, settings: &RenderSettings) {
 /// The photon map the passes read, built (once, in parallel) before them,
 /// when the settings ask for photon mapping on the shaded view.
 pub fn build_photon_map(prepared: &PreparedScene, settings: &RenderSettings) -> Option<std::sync::Arc<crate::render::transport::photon_map::PhotonMap>> {
-    (settings.gi.mode == crate::render::transport::gi::GiMode::Photons && matches!(settings.view, crate::render::inspect::debug::View::Shaded | crate::render::inspect::debug::View::Diff | crate::render::inspect::debug::View::FalseColour))
+    (settings.gi.mode == crate::render::transport::gi::GiMode::Photons && settings.view.renders_shaded())
         .then(|| prepared.photon_map(&settings.gi, settings.shadow_bump))
 }
 
@@ -170,11 +170,15 @@ pub fn replay_pixel(renderer: &dyn Renderer, prepared: &PreparedScene, settings:
     }
     // The wireframe view is the shaded frame with lines over it: the samples
     // are shaded, and a pixel under a line takes the line's colour.
-    // So is the false-colour view, mapped once the pixel's value is final.
-    let wireframe = settings.view == crate::render::inspect::debug::View::Wireframe;
-    let false_colour = settings.view == crate::render::inspect::debug::View::FalseColour;
-    let shaded = RenderSettings { view: crate::render::inspect::debug::View::Shaded, ..settings.clone() };
-    let settings = if wireframe || false_colour { &shaded } else { settings };
+    // So is the false-colour view, mapped once the pixel's value is final,
+    // and the nan view, marked when a sample is not finite. The error views
+    // replay the shaded pixel (the reference is their caller's).
+    use crate::render::inspect::debug::View;
+    let wireframe = settings.view == View::Wireframe;
+    let false_colour = settings.view == View::FalseColour;
+    let nan = settings.view == View::Nan;
+    let shaded = RenderSettings { view: View::Shaded, ..settings.clone() };
+    let settings = if wireframe || false_colour || nan || settings.view.error_kind().is_some() { &shaded } else { settings };
     build_shadow_maps(prepared, settings);
     let photons = build_photon_map(prepared, settings);
     let view = prepared.scene.camera.view(settings.width, settings.height);
@@ -191,7 +195,7 @@ pub fn replay_pixel(renderer: &dyn Renderer, prepared: &PreparedScene, settings:
             break;
         }
         let offset = sample_offset(i, spp, settings.gi.seed);
-        let job = PassJob { prepared, view: &view, settings, offset, sample: i, photons: photons.as_deref(), active: None, rows: y..y + 1, cancel: &cancel };
+        let job = PassJob { prepared, view: &view, settings, offset, sample: i, photons: photons.as_deref(), active: None, rows: y..y + 1, cancel: &cancel, keep_non_finite: false };
         let mut rec = crate::render::inspect::pixel_record::PixelTrace::new();
         let value = renderer
             .trace_pixel(&job, x, y, &mut rec)
@@ -207,6 +211,11 @@ pub fn replay_pixel(renderer: &dyn Renderer, prepared: &PreparedScene, settings:
     }
     if false_colour {
         radiance = crate::display::false_colour::false_colour_linear(radiance);
+    }
+    if nan {
+        let mut one = [radiance];
+        accumulator::nan_view_in_place(&mut one, &[samples.iter().any(|(_, _, v)| !v.is_finite())]);
+        radiance = one[0];
     }
     Ok(PixelReplay { samples, radiance })
 }

@@ -10,6 +10,7 @@ pub mod admit;
 pub mod camera_support;
 pub mod differentials;
 pub mod finite;
+pub mod aov;
 pub mod frame;
 pub mod gi_settings;
 pub mod inspect;
@@ -238,6 +239,9 @@ pub struct RayCounts {
     /// Rasterizer: copies made by `instances` set up, and culled whole.
     pub instances_drawn: u64,
     pub instances_culled: u64,
+    /// Samples that came out NaN or infinite and were zeroed before they
+    /// reached a pixel (`finite::admit_all`).
+    pub non_finite: u64,
 }
 
 impl std::ops::AddAssign for RayCounts {
@@ -253,6 +257,7 @@ impl std::ops::AddAssign for RayCounts {
         self.depth_fails += o.depth_fails;
         self.instances_drawn += o.instances_drawn;
         self.instances_culled += o.instances_culled;
+        self.non_finite += o.non_finite;
     }
 }
 
@@ -350,6 +355,10 @@ pub struct PassJob<'a> {
     /// Rows to render; `out` holds `width * rows.len()` pixels.
     pub rows: Range<u32>,
     pub cancel: &'a AtomicBool,
+    /// The frame looks for non-finite samples itself (the nan view marks
+    /// their pixels): a renderer that admits its samples leaves them as
+    /// they are for the frame to find, count and zero.
+    pub keep_non_finite: bool,
 }
 
 impl PassJob<'_> {

@@ -28,8 +28,9 @@ pub struct Viewed<'a> {
     pub lights: &'a [Light],
     pub materials: &'a [Material],
     pub renderer: &'a str,
+    /// The scene's exposure (a linear factor) and the display transform.
     pub exposure: f32,
-    pub gamma: bool,
+    pub display: crate::display::DisplaySettings,
     /// The frame's own value at the selected pixel, once the frame of
     /// `generation` is complete.
     pub frame_pixel: Option<Radiance>,
@@ -451,16 +452,20 @@ fn final_value(viewed: &Viewed, ui: &mut egui::Ui, radiance: Radiance, current: 
         }
     }
     let exposure = viewed.exposure;
-    let d = crate::image_io::display_pixel(radiance, exposure, viewed.gamma);
+    // The pixel through the display transform on show; the numbers above are linear.
+    let t = viewed.display;
+    let d = crate::display::display_rgb8(radiance, t.scale(exposure), t.tonemap, t.gamma);
     ui.horizontal(|ui| {
         let (r, _) = ui.allocate_exact_size(egui::vec2(18.0, 18.0), egui::Sense::hover());
         ui.painter().rect_filled(r, 2.0, Color32::from_rgb(d[0], d[1], d[2]));
         ui.monospace(format!(
-            "displayed [{}, {}, {}] (exposure {exposure}, {})",
+            "displayed [{}, {}, {}] (exposure {exposure}, {:+} stops, {}, {})",
             d[0],
             d[1],
             d[2],
-            if viewed.gamma { "sRGB" } else { "no gamma" }
+            t.exposure_ev,
+            t.tonemap.name(),
+            t.gamma.name()
         ));
     });
 }

@@ -1,7 +1,7 @@
 //! Shading section (the debug view is in the top bar): shadows (none / ray / map / volume, the map's filter) and the ray bump,
 //! light samples and MIS for area lights and the sky,
 //! samples per pixel, secondary depth, ambient, background, exposure, the
-//! display transform (exposure in stops, tone map, gamma on/off and its curve); the rasterizers' knobs (MSAA, early depth, affine, depth
+//! display transform (exposure in stops, tone map, transfer curve); the rasterizers' knobs (MSAA, early depth, affine, depth
 //! buffer format) and the wireframe view's line algorithm.
 
 use eframe::egui;
@@ -28,11 +28,10 @@ pub struct InForce<'a> {
 }
 
 /// `settings`: the render knobs asked for (the worker renders with these,
-/// through the gate) and gamma; `look`: the scene's ambient, background and
+/// through the gate) and the display transform; `look`: the scene's ambient, background and
 /// exposure; `in_force`: what the gate admitted, shown where it differs.
 pub fn show(ui: &mut egui::Ui, settings: &mut ViewerSettings, look: &mut RenderDefaults, in_force: InForce) {
     let mut open = settings.panels.shading;
-    let gamma = &mut settings.gamma;
     section(ui, "Shading", &mut open, |ui| {
         let s = &mut settings.render;
         ui.horizontal(|ui| {
@@ -105,7 +104,8 @@ pub fn show(ui: &mut egui::Ui, settings: &mut ViewerSettings, look: &mut RenderD
             ui.add(egui::Slider::new(&mut r.exposure, 0.01..=100.0).logarithmic(true)).labelled_by(l.id);
         });
         // The display transform (`crate::display`): stops on top of the
-        // scene's exposure, a tone map, the transfer curve (gamma off: none).
+        // scene's exposure, a tone map, the transfer curve (off: none). The
+        // curve has this one control: `display.gamma` is its only setting.
         ui.horizontal(|ui| {
             let l = ui.label("exposure (stops)");
             ui.add(egui::Slider::new(&mut s.display.exposure_ev, -10.0..=10.0).step_by(0.1)).labelled_by(l.id);
@@ -115,13 +115,10 @@ pub fn show(ui: &mut egui::Ui, settings: &mut ViewerSettings, look: &mut RenderD
                 ui.selectable_value(&mut s.display.tonemap, t, t.name());
             }
         });
-        ui.horizontal(|ui| {
-            ui.checkbox(gamma, "gamma");
-            egui::ComboBox::from_label("transfer curve").selected_text(s.display.gamma.name()).show_ui(ui, |ui| {
-                for g in Gamma::ALL.into_iter().filter(|g| *g != Gamma::Off) {
-                    ui.selectable_value(&mut s.display.gamma, g, g.name());
-                }
-            });
+        egui::ComboBox::from_label("transfer curve").selected_text(s.display.gamma.name()).show_ui(ui, |ui| {
+            for g in Gamma::ALL {
+                ui.selectable_value(&mut s.display.gamma, g, g.name());
+            }
         });
         ui.horizontal(|ui| {
             ui.label("interpolation");

@@ -43,6 +43,10 @@ pub fn show(ui: &mut egui::Ui, split: &mut SplitView, a_label: &str, b_label: &s
                             if ui.small_button("clear region").clicked() {
                                 split.region = None;
                             }
+                            if let Some(s) = &split.region_stats {
+                                ui.end_row();
+                                ui.label(region_text(s)).on_hover_text("A's linear values over the dragged rectangle, per channel (r, g, b): population std, numpy's median");
+                            }
                         }
                         None => {
                             ui.weak("alt+drag: measure a region");
@@ -59,4 +63,22 @@ pub fn show(ui: &mut egui::Ui, split: &mut SplitView, a_label: &str, b_label: &s
         });
     });
     req
+}
+
+/// The region's statistics as one line: per channel r, g, b.
+pub fn region_text(s: &crate::app::region_stats::RegionStats) -> String {
+    let [x0, y0, x1, y1] = s.region;
+    let each = |f: &dyn Fn(&crate::app::region_stats::ChannelStats) -> f64| -> String {
+        s.channels.iter().map(|c| c.map_or("-".to_string(), |c| format!("{:.4}", f(&c)))).collect::<Vec<_>>().join(", ")
+    };
+    format!(
+        "region {x0},{y0}-{x1},{y1} ({} px): mean ({}) median ({}) min ({}) max ({}) std ({}) non-finite {}",
+        s.pixels,
+        each(&|c| c.mean),
+        each(&|c| c.median),
+        each(&|c| c.min as f64),
+        each(&|c| c.max as f64),
+        each(&|c| c.std),
+        s.non_finite
+    )
 }

@@ -36,31 +36,49 @@ pub fn add_sample(sum: &mut Radiance, sample: Radiance, spp: u32) {
 /// sample counts go up. Pixels are independent, so without `--adaptive`
 /// (the frames that are timed) chunks go in parallel: at many samples per
 /// pixel this loop would otherwise be a serial part of every pass.
-fn add_pass(pass: &[Radiance], sum: &mut [Radiance], sum_sq: &mut [f32], adaptive: Option<(&[bool], &mut [u32])>, spp: u32) {
+/// Returns how many of the samples added were not finite (and added nothing).
+fn add_pass(pass: &[Radiance], sum: &mut [Radiance], sum_sq: &mut [f32], adaptive: Option<(&[bool], &mut [u32])>, spp: u32) -> u64 {
     const CHUNK: usize = 8192;
     debug_assert!(spp > 1, "one sample is stored, not added");
-    let add = |p: &Radiance, s: &mut Radiance, q: &mut f32| {
+    let add = |p: &Radiance, s: &mut Radiance, q: &mut f32| -> u64 {
         // `add_sample` with several samples, the check made once for both sums.
         let sample = admitted(*p);
         *s += sample;
         let l = luminance(sample);
         *q += l * l;
+        u64::from(!p.is_finite())
     };
     match adaptive {
-        None => pass.par_chunks(CHUNK).zip(sum.par_chunks_mut(CHUNK)).zip(sum_sq.par_chunks_mut(CHUNK)).for_each(|((pass, sum), sum_sq)| {
-            for ((p, s), q) in pass.iter().zip(sum).zip(sum_sq) {
-                add(p, s, q);
-            }
-        }),
+        None => pass
+            .par_chunks(CHUNK)
+            .zip(sum.par_chunks_mut(CHUNK))
+            .zip(sum_sq.par_chunks_mut(CHUNK))
+            .map(|((pass, sum), sum_sq)| pass.iter().zip(sum).zip(sum_sq).map(|((p, s), q)| add(p, s, q)).sum::<u64>())
+            .sum(),
         Some((active, samples)) => {
+            let mut non_finite = 0;
             for ((((p, s), q), &on), n) in pass.iter().zip(sum).zip(sum_sq).zip(active).zip(samples) {
                 if on {
                     *n += 1;
-                    add(p, s, q);
+                    non_finite += add(p, s, q);
                 }
             }
+            non_finite
         }
     }
+}
+
+/// Marks in `marks` the pixels of `pass` whose sample is not finite and
+/// returns how many there are (the nan view, before the frame zeroes them).
+fn mark_non_finite(pass: &[Radiance], marks: &mut [bool]) -> u64 {
+    let mut found = 0;
+    for (p, m) in pass.iter().zip(marks) {
+        if !p.is_finite() {
+            *m = true;
+            found += 1;
+        }
+    }
+    found
 }
 
 /// The average of a pixel whose sum holds `passes` samples.
@@ -153,6 +171,9 @@ pub struct Accumulator {
     /// False-colour view: the passes are shaded; the average is shown as
     /// its log2 luminance through the colour map (`display::false_colour`).
     false_colour: bool,
+    /// Nan view: the passes are shaded, their non-finite samples left by
+    /// the renderer for the frame to find; per pixel whether one had any.
+    nan_marks: Option<Vec<bool>>,
     /// With more than one sample, what a band's pass renders before it is
     /// added to `sum`: kept from band to band, since a fresh buffer per
     /// band costs its allocation, zeroing and page faults every pass.
@@ -171,6 +192,20 @@ fn zeros(n: usize) -> Vec<Radiance> {
     v.par_extend(rayon::iter::repeat_n(Radiance::ZERO, n));
     v
 }
+
+/// The nan view of shaded pixels: the pixels that took a non-finite sample
+/// in `NAN_MARK`, the others as their luminance, dimmed grey, so the marks
+/// stand out against the picture they are in.
+pub fn nan_view_in_place(pixels: &mut [Radiance], marks: &[bool]) {
+    for (c, &marked) in pixels.iter_mut().zip(marks) {
+        *c = if marked { NAN_MARK } else { Radiance::splat((luminance(*c) * NAN_DIM).clamp(0.0, NAN_DIM)) };
+    }
+}
+
+/// The nan view's colour of a pixel that took a non-finite sample: magenta.
+pub const NAN_MARK: Radiance = Radiance::new(1.0, 0.0, 1.0);
+/// The nan view's other pixels are grey, at most this bright.
+pub const NAN_DIM: f32 = 0.25;
 
 /// The false-colour view of shaded pixels: each becomes the linear colour
 /// whose sRGB encoding is the colour map's colour for its stop.
@@ -196,8 +231,8 @@ impl Accumulator {
         let diff = settings.view == View::Diff;
         let wireframe = (settings.view == View::Wireframe).then_some(settings.lines);
         let false_colour = settings.view == View::FalseColour;
-        let shaded = diff || wireframe.is_some() || false_colour;
-        let settings = if shaded { RenderSettings { view: View::Shaded, ..settings.clone() } } else { settings.clone() };
+        let nan = settings.view == View::Nan;
+        let settings = if settings.view.renders_shaded() { RenderSettings { view: View::Shaded, ..settings.clone() } } else { settings.clone() };
         let n = settings.width as usize * settings.height as usize;
         Accumulator {
             spp: settings.spp.max(1),
@@ -212,6 +247,7 @@ impl Accumulator {
             wireframe,
             lines: None,
             false_colour,
+            nan_marks: nan.then(|| vec![false; n]),
             pass_buffer: Vec::new(),
             rows: 0..settings.height,
             passes: 0..settings.spp.max(1),
@@ -303,6 +339,7 @@ impl Accumulator {
                 active: self.adaptive.as_ref().map(|a| &a.active[span.clone()]),
                 rows: rows.clone(),
                 cancel,
+                keep_non_finite: self.nan_marks.is_some(),
             };
             let cancelled = || cancel.load(Ordering::Relaxed);
             // With one sample the pass is the frame: render straight into it
@@ -325,17 +362,25 @@ impl Accumulator {
                     return None;
                 }
             }
+            // The nan view finds the non-finite samples the renderer left.
+            let marked = self.nan_marks.as_mut().map(|marks| {
+                let pass = if self.spp == 1 { &self.sum[span.clone()] } else { &mine[..] };
+                mark_non_finite(pass, &mut marks[span.clone()])
+            });
             if self.spp == 1 {
                 // A renderer that checks its bands as it writes them has
                 // left nothing to do; for the others, a read-only scan in
                 // parallel (`admit_all`).
-                if !renderer.admits_its_samples() {
-                    self.sum[span.clone()].par_chunks_mut(8192).for_each(admit_all);
+                if !renderer.admits_its_samples() || marked.is_some() {
+                    let zeroed: u64 = self.sum[span.clone()].par_chunks_mut(8192).map(admit_all).sum();
+                    counts.non_finite += if marked.is_some() { 0 } else { zeroed };
                 }
             } else {
                 let adaptive = self.adaptive.as_mut().map(|a| (&a.active[span.clone()], &mut a.samples[span.clone()]));
-                add_pass(&mine, &mut self.sum[span.clone()], &mut self.sum_sq[span.clone()], adaptive, self.spp);
+                let zeroed = add_pass(&mine, &mut self.sum[span.clone()], &mut self.sum_sq[span.clone()], adaptive, self.spp);
+                counts.non_finite += if marked.is_some() { 0 } else { zeroed };
             }
+            counts.non_finite += marked.unwrap_or(0);
             // (A cancelled band returns above and drops the buffer: the
             // next band makes a new one.)
             self.pass_buffer = mine;
@@ -386,7 +431,7 @@ impl Accumulator {
     /// work per pass beside the renderer's (the diff view's reference, the
     /// wireframe's lines).
     pub fn renders_in_chunks(&self) -> bool {
-        self.spp > 1 && self.pass == self.passes.start && self.row == self.rows.start && self.adaptive.is_none() && self.reference.is_none() && self.wireframe.is_none()
+        self.spp > 1 && self.pass == self.passes.start && self.row == self.rows.start && self.adaptive.is_none() && self.reference.is_none() && self.wireframe.is_none() && self.nan_marks.is_none()
     }
 
     /// Renders the whole frame chunk by chunk: chunks of `chunk_rows` rows
@@ -428,12 +473,12 @@ impl Accumulator {
                     let passes = first..(first + group as u32).min(passes_range.end);
                     let jobs: Vec<PassJob> = passes
                         .clone()
-                        .map(|pass| PassJob { prepared, view: &view, settings, offset: sample_offset(pass, spp, settings.gi.seed), sample: pass, photons, active: None, rows: rows.clone(), cancel })
+                        .map(|pass| PassJob { prepared, view: &view, settings, offset: sample_offset(pass, spp, settings.gi.seed), sample: pass, photons, active: None, rows: rows.clone(), cancel, keep_non_finite: false })
                         .collect();
                     let buffers = &mut pass_buffers[..jobs.len() * sum.len()];
                     counts += renderer.render_passes(&jobs, buffers);
                     for pass_buffer in buffers.chunks(sum.len()) {
-                        add_pass(pass_buffer, sum, sum_sq, None, spp);
+                        counts.non_finite += add_pass(pass_buffer, sum, sum_sq, None, spp);
                         if let Some(done) = rows_done {
                             done.fetch_add(rows.len() as u64, Ordering::Relaxed);
                         }
@@ -462,6 +507,7 @@ impl Accumulator {
     pub fn mean_rows(&self, rows: Range<u32>) -> Vec<Radiance> {
         let w = self.settings.width as usize;
         let mut out = Vec::with_capacity(rows.len() * w);
+        let rows_start = rows.start as usize;
         for y in rows {
             let passes = self.row_passes[y as usize];
             let row = &self.sum[y as usize * w..(y as usize + 1) * w];
@@ -480,6 +526,11 @@ impl Accumulator {
         }
         if self.false_colour {
             false_colour_in_place(&mut out);
+        }
+        if let Some(marks) = &self.nan_marks {
+            let start = rows_start * w;
+            let n = out.len();
+            nan_view_in_place(&mut out, &marks[start..start + n]);
         }
         out
     }
@@ -538,6 +589,9 @@ impl Accumulator {
         }
         if self.false_colour {
             false_colour_in_place(&mut mine);
+        }
+        if let Some(marks) = &self.nan_marks {
+            nan_view_in_place(&mut mine, marks);
         }
         let (pixels, differing_pixels) = match self.reference {
             Some(reference) => {

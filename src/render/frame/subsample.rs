@@ -87,6 +87,7 @@ pub fn render_subsampled(renderer: &dyn Renderer, prepared: &PreparedScene, sett
                 active: Some(active),
                 rows: 0..h,
                 cancel,
+                keep_non_finite: false,
             };
             renderer.render_pass(&job, out)
         };

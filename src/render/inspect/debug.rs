@@ -58,6 +58,38 @@ named_enum! {
         /// The shaded image's log2 luminance (stops) through the viridis
         /// colour map (`display::false_colour`), legend in stops.
         FalseColour = "false-colour",
+        /// The shaded image's relative error against a reference image,
+        /// |a - b| / b in luminance, on a log scale (`display::error_view`).
+        /// The frame is the shaded image; whoever holds the reference maps it.
+        Error = "error" | "relative-error",
+        /// The absolute error |a - b| in luminance against a reference image.
+        AbsoluteError = "absolute-error",
+        /// The signed error a - b in luminance against a reference image:
+        /// red brighter, green darker, on a symmetric scale.
+        SignedError = "signed-error",
+        /// The pixels that took a non-finite sample (before the frame
+        /// zeroed it) marked over the shaded image, greyed.
+        Nan = "nan",
+    }
+}
+
+impl View {
+    /// Which comparison an error view makes (`None` for the other views).
+    pub fn error_kind(self) -> Option<crate::display::error_view::ErrorKind> {
+        use crate::display::error_view::ErrorKind;
+        match self {
+            View::Error => Some(ErrorKind::Relative),
+            View::AbsoluteError => Some(ErrorKind::Absolute),
+            View::SignedError => Some(ErrorKind::Signed),
+            _ => None,
+        }
+    }
+
+    /// Views whose passes render the shaded image, the view being made
+    /// from it once the frame is final (or, for the error views, by whoever
+    /// holds the reference image).
+    pub fn renders_shaded(self) -> bool {
+        matches!(self, View::Shaded | View::Diff | View::Wireframe | View::FalseColour | View::Error | View::AbsoluteError | View::SignedError | View::Nan)
     }
 }
 
@@ -124,7 +156,7 @@ pub fn surface_color(view: View, camera: &CameraView, h: &SurfaceHit) -> Radianc
         // The shadow map view is drawn by `shadow_map::view_sample`.
         // The wireframe view is the shaded image with lines drawn after the frame.
         // The mip view needs the scene's textures (`mip_view`).
-        View::Shaded | View::Raydir | View::Cost | View::Diff | View::Shadowmap | View::Wireframe | View::Mip | View::FalseColour => Vec3::ZERO,
+        View::Shaded | View::Raydir | View::Cost | View::Diff | View::Shadowmap | View::Wireframe | View::Mip | View::FalseColour | View::Error | View::AbsoluteError | View::SignedError | View::Nan => Vec3::ZERO,
         View::Barycentric => h.barycentric,
         View::Depth => Vec3::splat(depth_value(camera, (h.position - camera.eye).length())),
         View::Zbuffer => Vec3::splat(zbuffer_value(camera, camera.view_depth(h.position).max(camera.near))),
@@ -152,7 +184,7 @@ pub fn surface_color(view: View, camera: &CameraView, h: &SurfaceHit) -> Radianc
 pub fn miss_color(view: View) -> Option<Radiance> {
     match view {
         View::Barycentric | View::Depth | View::Zbuffer | View::Normal | View::GeometricNormal | View::Id | View::TriangleId | View::MaterialId | View::Uv => Some(Vec3::ZERO),
-        View::Shaded | View::Raydir | View::Cost | View::Diff | View::Shadowmap | View::Wireframe | View::Mip | View::FalseColour => None,
+        View::Shaded | View::Raydir | View::Cost | View::Diff | View::Shadowmap | View::Wireframe | View::Mip | View::FalseColour | View::Error | View::AbsoluteError | View::SignedError | View::Nan => None,
     }
 }
 

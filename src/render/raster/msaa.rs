@@ -89,6 +89,8 @@ pub fn resolve<Q: SceneQuery, R: FragmentRecorder>(vbs: &mut [VisBuffer<Q, R>], 
 pub fn resolve_into<Q: SceneQuery, R: FragmentRecorder>(vbs: &mut [VisBuffer<Q, R>], out: &mut [Radiance], out_stride: usize, x_offset: usize) -> RayCounts {
     let r = vbs[0].rect;
     let w = r.width() as usize;
+    let keep_non_finite = vbs[0].job.keep_non_finite;
+    let mut non_finite = 0;
     let mut i = 0;
     for (row, y) in (r.y0..r.y1).enumerate() {
         let line = &mut out[row * out_stride + x_offset..row * out_stride + x_offset + w];
@@ -96,9 +98,11 @@ pub fn resolve_into<Q: SceneQuery, R: FragmentRecorder>(vbs: &mut [VisBuffer<Q, 
             *px = resolve(vbs, i, x, y);
             i += 1;
         }
-        admit_all(line);
+        if !keep_non_finite {
+            non_finite += admit_all(line);
+        }
     }
-    let mut counts = RayCounts::default();
+    let mut counts = RayCounts { non_finite, ..RayCounts::default() };
     for vb in vbs {
         counts += std::mem::take(&mut vb.counts);
     }

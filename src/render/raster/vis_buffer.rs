@@ -682,7 +682,9 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
                 *px = self.resolve(i, x, y);
                 i += 1;
             }
-            admit_all(line);
+            if !self.job.keep_non_finite {
+                self.counts.non_finite += admit_all(line);
+            }
         }
         std::mem::take(&mut self.counts)
     }
@@ -823,7 +825,9 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         queue.finish(self.job, self.query, &mut self.counts, out);
         streaming::fence();
         let rows = (0..r.height() as usize).map(|row| row * out_stride + x_offset..row * out_stride + x_offset + self.stride);
-        admit_rows_except(out, rows, &streamed);
+        if !self.job.keep_non_finite {
+            self.counts.non_finite += admit_rows_except(out, rows, &streamed);
+        }
         streamed.clear();
         self.streamed = streamed;
         self.queue = Some(queue);

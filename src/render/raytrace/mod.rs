@@ -32,7 +32,9 @@ pub fn cast_pass<Q: SceneQuery>(job: &PassJob, query: &Q, out: &mut [Radiance]) 
                     *px = cast_pixel(job, query, x as u32, y, &mut counts, &mut NoRecord);
                 }
             }
-            crate::render::finite::admit_all(row);
+            if !job.keep_non_finite {
+                counts.non_finite += crate::render::finite::admit_all(row);
+            }
             counts
         })
         .reduce(RayCounts::default, |mut a, b| {

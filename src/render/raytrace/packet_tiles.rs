@@ -91,7 +91,9 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
                     }
                 }
                 context.paths.follow_into(job, query, &mut counts, band);
-                crate::render::finite::admit_all(band);
+                if !job.keep_non_finite {
+                    counts.non_finite += crate::render::finite::admit_all(band);
+                }
                 counts
             },
         )
@@ -662,7 +664,7 @@ mod tests {
         assert!(floor_behind, "the floor should reach behind the near plane");
         let settings = RenderSettings::for_scene(&prepared.scene);
         let cancel = std::sync::atomic::AtomicBool::new(false);
-        let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: Vec2::splat(0.5), sample: 0, photons: None, active: None, rows: 0..h, cancel: &cancel };
+        let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: Vec2::splat(0.5), sample: 0, photons: None, active: None, rows: 0..h, cancel: &cancel, keep_non_finite: false };
         let tiles = SeenTiles::new(&query, &job, (TILE_W, TILE_H), SeenTiles::LEVELS_WHOLE);
         let top_row_left_out = (0..w as usize).step_by(TILE_W).filter(|&x0| !tiles.may_see(0, x0)).count();
         assert!(top_row_left_out >= 10, "only {top_row_left_out} of the top row's {} tiles left out", (w as usize).div_ceil(TILE_W));
@@ -693,7 +695,7 @@ mod tests {
                 let view = prepared.scene.camera.view(w, h);
                 let settings = RenderSettings::for_scene(&prepared.scene);
                 let cancel = std::sync::atomic::AtomicBool::new(false);
-                let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: Vec2::splat(0.5), sample: 0, photons: None, active: None, rows: rows.clone(), cancel: &cancel };
+                let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: Vec2::splat(0.5), sample: 0, photons: None, active: None, rows: rows.clone(), cancel: &cancel, keep_non_finite: false };
                 // The one-pass tiles and those of 2, 8 and 16 passes, each
                 // with the outlines of both depths.
                 let sizes = [(TILE_W, TILE_H), pass_tile(2), pass_tile(8), pass_tile(16)];
@@ -749,7 +751,7 @@ mod tests {
                 settings.gi.mode = gi;
                 let rows = 2..h;
                 let jobs: Vec<PassJob> = (passes..2 * passes)
-                    .map(|pass| PassJob { prepared: &prepared, view: &view, settings: &settings, offset: sample_offset(pass, settings.spp, settings.gi.seed), sample: pass, photons: None, active: None, rows: rows.clone(), cancel: &cancel })
+                    .map(|pass| PassJob { prepared: &prepared, view: &view, settings: &settings, offset: sample_offset(pass, settings.spp, settings.gi.seed), sample: pass, photons: None, active: None, rows: rows.clone(), cancel: &cancel, keep_non_finite: false })
                     .collect();
                 let n = (rows.len() * w as usize).max(1);
                 let mut together = vec![Radiance::splat(-1.0); jobs.len() * n];
@@ -766,7 +768,7 @@ mod tests {
             }
             // One pass, or more than a packet holds, go pass by pass.
             let settings = RenderSettings { width: w, height: h, spp: 17, ..RenderSettings::for_scene(&prepared.scene) };
-            let jobs: Vec<PassJob> = (0..17).map(|pass| PassJob { prepared: &prepared, view: &view, settings: &settings, offset: sample_offset(pass, 17, settings.gi.seed), sample: pass, photons: None, active: None, rows: 0..h, cancel: &cancel }).collect();
+            let jobs: Vec<PassJob> = (0..17).map(|pass| PassJob { prepared: &prepared, view: &view, settings: &settings, offset: sample_offset(pass, 17, settings.gi.seed), sample: pass, photons: None, active: None, rows: 0..h, cancel: &cancel, keep_non_finite: false }).collect();
             let mut out = vec![Radiance::ZERO; 17 * (w * h) as usize];
             assert!(cast_passes_packets(&jobs, &query, &mut out).is_none());
             assert!(cast_passes_packets(&jobs[..1], &query, &mut out[..(w * h) as usize]).is_none());

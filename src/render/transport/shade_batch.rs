@@ -900,7 +900,7 @@ mod tests {
         let view = prepared.scene.camera.view(100, 40);
         let settings = RenderSettings::for_scene(&prepared.scene);
         let cancel = AtomicBool::new(false);
-        let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: glam::Vec2::new(0.3, 0.85), sample: 5, photons: None, active: None, rows: 0..40, cancel: &cancel };
+        let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: glam::Vec2::new(0.3, 0.85), sample: 5, photons: None, active: None, rows: 0..40, cancel: &cancel, keep_non_finite: false };
         let index = [7, 3, 3, 90, 1, 0, 44, 12];
         let bary: [[f32; 2]; LANES] = std::array::from_fn(|k| [0.1 * k as f32, 0.35 - 0.03 * k as f32]);
         let (x, y, slot) = (61u32, 17u32, 977usize);
@@ -942,7 +942,7 @@ mod tests {
             ] {
                 let mut settings = RenderSettings { interpolation, shadows, ..RenderSettings::for_scene(&prepared.scene) };
                 settings.gi.mode = gi;
-                let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: glam::Vec2::splat(0.5), sample: 0, photons: None, active: None, rows: 0..h, cancel: &cancel };
+                let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: glam::Vec2::splat(0.5), sample: 0, photons: None, active: None, rows: 0..h, cancel: &cancel, keep_non_finite: false };
                 check(name, &job, &query);
             }
         }
@@ -1094,7 +1094,7 @@ use crate::render::transport::shadow_packets::shadow_packets;
             let cancel = AtomicBool::new(false);
             for interpolation in [Interpolation::Phong, Interpolation::Flat] {
                 let settings = RenderSettings { interpolation, ..RenderSettings::for_scene(scene) };
-                let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: glam::Vec2::new(0.25, 0.75), sample: 3, photons: None, active: None, rows: 0..h, cancel: &cancel };
+                let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: glam::Vec2::new(0.25, 0.75), sample: 3, photons: None, active: None, rows: 0..h, cancel: &cancel, keep_non_finite: false };
                 let mut hits = Vec::new();
                 for (x, y) in (0..h).flat_map(|y| (0..w).map(move |x| (x, y))) {
                     let p = job.sample_position(x, y);

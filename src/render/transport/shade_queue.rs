@@ -219,7 +219,7 @@ mod tests {
             for (shadows, gi) in [(ShadowMode::Ray, GiMode::None), (ShadowMode::Ray, GiMode::Path), (ShadowMode::None, GiMode::None)] {
                 let mut settings = RenderSettings { interpolation: Interpolation::Phong, shadows, spp: 2, ..RenderSettings::for_scene(&prepared.scene) };
                 settings.gi.mode = gi;
-                let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: glam::Vec2::splat(0.5), sample: 1, photons: None, active: None, rows: 0..h, cancel: &cancel };
+                let job = PassJob { prepared: &prepared, view: &view, settings: &settings, offset: glam::Vec2::splat(0.5), sample: 1, photons: None, active: None, rows: 0..h, cancel: &cancel, keep_non_finite: false };
                 let mut queue = ShadeQueue::new(prepared.scene.lights.len());
                 let mut out = vec![Radiance::splat(-1.0); (w * h) as usize];
                 let mut expected = vec![None; (w * h) as usize];
