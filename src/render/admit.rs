@@ -83,6 +83,9 @@ fn approximations(scene: &Scene, settings: &RenderSettings) -> Vec<String> {
     if shaded && sky && matches!(settings.shadows, ShadowMode::Map | ShadowMode::Volume) {
         notes.push(format!("--shadows {} holds no shadows of the [environment]; its light samples cast shadow rays", settings.shadows.name()));
     }
+    if shaded && matches!(settings.shadows, ShadowMode::Map | ShadowMode::Volume) && scene.has_cutouts() {
+        notes.push(format!("--shadows {} casts the shadows of alphaMode MASK surfaces whole, cut-away parts included; --shadows ray passes light through them", settings.shadows.name()));
+    }
     if settings.view == View::FalseColour && settings.display != crate::display::DisplaySettings::default() {
         notes.push("--view false-colour holds its colour map as linear values, so --exposure, --tonemap and --gamma other than 0, standard and srgb change its colours (the legend no longer matches)".to_string());
     }
