@@ -94,7 +94,8 @@ const H: u32 = 40;
 
 /// The pixel column that sees x (at z = 0) on the middle row.
 fn column(x: f32) -> u32 {
-    (40.0 + x * 40.0 / (3.0 * 0.4f32.tan())).floor() as u32
+    // Half the image's height is 3 tan(yfov / 2) there; its width is twice its height.
+    (40.0 + x * 40.0 / (2.0 * 3.0 * 0.4f32.tan())).floor() as u32
 }
 
 fn write(dir: &Path, name: &str, json: String) -> PathBuf {
@@ -264,3 +265,4 @@ fn vertex_colours_show_on_every_copy_of_a_shared_mesh() {
         }
     }
 }
+
