@@ -65,7 +65,7 @@ fn add_gltf_unnamed(scene: &mut Scene, path: &Path, placement: &Placement, objec
     let bytes = read_asset(path, InputKind::Mesh).map_err(|e| format!("cannot read glTF: {e}"))?;
     let folder = path.parent().unwrap_or(Path::new("."));
     refuse_required_extensions(&bytes)?;
-    let gltf::Gltf { document: doc, blob } = gltf::Gltf::from_slice_without_validation(&bytes).map_err(describe)?;
+    let gltf::Gltf { document: doc, mut blob } = gltf::Gltf::from_slice_without_validation(&bytes).map_err(describe)?;
     drop(bytes);
     // The crate's validation reads each POSITION accessor without checking
     // that it exists: an index beyond the accessors is refused here first.
@@ -96,7 +96,8 @@ fn add_gltf_unnamed(scene: &mut Scene, path: &Path, placement: &Placement, objec
     for b in doc.buffers() {
         let what = format!("buffer {}", b.index());
         let data = match b.source() {
-            gltf::buffer::Source::Bin => blob.clone().ok_or(format!("{what} is the GLB's binary chunk, but the file has none"))?,
+            // Taken, not copied: a large model's binary chunk is held once.
+            gltf::buffer::Source::Bin => blob.take().ok_or(format!("{what} is the GLB's binary chunk, but the file has none (or another buffer took it)"))?,
             gltf::buffer::Source::Uri(uri) => source::read_uri(uri, folder, &what, InputKind::Mesh)?,
         };
         if data.len() < b.length() {
@@ -216,7 +217,7 @@ fn add_gltf_unnamed(scene: &mut Scene, path: &Path, placement: &Placement, objec
         let part_name = |node: usize| {
             format!("glTF node {node}{}, mesh {}{}", quoted(node_names.get(node).copied().flatten()), mesh.index(), quoted(mesh.name()))
         };
-        let MeshCorners { triangles: local, colours, tangents } = mesh_triangles(&mesh, &buffers, first_material, fallback, &double_sided, object, &mut degenerate, &mut parts.ignored)?;
+        let MeshCorners { triangles: local, keys, vertices, colours, tangents } = mesh_triangles(&mesh, &buffers, first_material, fallback, &double_sided, object, &mut degenerate, &mut parts.ignored)?;
         if placed.len() == 1 {
             let p = Placement::from_matrix(placed[0].0);
             let start = scene.triangles.len();
@@ -236,12 +237,17 @@ fn add_gltf_unnamed(scene: &mut Scene, path: &Path, placement: &Placement, objec
                 scene.given_tangents.resize(start, [Vec4::ZERO; 3]);
                 scene.given_tangents.extend(tangents.into_iter().map(|c| in_corner_order(c.map(place), flips)));
             }
-            for t in local {
+            // Corners are shared by vertex as they are pushed (each is a
+            // function of its vertex), so no table of every corner is built
+            // to merge them afterwards.
+            let mut made = vec![u32::MAX; vertices];
+            scene.triangles.reserve_faces(local.len());
+            for (t, key) in local.into_iter().zip(keys) {
                 let t = p.apply(t);
                 if !t.v.iter().all(|v| v.abs().max_element() <= MAX_COORDINATE) {
                     return Err(format!("mesh {} placed by node {}: a vertex lands out of range (coordinates must be between -{MAX_COORDINATE:e} and {MAX_COORDINATE:e})", mesh.index(), placed[0].1));
                 }
-                scene.triangles.push(t);
+                scene.triangles.push_keyed(t, in_corner_order(key, flips).map(|k| k as usize), &mut made);
             }
             scene.parts.push(NamedPart { object, what: PartOf::Triangles(start..scene.triangles.len()), name: part_name(placed[0].1) });
         } else if !local.is_empty() {
@@ -287,6 +293,11 @@ fn in_corner_order<T>(mut c: [T; 3], flips: bool) -> [T; 3] {
 /// besides position, normal and uv.
 struct MeshCorners {
     triangles: Vec<Triangle>,
+    /// Per triangle, its corners' vertices numbered across the mesh's
+    /// primitives (each primitive's after the previous one's).
+    keys: Vec<[u32; 3]>,
+    /// How many vertices the numbering covers.
+    vertices: usize,
     /// Per triangle, when a primitive has `COLOR_0` (white where another has none).
     colours: Option<Vec<[Vec3; 3]>>,
     /// Per triangle, when a primitive has `TANGENT`: the tangent (xyz) and
@@ -310,6 +321,8 @@ fn mesh_triangles(
     let mut out = Vec::new();
     let mut colours_out: Option<Vec<[Vec3; 3]>> = None;
     let mut tangents_out: Option<Vec<[Vec4; 3]>> = None;
+    let mut keys = Vec::new();
+    let mut vertices = 0usize;
     for prim in mesh.primitives() {
         let at = format!("mesh {} primitive {}", mesh.index(), prim.index());
         let positions = prim.get(&gltf::Semantic::Positions).ok_or(format!("{at} has no POSITION attribute"))?;
@@ -390,11 +403,15 @@ fn mesh_triangles(
                 continue;
             }
         };
+        drop(indices);
         let (material, two_sided) = match prim.material().index() {
             Some(m) => (first_material + m as u32, double_sided.get(m).copied().unwrap_or(false)),
             None => (fallback, false),
         };
         out.reserve(triangles.len());
+        keys.reserve(triangles.len());
+        let first_vertex = vertices as u32;
+        vertices += pos.len();
         for idx in triangles {
             let v = idx.map(|i| pos[i as usize]);
             let Some(geo) = Triangle::normal_if_not_degenerate(&v) else {
@@ -415,6 +432,7 @@ fn mesh_triangles(
                 None => [Vec2::ZERO; 3],
             };
             out.push(Triangle { v, n, uv, material, object, two_sided });
+            keys.push(idx.map(|i| first_vertex + i));
             if let Some(c) = colours_out.as_mut() {
                 c.push(colours.as_ref().map_or([Vec3::ONE; 3], |cs| idx.map(|i| cs[i as usize])));
             }
@@ -423,7 +441,7 @@ fn mesh_triangles(
             }
         }
     }
-    Ok(MeshCorners { triangles: out, colours: colours_out, tangents: tangents_out })
+    Ok(MeshCorners { triangles: out, keys, vertices, colours: colours_out, tangents: tangents_out })
 }
 
 /// Refuses a file whose `extensionsRequired` names an extension pinhole
