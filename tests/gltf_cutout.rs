@@ -1,7 +1,8 @@
 //! glTF `alphaMode` MASK: a quad whose base-colour texture is opaque on its
 //! left half and transparent on its right half stands in front of a green
 //! wall. Every CPU renderer shows the quad's red where its alpha reaches
-//! the cutoff and the wall through the cut-away half; shadow rays pass
+//! the cutoff and the wall through the cut-away half (also when the quad
+//! is a copy in the instance layer); shadow rays pass
 //! through the cut-away half only; OPAQUE and BLEND draw the whole quad;
 //! the OpenGL renderer refuses the cutout in one sentence.
 
@@ -38,6 +39,12 @@ fn half_transparent_png() -> String {
 /// `alpha_mode` is the front material's alphaMode (it is two-sided, as
 /// cut-out leaves are, so that shadow rays from the wall meet it).
 fn write_scene(dir: &std::path::Path, alpha_mode: &str) -> PathBuf {
+    write_scene_with(dir, alpha_mode, false)
+}
+
+/// `write_scene`; with `shared`, a second node uses the quad's mesh (out
+/// of sight, far above), so that the quad is a copy in the instance layer.
+fn write_scene_with(dir: &std::path::Path, alpha_mode: &str, shared: bool) -> PathBuf {
     let positions: [[f32; 3]; 8] = [
         [-1.0, -0.5, 0.0], [1.0, -0.5, 0.0], [1.0, 0.5, 0.0], [-1.0, 0.5, 0.0],
         [-3.0, -2.0, -1.0], [3.0, -2.0, -1.0], [3.0, 2.0, -1.0], [-3.0, 2.0, -1.0],
@@ -52,8 +59,8 @@ fn write_scene(dir: &std::path::Path, alpha_mode: &str) -> PathBuf {
         r#"{{
   "asset": {{"version": "2.0"}},
   "scene": 0,
-  "scenes": [{{"nodes": [0, 1, 2]}}],
-  "nodes": [{{"mesh": 0}}, {{"mesh": 1}}, {{"camera": 0, "translation": [0, 0, 3]}}],
+  "scenes": [{{"nodes": [0, 1, 2{more_nodes}]}}],
+  "nodes": [{{"mesh": 0}}, {{"mesh": 1}}, {{"camera": 0, "translation": [0, 0, 3]}}{more}],
   "cameras": [{{"type": "perspective", "perspective": {{"yfov": 0.8, "znear": 0.1, "zfar": 100, "aspectRatio": 2.0}}}}],
   "meshes": [
     {{"primitives": [{{"attributes": {{"POSITION": 0, "TEXCOORD_0": 2}}, "indices": 4, "material": 0}}]}},
@@ -78,10 +85,12 @@ fn write_scene(dir: &std::path::Path, alpha_mode: &str) -> PathBuf {
   ]
 }}"#,
         png = half_transparent_png(),
+        more_nodes = if shared { ", 3" } else { "" },
+        more = if shared { r#", {"mesh": 0, "translation": [0, 100, 0]}"# } else { "" },
         len = bin.len(),
         data = common::base64(&bin)
     );
-    let path = dir.join(format!("cutout_{}.gltf", alpha_mode.to_lowercase()));
+    let path = dir.join(format!("cutout_{}{}.gltf", alpha_mode.to_lowercase(), if shared { "_shared" } else { "" }));
     std::fs::write(&path, json).unwrap();
     path
 }
@@ -146,6 +155,19 @@ fn a_masked_texel_shows_what_is_behind_it_in_every_cpu_renderer() {
         // The whole cut-away half: no pixel there keeps the quad's red.
         let red_right = (RIGHT.0 - 6..RIGHT.0 + 6).filter(|&x| is_red(at(&img, (x, RIGHT.1)))).count();
         assert_eq!(red_right, 0, "{renderer}: {red_right} pixels of the cut-away half are red");
+    }
+}
+
+#[test]
+fn a_masked_copy_in_the_instance_layer_is_cut_out_too() {
+    let dir = work_dir("mask-shared");
+    let scene = unlit(&write_scene_with(&dir, "MASK", true));
+    assert!(scene.layer.is_some(), "the quad's mesh is shared, so held in the instance layer");
+    for renderer in ["raytrace:bvh", "rasterize:fixed", "rasterize:naive"] {
+        let img = render(&scene, renderer);
+        let (left, right) = (at(&img, LEFT), at(&img, RIGHT));
+        assert!(is_red(left), "{renderer}: the opaque half shows {left}, not the quad's red");
+        assert!(is_green(right), "{renderer}: the cut-away half shows {right}, not the wall's green behind it");
     }
 }
 
