@@ -83,6 +83,9 @@ fn approximations(scene: &Scene, settings: &RenderSettings) -> Vec<String> {
     if shaded && sky && matches!(settings.shadows, ShadowMode::Map | ShadowMode::Volume) {
         notes.push(format!("--shadows {} holds no shadows of the [environment]; its light samples cast shadow rays", settings.shadows.name()));
     }
+    if shaded && matches!(settings.shadows, ShadowMode::Map | ShadowMode::Volume) && scene.has_cutouts() {
+        notes.push(format!("--shadows {} casts the shadows of alphaMode MASK surfaces whole, cut-away parts included; --shadows ray passes light through them", settings.shadows.name()));
+    }
     let colour_map = matches!(settings.view, View::FalseColour | View::Nan) || settings.view.error_kind().is_some();
     if colour_map && settings.display != crate::display::DisplaySettings::default() {
         notes.push(format!("--view {} holds its colours as linear values, so --exposure, --tonemap and --gamma other than 0, standard and srgb change them (the legend no longer matches)", settings.view.name()));

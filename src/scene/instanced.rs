@@ -32,6 +32,9 @@ pub struct InstanceLayer {
     /// Meshes with the object's placement, material, object id and
     /// two-sidedness applied: what every copy of the object starts from.
     pub meshes: Vec<Arc<Vec<Triangle>>>,
+    /// Per mesh, its triangles' vertex colours (per corner) when its file
+    /// gives them: every copy of the mesh shows them.
+    pub colours: Vec<Option<Arc<Vec<[Vec3; 3]>>>>,
     /// In virtual index order.
     pub instances: Vec<LayerInstance>,
 }
@@ -54,6 +57,18 @@ impl InstanceLayer {
             t.material = m;
         }
         inst.placement.apply(t)
+    }
+
+    /// The vertex colours of triangle `local` of copy `inst`, in the corner
+    /// order of `world` (a mirroring placement swaps corners 1 and 2);
+    /// `None` when its mesh has none.
+    #[inline]
+    pub fn world_colours(&self, inst: &LayerInstance, local: usize) -> Option<[Vec3; 3]> {
+        let mut c = *self.colours.get(inst.mesh as usize)?.as_ref()?.get(local)?;
+        if inst.placement.flips() {
+            c.swap(1, 2);
+        }
+        Some(c)
     }
 
     /// Only the vertices of `world`: what intersection tests read.
@@ -81,6 +96,9 @@ pub struct Layered {
     pub flattened: usize,
     /// Per object: its id, its placed mesh and its copies.
     pub objects: Vec<(u32, Arc<Vec<Triangle>>, Vec<MeshCopy>)>,
+    /// Per entry of `objects` (missing at the end: none), its mesh's
+    /// vertex colours per triangle.
+    pub colours: Vec<Option<Arc<Vec<[Vec3; 3]>>>>,
 }
 
 /// One placed copy of a mesh object's triangles.
@@ -100,11 +118,13 @@ pub fn build_layer(scene: &mut Scene, layered: Layered) -> Result<(), String> {
     }
     let mut layer = InstanceLayer::default();
     let mut base = scene.triangles.len() as u64;
+    let mut colours = layered.colours.into_iter();
     for (object, mesh, copies) in layered.objects {
         let (center, radius) = bounding_sphere(&mesh);
         let mesh_index = layer.meshes.len() as u32;
         let len = mesh.len() as u64;
         layer.meshes.push(mesh);
+        layer.colours.push(colours.next().flatten());
         for copy in copies {
             let placement = copy.placement.unwrap_or_else(|| Placement::new(Vec3::ZERO, Vec3::ZERO, Vec3::ONE));
             if base + len >= 1 << 30 {

@@ -132,6 +132,30 @@ pub struct Metallic {
     pub map: Option<Arc<Texture>>,
 }
 
+/// How one texture is read: addressing along u and v outside [0, 1], and
+/// the finest filter (the render's filter is lowered to it).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Sampler {
+    pub wrap: [Wrap; 2],
+    pub finest_filter: TextureFilter,
+}
+
+/// Samplers of a material's maps other than its base texture; `None`
+/// reads the map with the material's own `wrap` and `finest_filter`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MapSamplers {
+    pub metallic: Option<Sampler>,
+    pub normal: Option<Sampler>,
+    pub emission: Option<Sampler>,
+}
+
+impl MapSamplers {
+    /// Whether some map has a sampler of its own.
+    pub fn any(&self) -> bool {
+        self.metallic.is_some() || self.normal.is_some() || self.emission.is_some()
+    }
+}
+
 /// F0 of dielectrics in the metallic-roughness model.
 pub const DIELECTRIC_F0: f32 = 0.04;
 
@@ -203,13 +227,18 @@ pub struct Material {
     /// Multiplies `lambertian` when present (linear values, decoded from
     /// sRGB); with `metallic`, multiplies its base colour instead.
     pub texture: Option<Arc<Texture>>,
-    /// Addressing of every texture of the material outside [0, 1]: along u
-    /// (columns) and along v (rows).
+    /// Addressing of the material's textures outside [0, 1]: along u
+    /// (columns) and along v (rows); `map_samplers` may give other maps
+    /// their own.
     pub wrap: [Wrap; 2],
     /// The finest filter the material's textures are read with: the
     /// render's filter is lowered to it (a sampler that asks for nearest
-    /// or unmipmapped reads).
+    /// or unmipmapped reads); `map_samplers` may give other maps their own.
     pub finest_filter: TextureFilter,
+    /// The samplers of the metallic-roughness, normal and emission maps
+    /// where they differ from `wrap` and `finest_filter` (a glTF gives
+    /// each texture its own).
+    pub map_samplers: MapSamplers,
     /// Lobes worked out point by point from a base colour, metalness and
     /// roughness (the metallic-roughness model), instead of `lambertian`,
     /// `glossy` and `roughness`.
@@ -220,6 +249,20 @@ pub struct Material {
     pub uv_scale: Vec2,
     /// Tangent-space normal map (linear data: 0.5, 0.5, 1 is "straight out").
     pub normal_map: Option<Arc<Texture>>,
+    /// Where the surface is cut away (glTF's `alphaMode` MASK): rays pass
+    /// through the points whose alpha is below the cutoff.
+    pub cutout: Option<Cutout>,
+}
+
+/// An alpha-tested surface: its alpha at a point is `alpha` times the
+/// alpha map there, and the surface is absent where that is below `cutoff`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Cutout {
+    pub cutoff: f32,
+    /// The constant alpha (glTF's base colour factor's fourth component).
+    pub alpha: f32,
+    /// Alpha in every channel, read with the material's `wrap` and filter.
+    pub map: Option<Arc<Texture>>,
 }
 
 impl Material {
@@ -239,12 +282,15 @@ impl Material {
             normal_map: None,
             emission_map: None,
             metallic: m.metallic.clone().map(|metallic| Metallic { map: None, ..metallic }),
+            cutout: m.cutout.clone().map(|cutout| Cutout { map: None, ..cutout }),
             ..m.clone()
         };
+        let cutout_map = |m: &Material| m.cutout.as_ref().and_then(|c| c.map.clone());
         same_texture(&self.texture, &o.texture)
             && same_texture(&self.normal_map, &o.normal_map)
             && same_texture(&self.emission_map, &o.emission_map)
             && same_texture(&metallic_map(self), &metallic_map(o))
+            && same_texture(&cutout_map(self), &cutout_map(o))
             && without_texels(self) == without_texels(o)
     }
 
@@ -271,10 +317,12 @@ impl Material {
             texture: None,
             wrap: [Wrap::Repeat; 2],
             finest_filter: TextureFilter::Trilinear,
+            map_samplers: MapSamplers::default(),
             metallic: None,
             emission_map: None,
             uv_scale: Vec2::ONE,
             normal_map: None,
+            cutout: None,
         }
     }
 
@@ -328,8 +376,8 @@ impl Material {
     /// diffuse albedo, or under the metallic-roughness model the base
     /// colour (so a metal's F0 too). White changes nothing, bit for bit.
     #[inline]
-    pub fn lobes_tinted(&self, uv: Vec2, f: &Footprint, filter: TextureFilter, tint: Vec3) -> PointLobes {
-        let filter = filter.at_most(self.finest_filter);
+    pub fn lobes_tinted(&self, uv: Vec2, f: &Footprint, requested: TextureFilter, tint: Vec3) -> PointLobes {
+        let filter = requested.at_most(self.finest_filter);
         let Some(m) = &self.metallic else {
             let albedo = match &self.texture {
                 Some(t) => {
@@ -347,7 +395,8 @@ impl Material {
         } * tint;
         let (metallic, roughness) = match &m.map {
             Some(t) => {
-                let texel = t.sample(uv, &f, filter, self.wrap);
+                let (wrap, filter) = self.read_with(self.map_samplers.metallic, requested);
+                let texel = t.sample(uv, &f, filter, wrap);
                 (m.metallic * texel.z, m.roughness * texel.y)
             }
             None => (m.metallic, m.roughness),
@@ -366,7 +415,8 @@ impl Material {
         match &self.emission_map {
             Some(t) => {
                 let (uv, f) = self.scaled(uv, &Footprint::default());
-                self.emission * t.sample(uv, &f, TextureFilter::Bilinear.at_most(self.finest_filter), self.wrap)
+                let (wrap, filter) = self.read_with(self.map_samplers.emission, TextureFilter::Bilinear);
+                self.emission * t.sample(uv, &f, filter, wrap)
             }
             None => self.emission,
         }
@@ -377,8 +427,35 @@ impl Material {
     pub fn normal_map_texel(&self, uv: Vec2, f: &Footprint, filter: TextureFilter) -> Option<Vec3> {
         self.normal_map.as_ref().map(|t| {
             let (uv, f) = self.scaled(uv, f);
-            t.sample(uv, &f, filter.at_most(self.finest_filter), self.wrap)
+            let (wrap, filter) = self.read_with(self.map_samplers.normal, filter);
+            t.sample(uv, &f, filter, wrap)
         })
+    }
+
+    /// Whether the surface is cut away at `uv`: its alpha there (read
+    /// bilinearly at the finest level, or nearest when the sampler asks for
+    /// it) is below the cutoff. Always false without a cutout.
+    #[inline]
+    pub fn cut_out_at(&self, uv: Vec2) -> bool {
+        let Some(c) = &self.cutout else { return false };
+        let alpha = match &c.map {
+            Some(t) => {
+                let (uv, f) = self.scaled(uv, &Footprint::default());
+                c.alpha * t.sample(uv, &f, TextureFilter::Bilinear.at_most(self.finest_filter), self.wrap).x
+            }
+            None => c.alpha,
+        };
+        alpha < c.cutoff
+    }
+
+    /// The addressing and filter a map is read with: its own `sampler`, or
+    /// the material's; `requested` lowered to the sampler's finest filter.
+    #[inline]
+    fn read_with(&self, sampler: Option<Sampler>, requested: TextureFilter) -> ([Wrap; 2], TextureFilter) {
+        match sampler {
+            Some(s) => (s.wrap, requested.at_most(s.finest_filter)),
+            None => (self.wrap, requested.at_most(self.finest_filter)),
+        }
     }
 
     /// uv and footprint with `uv_scale` applied.

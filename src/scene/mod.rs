@@ -398,6 +398,12 @@ pub struct Scene {
     /// material's base colour (a glTF's `COLOR_0`). Triangles past its end
     /// have none (white); empty when no file gives colours.
     pub vertex_colours: Vec<[Vec3; 3]>,
+    /// Per flattened triangle, per corner: the tangent (xyz, world space)
+    /// and handedness (w) a file gives (a glTF's `TANGENT`), which
+    /// `tangents::build_tangents` takes instead of the uvs' frame. Zero
+    /// where none is given, and triangles past its end have none; empty
+    /// when no file gives tangents.
+    pub given_tangents: Vec<[glam::Vec4; 3]>,
     /// The emissive triangles and spheres, gathered by `refresh_emitters`
     /// (after loading, and whenever materials or geometry change).
     pub emitters: std::sync::Arc<emitters::Emitters>,
@@ -573,6 +579,23 @@ impl Scene {
         }
     }
 
+    /// Whether triangle `index` is cut away where its barycentric weights
+    /// of v1 and v2 are `b1` and `b2` (its material's alpha there is below
+    /// the cutoff): a ray meeting it there passes through.
+    pub fn cut_out_at(&self, index: u32, b1: f32, b2: f32) -> bool {
+        let tri = self.triangle(index);
+        match self.materials.get(tri.material as usize) {
+            Some(m) if m.cutout.is_some() => m.cut_out_at(tri.uv[0] * (1.0 - b1 - b2) + tri.uv[1] * b1 + tri.uv[2] * b2),
+            _ => false,
+        }
+    }
+
+    /// Whether any material has a cutout, so ray queries must look at the
+    /// alpha of what they meet.
+    pub fn has_cutouts(&self) -> bool {
+        self.materials.iter().any(|m| m.cutout.is_some())
+    }
+
     /// The vertex positions of `triangle(index)`, without its other attributes.
     #[inline]
     pub fn triangle_positions(&self, index: u32) -> [Vec3; 3] {
@@ -689,10 +712,27 @@ impl Scene {
     /// The vertex colour at a hit (white where there is none).
     #[inline]
     pub fn vertex_colour(&self, kind: PrimitiveKind, index: u32, b: Vec3) -> Vec3 {
-        match (kind, self.vertex_colours.get(index as usize)) {
-            (PrimitiveKind::Triangle, Some(c)) => c[0] * b.x + c[1] * b.y + c[2] * b.z,
-            _ => Vec3::ONE,
+        if kind != PrimitiveKind::Triangle {
+            return Vec3::ONE;
         }
+        let c = match self.vertex_colours.get(index as usize) {
+            Some(c) => *c,
+            // A copy in the two-level layer: its shared mesh's colours.
+            None if index as usize >= self.triangles.len() => {
+                let Some(layer) = self.layer.as_ref().filter(|l| !l.colours.is_empty()) else { return Vec3::ONE };
+                match layer.locate(index).and_then(|(inst, local)| layer.world_colours(inst, local)) {
+                    Some(c) => c,
+                    None => return Vec3::ONE,
+                }
+            }
+            None => return Vec3::ONE,
+        };
+        c[0] * b.x + c[1] * b.y + c[2] * b.z
+    }
+
+    /// Whether any triangle, flattened or in the layer, has vertex colours.
+    pub fn has_vertex_colours(&self) -> bool {
+        !self.vertex_colours.is_empty() || self.layer.as_ref().is_some_and(|l| l.colours.iter().any(Option::is_some))
     }
 
     /// The name of the part (a glTF node and mesh) triangle `index` belongs to, if it has one.

@@ -2,7 +2,8 @@
 //! the direction in which u grows across each triangle, built from its uvs,
 //! then summed over the triangles that share a vertex (same object,
 //! position, normal and uv), so that the frame turns smoothly across a mesh
-//! as its normals do.
+//! as its normals do. A tangent the file gives (`Scene::given_tangents`,
+//! a glTF's `TANGENT`) is taken instead, with its handedness.
 
 use crate::scene::{PrimitiveKind, Scene, SurfaceHit};
 use crate::math::Vec3;
@@ -53,12 +54,17 @@ pub fn build_tangents(scene: &Scene) -> Vec<[Vec4; 3]> {
     }
     (0..scene.triangles.len())
         .map(|i| {
-            if per_triangle[i].is_none() {
+            let given = scene.given_tangents.get(i).filter(|_| mapped(scene.triangles.at(i).material));
+            if per_triangle[i].is_none() && given.is_none_or(|g| g.contains(&Vec4::ZERO)) {
                 return [Vec4::ZERO; 3];
             }
             std::array::from_fn(|k| {
-                let (t, b) = sums[&key(i, k)];
                 let n = scene.triangles.at(i).n[k];
+                if let Some(g) = given.map(|g| g[k]).filter(|g| *g != Vec4::ZERO) {
+                    let t = (g.truncate() - n * n.dot(g.truncate())).normalize_or_zero();
+                    return t.extend(if g.w < 0.0 { -1.0 } else { 1.0 });
+                }
+                let Some(&(t, b)) = sums.get(&key(i, k)) else { return Vec4::ZERO };
                 let t = (t - n * n.dot(t)).normalize_or_zero();
                 let w = if n.cross(t).dot(b) < 0.0 { -1.0 } else { 1.0 };
                 t.extend(w)

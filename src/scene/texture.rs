@@ -272,6 +272,19 @@ pub fn decode_texture(bytes: Vec<u8>, name: &str, encoding: Encoding) -> Result<
     Ok(Texture::new(rgb.width(), rgb.height(), texels))
 }
 
+/// The alpha channel of an image file's bytes as a texture (alpha in
+/// every channel, linear as glTF defines it), or `None` when the image has
+/// no alpha channel (opaque everywhere). `name` names the image in messages.
+pub fn decode_alpha(bytes: &[u8], name: &str) -> Result<Option<Texture>, String> {
+    let img = decode_image(bytes, name)?;
+    if !img.color().has_alpha() {
+        return Ok(None);
+    }
+    let rgba = img.into_rgba32f();
+    let texels = rgba.pixels().map(|p| Vec3::splat(if p[3].is_finite() { p[3].clamp(0.0, 1.0) } else { 1.0 })).collect();
+    Ok(Some(Texture::new(rgba.width(), rgba.height(), texels)))
+}
+
 fn srgb_to_linear(c: f32) -> f32 {
     if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
 }

@@ -240,6 +240,11 @@ impl Triangles {
         self.faces.push(Face { corner: [first, first + 1, first + 2], material: t.material, object_and_flags: (t.object & !FLAG_BITS) | flags });
     }
 
+    /// Room for `n` more triangles (their corners are counted as they come).
+    pub fn reserve_faces(&mut self, n: usize) {
+        self.faces.reserve(n);
+    }
+
     /// Room for `copies` copies of `mesh` (`append_copy`).
     pub fn reserve_copies(&mut self, mesh: &Triangles, copies: usize) {
         self.faces.reserve(mesh.faces.len() * copies);

@@ -1,6 +1,7 @@
 //! The reference ray caster (CGPP listings 15.13 to 15.20): every ray is
 //! tested against every primitive, in scene order. It stays in the program as
-//! the thing every faster method is checked against.
+//! the thing every faster method is checked against. A triangle met where
+//! its material is cut away (alpha below the cutoff) is passed through.
 
 use crate::render::accel::intersect::{intersect_sphere, intersect_triangle};
 use crate::math::Ray;
@@ -14,6 +15,7 @@ pub struct BruteQuery<'a>(pub &'a PreparedScene);
 impl SceneQuery for BruteQuery<'_> {
     fn closest<R: Recorder>(&self, ray: &Ray, t_max: f32, inside: bool, counts: &mut RayCounts, rec: &mut R) -> Option<SurfaceHit> {
         let prepared = self.0;
+        let cutouts = prepared.scene.has_cutouts();
         let mut best_t = t_max;
         let mut best: Option<(PrimitiveId, f32, f32)> = None;
         for (i, tri) in prepared.edges.iter().enumerate() {
@@ -23,6 +25,10 @@ impl SceneQuery for BruteQuery<'_> {
                 rec.primitive_test(PrimitiveTest { kind: PrimitiveKind::Triangle, index: i as u32, outcome });
             }
             if let Ok((t, b1, b2)) = outcome {
+                // A cut-away point is no hit: the ray passes through it.
+                if cutouts && prepared.scene.cut_out_at(i as u32, b1, b2) {
+                    continue;
+                }
                 best_t = t;
                 best = Some((PrimitiveId::triangle(i as u32), b1, b2));
             }
@@ -47,13 +53,17 @@ impl SceneQuery for BruteQuery<'_> {
 
     fn occluder<R: Recorder>(&self, ray: &Ray, t_max: f32, counts: &mut RayCounts, rec: &mut R) -> Option<Occluder> {
         let prepared = self.0;
+        let cutouts = prepared.scene.has_cutouts();
         for (i, tri) in prepared.edges.iter().enumerate() {
             counts.tests += 1;
             let outcome = intersect_triangle(ray, tri, t_max);
             if R::ENABLED {
                 rec.primitive_test(PrimitiveTest { kind: PrimitiveKind::Triangle, index: i as u32, outcome });
             }
-            if let Ok((t, _, _)) = outcome {
+            if let Ok((t, b1, b2)) = outcome {
+                if cutouts && prepared.scene.cut_out_at(i as u32, b1, b2) {
+                    continue;
+                }
                 return Some(Occluder { kind: PrimitiveKind::Triangle, index: i as u32, t });
             }
         }

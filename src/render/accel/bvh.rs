@@ -352,17 +352,65 @@ pub struct BvhQuery<'a> {
     /// CSG objects, some primitives (`closest_for_batch_at`, `occluder_at`
     /// ask this per ray).
     flat_only: bool,
+    /// Whether some material is cut out where its alpha is low: every hit
+    /// is then checked (`past_cutouts`), and no query takes the flat or
+    /// packet shortcuts, which do not check.
+    cutouts: bool,
 }
+
+/// The most cut-away surfaces one query passes through before it stops
+/// looking and reports nothing hit (a bound on the work per ray).
+const MAX_CUTOUT_LAYERS: usize = 256;
 
 impl<'a> BvhQuery<'a> {
     #[inline]
     pub fn new(prepared: &'a PreparedScene) -> BvhQuery<'a> {
-        let flat_only = prepared.scene.csgs.is_empty() && prepared.instances.is_none() && !prepared.bvh.prims.is_empty();
-        BvhQuery { prepared, flat_only }
+        let cutouts = prepared.scene.has_cutouts();
+        let flat_only = prepared.scene.csgs.is_empty() && prepared.instances.is_none() && !prepared.bvh.prims.is_empty() && !cutouts;
+        BvhQuery { prepared, flat_only, cutouts }
+    }
+
+    /// Whether rays may pass through cut-away surfaces, which packets of
+    /// rays do not check: frames then cast their rays one by one.
+    #[inline]
+    pub fn has_cutouts(&self) -> bool {
+        self.cutouts
+    }
+
+    /// The hit of a walk that passes through cut-away surfaces. Without
+    /// cutouts, one walk. With them, a shadow query too looks for the
+    /// closest hit (the first occluder found may be cut away while a nearer
+    /// one is not), and a hit where the surface is cut away is walked past:
+    /// the ray goes on from just beyond it, its hits' `t` measured from the
+    /// original origin.
+    #[inline(always)]
+    fn traverse<const ANY: bool, R: Recorder>(&self, ray: &Ray, t_max: f32, inside: bool, counts: &mut RayCounts, rec: &mut R) -> Option<BestHit> {
+        if !self.cutouts {
+            return self.traverse_once::<ANY, R>(ray, t_max, inside, counts, rec);
+        }
+        let scene = &self.prepared.scene;
+        let mut start = 0.0f32;
+        for _ in 0..MAX_CUTOUT_LAYERS {
+            let rest = Ray { origin: ray.at(start), ..*ray };
+            let best = self.traverse_once::<false, R>(&rest, t_max - start, inside, counts, rec)?;
+            let t = start + best.t;
+            if best.id.kind() != PrimitiveKind::Triangle || !scene.cut_out_at(best.id.index(), best.bary.0, best.bary.1) {
+                return Some(BestHit { t, limit: t, ..best });
+            }
+            // Just beyond the cut-away surface, by a step relative to the
+            // coordinates' size so that the same triangle is not met again.
+            let at = ray.at(t);
+            let step = 1e-5 * (1.0 + at.abs().max_element()) / ray.dir.length().max(f32::MIN_POSITIVE);
+            start = t + step;
+            if !(start < t_max) {
+                return None;
+            }
+        }
+        None
     }
 
     #[inline(always)]
-    fn traverse<const ANY: bool, R: Recorder>(&self, ray: &Ray, t_max: f32, inside: bool, counts: &mut RayCounts, rec: &mut R) -> Option<BestHit> {
+    fn traverse_once<const ANY: bool, R: Recorder>(&self, ray: &Ray, t_max: f32, inside: bool, counts: &mut RayCounts, rec: &mut R) -> Option<BestHit> {
         let bvh = &self.prepared.bvh;
         if let (Some(accel), Some(layer)) = (&self.prepared.instances, &self.prepared.scene.layer) {
             let found = if bvh.prims.is_empty() { None } else { self.traverse_flat::<ANY, R>(ray, t_max, inside, counts, rec) };

@@ -211,11 +211,17 @@ fn unsupported(scene: &Scene, settings: &RenderSettings) -> Result<(), String> {
     // Only materials something is drawn with: one merely named in the file asks nothing.
     let in_use = scene.materials_in_use();
     let mut drawn = scene.materials.iter().zip(in_use).filter(|(_, used)| *used).map(|(m, _)| m);
-    if !scene.vertex_colours.is_empty() {
+    if scene.has_vertex_colours() {
         return refuse("cannot draw vertex colours yet; use raytrace or rasterize");
+    }
+    if let Some(m) = drawn.clone().find(|m| m.cutout.is_some()) {
+        return refuse(&format!("cannot cut surfaces away where their alpha is low (alphaMode MASK, material \"{}\") yet; use raytrace or rasterize", m.name));
     }
     if let Some(m) = drawn.clone().find(|m| m.metallic.is_some() || m.emission_map.is_some()) {
         return refuse(&format!("cannot draw textured metallic-roughness or emission yet (material \"{}\"); use raytrace or rasterize", m.name));
+    }
+    if let Some(m) = drawn.clone().find(|m| m.map_samplers.any()) {
+        return refuse(&format!("reads every texture of a material with one sampler, and material \"{}\" gives its maps different wrap modes or filters; use raytrace or rasterize", m.name));
     }
     if let Some(m) = drawn.clone().find(|m| m.wrap[0] != m.wrap[1] || m.wrap[0] == crate::scene::texture::Wrap::MirroredRepeat) {
         return refuse(&format!("wraps textures the same way along u and v, by repeat or clamp only (material \"{}\"); use raytrace or rasterize", m.name));

@@ -105,6 +105,10 @@ pub struct VisBuffer<'j, 'a, Q: SceneQuery, R: FragmentRecorder = NoRecord> {
     /// keys, perspective interpolation, no painter, no cost view, nothing
     /// recorded). Worked out once per buffer, not per row.
     rows_in_lanes: bool,
+    /// Whether some material is cut away where its alpha is low: each
+    /// triangle sample is then looked up there, and a cut-away one is
+    /// discarded before the depth test, as if not covered.
+    cutouts: bool,
     /// Shade every fragment that passes the depth test (forward) instead of
     /// once per pixel after visibility is known (early depth).
     pub forward: bool,
@@ -178,6 +182,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             enc,
             paint: false,
             rows_in_lanes,
+            cutouts: job.prepared.scene.has_cutouts(),
             forward,
             depth,
             id: vec![PrimitiveId::NONE; n],
@@ -205,7 +210,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
 
     /// `rows_in_lanes` apart from the painter.
     fn rows_in_lanes_allowed(job: &PassJob, forward: bool, enc: &DepthEncoding) -> bool {
-        !R::ENABLED && !forward && job.settings.view != View::Cost && !job.settings.affine && enc.format == DepthFormat::F32
+        !R::ENABLED && !job.prepared.scene.has_cutouts() && !forward && job.settings.view != View::Cost && !job.settings.affine && enc.format == DepthFormat::F32
     }
 
     /// Index of image pixel `(x, y)` in this region's buffers.
@@ -272,10 +277,14 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
     /// depth test on -1/z, then perspective-correct barycentrics on a pass.
     #[inline(always)]
     pub fn triangle_fragment(&mut self, st: &ScreenTri, x: u32, y: u32, l: [f32; 3]) {
+        let inv_z = st.inv_z_at(l);
+        let affine = self.job.settings.affine;
+        if self.cut_out(st.tri, || if affine { st.affine_bary_at(l) } else { st.bary_at(l, inv_z) }) {
+            return;
+        }
         self.counts.samples_covered += 1;
         let i = self.index(x, y);
         self.count_work(i);
-        let inv_z = st.inv_z_at(l);
         let key = if self.enc.format == DepthFormat::LinearZ { self.enc.key(1.0 / st.linear_z_at(l)) } else { self.enc.key(inv_z) };
         let stored = self.depth[i];
         let passed = self.paint || key < stored;
@@ -358,6 +367,16 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         }
     }
 
+    /// Whether triangle `tri` is cut away at the sample whose (b1, b2)
+    /// `bary` gives (looked up only in scenes with cutouts).
+    #[inline(always)]
+    fn cut_out(&self, tri: u32, bary: impl FnOnce() -> [f32; 2]) -> bool {
+        self.cutouts && {
+            let [b1, b2] = bary();
+            self.job.prepared.scene.cut_out_at(tri, b1, b2)
+        }
+    }
+
     #[allow(clippy::too_many_arguments)]
     fn record(&mut self, kind: PrimitiveKind, primitive: u32, screen: Option<Vec3>, b: Vec3, key: f32, stored: f32, passed: bool, i: usize, x: u32, y: u32) {
         let f = FragmentRecord {
@@ -379,6 +398,9 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
     /// hit's view depth, keeping the ray test's barycentrics.
     #[inline]
     pub fn small_triangle_fragment(&mut self, x: u32, y: u32, tri: u32, t: f32, b1: f32, b2: f32) {
+        if self.cut_out(tri, || [b1, b2]) {
+            return;
+        }
         self.counts.samples_covered += 1;
         let i = self.index(x, y);
         self.count_work(i);
@@ -406,6 +428,9 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
     /// depth (naive, bbox: the ray test's `t_max`).
     #[inline(always)]
     pub fn ray_fragment(&mut self, x: u32, y: u32, tri: u32, t: f32, b1: f32, b2: f32) {
+        if self.cut_out(tri, || [b1, b2]) {
+            return;
+        }
         self.counts.samples_covered += 1;
         let i = self.index(x, y);
         self.count_work(i);

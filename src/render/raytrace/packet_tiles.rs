@@ -36,7 +36,7 @@ use crate::render::transport::shadow_packets::shadow_packets;
 /// (`CameraView::eye_ray_lanes`) and empty tiles (`SeenTiles`) do not
 /// describe.
 pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) -> RayCounts {
-    if query.prepared.bvh.deep || job.settings.view == View::Cost || !query.prepared.scene.csgs.is_empty() || !job.view.is_pinhole() {
+    if query.prepared.bvh.deep || query.has_cutouts() || job.settings.view == View::Cost || !query.prepared.scene.csgs.is_empty() || !job.view.is_pinhole() {
         return cast_pass(job, query, out);
     }
     let width = job.view.width as usize;
@@ -117,7 +117,7 @@ pub fn cast_pass_packets(job: &PassJob, query: &BvhQuery, out: &mut [Radiance]) 
 pub fn cast_passes_packets(jobs: &[PassJob], query: &BvhQuery, out: &mut [Radiance]) -> Option<RayCounts> {
     let first = jobs.first()?;
     let scene = &query.prepared.scene;
-    if !(2..=MAX_PASSES).contains(&jobs.len()) || query.prepared.bvh.deep || first.settings.view == View::Cost || !scene.csgs.is_empty() || !shade_batch::batchable(first) || first.active.is_some() || !first.view.is_pinhole() {
+    if !(2..=MAX_PASSES).contains(&jobs.len()) || query.prepared.bvh.deep || query.has_cutouts() || first.settings.view == View::Cost || !scene.csgs.is_empty() || !shade_batch::batchable(first) || first.active.is_some() || !first.view.is_pinhole() {
         return None;
     }
     let width = first.view.width as usize;

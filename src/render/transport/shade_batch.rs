@@ -399,7 +399,7 @@ pub fn direct_in_lanes<Q: SceneQuery>(
     };
     let mut lobes = [PointLobes { albedo: Vec3::ZERO, glossy: Vec3::ZERO, roughness: 1.0 }; LANES];
     let first = &scene.materials[hits.material[0] as usize];
-    let materials = if n > 0 && !first.varies_over_surface() && scene.vertex_colours.is_empty() && settings.gi.mode != GiMode::Ao && hits.material[1..n].iter().all(|&m| m == hits.material[0]) {
+    let materials = if n > 0 && !first.varies_over_surface() && !scene.has_vertex_colours() && settings.gi.mode != GiMode::Ao && hits.material[1..n].iter().all(|&m| m == hits.material[0]) {
         // One untextured material (the common batch): its albedo, lobes and
         // ambient term are the same in every lane, worked out once and
         // splatted, rather than written lane by lane and loaded back.
@@ -639,7 +639,7 @@ pub fn shade_batch_pair<Q: SceneQuery>(job: &PassJob, query: &Q, pair: [&Batch; 
     }
     let material = &scene.materials[index as usize];
     // Ward's lobe needs each lane's tangent, which pairs do not carry.
-    if material.varies_over_surface() || !scene.vertex_colours.is_empty() || material.glossy_model == GlossyModel::Ward || shade::adds_after_direct(scene, settings, material) {
+    if material.varies_over_surface() || !!scene.has_vertex_colours() || material.glossy_model == GlossyModel::Ward || shade::adds_after_direct(scene, settings, material) {
         return false;
     }
     // `direct_in_lanes`' one-material case, for each batch: the albedo

@@ -9,12 +9,15 @@
 //! metallic-roughness texture's blue channel `m` and its green channel `r`.
 //! The emissive factor (times `KHR_materials_emissive_strength`, times the
 //! emissive texture) is the emitted radiance; the normal texture bends the
-//! shading normal in the frame the uvs give.
+//! shading normal in the frame the uvs give (or the file's TANGENTs). Each
+//! texture is read with its own sampler's wrap modes and filters. `alphaMode` MASK cuts the
+//! surface away where the base colour's alpha (factor times texture) is
+//! below `alphaCutoff`.
 
 use crate::input::{InputKind, MAX_LIGHT};
 use crate::math::Vec3;
-use crate::scene::material::{Fresnel, GlossyModel, Metallic, DIELECTRIC_F0, MIN_ROUGHNESS};
-use crate::scene::texture::{decode_texture, Encoding, Texture, TextureFilter, Wrap};
+use crate::scene::material::{Cutout, Fresnel, GlossyModel, MapSamplers, Metallic, Sampler, DIELECTRIC_F0, MIN_ROUGHNESS};
+use crate::scene::texture::{decode_alpha, decode_texture, Encoding, Texture, TextureFilter, Wrap};
 use crate::scene::Material;
 use std::collections::HashMap;
 use std::path::Path;
@@ -25,26 +28,43 @@ pub struct Images<'a> {
     pub folder: &'a Path,
     pub buffers: &'a [Vec<u8>],
     pub decoded: HashMap<(usize, bool), Arc<Texture>>,
+    /// Each image's alpha channel, `None` for an image without one.
+    pub alphas: HashMap<usize, Option<Arc<Texture>>>,
 }
 
 impl Images<'_> {
+    /// The image's encoded bytes, from its buffer view or its URI.
+    fn bytes(&self, image: &gltf::Image) -> Result<Vec<u8>, String> {
+        let what = format!("image {}", image.index());
+        match image.source() {
+            gltf::image::Source::View { view, .. } => {
+                let buffer = &self.buffers[view.buffer().index()];
+                let range = view.offset()..view.offset().saturating_add(view.length());
+                Ok(buffer.get(range).ok_or(format!("{what}: buffer view {} runs past the end of buffer {}", view.index(), view.buffer().index()))?.to_vec())
+            }
+            gltf::image::Source::Uri { uri, .. } => super::source::read_uri(uri, self.folder, &what, InputKind::Image),
+        }
+    }
+
     fn get(&mut self, image: &gltf::Image, encoding: Encoding) -> Result<Arc<Texture>, String> {
         let i = image.index();
         let key = (i, encoding == Encoding::Srgb);
         if let Some(t) = self.decoded.get(&key) {
             return Ok(Arc::clone(t));
         }
-        let what = format!("image {i}");
-        let bytes = match image.source() {
-            gltf::image::Source::View { view, .. } => {
-                let buffer = &self.buffers[view.buffer().index()];
-                let range = view.offset()..view.offset().saturating_add(view.length());
-                buffer.get(range).ok_or(format!("{what}: buffer view {} runs past the end of buffer {}", view.index(), view.buffer().index()))?.to_vec()
-            }
-            gltf::image::Source::Uri { uri, .. } => super::source::read_uri(uri, self.folder, &what, InputKind::Image)?,
-        };
-        let texture = Arc::new(decode_texture(bytes, &what, encoding)?);
+        let texture = Arc::new(decode_texture(self.bytes(image)?, &format!("image {i}"), encoding)?);
         self.decoded.insert(key, Arc::clone(&texture));
+        Ok(texture)
+    }
+
+    /// The image's alpha channel, `None` when it has none.
+    fn alpha(&mut self, image: &gltf::Image) -> Result<Option<Arc<Texture>>, String> {
+        let i = image.index();
+        if let Some(t) = self.alphas.get(&i) {
+            return Ok(t.clone());
+        }
+        let texture = decode_alpha(&self.bytes(image)?, &format!("image {i}"))?.map(Arc::new);
+        self.alphas.insert(i, texture.clone());
         Ok(texture)
     }
 }
@@ -98,8 +118,9 @@ pub fn convert(m: &gltf::Material, name: String, images: &mut Images, ignored: &
         return Err(format!("{at}: emissiveFactor times emissiveStrength must be finite, not negative and at most {MAX_LIGHT:e}"));
     }
 
-    // The textures pinhole reads, each with its uv set and sampler; the
-    // material has one sampler, the first texture's.
+    // The textures pinhole reads, each with its uv set and sampler: the
+    // material's own sampler is the base-colour texture's (or the first
+    // texture's), and any other map whose sampler differs keeps its own.
     let normal = m.normal_texture();
     let emissive = m.emissive_texture();
     let slots: [(&str, Option<(gltf::Texture, u32)>); 4] = [
@@ -108,7 +129,7 @@ pub fn convert(m: &gltf::Material, name: String, images: &mut Images, ignored: &
         ("normalTexture", normal.as_ref().map(|i| (i.texture(), i.tex_coord()))),
         ("emissiveTexture", emissive.as_ref().map(|i| (i.texture(), i.tex_coord()))),
     ];
-    let mut sampler: Option<(usize, [Wrap; 2], TextureFilter)> = None;
+    let mut samplers: [Option<Sampler>; 4] = [None; 4];
     let mut read = [None, None, None, None];
     for (k, (what, slot)) in slots.into_iter().enumerate() {
         let Some((texture, set)) = slot else { continue };
@@ -117,21 +138,17 @@ pub fn convert(m: &gltf::Material, name: String, images: &mut Images, ignored: &
             continue;
         }
         let s = texture.sampler();
-        let this = ([wrap(s.wrap_s()), wrap(s.wrap_t())], finest_filter(&s));
-        match sampler {
-            None => sampler = Some((texture.index(), this.0, this.1)),
-            Some((first, w, f)) if (w, f) != this => {
-                ignored.push(format!("{at}: the sampler of its {what} (texture {} is read with texture {first}'s)", texture.index()))
-            }
-            Some(_) => {}
-        }
+        samplers[k] = Some(Sampler { wrap: [wrap(s.wrap_s()), wrap(s.wrap_t())], finest_filter: finest_filter(&s) });
         let encoding = if matches!(k, 1 | 2) { Encoding::Linear } else { Encoding::Srgb };
         read[k] = Some(images.get(&texture.source(), encoding).map_err(|e| format!("{at}: {what}: {e}"))?);
     }
-    if let Some((_, w, f)) = sampler {
-        mat.wrap = w;
-        mat.finest_filter = f;
+    if let Some(own) = samplers.iter().flatten().next() {
+        mat.wrap = own.wrap;
+        mat.finest_filter = own.finest_filter;
     }
+    let own = (mat.wrap, mat.finest_filter);
+    let differs = |s: Option<Sampler>| s.filter(|s| (s.wrap, s.finest_filter) != own);
+    mat.map_samplers = MapSamplers { metallic: differs(samplers[1]), normal: differs(samplers[2]), emission: differs(samplers[3]) };
     let [base_map, metallic_map, normal_map, emission_map] = read;
     if base_map.is_some() || metallic_map.is_some() {
         mat.metallic = Some(Metallic { base, metallic, roughness, map: metallic_map });
@@ -149,7 +166,20 @@ pub fn convert(m: &gltf::Material, name: String, images: &mut Images, ignored: &
     }
     match m.alpha_mode() {
         gltf::material::AlphaMode::Opaque => {}
-        gltf::material::AlphaMode::Mask => ignored.push(format!("{at}: alphaMode MASK (drawn opaque)")),
+        gltf::material::AlphaMode::Mask => {
+            // Alpha is the base colour factor's fourth component times the
+            // base-colour texture's alpha (vertex colours' alpha is not read).
+            let alpha = pbr.base_color_factor()[3];
+            let cutoff = m.alpha_cutoff().unwrap_or(0.5);
+            if !(alpha.is_finite() && (0.0..=1.0).contains(&alpha) && cutoff.is_finite() && cutoff >= 0.0) {
+                return Err(format!("{at}: the base colour's alpha must be a number from 0 to 1 and alphaCutoff a number from 0 up"));
+            }
+            let map = match pbr.base_color_texture().filter(|t| t.tex_coord() == 0) {
+                Some(info) => images.alpha(&info.texture().source()).map_err(|e| format!("{at}: baseColorTexture: {e}"))?,
+                None => None,
+            };
+            mat.cutout = Some(Cutout { cutoff, alpha, map });
+        }
         gltf::material::AlphaMode::Blend => ignored.push(format!("{at}: alphaMode BLEND (drawn opaque)")),
     }
     Ok(mat)

@@ -19,7 +19,7 @@ use crate::scene::assets::read_asset;
 use crate::scene::instanced::{Layered, MeshCopy};
 use crate::scene::placement::Placement;
 use crate::scene::{Camera, Fov, Light, NamedPart, ObjectInfo, PartOf, Scene, Triangle};
-use glam::Mat4;
+use glam::{Mat4, Vec4};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -65,7 +65,7 @@ fn add_gltf_unnamed(scene: &mut Scene, path: &Path, placement: &Placement, objec
     let bytes = read_asset(path, InputKind::Mesh).map_err(|e| format!("cannot read glTF: {e}"))?;
     let folder = path.parent().unwrap_or(Path::new("."));
     refuse_required_extensions(&bytes)?;
-    let gltf::Gltf { document: doc, blob } = gltf::Gltf::from_slice_without_validation(&bytes).map_err(describe)?;
+    let gltf::Gltf { document: doc, mut blob } = gltf::Gltf::from_slice_without_validation(&bytes).map_err(describe)?;
     drop(bytes);
     // The crate's validation reads each POSITION accessor without checking
     // that it exists: an index beyond the accessors is refused here first.
@@ -96,7 +96,8 @@ fn add_gltf_unnamed(scene: &mut Scene, path: &Path, placement: &Placement, objec
     for b in doc.buffers() {
         let what = format!("buffer {}", b.index());
         let data = match b.source() {
-            gltf::buffer::Source::Bin => blob.clone().ok_or(format!("{what} is the GLB's binary chunk, but the file has none"))?,
+            // Taken, not copied: a large model's binary chunk is held once.
+            gltf::buffer::Source::Bin => blob.take().ok_or(format!("{what} is the GLB's binary chunk, but the file has none (or another buffer took it)"))?,
             gltf::buffer::Source::Uri(uri) => source::read_uri(uri, folder, &what, InputKind::Mesh)?,
         };
         if data.len() < b.length() {
@@ -121,7 +122,7 @@ fn add_gltf_unnamed(scene: &mut Scene, path: &Path, placement: &Placement, objec
     // Materials, appended under "<file stem>/<name>".
     let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     let first_material = scene.materials.len() as u32;
-    let mut images = materials::Images { folder, buffers: &buffers, decoded: Default::default() };
+    let mut images = materials::Images { folder, buffers: &buffers, decoded: Default::default(), alphas: Default::default() };
     let mut double_sided = Vec::new();
     for m in doc.materials() {
         let label = m.name().map(str::to_string).unwrap_or_else(|| format!("material {}", m.index().unwrap_or(0)));
@@ -216,25 +217,42 @@ fn add_gltf_unnamed(scene: &mut Scene, path: &Path, placement: &Placement, objec
         let part_name = |node: usize| {
             format!("glTF node {node}{}, mesh {}{}", quoted(node_names.get(node).copied().flatten()), mesh.index(), quoted(mesh.name()))
         };
-        let (local, colours) = mesh_triangles(&mesh, &buffers, first_material, fallback, &double_sided, object, &mut degenerate, &mut parts.ignored)?;
+        let MeshCorners { triangles: local, keys, vertices, colours, tangents } = mesh_triangles(&mesh, &buffers, first_material, fallback, &double_sided, object, &mut degenerate, &mut parts.ignored)?;
         if placed.len() == 1 {
             let p = Placement::from_matrix(placed[0].0);
             let start = scene.triangles.len();
+            // A mirroring placement swaps corners 1 and 2 of each triangle
+            // (`Placement::apply`); their colours and tangents go with them.
+            let flips = p.flips();
             if let Some(colours) = colours {
                 scene.vertex_colours.resize(start, [Vec3::ONE; 3]);
-                scene.vertex_colours.extend(colours);
+                scene.vertex_colours.extend(colours.into_iter().map(|c| in_corner_order(c, flips)));
             }
-            for t in local {
+            if let Some(tangents) = tangents {
+                // A tangent is a direction in the surface: it turns with the
+                // placement's matrix, and a mirror flips the frame's handedness.
+                let m = p.matrix();
+                let w_sign = if m.determinant() < 0.0 { -1.0 } else { 1.0 };
+                let place = |t: Vec4| if t == Vec4::ZERO { t } else { m.transform_vector3(t.truncate()).normalize_or_zero().extend(t.w * w_sign) };
+                scene.given_tangents.resize(start, [Vec4::ZERO; 3]);
+                scene.given_tangents.extend(tangents.into_iter().map(|c| in_corner_order(c.map(place), flips)));
+            }
+            // Corners are shared by vertex as they are pushed (each is a
+            // function of its vertex), so no table of every corner is built
+            // to merge them afterwards.
+            let mut made = vec![u32::MAX; vertices];
+            scene.triangles.reserve_faces(local.len());
+            for (t, key) in local.into_iter().zip(keys) {
                 let t = p.apply(t);
                 if !t.v.iter().all(|v| v.abs().max_element() <= MAX_COORDINATE) {
                     return Err(format!("mesh {} placed by node {}: a vertex lands out of range (coordinates must be between -{MAX_COORDINATE:e} and {MAX_COORDINATE:e})", mesh.index(), placed[0].1));
                 }
-                scene.triangles.push(t);
+                scene.triangles.push_keyed(t, in_corner_order(key, flips).map(|k| k as usize), &mut made);
             }
             scene.parts.push(NamedPart { object, what: PartOf::Triangles(start..scene.triangles.len()), name: part_name(placed[0].1) });
         } else if !local.is_empty() {
-            if colours.is_some() {
-                parts.ignored.push(format!("mesh {}: vertex colours (its nodes share it, and shared meshes have none yet)", mesh.index()));
+            if tangents.is_some() {
+                parts.ignored.push(format!("mesh {}: TANGENT (its nodes share it, and shared meshes take no tangent frame)", mesh.index()));
             }
             let (lo, hi) = local.iter().flat_map(|t| t.v).fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), v| (lo.min(v), hi.max(v)));
             let mut copies = Vec::new();
@@ -249,6 +267,8 @@ fn add_gltf_unnamed(scene: &mut Scene, path: &Path, placement: &Placement, objec
                 scene.parts.push(NamedPart { object, what: PartOf::Copy(copy_index), name: part_name(*node) });
                 copy_index += 1;
             }
+            layered.colours.resize(layered.objects.len(), None);
+            layered.colours.push(colours.map(Arc::new));
             layered.objects.push((object, Arc::new(local), copies));
         }
     }
@@ -260,8 +280,33 @@ fn add_gltf_unnamed(scene: &mut Scene, path: &Path, placement: &Placement, objec
     Ok(parts)
 }
 
+/// A triangle's per-corner values in the corner order of the placed
+/// triangle: a mirroring placement swaps corners 1 and 2.
+fn in_corner_order<T>(mut c: [T; 3], flips: bool) -> [T; 3] {
+    if flips {
+        c.swap(1, 2);
+    }
+    c
+}
+
+/// The triangles of a mesh in its own frame, with what their corners carry
+/// besides position, normal and uv.
+struct MeshCorners {
+    triangles: Vec<Triangle>,
+    /// Per triangle, its corners' vertices numbered across the mesh's
+    /// primitives (each primitive's after the previous one's).
+    keys: Vec<[u32; 3]>,
+    /// How many vertices the numbering covers.
+    vertices: usize,
+    /// Per triangle, when a primitive has `COLOR_0` (white where another has none).
+    colours: Option<Vec<[Vec3; 3]>>,
+    /// Per triangle, when a primitive has `TANGENT`: the tangent (xyz) and
+    /// the handedness of the frame (w); zero where another has none.
+    tangents: Option<Vec<[Vec4; 3]>>,
+}
+
 /// The triangles of every primitive of `mesh`, in the mesh's own frame,
-/// and their corners' vertex colours when a primitive has `COLOR_0`.
+/// and their corners' vertex colours and tangents where a primitive has them.
 #[allow(clippy::too_many_arguments)]
 fn mesh_triangles(
     mesh: &gltf::Mesh,
@@ -272,9 +317,12 @@ fn mesh_triangles(
     object: u32,
     degenerate: &mut usize,
     ignored: &mut Vec<String>,
-) -> Result<(Vec<Triangle>, Option<Vec<[Vec3; 3]>>), String> {
+) -> Result<MeshCorners, String> {
     let mut out = Vec::new();
     let mut colours_out: Option<Vec<[Vec3; 3]>> = None;
+    let mut tangents_out: Option<Vec<[Vec4; 3]>> = None;
+    let mut keys = Vec::new();
+    let mut vertices = 0usize;
     for prim in mesh.primitives() {
         let at = format!("mesh {} primitive {}", mesh.index(), prim.index());
         let positions = prim.get(&gltf::Semantic::Positions).ok_or(format!("{at} has no POSITION attribute"))?;
@@ -316,6 +364,21 @@ fn mesh_triangles(
         if colours.is_some() && colours_out.is_none() {
             colours_out = Some(vec![[Vec3::ONE; 3]; out.len()]);
         }
+        let tangents: Option<Vec<Vec4>> = match prim.get(&gltf::Semantic::Tangents) {
+            Some(a) => {
+                let t = accessor::read_floats::<4>(&a, buffers).map_err(|e| format!("{at}: TANGENT: {e}"))?;
+                if t.len() != pos.len() {
+                    return Err(format!("{at}: its TANGENT and positions differ in count"));
+                }
+                // A tangent that is not finite, or has no length, gives no
+                // frame: the uvs' frame is used at that corner instead.
+                Some(t.into_iter().map(Vec4::from).map(|t| if t.is_finite() && t.truncate().length() > 0.0 { t } else { Vec4::ZERO }).collect())
+            }
+            None => None,
+        };
+        if tangents.is_some() && tangents_out.is_none() {
+            tangents_out = Some(vec![[Vec4::ZERO; 3]; out.len()]);
+        }
         if prim.morph_targets().next().is_some() {
             ignored.push(format!("{at}: morph targets"));
         }
@@ -340,11 +403,15 @@ fn mesh_triangles(
                 continue;
             }
         };
+        drop(indices);
         let (material, two_sided) = match prim.material().index() {
             Some(m) => (first_material + m as u32, double_sided.get(m).copied().unwrap_or(false)),
             None => (fallback, false),
         };
         out.reserve(triangles.len());
+        keys.reserve(triangles.len());
+        let first_vertex = vertices as u32;
+        vertices += pos.len();
         for idx in triangles {
             let v = idx.map(|i| pos[i as usize]);
             let Some(geo) = Triangle::normal_if_not_degenerate(&v) else {
@@ -365,12 +432,16 @@ fn mesh_triangles(
                 None => [Vec2::ZERO; 3],
             };
             out.push(Triangle { v, n, uv, material, object, two_sided });
+            keys.push(idx.map(|i| first_vertex + i));
             if let Some(c) = colours_out.as_mut() {
                 c.push(colours.as_ref().map_or([Vec3::ONE; 3], |cs| idx.map(|i| cs[i as usize])));
             }
+            if let Some(t) = tangents_out.as_mut() {
+                t.push(tangents.as_ref().map_or([Vec4::ZERO; 3], |ts| idx.map(|i| ts[i as usize])));
+            }
         }
     }
-    Ok((out, colours_out))
+    Ok(MeshCorners { triangles: out, keys, vertices, colours: colours_out, tangents: tangents_out })
 }
 
 /// Refuses a file whose `extensionsRequired` names an extension pinhole
@@ -447,6 +518,9 @@ pub fn frame_bare_gltf(path: &Path, camera: Option<&str>) -> Result<Scene, Strin
         scene.warnings.push(format!("{name}: not drawn: {}", parts.ignored.join("; ")));
     }
     scene.triangles.share_corners();
+    if scene.materials.iter().any(|m| m.normal_map.is_some() || m.glossy_model == crate::scene::material::GlossyModel::Ward) {
+        scene.tangents = crate::scene::tangents::build_tangents(&scene);
+    }
     scene.refresh_emitters();
     Ok(scene)
 }
