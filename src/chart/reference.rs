@@ -211,6 +211,17 @@ mod tests {
     }
 
     #[test]
+    fn references_split_into_ranges_of_at_most_32_samples_covering_all() {
+        assert_eq!(reference_ranges(1), vec![0..1]);
+        assert_eq!(reference_ranges(32), vec![0..32]);
+        assert_eq!(reference_ranges(40), vec![0..20, 20..40]);
+        let r = reference_ranges(256);
+        assert_eq!(r.len(), 8);
+        assert!(r.windows(2).all(|w| w[0].end == w[1].start) && r[0].start == 0 && r[7].end == 256);
+        assert!(r.iter().all(|x| x.len() == 32));
+    }
+
+    #[test]
     fn the_cache_key_changes_with_the_scene_and_the_settings() {
         let p = prepared("spheres");
         let s = path_settings(&p, 32, 20, 4);
