@@ -18,6 +18,7 @@ split=${SPLIT:-tiles}
 bin=$(readlink -f "${CARGO_TARGET_DIR:-target}/release/pinhole")
 [ -x "$bin" ] || { echo "bench_slurm.sh: build first (cargo build --release)" >&2; exit 2; }
 work=$(mktemp -d /tmp/bench-slurm.XXXXXX)
+chmod 755 "$work"   # munged wants its socket's folders open to all
 ports=(SLURM_CTLD_PORT=6937 SLURMD_PORT=6938 SLURM_SRUN_PORTS=63401-63700)
 env "${ports[@]}" SLURM_NO_INSTALL=1 SLURM_CPUS=4 scripts/cluster/start_local_slurm.sh "$work/cluster" >/dev/null
 trap 'env "${ports[@]}" scripts/cluster/stop_local_slurm.sh "$work/cluster" --purge >/dev/null 2>&1; rm -rf "$work"' EXIT
