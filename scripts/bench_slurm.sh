@@ -26,6 +26,11 @@ export SLURM_CONF=$work/cluster/etc/slurm.conf
 opts=(--gi path --spp 256)
 now() { date +%s.%N; }
 for round in $(seq 1 "$rounds"); do
+    # With as many threads as the 4 parts run together (each part takes every
+    # core): on a machine shared with other work the scheduler shares the
+    # cores out per thread, so this is the fair single-process figure there.
+    s0=$(now)
+    "$bin" render cornell-gi -o "$work/single8.exr" "${opts[@]}" --threads $((4 * $(nproc))) 2>/dev/null
     t0=$(now)
     "$bin" render cornell-gi -o "$work/single.exr" "${opts[@]}" 2>/dev/null
     t1=$(now)
@@ -36,11 +41,18 @@ for round in $(seq 1 "$rounds"); do
     t2=$(now)
     [ -f "$work/split.exr" ] || { echo "round $round: the merge wrote nothing; logs in $work/split.exr.parts" >&2; cat "$work"/split.exr.parts/*.log >&2; exit 1; }
     same=$("$bin" compare "$work/single.exr" "$work/split.exr" --json | python3 -c 'import json,sys; print("the same pixels" if json.load(sys.stdin)["max_abs"] == 0 else "DIFFERENT pixels")')
-    python3 - "$t0" "$t1" "$t2" "$round" "$same" <<'PY'
-import sys
+    python3 - "$t0" "$t1" "$t2" "$round" "$same" "$work/split.exr.json" "$s0" <<'PY'
+import json, sys
 t0, t1, t2 = map(float, sys.argv[1:4])
 single, split = t1 - t0, t2 - t1
+single_many = t0 - float(sys.argv[7])
+# The parts' own span (first start to last end) from the merged statistics:
+# what Slurm adds is the wait before the first part and after the last.
+stats = json.load(open(sys.argv[6]))
+before = stats["started_unix_ms"] / 1e3 - t1
+after = t2 - stats["finished_unix_ms"] / 1e3
 print(f"round {sys.argv[4]}: one process {single:.1f} s, 4 Slurm parts {split:.1f} s (submission to merged image), "
-      f"ratio {split / single:.3f}, overhead {split - single:.1f} s, {sys.argv[5]}")
+      f"ratio {split / single:.3f}; one process with the parts' thread count {single_many:.1f} s, ratio {split / single_many:.3f}; parts rendering {stats['wall_clock_ms'] / 1e3:.1f} s, "
+      f"submission to first part {before:.1f} s, last part to merged image {after:.1f} s; {sys.argv[5]}")
 PY
 done
