@@ -84,6 +84,15 @@ fn a_planned_chart_has_the_rows_of_a_chart_measured_in_one_process() {
     assert!(!planned.exists());
     std::fs::write(&config, kept).unwrap();
 
+    // The reference's two ranges merged are the one-process chart's
+    // reference (which it cached) to the bit: both add the same ranges.
+    let merged = d.join("reference.exr");
+    let refs: Vec<String> = (0..2).map(|k| plan.join(format!("reference-{k:03}.exr")).to_string_lossy().into_owned()).collect();
+    ok(&pinhole(&["merge", &refs[0], &refs[1], "-o", merged.to_str().unwrap()], &cache));
+    let cached = std::fs::read_dir(&cache).unwrap().next().unwrap().unwrap().path();
+    let bits = |p: &Path| pinhole::image_io::load_image(p).unwrap().pixels.iter().map(|c| [c.x.to_bits(), c.y.to_bits(), c.z.to_bits()]).collect::<Vec<_>>();
+    assert!(bits(&merged) == bits(&cached), "the planned reference differs from the one-process chart's");
+
     ok(&assemble(&plan, &d.join("cache-plan")));
     let (a, b) = (rows_without_times(&direct.with_extension("csv")), rows_without_times(&planned.with_extension("csv")));
     assert!(a.len() > 12, "{a:?}");
