@@ -14,8 +14,11 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::Instant;
 
+mod chart_jobs;
+mod gallery_jobs;
 mod interrupt;
 mod part_opts;
+mod plan_lines;
 mod render_opts;
 mod usage_error;
 use render_opts::RenderOpts;
@@ -135,6 +138,15 @@ enum Command {
         /// header series,label,ms,rel_rmse (scripts/gi_chart.sh measures Mitsuba's).
         #[arg(long, value_name = "FILE.csv")]
         peer: Option<PathBuf>,
+        /// Instead of measuring (--sweep methods|gi): write one `pinhole render` command
+        /// line per configuration and per sample range of the reference to DIR/jobs.txt,
+        /// and the command that assembles their results to DIR/assemble.txt.
+        #[arg(long, value_name = "DIR", conflicts_with = "from")]
+        plan: Option<PathBuf>,
+        /// Assemble the chart from the results of the jobs `--plan DIR` wrote (give
+        /// the same scene and options as the plan had).
+        #[arg(long, value_name = "DIR")]
+        from: Option<PathBuf>,
         #[command(flatten)]
         opts: RenderOpts,
     },
@@ -149,6 +161,17 @@ enum Command {
         /// Worker threads (default: all cores).
         #[arg(long)]
         threads: Option<usize>,
+        /// Also write each case's truth, failing and cured images as linear EXRs
+        /// (CASE-truth.exr, CASE-failing.exr, CASE-cured.exr) in DIR.
+        #[arg(long)]
+        exr: bool,
+        /// Instead of measuring: write one command line per case to DIR/jobs.txt and
+        /// the command that assembles their results to DIR/assemble.txt.
+        #[arg(long, value_name = "DIR", conflicts_with = "from")]
+        plan: Option<PathBuf>,
+        /// Assemble the gallery from the results of the jobs `--plan DIR` wrote.
+        #[arg(long, value_name = "DIR")]
+        from: Option<PathBuf>,
     },
     /// List renderers, views and built-in scenes.
     List,
@@ -166,15 +189,20 @@ pub enum Outcome {
     OpenViewer { scene: Option<String>, screenshot: Option<PathBuf> },
 }
 
+/// The command line's grammar. Negative numbers reach the value parsers,
+/// which then name the option and its range, instead of reading as unknown
+/// flags. Options' values may start with '-' (`--bump -1e-9` is a value out
+/// of range, not an unknown flag `-1`); so may positional numbers.
+fn command() -> clap::Command {
+    use clap::CommandFactory;
+    let hyphens = |a: clap::Arg| if a.get_action().takes_values() && !a.is_positional() { a.allow_hyphen_values(true) } else { a };
+    Cli::command().allow_negative_numbers(true).mut_subcommands(|s| s.allow_negative_numbers(true).mut_args(hyphens))
+}
+
 /// Parses the arguments and runs the command.
 pub fn run() -> Result<Outcome, String> {
-    use clap::{CommandFactory, FromArgMatches};
-    // Negative numbers reach the value parsers, which then name the option
-    // and its range, instead of reading as unknown flags.
-    // Options' values may start with '-' (`--bump -1e-9` is a value out of
-    // range, not an unknown flag `-1`); so may positional numbers.
-    let hyphens = |a: clap::Arg| if a.get_action().takes_values() && !a.is_positional() { a.allow_hyphen_values(true) } else { a };
-    let command = Cli::command().allow_negative_numbers(true).mut_subcommands(|s| s.allow_negative_numbers(true).mut_args(hyphens));
+    use clap::FromArgMatches;
+    let command = command();
     let parsed = command.clone().try_get_matches().and_then(|m| Cli::from_arg_matches(&m));
     let cli = match parsed {
         Ok(c) => c,
@@ -201,16 +229,26 @@ pub fn run() -> Result<Outcome, String> {
         Some(Command::Bench { scene, opts, frames, display_pass: true }) => cmd_bench_display(&scene, &opts, frames),
         Some(Command::Compare { a, b, json }) => cmd_compare(&a, &b, json),
         Some(Command::Pixel { scene, x, y, opts, json }) => cmd_pixel(&scene, x, y, &opts, json),
-        Some(Command::Chart { scene, output, sweep, metric, renderers, spp_list, reference, reference_spp, peer, opts }) => match sweep.as_str() {
-            _ if peer.is_some() && sweep != "gi" => Err("--peer: a peer's curve is drawn on --sweep gi charts only".to_string()),
-            "methods" => cmd_chart_methods(&scene, &output, &metric, reference.as_deref(), reference_spp, None, &opts),
-            "gi" => parse_spp_list(&spp_list).and_then(|spps| {
-                cmd_chart_methods(&scene, &output, &metric, reference.as_deref(), reference_spp, Some((&spps, peer.as_deref())), &opts)
-            }),
-            "spp" => cmd_chart(&scene, &output, &renderers, &spp_list, reference.as_deref(), reference_spp, &opts),
-            other => Err(format!("--sweep: \"{other}\" is not one of methods, gi, spp")),
+        Some(Command::Chart { scene, output, sweep, metric, renderers, spp_list, reference, reference_spp, peer, plan, from, opts }) => {
+            let jobs = match (&plan, &from) {
+                (Some(dir), _) => Jobs::Plan(dir),
+                (_, Some(dir)) => Jobs::From(dir),
+                _ => Jobs::Run,
+            };
+            match sweep.as_str() {
+                _ if peer.is_some() && sweep != "gi" => Err("--peer: a peer's curve is drawn on --sweep gi charts only".to_string()),
+                "methods" => cmd_chart_methods(&scene, &output, &metric, reference.as_deref(), reference_spp, None, &opts, jobs),
+                "gi" => parse_spp_list(&spp_list).and_then(|spps| {
+                    cmd_chart_methods(&scene, &output, &metric, reference.as_deref(), reference_spp, Some((&spps, peer.as_deref())), &opts, jobs)
+                }),
+                "spp" if !matches!(jobs, Jobs::Run) => Err("--plan and --from split --sweep methods and --sweep gi charts; the spp sweep runs in one process".to_string()),
+                "spp" => cmd_chart(&scene, &output, &renderers, &spp_list, reference.as_deref(), reference_spp, &opts),
+                other => Err(format!("--sweep: \"{other}\" is not one of methods, gi, spp")),
+            }
         }
-        Some(Command::Gallery { output, case, threads }) => cmd_gallery(&output, case.as_deref(), threads),
+        Some(Command::Gallery { case, plan: Some(dir), .. }) => gallery_jobs::plan(&dir, case.as_deref()),
+        Some(Command::Gallery { output, case, exr, from: Some(dir), .. }) => gallery_jobs::assemble(&dir, &output, case.as_deref(), exr),
+        Some(Command::Gallery { output, case, threads, exr, .. }) => cmd_gallery(&output, case.as_deref(), threads, exr),
         Some(Command::List) => cmd_list(),
     };
     if interrupt::interrupted() {
@@ -220,8 +258,19 @@ pub fn run() -> Result<Outcome, String> {
     ran.map(|()| Outcome::Done)
 }
 
+/// Whether a chart or gallery measures in this process, writes its jobs
+/// as command lines (`--plan DIR`), or assembles their results (`--from DIR`).
+#[derive(Clone, Copy)]
+enum Jobs<'a> {
+    Run,
+    Plan(&'a Path),
+    From(&'a Path),
+}
+
 /// A scene loaded and prepared under the requested thread pool, with timings.
 struct Loaded {
+    /// `--glossy-model`: the model every glossy lobe was switched to.
+    glossy_model: Option<&'static str>,
     prepared: PreparedScene,
     settings: RenderSettings,
     renderer: Box<dyn render::Renderer>,
@@ -258,9 +307,13 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
     // The options are checked before the scene loads (which can take seconds)
     // and written over the scene's settings once it has.
     opts.write_into(&mut RenderSettings::default())?;
+    let glossy_model = opts.glossy_model()?;
     let pool = worker_pool(opts.threads)?;
     let start = Instant::now();
-    let scene: Scene = crate::scene::load::load_scene_with_camera(scene_arg, opts.camera.as_deref())?;
+    let mut scene: Scene = crate::scene::load::load_scene_with_camera(scene_arg, opts.camera.as_deref())?;
+    if let Some(model) = glossy_model {
+        scene = crate::chart::glossy_models::switched(&scene, model);
+    }
     let load_ms = start.elapsed().as_secs_f64() * 1e3;
     for w in &scene.warnings {
         eprintln!("warning: {w}");
@@ -275,7 +328,7 @@ fn load(scene_arg: &str, opts: &RenderOpts) -> Result<Loaded, String> {
     renderer.ready(&admitted.settings)?;
     let prepared = pool.install(|| PreparedScene::new(scene));
     pool.install(|| render::admit::admit_prepared(&prepared, &admitted.settings))?;
-    Ok(Loaded { prepared, settings: admitted.settings, renderer, pool, load_ms })
+    Ok(Loaded { glossy_model: glossy_model.map(crate::chart::glossy_models::name), prepared, settings: admitted.settings, renderer, pool, load_ms })
 }
 
 fn stats_json(l: &Loaded, render_ms: f64, counts: &RayCounts, spp: u32) -> serde_json::Value {
@@ -327,6 +380,7 @@ fn stats_json(l: &Loaded, render_ms: f64, counts: &RayCounts, spp: u32) -> serde
     j["tonemap"] = json!(l.settings.display.tonemap.name());
     j["exposure_ev"] = json!(l.settings.display.exposure_ev);
     j["gamma"] = json!(l.settings.display.gamma.name());
+    j["glossy_model"] = json!(l.glossy_model);
     j
 }
 
@@ -431,7 +485,8 @@ fn cmd_render(scene_arg: &str, output: &Path, opts: &RenderOpts, part_opts: &par
         let record = crate::part_file::PartRecord {
             version: env!("CARGO_PKG_VERSION").to_string(),
             scene: l.prepared.scene.name.clone(),
-            scene_hash: crate::part_file::scene_hash(&l.prepared.scene.name, &crate::file_identity::inputs_read())?,
+            // A switched glossy model is part of what the parts drew.
+            scene_hash: crate::part_file::scene_hash(&scene_identity(&l), &crate::file_identity::inputs_read())?,
             renderer: l.renderer.name().to_string(),
             settings: serde_json::to_value(&l.settings).map_err(|e| e.to_string())?,
             frame_width: l.settings.width,
@@ -455,6 +510,41 @@ fn cmd_render(scene_arg: &str, output: &Path, opts: &RenderOpts, part_opts: &par
         // After the frame and its image: the run's peak (null where unknown).
         j["peak_rss_bytes"] = json!(peak_rss_bytes());
         write_json(dest, &j)?;
+    }
+    Ok(())
+}
+
+/// What a part's scene hash covers besides the files: the scene's name, and
+/// the glossy model `--glossy-model` switched its lobes to.
+fn scene_identity(l: &Loaded) -> String {
+    match l.glossy_model {
+        Some(m) => format!("{} glossy-model {m}", l.prepared.scene.name),
+        None => l.prepared.scene.name.clone(),
+    }
+}
+
+/// Checks that `argv`, a `pinhole render` job line, renders `scene` with
+/// `renderer` and exactly `target`: it is parsed and admitted as the job
+/// will parse and admit it. `what` names the work in the error.
+fn check_render_job(argv: &[String], scene: &Scene, renderer: &str, target: &RenderSettings, what: &str) -> Result<(), String> {
+    use clap::FromArgMatches;
+    let cmd = command();
+    let words = std::iter::once("pinhole".to_string()).chain(argv[1..].iter().cloned());
+    let parsed = cmd.clone().try_get_matches_from(words).and_then(|m| Cli::from_arg_matches(&m));
+    let cli = parsed.map_err(|e| format!("{what}: its job line does not parse: {}", usage_error::one_sentence(&e, &cmd)))?;
+    let Some(Command::Render { opts, .. }) = cli.command else {
+        return Err(format!("{what}: its job line is not a pinhole render command"));
+    };
+    let r = render::renderer_by_name(&opts.renderer)?;
+    let mut settings = RenderSettings::for_scene(scene);
+    opts.write_into(&mut settings)?;
+    let admitted = render::admit::admit(r.as_ref(), scene, &settings)?;
+    if r.name() != renderer {
+        return Err(format!("{what}: its job line renders with {} instead of {renderer}", r.name()));
+    }
+    if admitted.settings != *target {
+        let keys = plan_lines::differing_settings(&admitted.settings, target);
+        return Err(format!("{what} cannot be written as a pinhole render command line: it would render with other {}", keys.join(", ")));
     }
     Ok(())
 }
@@ -677,7 +767,9 @@ fn parse_spp_list(list: &str) -> Result<Vec<u32>, String> {
 /// against the reference, as a scatter with its Pareto front, and the CSV.
 /// With `gi = Some((path spps, peer))`, `chart --sweep gi`: the methods of
 /// indirect light as curves, a peer's curve beside them, the same CSV.
-fn cmd_chart_methods(scene_arg: &str, output: &Path, metric: &str, reference: Option<&Path>, reference_spp: u32, gi: Option<(&[u32], Option<&Path>)>, opts: &RenderOpts) -> Result<(), String> {
+/// `jobs`: measured here, written as job lines, or assembled from their results.
+#[allow(clippy::too_many_arguments)]
+fn cmd_chart_methods(scene_arg: &str, output: &Path, metric: &str, reference: Option<&Path>, reference_spp: u32, gi: Option<(&[u32], Option<&Path>)>, opts: &RenderOpts, jobs: Jobs) -> Result<(), String> {
     check_png_output(output)?;
     let peers = match gi.and_then(|(_, peer)| peer) {
         Some(path) => crate::chart::gi_sweep::load_peer_csv(path)?,
@@ -699,24 +791,6 @@ fn cmd_chart_methods(scene_arg: &str, output: &Path, metric: &str, reference: Op
         return Err(format!("--metric flip: {w}x{h} is more than the {} pixels FLIP is computed for", crate::metrics::MAX_FLIP_PIXELS));
     }
     let source = crate::chart::ReferenceSource::choose(reference, &l.prepared, reference_spp);
-    let cancel = interrupt::flag();
-    let cache = crate::chart::reference::default_cache_dir();
-    // A path-traced reference can take minutes: its passes are reported
-    // every ten seconds.
-    let passes = std::sync::atomic::AtomicU32::new(0);
-    let loaded = AtomicBool::new(false);
-    let truth = std::thread::scope(|s| {
-        if let crate::chart::ReferenceSource::PathTraced { spp } = source {
-            let (passes, loaded) = (&passes, &loaded);
-            s.spawn(move || report_passes("reference", passes, spp, loaded));
-        }
-        let r = l.pool.install(|| crate::chart::load_reference(&source, &l.prepared, w, h, cache.as_deref(), cancel, Some(&passes)));
-        loaded.store(true, Ordering::Relaxed);
-        r
-    })?
-    .ok_or("cancelled")?;
-    eprintln!("reference: {}", truth.name);
-    check_chart_outputs(output)?;
     let configs = match gi {
         Some((spps, _)) => {
             if l.prepared.scene.render.ambient.max_element() <= 0.0 {
@@ -726,16 +800,47 @@ fn cmd_chart_methods(scene_arg: &str, output: &Path, metric: &str, reference: Op
         }
         None => crate::chart::method_configurations(&l.prepared.scene, &l.settings),
     };
+    let planned = match jobs {
+        Jobs::Plan(dir) => return chart_jobs::plan(dir, scene_arg, opts, &l, &configs, &source),
+        Jobs::From(dir) => Some(chart_jobs::Planned::new(dir, &l, &source)?),
+        Jobs::Run => None,
+    };
+    let cancel = interrupt::flag();
+    let cache = crate::chart::reference::default_cache_dir();
+    // A path-traced reference can take minutes: its passes are reported
+    // every ten seconds.
+    let passes = std::sync::atomic::AtomicU32::new(0);
+    let loaded = AtomicBool::new(false);
+    let truth = match planned.as_ref().map(chart_jobs::Planned::reference).transpose()?.flatten() {
+        Some(r) => r,
+        None => std::thread::scope(|s| {
+            if let crate::chart::ReferenceSource::PathTraced { spp } = source {
+                let (passes, loaded) = (&passes, &loaded);
+                s.spawn(move || report_passes("reference", passes, spp, loaded));
+            }
+            let r = l.pool.install(|| crate::chart::load_reference(&source, &l.prepared, w, h, cache.as_deref(), cancel, Some(&passes)));
+            loaded.store(true, Ordering::Relaxed);
+            r
+        })?
+        .ok_or("cancelled")?,
+    };
+    eprintln!("reference: {}", truth.name);
+    check_chart_outputs(output)?;
     let mut points = Vec::new();
     for (i, c) in configs.iter().enumerate() {
         eprintln!("[{}/{}] {}", i + 1, configs.len(), c.label);
-        let m = match gi {
-            Some(_) => l.pool.install(|| crate::chart::gi_sweep::measure_with_builds(&l.prepared, c, &truth, cancel)),
-            None => l.pool.install(|| crate::chart::measure(&l.prepared, c, &truth, 3, cancel)),
+        let m = match (&planned, gi) {
+            (Some(p), _) => p.measurement(i, c, &truth).map(Some),
+            (None, Some(_)) => l.pool.install(|| crate::chart::gi_sweep::measure_with_builds(&l.prepared, c, &truth, cancel)),
+            (None, None) => l.pool.install(|| crate::chart::measure(&l.prepared, c, &truth, 3, cancel)),
         };
         points.push(m?.ok_or("cancelled")?);
     }
-    let title = format!("{}: error against time, {w}x{h}, {} threads; reference: {}", l.prepared.scene.name, l.pool.current_num_threads(), truth.name);
+    let runs_on = match planned {
+        Some(_) => "times of the planned jobs".to_string(),
+        None => format!("{} threads", l.pool.current_num_threads()),
+    };
+    let title = format!("{}: error against time, {w}x{h}, {runs_on}; reference: {}", l.prepared.scene.name, truth.name);
     let png = match gi {
         Some(_) => crate::chart::plot::draw_curves_png(&points, &peers, metric, &title, 1100, 700)?,
         None => crate::chart::plot::draw_methods_png(&points, metric, &title, 1100, 700)?,
@@ -840,18 +945,12 @@ fn cmd_compare(a: &Path, b: &Path, as_json: bool) -> Result<(), String> {
     }
 }
 
-fn cmd_gallery(dir: &Path, only: Option<&str>, threads: Option<usize>) -> Result<(), String> {
-    use crate::gallery;
-    let cases = match only {
-        Some(name) => vec![gallery::case_by_name(name)?],
-        None => gallery::cases(),
-    };
+/// `pinhole gallery`: every case (or `only`) measured here; with `exr`, its
+/// three images kept as EXRs beside the sheet.
+fn cmd_gallery(dir: &Path, only: Option<&str>, threads: Option<usize>, exr: bool) -> Result<(), String> {
+    let cases = gallery_jobs::cases(only)?;
     let pool = worker_pool(threads)?;
-    if dir.exists() && !dir.is_dir() {
-        return Err(format!("{}: exists and is not a directory", dir.display()));
-    }
-    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create the directory {}: {e}", dir.display()))?;
-    crate::image_io::check_writable(&dir.join("gallery.png"))?;
+    gallery_jobs::prepare_output(dir)?;
     let start = Instant::now();
     let mut results = Vec::new();
     for (i, case) in cases.iter().enumerate() {
@@ -860,25 +959,15 @@ fn cmd_gallery(dir: &Path, only: Option<&str>, threads: Option<usize>) -> Result
         }
         eprintln!("[{}/{}] {}: {} ...", i + 1, cases.len(), case.name, case.method);
         let t = Instant::now();
-        let r = pool.install(|| gallery::measure_case(case))?;
-        eprintln!(
-            "    failing {}: {} wrong px; cured {}: {} wrong px (threshold {}){} in {:.1} s",
-            r.failing.setting,
-            r.failing.wrong_pixels,
-            r.cured.setting,
-            r.cured.wrong_pixels,
-            r.threshold,
-            if r.demonstrated() { "" } else { " NOT DEMONSTRATED" },
-            t.elapsed().as_secs_f64()
-        );
+        let images = pool.install(|| crate::gallery::render_case(case))?;
+        if exr {
+            gallery_jobs::write_case_images(dir, case.name, &images)?;
+        }
+        let r = crate::gallery::judge(case, images)?;
+        gallery_jobs::report(&r, t.elapsed().as_secs_f64());
         results.push((r, case.explanation));
     }
-    let png = gallery::sheet::draw_png(&results)?;
-    let json = serde_json::to_value(results.iter().map(|(r, _)| r).collect::<Vec<_>>()).map_err(|e| e.to_string())?;
-    let text = serde_json::to_string_pretty(&json).map_err(|e| e.to_string())? + "\n";
-    crate::image_io::write_all_atomic(&[(&dir.join("gallery.png"), &png), (&dir.join("gallery.json"), text.as_bytes())])?;
-    eprintln!("wrote {} and {} in {:.1} s", dir.join("gallery.png").display(), dir.join("gallery.json").display(), start.elapsed().as_secs_f64());
-    Ok(())
+    gallery_jobs::write_gallery(dir, &results, start)
 }
 
 fn cmd_list() -> Result<(), String> {

@@ -123,12 +123,34 @@ pub fn read(path: &Path) -> Result<PartFile, String> {
         .from_buffered(std::io::Cursor::new(bytes))
         .map_err(|e| format!("{name}: not a readable RGB EXR: {e}"))?;
     let layer = image.layer_data;
-    let text = match layer.attributes.other.get(&Text::new_or_panic(ATTRIBUTE)) {
+    let record = checked_record(path, &layer.attributes, layer.size.width(), layer.size.height())?;
+    let w = layer.size.width();
+    let pixels = layer.channel_data.pixels.1;
+    if let Some(i) = pixels.iter().position(|p| !p.is_finite()) {
+        return Err(format!("{name}: pixel ({}, {}) is not finite", i % w, i / w));
+    }
+    Ok(PartFile { record, pixels })
+}
+
+/// Reads only a part file's header (its record and size), not its pixels:
+/// what `pinhole merge --status` needs of every part, however large.
+pub fn read_record(path: &Path) -> Result<PartRecord, String> {
+    let name = path.display();
+    let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| format!("{name}: not a readable EXR: {e}"))?;
+    let header = meta.headers.first().ok_or_else(|| format!("{name}: an EXR without a layer"))?;
+    checked_record(path, &header.own_attributes, header.layer_size.width(), header.layer_size.height())
+}
+
+/// The record in a part's layer `attributes`, checked against its `w` x `h`
+/// pixels.
+fn checked_record(path: &Path, attributes: &exr::prelude::LayerAttributes, w: usize, h: usize) -> Result<PartRecord, String> {
+    use exr::prelude::*;
+    let name = path.display();
+    let text = match attributes.other.get(&Text::new_or_panic(ATTRIBUTE)) {
         Some(AttributeValue::Text(t)) => String::from_utf8_lossy(t.as_slice()).into_owned(),
         _ => return Err(format!("{name}: not a pinhole part (its header has no {ATTRIBUTE} record)")),
     };
     let record: PartRecord = serde_json::from_str(&text).map_err(|e| format!("{name}: its {ATTRIBUTE} record is unreadable: {e}"))?;
-    let (w, h) = (layer.size.width(), layer.size.height());
     let [x0, y0, x1, y1] = record.region;
     if x1 <= x0 || y1 <= y0 || x1 > record.frame_width || y1 > record.frame_height || record.width() as usize != w || record.height() as usize != h {
         return Err(format!("{name}: its region {x0},{y0},{x1},{y1} does not match its {w}x{h} pixels inside a {}x{} frame", record.frame_width, record.frame_height));
@@ -136,11 +158,7 @@ pub fn read(path: &Path) -> Result<PartFile, String> {
     if record.passes[0] >= record.passes[1] || record.passes[1] > record.spp.max(1) {
         return Err(format!("{name}: its sample range {}..{} is not within 0..{}", record.passes[0], record.passes[1], record.spp));
     }
-    let pixels = layer.channel_data.pixels.1;
-    if let Some(i) = pixels.iter().position(|p| !p.is_finite()) {
-        return Err(format!("{name}: pixel ({}, {}) is not finite", i % w, i / w));
-    }
-    Ok(PartFile { record, pixels })
+    Ok(record)
 }
 
 #[cfg(test)]
@@ -171,8 +189,10 @@ mod tests {
         let path = std::env::temp_dir().join(format!("pinhole-part-file-{}.exr", std::process::id()));
         std::fs::write(&path, bytes).unwrap();
         let back = read(&path).unwrap();
+        let header_only = read_record(&path).unwrap();
         let _ = std::fs::remove_file(&path);
         assert_eq!(back.record, record());
+        assert_eq!(header_only, record());
         let bits = |v: &[Radiance]| v.iter().map(|c| [c.x.to_bits(), c.y.to_bits(), c.z.to_bits()]).collect::<Vec<_>>();
         assert_eq!(bits(&back.pixels), bits(&pixels));
     }

@@ -1,9 +1,9 @@
 //! `pinhole merge --status DIR`: while the parts of a split render are
 //! still being made, which exist, which are missing, and about how much
 //! rendering is left, judged from the finished parts' own render times.
-//! It reads what is there and writes nothing.
+//! It reads only the parts' headers (not their pixels) and writes nothing.
 
-use crate::part_file::{PartFile, PartRecord};
+use crate::part_file::PartRecord;
 use std::path::{Path, PathBuf};
 
 /// What a folder of parts says about the frame they belong to.
@@ -30,7 +30,7 @@ pub fn status(dir: &Path) -> Result<PartStatus, String> {
         .filter(|p| p.extension().and_then(|x| x.to_str()).is_some_and(|x| x.eq_ignore_ascii_case("exr")))
         .collect();
     paths.sort();
-    let mut read: Vec<(PathBuf, Result<PartFile, String>)> = paths.into_iter().map(|p| (p.clone(), crate::part_file::read(&p))).collect();
+    let mut read: Vec<(PathBuf, Result<PartRecord, String>)> = paths.into_iter().map(|p| (p.clone(), crate::part_file::read_record(&p))).collect();
     Ok(summarise(&mut read))
 }
 
@@ -39,10 +39,10 @@ fn same_frame(a: &PartRecord, b: &PartRecord) -> bool {
     a.version == b.version && a.scene_hash == b.scene_hash && a.renderer == b.renderer && a.settings == b.settings
 }
 
-fn summarise(read: &mut [(PathBuf, Result<PartFile, String>)]) -> PartStatus {
+fn summarise(read: &mut [(PathBuf, Result<PartRecord, String>)]) -> PartStatus {
     // The frame most parts belong to (a stray part of another render
     // should not make the real ones look foreign).
-    let records: Vec<&PartRecord> = read.iter().filter_map(|(_, r)| r.as_ref().ok().map(|f| &f.record)).collect();
+    let records: Vec<&PartRecord> = read.iter().filter_map(|(_, r)| r.as_ref().ok()).collect();
     let base = records
         .iter()
         .enumerate()
@@ -53,7 +53,7 @@ fn summarise(read: &mut [(PathBuf, Result<PartFile, String>)]) -> PartStatus {
     for (path, r) in read.iter() {
         match (r, &base) {
             (Err(e), _) => others.push((path.clone(), e.clone())),
-            (Ok(f), Some(b)) if same_frame(b, &f.record) => mine.push(&f.record),
+            (Ok(r), Some(b)) if same_frame(b, r) => mine.push(r),
             (Ok(_), _) => others.push((path.clone(), "a part of another frame (scene, settings, renderer or version)".into())),
         }
     }

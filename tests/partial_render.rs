@@ -90,6 +90,36 @@ fn crops_and_tiles_are_the_whole_frame_bit_for_bit() {
     let _ = std::fs::remove_dir_all(&d);
 }
 
+/// Set to `1` where a driver must exist (CI installs Mesa): the OpenGL
+/// test fails instead of skipping without one (as in tests/opengl.rs).
+const REQUIRE_GL: &str = "PINHOLE_REQUIRE_GL";
+
+/// The OpenGL renderer draws a tile's rows through a scissor over the
+/// whole frame's viewport, so a tile's pixels are the whole frame's.
+#[test]
+fn opengl_tiles_are_the_whole_frame_bit_for_bit() {
+    if let Err(e) = pinhole::render::opengl::driver() {
+        assert!(!std::env::var(REQUIRE_GL).is_ok_and(|v| v == "1"), "{REQUIRE_GL}=1 but there is no OpenGL driver: {e}");
+        eprintln!("skipped: {e}");
+        return;
+    }
+    let d = dir("opengl");
+    for (k, args) in [&["--renderer", "opengl", "--shadows", "map"][..], &["--renderer", "opengl", "--msaa", "4", "--spp", "2"][..]].iter().enumerate() {
+        let whole_path = d.join(format!("whole{k}.exr"));
+        render("cornell-box", args, &[], &whole_path);
+        let whole = load(&whole_path);
+        let n = 3;
+        let tiles: Vec<PathBuf> = (0..n).map(|i| d.join(format!("tile{k}-{i}.exr"))).collect();
+        for (i, t) in tiles.iter().enumerate() {
+            render("cornell-box", args, &["--tile", &format!("{i}/{n}")], t);
+        }
+        let merged_path = d.join(format!("merged{k}.exr"));
+        ok(merge(&tiles, &merged_path, &[]));
+        assert_eq!(bits(&load(&merged_path).pixels), bits(&whole.pixels), "{args:?}: merged OpenGL tiles differ from the whole frame");
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}
+
 /// rmse over the image divided by its mean, over all channels.
 fn relative_rmse(a: &[Radiance], b: &[Radiance]) -> f64 {
     let (mut e2, mut m) = (0f64, 0f64);

@@ -2,7 +2,8 @@
 //! (scripts/cluster/start_local_slurm.sh), a 4-part render of `cornell-gi`
 //! at `--gi path` submitted through scripts/cluster/slurm-render.sh, its
 //! merge job awaited, and the merged image compared with a render on one
-//! machine. The cluster is stopped at the end, also when the test fails.
+//! machine; then a chart's plan run through scripts/cluster/slurm-chart.sh.
+//! The cluster is stopped at the end, also when the test fails.
 //!
 //! Needs root and Debian's `slurm-wlm` and `munge`. Where they are missing
 //! the test says why and skips; with `PINHOLE_REQUIRE_SLURM=1` (as CI runs
@@ -129,6 +130,34 @@ fn a_split_render_on_slurm_equals_one_machines() {
     let stats: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(merged.with_extension("exr.json")).unwrap()).unwrap();
     assert_eq!(stats["parts"], 4);
     assert_eq!(stats["spp"], 8);
+
+    // A chart's plan through slurm-chart.sh: a job array over its lines and
+    // the assembling job after them.
+    let plan = work.join("plan");
+    let chart = work.join("chart.png");
+    let out = Command::new(pinhole)
+        .args(["chart", "one-triangle", "-o", chart.to_str().unwrap(), "--width", "16", "--height", "12", "--reference-spp", "4", "--plan", plan.to_str().unwrap()])
+        .env("PINHOLE_CACHE_DIR", work.join("cache"))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = cluster.command(repo().join("scripts/cluster/slurm-chart.sh")).arg(&plan).current_dir(&work).output().expect("run slurm-chart.sh");
+    let said = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(out.status.success(), "slurm-chart.sh failed: {said}{}", String::from_utf8_lossy(&out.stderr));
+    let assemble_job = said.lines().find_map(|l| l.strip_prefix("assemble ")).map(|s| s.trim().to_string()).unwrap_or_else(|| panic!("no assemble job id in {said:?}"));
+    let deadline = Instant::now() + Duration::from_secs(300);
+    loop {
+        let q = cluster.command("squeue").args(["-h", "-j", &assemble_job]).output().expect("run squeue");
+        if q.status.success() && q.stdout.is_empty() {
+            break;
+        }
+        assert!(Instant::now() < deadline, "the assemble job {assemble_job} was still queued after 300 s");
+        std::thread::sleep(Duration::from_millis(250));
+    }
+    let csv = std::fs::read_to_string(chart.with_extension("csv")).unwrap_or_else(|e| panic!("no chart CSV ({e}); {}", std::fs::read_to_string(plan.join("assemble.log")).unwrap_or_default()));
+    let lines = std::fs::read_to_string(plan.join("jobs.txt")).unwrap().lines().count();
+    // One row per configuration: every line but the reference's one range.
+    assert_eq!(csv.lines().count() - 1, lines - 1, "{csv}");
     drop(cluster);
     let _ = std::fs::remove_dir_all(&work);
 }

@@ -83,15 +83,22 @@ pub fn measure(prepared: &PreparedScene, config: &Configuration, reference: &Ref
             break;
         }
     }
-    let m = crate::metrics::compare_images(&image, &reference.pixels, s.width as usize, s.height as usize)?;
-    Ok(Some(Measurement {
-        label: config.label.clone(),
-        group: config.group.to_string(),
-        renderer: config.renderer.clone(),
-        ms: best,
-        rel_rmse: m.rmse / m.reference_mean.max(1e-12),
-        flip: m.flip.unwrap_or(f64::NAN),
-    }))
+    Measurement::of_image(config, best, &image, reference).map(Some)
+}
+
+impl Measurement {
+    /// `config`'s row: `image`, rendered in `ms`, against `reference`.
+    pub fn of_image(config: &Configuration, ms: f64, image: &[crate::math::Radiance], reference: &Reference) -> Result<Measurement, String> {
+        let m = crate::metrics::compare_images(image, &reference.pixels, reference.width as usize, reference.height as usize)?;
+        Ok(Measurement {
+            label: config.label.clone(),
+            group: config.group.to_string(),
+            renderer: config.renderer.clone(),
+            ms,
+            rel_rmse: m.rmse / m.reference_mean.max(1e-12),
+            flip: m.flip.unwrap_or(f64::NAN),
+        })
+    }
 }
 
 /// Indices of the measurements no other one beats in both time and error,

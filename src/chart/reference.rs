@@ -14,6 +14,41 @@ use std::sync::atomic::{AtomicBool, AtomicU32};
 /// Samples per pixel of a path-traced reference.
 pub const PATH_REFERENCE_SPP: u32 = 256;
 
+/// A path-traced reference renders as sample ranges of at most this many
+/// samples, added in order and divided once, whether in one process or as
+/// the jobs of `chart --plan` merged by `chart --from`: the same additions
+/// in the same order give both the same bits.
+pub const SAMPLES_PER_RANGE: u32 = 32;
+
+/// The sample ranges a path-traced reference of `spp` samples renders in.
+pub fn reference_ranges(spp: u32) -> Vec<std::ops::Range<u32>> {
+    let spp = spp.max(1);
+    let n = spp.div_ceil(SAMPLES_PER_RANGE);
+    (0..n).map(|i| render::FramePart::band_rows(i, n, spp)).collect()
+}
+
+/// Renders `settings` as `reference_ranges` says: each range's sums, added
+/// range by range, divided by the samples once (as `pinhole merge` adds
+/// the ranges' parts). `None` when cancelled.
+fn render_in_ranges(renderer: &dyn render::Renderer, prepared: &PreparedScene, settings: &RenderSettings, cancel: &AtomicBool, passes_done: Option<&AtomicU32>) -> Option<Vec<Radiance>> {
+    let ranges = reference_ranges(settings.spp);
+    if ranges.len() == 1 {
+        return render::render_frame(renderer, prepared, settings, cancel, passes_done).map(|f| f.pixels);
+    }
+    let mut sum: Option<Vec<Radiance>> = None;
+    for passes in ranges {
+        let part = render::FramePart { passes, ..render::FramePart::whole(settings) };
+        let options = render::FrameOptions { passes_done, part: Some(part), ..render::FrameOptions::default() };
+        let frame = render::render_frame_with(renderer, prepared, settings, cancel, options)?;
+        match &mut sum {
+            None => sum = Some(frame.pixels),
+            Some(s) => s.iter_mut().zip(&frame.pixels).for_each(|(a, b)| *a += *b),
+        }
+    }
+    let spp = settings.spp.max(1);
+    Some(sum?.into_iter().map(|v| render::frame::final_value(v, spp)).collect())
+}
+
 /// The reference's own seed: its noise must not be the noise of the path
 /// configurations it judges (they use the scene's seed), or their error
 /// would look smaller than it is.
@@ -89,18 +124,18 @@ pub fn load_reference(
                 }
             }
             let renderer = render::renderer_by_name(render::DEFAULT_RAYTRACE)?;
-            let Some(frame) = render::render_frame(renderer.as_ref(), prepared, &settings, cancel, passes_done) else {
+            let Some(pixels) = render_in_ranges(renderer.as_ref(), prepared, &settings, cancel, passes_done) else {
                 return Ok(None);
             };
             if let Some(p) = &cached {
                 // A cache that cannot be written only costs time next run.
                 let saved = p.parent().map_or(Ok(()), |d| std::fs::create_dir_all(d).map_err(|e| e.to_string()))
-                    .and_then(|_| crate::image_io::save_image(p, width, height, &frame.pixels, 1.0));
+                    .and_then(|_| crate::image_io::save_image(p, width, height, &pixels, 1.0));
                 if let Err(e) = saved {
                     eprintln!("pinhole: cannot cache the reference in {}: {e}", p.display());
                 }
             }
-            Ok(Some(Reference { pixels: frame.pixels, width, height, name: source.describe() }))
+            Ok(Some(Reference { pixels, width, height, name: source.describe() }))
         }
     }
 }
@@ -158,6 +193,8 @@ pub fn cache_key(prepared: &PreparedScene, settings: &RenderSettings) -> u64 {
     }
     let mut h = Fnv(0xcbf2_9ce4_8422_2325);
     let s = &prepared.scene;
+    // References rendered in one piece, before the sample ranges, round differently.
+    let _ = write!(h, "ranges of {SAMPLES_PER_RANGE}");
     let _ = write!(h, "{:?}{:?}{:?}{:?}{:?}{:?}", s.camera, s.render, s.lights, s.materials, s.spheres, settings);
     for t in &s.triangles {
         let _ = write!(h, "{t:?}");
@@ -171,6 +208,17 @@ mod tests {
 
     fn prepared(name: &str) -> PreparedScene {
         PreparedScene::new(crate::scene::builtin::load_builtin(name).unwrap().unwrap())
+    }
+
+    #[test]
+    fn references_split_into_ranges_of_at_most_32_samples_covering_all() {
+        assert_eq!(reference_ranges(1), vec![0..1]);
+        assert_eq!(reference_ranges(32), vec![0..32]);
+        assert_eq!(reference_ranges(40), vec![0..20, 20..40]);
+        let r = reference_ranges(256);
+        assert_eq!(r.len(), 8);
+        assert!(r.windows(2).all(|w| w[0].end == w[1].start) && r[0].start == 0 && r[7].end == 256);
+        assert!(r.iter().all(|x| x.len() == 32));
     }
 
     #[test]

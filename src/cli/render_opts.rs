@@ -149,6 +149,10 @@ pub struct RenderOpts {
     /// Display tone map after the exposure: standard | reinhard | aces | agx | khronos-neutral.
     #[arg(long, default_value_t = defaults().display.tonemap.name().to_string(), value_name = "MAP")]
     pub tonemap: String,
+    /// Draw every glossy lobe with this model, its parameter matched to the
+    /// lobe's width: blinn-phong | phong | ggx | beckmann | ward (as the chart's model sweep does).
+    #[arg(long = "glossy-model", value_name = "MODEL")]
+    pub glossy_model: Option<String>,
     /// Display transfer curve: srgb | 2.2 | off.
     #[arg(long, default_value_t = defaults().display.gamma.name().to_string(), value_name = "srgb|2.2|off")]
     pub gamma: String,
@@ -202,6 +206,14 @@ impl RenderOpts {
         }
         // Every number's range, as the viewer checks its saved settings.
         render::settings_check::check(s).map_err(|p| p.for_command_line())
+    }
+
+    /// `--glossy-model`, checked: a change of the scene's materials rather
+    /// than a render setting, applied when the scene is loaded.
+    pub fn glossy_model(&self) -> Result<Option<crate::scene::material::GlossyModel>, String> {
+        let Some(name) = &self.glossy_model else { return Ok(None) };
+        let names: Vec<&str> = crate::scene::material::GlossyModel::NAMES.iter().map(|(n, _)| *n).collect();
+        crate::scene::material::GlossyModel::parse(name).map(Some).ok_or_else(|| format!("--glossy-model {name} is not one of {}", names.join(", ")))
     }
 
     /// The indirect-light options, checked, written into `gi`.

@@ -112,23 +112,45 @@ impl CaseResult {
     }
 }
 
-/// Renders the truth and both settings of `case` and counts their wrong pixels.
-pub fn measure_case(case: &GalleryCase) -> Result<CaseResult, String> {
+/// The three images a case is judged by, at one size.
+pub struct CaseImages {
+    pub truth: Vec<Radiance>,
+    pub failing: Vec<Radiance>,
+    pub cured: Vec<Radiance>,
+    pub width: u32,
+    pub height: u32,
+}
+
+/// Renders the truth and both settings of `case`.
+pub fn render_case(case: &GalleryCase) -> Result<CaseImages, String> {
     let (truth, w, h) = render_setting(case, &case.truth)?;
-    let mut measured = Vec::new();
+    let mut rendered = Vec::new();
     for setting in [&case.failing, &case.cured] {
         let (image, sw, sh) = render_setting(case, setting)?;
         if (sw, sh) != (w, h) {
             return Err(format!("gallery case {}: \"{}\" renders {sw}x{sh} but the truth is {w}x{h}", case.name, setting.description));
         }
-        let wrong = match case.noise_tolerance {
-            Some(relative) => image.iter().zip(&truth).filter(|(a, b)| pixel_wrong_within(**a, **b, relative)).count(),
-            None => wrong_pixels(&image, &truth, w, h),
-        };
-        measured.push(SettingResult { setting: format!("{} {}", setting.renderer, setting.description), wrong_pixels: wrong, image });
+        rendered.push(image);
     }
-    let cured = measured.pop().expect("two settings");
-    let failing = measured.pop().expect("two settings");
+    let cured = rendered.pop().expect("two settings");
+    let failing = rendered.pop().expect("two settings");
+    Ok(CaseImages { truth, failing, cured, width: w, height: h })
+}
+
+/// Counts the wrong pixels of both settings of `case` against the truth.
+pub fn judge(case: &GalleryCase, images: CaseImages) -> Result<CaseResult, String> {
+    let CaseImages { truth, failing, cured, width: w, height: h } = images;
+    let n = w as usize * h as usize;
+    if [&truth, &failing, &cured].iter().any(|i| i.len() != n) {
+        return Err(format!("gallery case {}: its three images are not all {w}x{h}", case.name));
+    }
+    let count = |image: &[Radiance]| match case.noise_tolerance {
+        Some(relative) => image.iter().zip(&truth).filter(|(a, b)| pixel_wrong_within(**a, **b, relative)).count(),
+        None => wrong_pixels(image, &truth, w, h),
+    };
+    let result = |setting: &Setting, image: Vec<Radiance>| SettingResult { setting: format!("{} {}", setting.renderer, setting.description), wrong_pixels: count(&image), image };
+    let failing = result(&case.failing, failing);
+    let cured = result(&case.cured, cured);
     let exposure = crate::scene::builtin::load_builtin(case.scene).and_then(Result::ok).map_or(1.0, |s| s.render.exposure);
     Ok(CaseResult {
         case: case.name.to_string(),
@@ -143,6 +165,11 @@ pub fn measure_case(case: &GalleryCase) -> Result<CaseResult, String> {
         threshold: case.threshold,
         exposure,
     })
+}
+
+/// Renders the truth and both settings of `case` and counts their wrong pixels.
+pub fn measure_case(case: &GalleryCase) -> Result<CaseResult, String> {
+    judge(case, render_case(case)?)
 }
 
 #[cfg(test)]

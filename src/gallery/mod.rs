@@ -11,4 +11,4 @@ pub mod measure;
 pub mod sheet;
 
 pub use cases::{cases, case_by_name, GalleryCase, Setting};
-pub use measure::{measure_case, render_setting, wrong_pixels, CaseResult, SettingResult};
+pub use measure::{judge, measure_case, render_case, render_setting, wrong_pixels, CaseImages, CaseResult, SettingResult};
