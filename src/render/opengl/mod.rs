@@ -72,13 +72,6 @@ impl Renderer for OpenGl {
         "the scene through OpenGL (CGPP 15.7): vertex and fragment shaders, GL's rasterizer and depth test, headless EGL"
     }
 
-    fn check_camera(&self, camera: &crate::scene::Camera) -> Result<(), String> {
-        if let crate::scene::camera::Projection::Orthographic { .. } = camera.projection {
-            return Err("opengl does not draw [camera] projection = \"orthographic\": its shaders divide by depth for perspective; use rasterize:fixed, raytrace:bvh or raytrace:brute".into());
-        }
-        crate::render::camera_support::check_rasterized(self.name(), camera)
-    }
-
     fn check(&self, scene: &Scene, settings: &RenderSettings) -> Result<(), String> {
         crate::render::accel::csg::check(scene, settings)?;
         csg_data::build(&scene.csgs)?;
