@@ -3,8 +3,9 @@
 //! orthographic camera is used; the thin lens equals the pinhole at
 //! aperture 0 bit for bit, keeps its plane in focus sharp and blurs an edge
 //! off it by the circle of confusion worked out by hand; the projections
-//! that bend lines render in the ray casters; the rasterizers refuse what
-//! they cannot draw in one sentence; bad values are refused naming the
+//! that bend lines render in the ray casters; the CPU rasterizers draw the
+//! orthographic camera (parallel lines parallel, the brute-force caster's
+//! pixels) and refuse what they cannot draw in one sentence; bad values are refused naming the
 //! file and the key.
 
 mod common;
@@ -119,6 +120,47 @@ fn orthographic_ray_casters_agree_with_brute_force_and_replay() {
     }
 }
 
+/// The CPU rasterizers that draw orthographic cameras: every variant but
+/// the painter's algorithm, whose draw order needs an eye point.
+fn orthographic_rasterizers() -> Vec<&'static str> {
+    renderer_names().into_iter().filter(|n| n.starts_with("rasterize:") && *n != "rasterize:painter").collect()
+}
+
+#[test]
+fn orthographic_rasterizers_keep_parallel_lines_parallel() {
+    let (w, h) = (160, 120);
+    let scene = scene_of(&stripes("projection = \"orthographic\"\nheight = 6.0"));
+    for name in orthographic_rasterizers() {
+        let sep = stripe_separations(&render(name, &scene, &settings(&scene, w, h, 1, View::Id)), w, h);
+        assert!(sep.len() > 40, "{name}: the stripes show in only {} rows", sep.len());
+        // The near ends (bottom rows) and the far ends (top rows) alike: 20 pixels by hand.
+        let (near, far) = (sep[sep.len() - 1], sep[0]);
+        let (lo, hi) = sep.iter().fold((f32::MAX, f32::MIN), |(a, b), &s| (a.min(s), b.max(s)));
+        assert!(hi - lo <= 1.0 && (lo - 20.0).abs() <= 1.0 && (hi - 20.0).abs() <= 1.0, "{name}: separation over [{lo}, {hi}] pixels (near end {near}, far end {far}), 20 by hand");
+    }
+}
+
+/// The share of pixels of `a` and `b` equal within the tolerance the
+/// rasterizer agreement tests use (1e-4 relative, 1e-2 with textures).
+fn agreement(a: &[Radiance], b: &[Radiance], tol: f32) -> f32 {
+    let same = a.iter().zip(b).filter(|(a, b)| (**a - **b).abs().max_element() <= tol * a.abs().max_element().max(b.abs().max_element()).max(1e-3)).count();
+    same as f32 / a.len() as f32
+}
+
+#[test]
+fn orthographic_rasterizers_agree_with_brute_force() {
+    for name in ["spheres", "cornell-box", "textures"] {
+        let scene = orthographic(common::builtin(name));
+        let tol = if scene.has_textures() { 1e-2 } else { 1e-4 };
+        let s = settings(&scene, 96, 64, 1, View::Shaded);
+        let reference = render("raytrace:brute", &scene, &s);
+        for r in orthographic_rasterizers() {
+            let share = agreement(&reference, &render(r, &scene, &s), tol);
+            assert!(share >= 0.995, "{name}: {r} agrees with raytrace:brute on {:.2}% of pixels", 100.0 * share);
+        }
+    }
+}
+
 #[test]
 fn rasterizers_refuse_cameras_they_cannot_draw_in_one_sentence() {
     let mut cases = vec![("orthographic", orthographic(common::builtin("spheres")))];
@@ -135,7 +177,9 @@ fn rasterizers_refuse_cameras_they_cannot_draw_in_one_sentence() {
         for name in renderer_names() {
             let r = renderer_by_name(name).unwrap();
             let answer = admit(r.as_ref(), scene, &s);
-            if name.starts_with("raytrace:") {
+            // Orthographic: every rasterizer but the painter's, and opengl (tests/opengl.rs draws it).
+            let draws_orthographic = orthographic_rasterizers().contains(&name) || name == "opengl";
+            if name.starts_with("raytrace:") || (*what == "orthographic" && draws_orthographic) {
                 assert!(answer.is_ok(), "{name} refuses {what}: {answer:?}");
                 continue;
             }
@@ -143,7 +187,11 @@ fn rasterizers_refuse_cameras_they_cannot_draw_in_one_sentence() {
             assert!(e.contains(what) && e.contains(name) && e.contains("raytrace:bvh"), "{name} on {what}: {e}");
             assert_eq!(e.matches(". ").count(), 0, "not one sentence: {e}");
             if matches!(*what, "fisheye" | "cylindrical") {
-                assert!(e.contains("straight lines"), "{e}");
+                assert!(e.contains("straight lines to stay straight"), "{e}");
+            }
+            if *what == "orthographic" {
+                assert_eq!(name, "rasterize:painter", "{e}");
+                assert!(e.contains("eye point"), "{e}");
             }
         }
     }

@@ -705,3 +705,47 @@ fn gl_environment_light_agrees_with_the_cpu_without_shadows() {
     assert!(error <= noise, "GL's environment light is {:.2}% off, the CPU's noise {:.2}%", error * 100.0, noise * 100.0);
     assert!(unlit > 4.0 * noise, "the comparison cannot tell: {:.2}%", unlit * 100.0);
 }
+
+/// `sc` seen through an orthographic camera as high as its perspective
+/// view is at the target's distance.
+fn orthographic(mut sc: Scene) -> Scene {
+    let c = &sc.camera;
+    let fov_y = match c.fov {
+        pinhole::scene::Fov::Y(d) => d,
+        pinhole::scene::Fov::X(d) => d * sc.render.height as f32 / sc.render.width as f32,
+    };
+    let height = 2.0 * (c.target - c.eye).length() * (fov_y.to_radians() * 0.5).tan();
+    sc.camera.projection = pinhole::scene::camera::Projection::Orthographic { height };
+    sc
+}
+
+#[test]
+fn gl_orthographic_camera_agrees_with_brute_force() {
+    // Parallel rays in the vertex shader (w = 1, depth linear), the
+    // fragments' eye rays, the spheres' and CSG objects' ray tests and
+    // the texture footprints: every part of GL's camera.
+    let Some(_) = driver() else { return };
+    let gl = renderer_by_name("opengl").unwrap();
+    let brute = renderer_by_name("raytrace:brute").unwrap();
+    let names = agreement_scenes();
+    let mut drawn = 0;
+    for name in ["spheres", "textures", "csg", "cornell-box"] {
+        if !names.contains(&name) {
+            continue;
+        }
+        let sc = orthographic(scene(name));
+        let s = RenderSettings { width: 96, height: 64, reflections: pinhole::render::Reflections::Env, ..settings(&sc) };
+        pinhole::render::admit::admit(gl.as_ref(), &sc, &s).unwrap_or_else(|e| panic!("{name}: refused: {e}"));
+        let prepared = PreparedScene::new(sc.clone());
+        let a = render(gl.as_ref(), &prepared, &s);
+        let b = render(brute.as_ref(), &prepared, &s);
+        let (fraction, wrong) = agreement(&a, &b);
+        eprintln!("{name} orthographic: {:.3}% agree ({wrong} pixels differ)", fraction * 100.0);
+        assert!(fraction >= 0.995, "{name} orthographic: opengl agrees with raytrace:brute on only {:.3}% of pixels", fraction * 100.0);
+        // Not the perspective image: the camera really changed.
+        let perspective = render(gl.as_ref(), &PreparedScene::new(scene(name)), &s);
+        assert!(agreement(&perspective, &a).1 > 300, "{name}: the orthographic image looks like the perspective one");
+        drawn += 1;
+    }
+    assert!(drawn >= 3, "only {drawn} scenes drawn");
+}

@@ -344,9 +344,28 @@ pub fn cases() -> Vec<GalleryCase> {
             size: Some((160, 100)),
             noise_tolerance: None,
         },
+        GalleryCase {
+            name: "thin-lens",
+            scene: "spheres",
+            method: "camera",
+            knob: "aperture",
+            explanation: "a pinhole sees everything sharp; a lens of radius 0.15 focused 2 units away blurs the blue and green spheres at depth 4 over a disk 0.15 (1 - 2/4) = 0.075 units in radius on the plane in focus, 7.5 pixels across, which the pinhole image lacks; the lens needs many samples per pixel to draw its blur without noise",
+            failing: Setting::new("raytrace", "aperture = 0 (pinhole) --spp 256", |s| s.spp = 256),
+            cured: Setting { transform: Some(thin_lens), ..Setting::new("raytrace", "aperture = 0.15, focus_distance = 2 --spp 256", |s| s.spp = 256) },
+            truth: Setting { transform: Some(thin_lens), ..Setting::new("raytrace", "aperture = 0.15, focus_distance = 2 --spp 1024", |s| s.spp = 1024) },
+            threshold: 400,
+            size: Some((160, 100)),
+            noise_tolerance: Some(0.25),
+        },
     ];
     all.extend(area_light_cases());
     all
+}
+
+/// The thin-lens case's camera: focused on the front of the red sphere.
+fn thin_lens(scene: &mut Scene) {
+    scene.camera.aperture = 0.15;
+    scene.camera.focus_distance = 2.0;
 }
 
 

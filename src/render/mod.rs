@@ -588,7 +588,7 @@ fn resolve_with<Q: SceneQuery, R: Recorder>(job: &PassJob, query: &Q, ray: &Ray,
             let shaded = with_shading_hit(job.settings.interpolation, h, |s| transport::shade::shade(&mut sh, s, -ray.dir, 0));
             match shaded {
                 Some(radiance) => radiance,
-                None => transport::shade::shade_gouraud(&mut sh, h, job.view.eye),
+                None => transport::shade::shade_gouraud(&mut sh, h, job.view),
             }
         }
         (inspect::debug::View::Shaded, None) => {

@@ -170,10 +170,16 @@ impl CameraView {
     }
 
     /// Whether every eye ray leaves the eye itself through a plane image:
-    /// perspective with no lens, the camera the rasterizers and the ray
-    /// casters' packets (`eye_ray_lanes`) are written for.
+    /// perspective with no lens, the camera the ray casters' packets and
+    /// their test for empty tiles are written for.
     pub fn is_pinhole(&self) -> bool {
         self.projection == Projection::Perspective && self.aperture == 0.0
+    }
+
+    /// Whether the eye rays are parallel (an orthographic camera): depth is
+    /// then affine across the image and nothing divides by it.
+    pub fn is_orthographic(&self) -> bool {
+        matches!(self.projection, Projection::Orthographic { .. })
     }
 
     /// The image position `(px, py)` in pixels scaled to the half extents.
@@ -233,25 +239,38 @@ impl CameraView {
         (ray, (self.far - self.near) * per_depth * d.length())
     }
 
-    /// `camera_dir` of the perspective projection (`is_pinhole` cameras
-    /// only) for lanes of image positions, with its arithmetic in
+    /// `camera_dir` of the perspective and orthographic projections (the
+    /// straight ones a rasterizer draws) for lanes of image positions, with its arithmetic in
     /// the same order (glam's), so a tile's eye rays made eight at a time
     /// are bit for bit the ones `eye_ray` makes for a pixel replay (a test
     /// holds them to it). The one-pixel functions above stay in glam's form,
     /// which the compiler turns into fewer instructions for a single ray.
     #[inline(always)]
     pub fn camera_dir_lanes<L: Lane>(&self, px: L, py: L) -> V3<L> {
+        if let Projection::Orthographic { .. } = self.projection {
+            return V3::new(px.splat(0.0), px.splat(0.0), px.splat(-1.0));
+        }
         let (one, two) = (px.splat(1.0), px.splat(2.0));
         let sx = (two * px / px.splat(self.width as f32) - one) * px.splat(self.half_x);
         let sy = (one - two * py / px.splat(self.height as f32)) * px.splat(self.half_y);
         V3::new(sx, sy, px.splat(-1.0))
     }
 
-    /// `eye_ray` for lanes: origins and unit directions.
+    /// `eye_ray` for lanes: origins and unit directions. Orthographic rays
+    /// start beside the axis, at the image position on the near plane.
     #[inline(always)]
     pub fn eye_ray_lanes<L: Lane>(&self, px: L, py: L) -> (V3<L>, V3<L>) {
         let d = self.camera_dir_lanes(px, py);
-        let origin = V3::splat(px, self.eye) + self.to_world_lanes(d.scale(px.splat(self.near)));
+        let start = match self.projection {
+            Projection::Orthographic { .. } => {
+                let (one, two) = (px.splat(1.0), px.splat(2.0));
+                let sx = (two * px / px.splat(self.width as f32) - one) * px.splat(self.half_x);
+                let sy = (one - two * py / px.splat(self.height as f32)) * px.splat(self.half_y);
+                V3::new(sx, sy, px.splat(-self.near))
+            }
+            _ => d.scale(px.splat(self.near)),
+        };
+        let origin = V3::splat(px, self.eye) + self.to_world_lanes(start);
         (origin, self.to_world_lanes(d).normalize())
     }
 
@@ -319,6 +338,17 @@ impl CameraView {
     pub fn forward(&self) -> Vec3 {
         -self.camera_to_world.z_axis
     }
+
+    /// The world direction (not of unit length) from `p` back towards
+    /// the camera along the eye ray that sees it: towards the eye for the
+    /// projections through one centre, the camera's backward axis for
+    /// parallel rays, whose eye lies at infinity.
+    pub fn toward_viewer(&self, p: Vec3) -> Vec3 {
+        match self.projection {
+            Projection::Orthographic { .. } => self.camera_to_world.z_axis,
+            _ => self.eye - p,
+        }
+    }
 }
 
 #[cfg(test)]
@@ -340,6 +370,8 @@ mod tests {
         let cameras = [
             book_camera(),
             Camera { eye: Vec3::new(0.3, 1.7, -2.9), target: Vec3::new(-0.4, 0.2, 0.5), fov: Fov::Y(37.0), near: 0.013, far: 71.0, ..Camera::default() }.view(641, 359),
+            // Parallel rays, which a rasterizer's shading makes in lanes too.
+            Camera { eye: Vec3::new(0.3, 1.7, -2.9), target: Vec3::new(-0.4, 0.2, 0.5), projection: Projection::Orthographic { height: 3.1 }, near: 0.013, far: 71.0, ..Camera::default() }.view(641, 359),
         ];
         for view in &cameras {
             let mut state = 0x2545_f491_u32;

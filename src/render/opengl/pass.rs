@@ -287,6 +287,7 @@ unsafe fn uniforms(gl: &glow::Context, program: glow::Program, job: &PassJob, en
         gl.uniform_2_f32(at("ndc_shift").as_ref(), (0.5 - job.offset.x) * 2.0 / w, (job.offset.y - 0.5) * 2.0 / h);
         gl.uniform_1_f32(at("near_plane").as_ref(), view.near);
         gl.uniform_1_f32(at("far_plane").as_ref(), view.far);
+        gl.uniform_1_i32(at("orthographic").as_ref(), view.is_orthographic() as i32);
         let a = scene.render.ambient;
         gl.uniform_3_f32(at("ambient").as_ref(), a.x, a.y, a.z);
         gl.uniform_1_i32(at("light_count").as_ref(), scene.lights.len() as i32);

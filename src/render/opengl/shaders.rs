@@ -48,6 +48,8 @@ uniform vec2 image_size;
 uniform vec2 sample_offset;
 uniform float near_plane;
 uniform float far_plane;
+// Parallel eye rays down the view axis (CameraView::is_orthographic).
+uniform bool orthographic;
 uniform vec3 ambient;
 uniform int light_count;
 uniform bool y_down;
@@ -431,13 +433,40 @@ vec2 sample_shift() {
 #endif
 }
 
-// Camera-space direction (z = -1) through this fragment's sample, pixel rows top-down.
-vec3 camera_dir() {
+// Camera-space point (z = -1) of the image plane at this fragment's sample,
+// pixel rows top-down.
+vec3 image_point() {
     vec2 shift = sample_shift();
     float px = floor(gl_FragCoord.x) + sample_offset.x + shift.x;
     float row = y_down ? floor(gl_FragCoord.y) : image_size.y - 1.0 - floor(gl_FragCoord.y);
     float py = row + sample_offset.y + shift.y;
     return vec3((2.0 * px / image_size.x - 1.0) * half_extent.x, (1.0 - 2.0 * py / image_size.y) * half_extent.y, -1.0);
+}
+
+// Camera-space direction of this fragment's eye ray: through the image
+// point (z = -1), or down the view axis along parallel rays.
+vec3 camera_dir() {
+    return orthographic ? vec3(0.0, 0.0, -1.0) : image_point();
+}
+
+// Camera-space start of this fragment's eye ray on the near plane, as
+// CameraView::eye_ray places it (beside the axis along parallel rays).
+vec3 ray_start() {
+    return orthographic ? vec3(image_point().xy, -near_plane) : camera_dir() * near_plane;
+}
+
+// How far the eye ray's start moves per pixel step `step` (camera space,
+// in the image plane) at view depth `w`: the step itself along parallel
+// rays, the step scaled by depth through one centre.
+vec3 ray_step(vec3 step, float w) {
+    return orthographic ? step : step * w;
+}
+
+// The reversed depth (near 1, far 0) GL stores for view depth `w`: 1/w
+// rescaled through one centre, linear in w along parallel rays.
+float stored_depth(float w) {
+    if (orthographic) return clamp((far_plane - w) / (far_plane - near_plane), 0.0, 1.0);
+    return clamp(near_plane * (far_plane - w) / ((far_plane - near_plane) * w), 0.0, 1.0);
 }
 
 vec3 normalize_or_zero(vec3 v) {
@@ -736,6 +765,7 @@ uniform vec2 ndc_shift;
 uniform bool y_down;
 uniform float near_plane;
 uniform float far_plane;
+uniform bool orthographic;
 out vec3 v_position;
 out vec3 v_normal;
 flat out vec3 v_face_normal;
@@ -779,9 +809,10 @@ void main() {
     uint primitive = uint(gl_VertexID / 3);
 #endif
     vec3 c = world_to_camera * (p - eye);
-    float w = -c.z;
-    // Reversed depth with glClipControl(ZERO_TO_ONE): near -> 1, far -> 0.
-    float z = near_plane * (far_plane - w) / (far_plane - near_plane);
+    // Reversed depth with glClipControl(ZERO_TO_ONE): near -> 1, far -> 0;
+    // parallel rays divide by nothing (w = 1), and their depth is linear.
+    float w = orthographic ? 1.0 : -c.z;
+    float z = orthographic ? (far_plane + c.z) / (far_plane - near_plane) : near_plane * (far_plane - w) / (far_plane - near_plane);
     gl_Position = vec4(c.x / half_extent.x + ndc_shift.x * w, (c.y / half_extent.y + ndc_shift.y * w) * (y_down ? -1.0 : 1.0), z, w);
     v_position = p;
     v_normal = world_normal;
@@ -844,7 +875,7 @@ void main() {
             vec3 steps[2] = vec3[2](camera_to_world * vec3(2.0 * half_extent.x / image_size.x, 0.0, 0.0), camera_to_world * vec3(0.0, -2.0 * half_extent.y / image_size.y, 0.0));
             vec2 d[2];
             for (int k = 0; k < 2; k++) {
-                vec3 dd = steps[k] * t;
+                vec3 dd = ray_step(steps[k], t);
                 vec3 dp = dd - big_d * (dot(dd, g) / facing);
                 float a = (yy * dot(ex, dp) - xy * dot(ey, dp)) / det;
                 float b = (xx * dot(ey, dp) - xy * dot(ex, dp)) / det;
@@ -888,6 +919,7 @@ uniform vec2 ndc_shift;
 uniform bool y_down;
 uniform float near_plane;
 uniform float far_plane;
+uniform bool orthographic;
 // Spheres are drawn one material at a time: the first one of this draw.
 uniform int first_sphere;
 flat out int v_sphere;
@@ -897,8 +929,8 @@ void main() {
     // Slightly larger than the sphere, so its silhouette is always inside.
     vec3 position = s.xyz + corner * (s.w * 1.01);
     vec3 c = world_to_camera * (position - eye);
-    float w = -c.z;
-    float z = near_plane * (far_plane - w) / (far_plane - near_plane);
+    float w = orthographic ? 1.0 : -c.z;
+    float z = orthographic ? (far_plane + c.z) / (far_plane - near_plane) : near_plane * (far_plane - w) / (far_plane - near_plane);
     gl_Position = vec4(c.x / half_extent.x + ndc_shift.x * w, (c.y / half_extent.y + ndc_shift.y * w) * (y_down ? -1.0 : 1.0), z, w);
     v_sphere = index;
 }
@@ -917,7 +949,7 @@ void main() {
     uint m = spheres[v_sphere].material.x;
     vec3 d = camera_dir();
     vec3 dir = normalize(camera_to_world * d);
-    vec3 origin = eye + camera_to_world * (d * near_plane);
+    vec3 origin = eye + camera_to_world * ray_start();
     // The ray tracer's test (intersect_sphere): from outside only, 0 < t < far.
     vec3 f = origin - s.xyz;
     float b = -dot(f, dir);
@@ -939,7 +971,7 @@ void main() {
     vec3 steps[2] = vec3[2](camera_to_world * vec3(2.0 * half_extent.x / image_size.x, 0.0, 0.0), camera_to_world * vec3(0.0, -2.0 * half_extent.y / image_size.y, 0.0));
     vec2 duv[2];
     for (int k = 0; k < 2; k++) {
-        vec3 dd = steps[k] * w;
+        vec3 dd = ray_step(steps[k], w);
         vec3 dp = dd - big_d * (dot(dd, o) / dot(big_d, o));
         vec3 q = dp / s.w;
         float ring = max(o.x * o.x + o.z * o.z, 1e-12);
@@ -957,7 +989,7 @@ void main() {
 #ifdef VIEWS
     write_surface(p, n, back, g, vec3(0.0), uv, 1u, uint(v_sphere));
 #endif
-    gl_FragDepth = clamp(near_plane * (far_plane - w) / ((far_plane - near_plane) * w), 0.0, 1.0);
+    gl_FragDepth = stored_depth(w);
     colour = vec4(shade(p, n, vec3(o.z, 0.0, -o.x), g, -dir, m, albedo_at(m, uv, duv[0], duv[1])) + emitted(m, back), 1.0);
 }
 "#
@@ -1102,6 +1134,7 @@ uniform vec2 ndc_shift;
 uniform bool y_down;
 uniform float near_plane;
 uniform float far_plane;
+uniform bool orthographic;
 uniform int csg_object;
 void main() {
     vec3 lo = csg_objects[3 * csg_object + 1].xyz;
@@ -1111,8 +1144,8 @@ void main() {
     vec3 grow = half_size * 0.01 + vec3(1e-4 * length(half_size) + 1e-6);
     vec3 position = (lo + hi) * 0.5 + corner * (half_size + grow);
     vec3 c = world_to_camera * (position - eye);
-    float w = -c.z;
-    float z = near_plane * (far_plane - w) / (far_plane - near_plane);
+    float w = orthographic ? 1.0 : -c.z;
+    float z = orthographic ? (far_plane + c.z) / (far_plane - near_plane) : near_plane * (far_plane - w) / (far_plane - near_plane);
     gl_Position = vec4(c.x / half_extent.x + ndc_shift.x * w, (c.y / half_extent.y + ndc_shift.y * w) * (y_down ? -1.0 : 1.0), z, w);
 }
 "#;
@@ -1307,7 +1340,7 @@ void combine(uint op, int s) {
 void main() {
     vec3 d = camera_dir();
     ray_dir = normalize(camera_to_world * d);
-    ray_origin = eye + camera_to_world * (d * near_plane);
+    ray_origin = eye + camera_to_world * ray_start();
     float t_max = (far_plane - near_plane) * length(d);
     uvec4 header = floatBitsToUint(csg_objects[3 * csg_object]);
     int first = int(header.x), count = int(header.y);
@@ -1400,7 +1433,7 @@ void main() {
     out_id.z = m;
 #endif
     float depth = dot(p - eye, -camera_to_world[2]);
-    gl_FragDepth = clamp(near_plane * (far_plane - depth) / ((far_plane - near_plane) * depth), 0.0, 1.0);
+    gl_FragDepth = stored_depth(depth);
     // CSG hits carry no footprint: the finest texture level.
     colour = vec4(shade(p, n, vec3(0.0), g, -ray_dir, m, albedo_at(m, uv, vec2(0.0), vec2(0.0))) + emitted(m, back), 1.0);
 }

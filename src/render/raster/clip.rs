@@ -36,14 +36,41 @@ named_enum! {
 /// below it, so no sample inside the image is ever cut off.
 pub const GUARD_PIXELS: f32 = 2.0;
 
+/// A plane of the view volume in camera space: a point `p` is inside
+/// when `n . p + d >= 0`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SidePlane {
+    pub n: Vec3,
+    pub d: f32,
+}
+
+impl SidePlane {
+    /// How far inside `p` lies, in units of `|n|`.
+    #[inline]
+    pub fn distance(&self, p: Vec3) -> f32 {
+        self.n.dot(p) + self.d
+    }
+
+    /// The same plane with a unit normal.
+    pub fn normalized(&self) -> SidePlane {
+        let l = self.n.length();
+        SidePlane { n: self.n / l, d: self.d / l }
+    }
+}
+
 /// The side planes of the view volume grown by `GUARD_PIXELS`, in camera
-/// space, as inward normals through the eye: a point `p` is inside when
-/// `n . p >= 0` for all four.
-pub fn side_planes(view: &CameraView) -> [Vec3; 4] {
+/// space, with inward normals: through the eye for a perspective camera,
+/// parallel to the view axis for an orthographic one.
+pub fn side_planes(view: &CameraView) -> [SidePlane; 4] {
     let gx = view.half_x * (1.0 + 2.0 * GUARD_PIXELS / view.width.max(1) as f32);
     let gy = view.half_y * (1.0 + 2.0 * GUARD_PIXELS / view.height.max(1) as f32);
+    if view.is_orthographic() {
+        // |x| <= gx  <=>  gx - x >= 0 and gx + x >= 0, and so on.
+        let plane = |n: Vec3, d: f32| SidePlane { n, d };
+        return [plane(Vec3::NEG_X, gx), plane(Vec3::X, gx), plane(Vec3::NEG_Y, gy), plane(Vec3::Y, gy)];
+    }
     // x / -z <= gx  <=>  gx * -z - x >= 0, and so on.
-    [Vec3::new(-1.0, 0.0, -gx), Vec3::new(1.0, 0.0, -gx), Vec3::new(0.0, -1.0, -gy), Vec3::new(0.0, 1.0, -gy)]
+    [Vec3::new(-1.0, 0.0, -gx), Vec3::new(1.0, 0.0, -gx), Vec3::new(0.0, -1.0, -gy), Vec3::new(0.0, 1.0, -gy)].map(|n| SidePlane { n, d: 0.0 })
 }
 
 /// What clipping against the whole view volume leaves of a triangle.
@@ -62,13 +89,13 @@ pub enum FrustumClip {
 /// other). Only the box of what is left is kept: the pixels a triangle can
 /// cover. A triangle wholly inside or wholly outside one plane is decided
 /// from its corners alone.
-pub fn clip_frustum(c: [Vec3; 3], view: &CameraView, planes: &[Vec3; 4]) -> FrustumClip {
+pub fn clip_frustum(c: [Vec3; 3], view: &CameraView, planes: &[SidePlane; 4]) -> FrustumClip {
     let mut inside = c.iter().all(|p| -p.z >= view.near);
     if c.iter().all(|p| -p.z < view.near) {
         return FrustumClip::Outside;
     }
     for n in planes {
-        let d = c.map(|p| n.dot(p));
+        let d = c.map(|p| n.distance(p));
         if d.iter().all(|&d| d < 0.0) {
             return FrustumClip::Outside;
         }
@@ -85,7 +112,7 @@ pub fn clip_frustum(c: [Vec3; 3], view: &CameraView, planes: &[Vec3; 4]) -> Frus
 
 /// The image-space box of what clipping `c` against the near plane and the
 /// side planes leaves, or `None` when nothing is.
-pub fn clip_frustum_box(c: [Vec3; 3], view: &CameraView, planes: &[Vec3; 4]) -> Option<(Vec2, Vec2)> {
+pub fn clip_frustum_box(c: [Vec3; 3], view: &CameraView, planes: &[SidePlane; 4]) -> Option<(Vec2, Vec2)> {
     const MAX: usize = 3 + 5;
     let mut poly = [Vec3::ZERO; MAX];
     let mut next = [Vec3::ZERO; MAX];
@@ -114,7 +141,7 @@ pub fn clip_frustum_box(c: [Vec3; 3], view: &CameraView, planes: &[Vec3; 4]) -> 
         if n == 0 {
             return None;
         }
-        n = cut(&mut poly, n, &|p: Vec3| plane.dot(p));
+        n = cut(&mut poly, n, &|p: Vec3| plane.distance(p));
     }
     if n == 0 {
         return None;

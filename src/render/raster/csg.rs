@@ -32,7 +32,7 @@ use crate::render::raster::abuffer::ABuffer;
 use crate::render::raster::clip::{clip_near, triangle_vertices};
 use crate::render::raster::fixed::FixedTri;
 use crate::render::raster::rect::PixelRect;
-use crate::render::raster::setup::ScreenTri;
+use crate::render::raster::setup::{project_piece, ScreenTri};
 use crate::render::raster::sphere::sphere_bounds;
 use crate::render::raster::subpixel::snap_offset;
 use crate::render::raster::vis_buffer::{DepthKey, FragmentRecorder, VisBuffer};
@@ -93,13 +93,11 @@ fn setup_operand_mesh(view: &CameraView, csg: &Csg, first: u32, end: u32, off: V
         let n = (t.v[1] - t.v[0]).cross(t.v[2] - t.v[0]);
         // Every eye ray meets the plane from the eye's side: against the
         // outward normal (an entry) when the eye lies in front of it.
-        let entering = (view.eye - t.v[0]).dot(n) > 0.0;
+        let entering = view.toward_viewer(t.v[0]).dot(n) > 0.0;
         let c = t.v.map(|v| view.to_camera(v));
         for piece in clip_near(triangle_vertices(c), view.near).as_slice() {
-            let p = piece.map(|v| view.project_camera(v.pos));
-            let inv_z = piece.map(|v| 1.0 / -v.pos.z);
-            let bz = [piece[0].bary * inv_z[0], piece[1].bary * inv_z[1], piece[2].bary * inv_z[2]];
-            let Some(st) = ScreenTri::new(index, p, inv_z, bz, off, view.width, view.height) else { continue };
+            let (p, depth, bz) = project_piece(view, piece);
+            let Some(st) = ScreenTri::new(index, p, depth, bz, !view.is_orthographic(), off, view.width, view.height) else { continue };
             if let Some(ft) = FixedTri::new(&st, snapped, off, view.width, view.height) {
                 out.push((ft, entering));
             }
@@ -150,7 +148,7 @@ fn scan_convert<Q: SceneQuery, R: FragmentRecorder>(vb: &mut VisBuffer<Q, R>, ci
                 for (ft, entering) in tris {
                     let v = &csg.triangles[ft.st.tri as usize].v;
                     crate::render::raster::fixed::raster(ft, r, off, &mut tested, |x, y, l| {
-                        let [b1, b2] = ft.st.bary_at(l, ft.st.inv_z_at(l));
+                        let [b1, b2] = ft.st.bary_at(l, ft.st.affine_depth_at(l));
                         let p = job.sample_position(x, y);
                         let ray = view.eye_ray(p.x, p.y);
                         let point = v[0] * (1.0 - b1 - b2) + v[1] * b1 + v[2] * b2;
@@ -218,7 +216,7 @@ fn resolve<Q: SceneQuery, R: FragmentRecorder>(vb: &mut VisBuffer<Q, R>, ci: u32
                 let key = match vb.key {
                     DepthKey::RayT => b.t,
                     // The eye ray starts on the near plane: depth = near + t / |d|.
-                    DepthKey::NegInvZ => vb.enc.key(1.0 / (view.near + b.t / view.camera_dir(p.x, p.y).length())),
+                    DepthKey::NegInvZ => vb.enc.key_at_depth(view.near + b.t / view.camera_dir(p.x, p.y).length()),
                 };
                 vb.csg_fragment(x, y, ci, b, key);
             }

@@ -5,7 +5,7 @@
 //! skipping it changes no pixel; the side planes are those of
 //! `clip::side_planes`, a little outside the image.
 
-use crate::render::raster::clip::side_planes;
+use crate::render::raster::clip::{side_planes, SidePlane};
 use crate::render::PassJob;
 use crate::scene::{CameraView, InstanceInfo, Scene};
 use std::ops::Range;
@@ -22,14 +22,14 @@ pub struct Visible {
 
 /// The view volume's planes in camera space, for spheres.
 pub struct Frustum {
-    sides: [glam::Vec3; 4],
+    sides: [SidePlane; 4],
     near: f32,
     far: f32,
 }
 
 impl Frustum {
     pub fn new(view: &CameraView) -> Frustum {
-        Frustum { sides: side_planes(view).map(|n| n.normalize()), near: view.near, far: view.far }
+        Frustum { sides: side_planes(view).map(|p| p.normalized()), near: view.near, far: view.far }
     }
 
     /// False when the sphere lies wholly outside one of the planes.
@@ -40,7 +40,7 @@ impl Frustum {
         if -c.z + r < self.near || -c.z - r > self.far {
             return false;
         }
-        self.sides.iter().all(|n| n.dot(c) >= -r)
+        self.sides.iter().all(|p| p.distance(c) >= -r)
     }
 }
 

@@ -28,6 +28,12 @@
 //!   as farther than it is and what lies just behind it shows through.
 //!   Wrong on purpose, for the lesson; spheres keep their exact ray depth.
 //!
+//! Through an orthographic camera every eye ray is parallel, and the view
+//! depth z itself is affine in image space: the buffer then interpolates z,
+//! `f32` stores it as it is, and the fixed-point formats store what a GPU's
+//! orthographic projection gives, d = (z - n) / (f - n), whose steps are
+//! spread evenly from the near plane to the far one (reversed: 1 - d).
+//!
 //! Only the variants with 2D weights (barycentric, incremental, scanline,
 //! fixed, tiled) store depth keys; naive and bbox compare exact ray
 //! parameters as the ray casters do, the painter keeps no depth buffer,
@@ -53,13 +59,17 @@ named_enum! {
     }
 }
 
-/// The format with the camera's near and far distances: turns 1/z into the
-/// key the buffer stores and back.
+/// The format with the camera's near and far distances and projection:
+/// turns the depth value a rasterizer interpolates (1/z, or z through an
+/// orthographic camera: `ScreenTri::affine_depth`) into the key the buffer
+/// stores and back.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DepthEncoding {
     pub format: DepthFormat,
     pub near: f32,
     pub far: f32,
+    /// Parallel eye rays: the interpolated value is the view depth itself.
+    pub orthographic: bool,
 }
 
 impl DepthFormat {
@@ -85,23 +95,44 @@ impl DepthFormat {
 }
 
 impl DepthEncoding {
+    /// The encoding for a camera seen through a perspective projection.
     pub fn new(format: DepthFormat, near: f32, far: f32) -> DepthEncoding {
-        DepthEncoding { format, near, far }
+        DepthEncoding { format, near, far, orthographic: false }
     }
 
-    /// The key stored for a fragment at 1 / view depth `inv_z`: smaller is nearer.
+    /// The encoding for `view`'s near and far planes and projection.
+    pub fn for_view(format: DepthFormat, view: &crate::scene::CameraView) -> DepthEncoding {
+        DepthEncoding { format, near: view.near, far: view.far, orthographic: view.is_orthographic() }
+    }
+
+    /// The key stored for a fragment whose interpolated depth value is
+    /// `value`: 1 / view depth, or the view depth itself when
+    /// `orthographic`. Smaller is nearer.
     #[inline(always)]
-    pub fn key(&self, inv_z: f32) -> f32 {
+    pub fn key(&self, value: f32) -> f32 {
         match self.format {
-            DepthFormat::F32 | DepthFormat::LinearZ => -inv_z,
-            _ => self.key_slow(inv_z),
+            DepthFormat::F32 | DepthFormat::LinearZ if !self.orthographic => -value,
+            _ => self.key_slow(value),
+        }
+    }
+
+    /// The key stored for a fragment at view depth `z` (a ray test's hit).
+    #[inline]
+    pub fn key_at_depth(&self, z: f32) -> f32 {
+        if self.orthographic {
+            self.key(z)
+        } else {
+            self.key(1.0 / z)
         }
     }
 
     #[inline(never)]
-    fn key_slow(&self, inv_z: f32) -> f32 {
+    fn key_slow(&self, value: f32) -> f32 {
+        if self.orthographic {
+            return self.linear_key(value);
+        }
         let (n, f) = (self.near as f64, self.far as f64);
-        let inv_z = inv_z as f64;
+        let inv_z = value as f64;
         match self.format {
             DepthFormat::F32 | DepthFormat::LinearZ => -inv_z as f32,
             DepthFormat::Reversed => -((n * (f * inv_z - 1.0) / (f - n)) as f32),
@@ -115,10 +146,29 @@ impl DepthEncoding {
         }
     }
 
+    /// The key of view depth `z` through an orthographic camera: z itself,
+    /// or d = (z - n) / (f - n) as the fixed-point and reversed formats
+    /// store it.
+    fn linear_key(&self, z: f32) -> f32 {
+        let (n, f) = (self.near as f64, self.far as f64);
+        let d = (z as f64 - n) / (f - n);
+        match self.format {
+            DepthFormat::F32 | DepthFormat::LinearZ => z,
+            DepthFormat::Reversed => -((1.0 - d) as f32),
+            DepthFormat::Unorm24 | DepthFormat::Unorm16 => {
+                let steps = self.format.steps().unwrap_or(1.0);
+                (d.clamp(0.0, 1.0) * steps).round() as f32
+            }
+        }
+    }
+
     /// The key a buffer is cleared to: that of the far plane (the f32
     /// format's -1/far exactly as the rasterizers always cleared it).
     #[inline]
     pub fn clear_key(&self) -> f32 {
+        if self.orthographic {
+            return self.linear_key(self.far);
+        }
         match self.format {
             DepthFormat::F32 | DepthFormat::LinearZ => -1.0 / self.far,
             DepthFormat::Reversed => 0.0,
@@ -129,6 +179,14 @@ impl DepthEncoding {
     /// The view depth a key stands for (for the fragment record).
     pub fn view_depth(&self, key: f32) -> f32 {
         let (n, f) = (self.near as f64, self.far as f64);
+        if self.orthographic {
+            let d = match self.format {
+                DepthFormat::F32 | DepthFormat::LinearZ => return key,
+                DepthFormat::Reversed => 1.0 + key as f64,
+                DepthFormat::Unorm24 | DepthFormat::Unorm16 => key as f64 / self.format.steps().unwrap_or(1.0),
+            };
+            return (n + d * (f - n)) as f32;
+        }
         let inv_z = match self.format {
             DepthFormat::F32 | DepthFormat::LinearZ => return -1.0 / key,
             DepthFormat::Reversed => (-key as f64 * (f - n) / n + 1.0) / f,
@@ -178,6 +236,27 @@ mod tests {
             let e = DepthEncoding::new(format, 0.01, 1000.0);
             assert_eq!(e.key(a) < e.key(b), separated, "{format:?}");
             assert!(e.key(a) <= e.key(b), "{format:?}: nearer never compares farther");
+        }
+    }
+
+    #[test]
+    fn orthographic_keys_are_linear_in_depth() {
+        // n = 1, f = 3: d = (z - 1) / 2; z = 2 -> 0.5, evenly spaced steps.
+        let mut e = DepthEncoding::new(DepthFormat::Unorm16, 1.0, 3.0);
+        e.orthographic = true;
+        assert_eq!(e.key(1.0), 0.0);
+        assert_eq!(e.key(2.0), 32768.0); // 0.5 * 65535 = 32767.5
+        assert_eq!(e.clear_key(), 65535.0);
+        assert!((e.view_depth(32768.0) - 2.0).abs() < 1e-4);
+        e.format = DepthFormat::Reversed;
+        assert_eq!(e.key(2.0), -0.5);
+        assert_eq!(e.clear_key(), 0.0);
+        assert!((e.view_depth(-0.5) - 2.0).abs() < 1e-6);
+        e.format = DepthFormat::F32;
+        assert_eq!((e.key(2.5), e.key_at_depth(2.5), e.clear_key(), e.view_depth(2.5)), (2.5, 2.5, 3.0, 2.5));
+        for format in [DepthFormat::F32, DepthFormat::Reversed, DepthFormat::Unorm24] {
+            e.format = format;
+            assert!(e.key(1.5) < e.key(2.5) && e.key(2.5) < e.clear_key(), "{format:?}: nearer is smaller");
         }
     }
 

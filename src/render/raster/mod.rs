@@ -107,6 +107,13 @@ impl Renderer for Rasterizer {
         crate::render::accel::csg::check(scene, settings)
     }
 
+    fn check_camera(&self, camera: &crate::scene::Camera) -> Result<(), String> {
+        if self.method == Method::Painter {
+            return crate::render::camera_support::check_rasterized_from_a_point(self.name(), camera);
+        }
+        crate::render::camera_support::check_rasterized(self.name(), camera)
+    }
+
     fn trace_pixel(&self, job: &PassJob, x: u32, y: u32, rec: &mut PixelTrace) -> Option<Radiance> {
         Some(pass::replay_pixel(self.method, job, x, y, rec))
     }

@@ -180,7 +180,7 @@ pub fn draw_order(job: &PassJob, fts: &[FixedTri], spheres: &[Option<PixelRect>]
     let scene = &job.prepared.scene;
     let mut items: Vec<Item> = Vec::with_capacity(fts.len() + spheres.len());
     for (i, ft) in fts.iter().enumerate() {
-        let depths = ft.st.inv_z.map(|w| 1.0 / w as f64);
+        let depths = [0, 1, 2].map(|k| ft.st.vertex_depth(k) as f64);
         let t = &scene.triangle(ft.st.tri);
         let v = t.v.map(|p| f64v(view.to_camera(p)));
         let n = cross(sub(v[1], v[0]), sub(v[2], v[0]));

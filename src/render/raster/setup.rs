@@ -3,7 +3,7 @@
 //! pixel bounding box. The result is a list of screen-space triangles in scene
 //! order, each remembering which scene triangle it came from.
 
-use crate::render::raster::clip::{clip_frustum, clip_near, side_planes, triangle_vertices, ClipMode, FrustumClip};
+use crate::render::raster::clip::{clip_frustum, clip_near, side_planes, triangle_vertices, ClipMode, ClipVertex, FrustumClip, SidePlane};
 use crate::render::raster::rect::{sample_span, PixelRect};
 use crate::render::raster::runs::Runs;
 use crate::render::raster::subpixel;
@@ -43,11 +43,17 @@ pub struct ScreenTri {
     pub tri: u32,
     /// Image positions (pixels), ordered so the signed area is positive.
     pub p: [Vec2; 3],
-    /// 1 / view depth at each vertex: affine in image space.
-    pub inv_z: [f32; 3],
-    /// Barycentrics in the original triangle divided by view depth, per vertex:
-    /// affine in image space, so perspective-correct weights are `sum / inv_z`.
+    /// The depth value at each vertex that is affine in image space: 1 /
+    /// view depth through a perspective camera, the view depth itself
+    /// through an orthographic one (`DepthEncoding` keys either).
+    pub affine_depth: [f32; 3],
+    /// Barycentrics in the original triangle per vertex, divided by view
+    /// depth when `perspective`: affine in image space, so the
+    /// perspective-correct weights are `sum / affine_depth` (orthographic:
+    /// the sum itself).
     pub bz: [Vec3; 3],
+    /// Seen through one centre of projection (else along parallel rays).
+    pub perspective: bool,
     /// Pixels whose sample position may be covered, clamped to the image.
     pub bbox: PixelRect,
     /// 1 / (twice the signed area) for the vertex order in `p`.
@@ -58,14 +64,14 @@ impl ScreenTri {
     /// A screen triangle from projected vertices; `None` when it has no area or
     /// no sample of the image can fall inside it. Vertices 1 and 2 are swapped
     /// when needed to make the area positive.
-    pub fn new(tri: u32, mut p: [Vec2; 3], mut inv_z: [f32; 3], mut bz: [Vec3; 3], off: Vec2, width: u32, height: u32) -> Option<ScreenTri> {
+    pub fn new(tri: u32, mut p: [Vec2; 3], mut affine_depth: [f32; 3], mut bz: [Vec3; 3], perspective: bool, off: Vec2, width: u32, height: u32) -> Option<ScreenTri> {
         let area = edge_function(p[0], p[1], p[2]);
         if !area.is_finite() || area == 0.0 {
             return None;
         }
         if area < 0.0 {
             p.swap(1, 2);
-            inv_z.swap(1, 2);
+            affine_depth.swap(1, 2);
             bz.swap(1, 2);
         }
         // Padded by one fixed-point unit: snapping (fixed, tiled) moves a vertex
@@ -79,47 +85,64 @@ impl ScreenTri {
         let (y0, y1) = sample_span(lo.y, hi.y, off.y, height);
         let bbox = PixelRect { x0, y0, x1, y1 };
         let inv_area = 1.0 / area.abs();
-        (!bbox.is_empty()).then_some(ScreenTri { tri, p, inv_z, bz, bbox, inv_area })
+        (!bbox.is_empty()).then_some(ScreenTri { tri, p, affine_depth, bz, perspective, bbox, inv_area })
     }
 
     /// A triangle given directly in image space at depth 1 (tests, coverage counts).
     pub fn flat(tri: u32, p: [Vec2; 3], off: Vec2, width: u32, height: u32) -> Option<ScreenTri> {
-        ScreenTri::new(tri, p, [1.0; 3], [Vec3::X, Vec3::Y, Vec3::Z], off, width, height)
+        ScreenTri::new(tri, p, [1.0; 3], [Vec3::X, Vec3::Y, Vec3::Z], true, off, width, height)
     }
 
-    /// Interpolated 1 / view depth for screen-space weights `l`.
+    /// The interpolated `affine_depth` (1 / view depth, or the view depth
+    /// through an orthographic camera) for screen-space weights `l`.
     #[inline(always)]
-    pub fn inv_z_at(&self, l: [f32; 3]) -> f32 {
-        self.inv_z_lanes(&l)
+    pub fn affine_depth_at(&self, l: [f32; 3]) -> f32 {
+        self.affine_depth_lanes(&l)
     }
 
     /// View depth interpolated linearly in image space for screen-space
-    /// weights `l` (`--depth-buffer linear-z`: not the surface's depth
-    /// between the corners, which `1 / inv_z_at(l)` is).
+    /// weights `l` (`--depth-buffer linear-z`): through a perspective
+    /// camera not the surface's depth between the corners (which the
+    /// reciprocal of `affine_depth_at(l)` is); through an orthographic one
+    /// the same.
     #[inline]
     pub fn linear_z_at(&self, l: [f32; 3]) -> f32 {
-        l[0] / self.inv_z[0] + l[1] / self.inv_z[1] + l[2] / self.inv_z[2]
+        l[0] * self.vertex_depth(0) + l[1] * self.vertex_depth(1) + l[2] * self.vertex_depth(2)
     }
 
-    /// `inv_z_at` for lanes of weights.
+    /// `affine_depth_at` for lanes of weights.
     #[inline(always)]
-    pub fn inv_z_lanes<L: Lane>(&self, l: &[L; 3]) -> L {
-        weighted(l, self.inv_z)
+    pub fn affine_depth_lanes<L: Lane>(&self, l: &[L; 3]) -> L {
+        weighted(l, self.affine_depth)
+    }
+
+    /// The view depth at vertex `k`.
+    pub fn vertex_depth(&self, k: usize) -> f32 {
+        if self.perspective {
+            1.0 / self.affine_depth[k]
+        } else {
+            self.affine_depth[k]
+        }
     }
 
     /// Perspective-correct barycentrics (b1, b2) in the original triangle for
-    /// screen-space weights `l`, given `inv_z = inv_z_at(l)`.
+    /// screen-space weights `l`, given `depth = affine_depth_at(l)`.
     #[inline(always)]
-    pub fn bary_at(&self, l: [f32; 3], inv_z: f32) -> [f32; 2] {
-        self.bary_lanes(&l, inv_z)
+    pub fn bary_at(&self, l: [f32; 3], depth: f32) -> [f32; 2] {
+        self.bary_lanes(&l, depth)
     }
 
-    /// `bary_at` for lanes of weights: (bz0 l0 + bz1 l1 + bz2 l2) / inv_z,
-    /// its y and z.
+    /// `bary_at` for lanes of weights: (bz0 l0 + bz1 l1 + bz2 l2) / depth,
+    /// its y and z; along parallel rays the weights need no division.
     #[inline(always)]
-    pub fn bary_lanes<L: Lane>(&self, l: &[L; 3], inv_z: L) -> [L; 2] {
+    pub fn bary_lanes<L: Lane>(&self, l: &[L; 3], depth: L) -> [L; 2] {
         let bz = &self.bz;
-        [weighted(l, [bz[0].y, bz[1].y, bz[2].y]) / inv_z, weighted(l, [bz[0].z, bz[1].z, bz[2].z]) / inv_z]
+        let (b1, b2) = (weighted(l, [bz[0].y, bz[1].y, bz[2].y]), weighted(l, [bz[0].z, bz[1].z, bz[2].z]));
+        if self.perspective {
+            [b1 / depth, b2 / depth]
+        } else {
+            [b1, b2]
+        }
     }
 
     /// Affine (screen-space) barycentrics (b1, b2) in the original triangle
@@ -134,7 +157,10 @@ impl ScreenTri {
     /// The 2D weights as weights of the original triangle's three vertices.
     #[inline(always)]
     pub fn affine_weights(&self, l: [f32; 3]) -> Vec3 {
-        (0..3).map(|k| self.bz[k] / self.inv_z[k] * l[k]).sum::<Vec3>()
+        if !self.perspective {
+            return (0..3).map(|k| self.bz[k] * l[k]).sum::<Vec3>();
+        }
+        (0..3).map(|k| self.bz[k] / self.affine_depth[k] * l[k]).sum::<Vec3>()
     }
 
     /// Screen-space (affine, NOT perspective-correct) weights of the sample `q`,
@@ -158,22 +184,37 @@ impl ScreenTri {
     /// Swaps vertices 1 and 2 with their attributes (the area changes sign).
     pub fn swap_12(&mut self) {
         self.p.swap(1, 2);
-        self.inv_z.swap(1, 2);
+        self.affine_depth.swap(1, 2);
         self.bz.swap(1, 2);
         self.inv_area = -self.inv_area;
     }
 }
 
 /// True when the single-sided test of the ray tracer would reject every eye
-/// ray hitting this triangle: its geometric normal faces away from the eye.
+/// ray hitting this triangle: its geometric normal faces away from the eye
+/// (from the direction the parallel rays come from, orthographic).
 #[inline]
 pub fn is_back_face(view: &CameraView, t: &Triangle) -> bool {
     if t.two_sided {
         return false;
     }
     let n = (t.v[1] - t.v[0]).cross(t.v[2] - t.v[0]);
-    (view.eye - t.v[0]).dot(n) <= 0.0
+    view.toward_viewer(t.v[0]).dot(n) <= 0.0
 }
+
+/// A clipped piece's image positions, affine depth values and per-vertex
+/// `bz` (see `ScreenTri`), as `view` projects them.
+#[inline]
+pub fn project_piece(view: &CameraView, piece: &[ClipVertex; 3]) -> ([Vec2; 3], [f32; 3], [Vec3; 3]) {
+    let p = piece.map(|v| view.project_camera(v.pos));
+    if !view.is_orthographic() {
+        let inv_z = piece.map(|v| 1.0 / -v.pos.z);
+        (p, inv_z, [piece[0].bary * inv_z[0], piece[1].bary * inv_z[1], piece[2].bary * inv_z[2]])
+    } else {
+        (p, piece.map(|v| -v.pos.z), piece.map(|v| v.bary))
+    }
+}
+
 
 /// Culls, clips and projects one scene triangle, appending 0, 1 or 2 pieces.
 /// Without `near_clip` a triangle reaching nearer than the near plane is
@@ -187,7 +228,7 @@ pub fn setup_triangle(view: &CameraView, t: &Triangle, index: u32, off: Vec2, ne
 /// against the side planes, which drops it when nothing is left and shrinks
 /// its pieces' pixel boxes to what is left. The pieces and their attributes
 /// are those of the near clip either way.
-pub fn setup_triangle_clipped(view: &CameraView, t: &Triangle, index: u32, off: Vec2, near_clip: bool, frustum: Option<&[Vec3; 4]>, out: &mut Vec<ScreenTri>) {
+pub fn setup_triangle_clipped(view: &CameraView, t: &Triangle, index: u32, off: Vec2, near_clip: bool, frustum: Option<&[SidePlane; 4]>, out: &mut Vec<ScreenTri>) {
     if is_back_face(view, t) {
         return;
     }
@@ -221,11 +262,10 @@ pub fn setup_triangle_clipped(view: &CameraView, t: &Triangle, index: u32, off: 
         clipped = clip_near(whole[0], view.near);
         clipped.as_slice()
     };
+    let perspective = !view.is_orthographic();
     for piece in pieces {
-        let p = piece.map(|v| view.project_camera(v.pos));
-        let inv_z = piece.map(|v| 1.0 / -v.pos.z);
-        let bz = [piece[0].bary * inv_z[0], piece[1].bary * inv_z[1], piece[2].bary * inv_z[2]];
-        if let Some(mut st) = ScreenTri::new(index, p, inv_z, bz, off, view.width, view.height) {
+        let (p, depth, bz) = project_piece(view, piece);
+        if let Some(mut st) = ScreenTri::new(index, p, depth, bz, perspective, off, view.width, view.height) {
             if let Some(r) = inside {
                 st.bbox = st.bbox.intersect(&r);
                 if st.bbox.is_empty() {
@@ -399,9 +439,9 @@ mod tests {
         // Corners at view depths 1, 10 and 10; halfway between the first
         // two in image space, 1/z is affine: the surface's depth there is
         // 1 / 0.55, while z drawn straight across is 5.5.
-        let st = ScreenTri::new(0, [Vec2::new(0.0, 0.0), Vec2::new(8.0, 0.0), Vec2::new(0.0, 8.0)], [1.0, 0.1, 0.1], [Vec3::X, Vec3::Y, Vec3::Z], Vec2::ZERO, 16, 16).unwrap();
+        let st = ScreenTri::new(0, [Vec2::new(0.0, 0.0), Vec2::new(8.0, 0.0), Vec2::new(0.0, 8.0)], [1.0, 0.1, 0.1], [Vec3::X, Vec3::Y, Vec3::Z], true, Vec2::ZERO, 16, 16).unwrap();
         let l = [0.5, 0.5, 0.0];
-        assert!((1.0 / st.inv_z_at(l) - 1.0 / 0.55).abs() < 1e-5);
+        assert!((1.0 / st.affine_depth_at(l) - 1.0 / 0.55).abs() < 1e-5);
         assert!((st.linear_z_at(l) - 5.5).abs() < 1e-5);
     }
     use crate::scene::{Camera, Fov};
@@ -464,7 +504,7 @@ mod tests {
             for k in 0..3 {
                 // Every piece lies below the horizon (y > 50) and at depth >= near.
                 assert!(st.p[k].y > 50.0, "{st:?}");
-                assert!(st.inv_z[k] <= 1.0 / 0.5 + 1e-6);
+                assert!(st.affine_depth[k] <= 1.0 / 0.5 + 1e-6);
             }
         }
     }
@@ -491,17 +531,17 @@ mod tests {
         let q = Vec2::new(40.5, 55.5);
         let l = st.screen_weights(q);
         assert!(l.iter().all(|&w| w > 0.0), "{l:?}");
-        let inv_z = st.inv_z_at(l);
+        let inv_z = st.affine_depth_at(l);
         let [b1, b2] = st.bary_at(l, inv_z);
         let ray = view.eye_ray(q.x, q.y);
         let (_, r1, r2) = intersect_triangle(&ray, &TriangleEdges::new(&t), f32::INFINITY).unwrap();
         assert!((b1 - r1).abs() < 1e-5 && (b2 - r2).abs() < 1e-5, "perspective-correct ({b1}, {b2}) vs ray ({r1}, {r2})");
         // The screen-space (affine) weights are those of the projection, not of the surface point.
         // Map them back to the original vertex order (the setup may have swapped 1 and 2).
-        let affine = st.bz[0] / st.inv_z[0] * l[0] + st.bz[1] / st.inv_z[1] * l[1] + st.bz[2] / st.inv_z[2] * l[2];
+        let affine = st.affine_weights(l);
         assert!((affine.y - r1).abs() > 0.05 || (affine.z - r2).abs() > 0.05, "affine {affine:?} vs ray ({r1}, {r2})");
         // By hand: 1/z is affine in the image; at the vertices it is 1 and 1/5.
-        assert!(st.inv_z.contains(&1.0) && st.inv_z.contains(&0.2));
+        assert!(st.affine_depth.contains(&1.0) && st.affine_depth.contains(&0.2));
         assert!(inv_z > 0.2 && inv_z < 1.0);
     }
 }

@@ -79,7 +79,7 @@ pub fn raster_sphere<Q: SceneQuery, R: FragmentRecorder>(vb: &mut VisBuffer<Q, R
                 let key = match vb.key {
                     DepthKey::RayT => t,
                     // The eye ray starts on the near plane: depth = near + t / |d|.
-                    DepthKey::NegInvZ => vb.enc.key(1.0 / (view.near + t / view.camera_dir(p.x, p.y).length())),
+                    DepthKey::NegInvZ => vb.enc.key_at_depth(view.near + t / view.camera_dir(p.x, p.y).length()),
                 };
                 vb.sphere_fragment(x, y, si, t, key);
             }

@@ -67,7 +67,7 @@ impl StencilSetup {
                 let mut out = Vec::new();
                 for piece in clip_near(triangle_vertices(c), view.near).as_slice() {
                     let p = piece.map(|v| view.project_camera(v.pos));
-                    let Some(st) = ScreenTri::new(0, p, [1.0; 3], [Vec3::X, Vec3::Y, Vec3::Z], off, w, h) else { continue };
+                    let Some(st) = ScreenTri::new(0, p, [1.0; 3], [Vec3::X, Vec3::Y, Vec3::Z], true, off, w, h) else { continue };
                     let Some(ft) = FixedTri::new(&st, soff, off, w, h) else { continue };
                     out.push(StencilTri { light: l as u32, ft, n, k });
                 }

@@ -157,7 +157,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
     /// A buffer whose recorder `rec` takes the history of pixel `focus`.
     pub fn with_recorder(job: &'j PassJob<'a>, query: &'j Q, rect: PixelRect, key: DepthKey, forward: bool, rec: R, focus: (u32, u32)) -> Self {
         let n = rect.area() as usize;
-        let enc = DepthEncoding::new(job.settings.depth_buffer, job.view.near, job.view.far);
+        let enc = DepthEncoding::for_view(job.settings.depth_buffer, job.view);
         let depth = match key {
             DepthKey::NegInvZ => vec![enc.clear_key(); n],
             DepthKey::RayT => {
@@ -277,21 +277,21 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
     /// depth test on -1/z, then perspective-correct barycentrics on a pass.
     #[inline(always)]
     pub fn triangle_fragment(&mut self, st: &ScreenTri, x: u32, y: u32, l: [f32; 3]) {
-        let inv_z = st.inv_z_at(l);
+        let depth = st.affine_depth_at(l);
         let affine = self.job.settings.affine;
-        if self.cut_out(st.tri, || if affine { st.affine_bary_at(l) } else { st.bary_at(l, inv_z) }) {
+        if self.cut_out(st.tri, || if affine { st.affine_bary_at(l) } else { st.bary_at(l, depth) }) {
             return;
         }
         self.counts.samples_covered += 1;
         let i = self.index(x, y);
         self.count_work(i);
-        let key = if self.enc.format == DepthFormat::LinearZ { self.enc.key(1.0 / st.linear_z_at(l)) } else { self.enc.key(inv_z) };
+        let key = if self.enc.format == DepthFormat::LinearZ && st.perspective { self.enc.key(1.0 / st.linear_z_at(l)) } else { self.enc.key(depth) };
         let stored = self.depth[i];
         let passed = self.paint || key < stored;
         if passed {
             self.depth[i] = key;
             self.id[i] = PrimitiveId::triangle(st.tri);
-            self.payload[i] = if self.job.settings.affine { st.affine_bary_at(l) } else { st.bary_at(l, inv_z) };
+            self.payload[i] = if self.job.settings.affine { st.affine_bary_at(l) } else { st.bary_at(l, depth) };
             if self.forward {
                 self.shade_now(i, x, y);
             }
@@ -302,7 +302,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
             // The 2D weights as weights of the scene triangle's vertices (affine
             // interpolation of the piece's vertex barycentrics).
             let screen = st.affine_weights(l);
-            let [b1, b2] = st.bary_at(l, inv_z);
+            let [b1, b2] = st.bary_at(l, depth);
             self.record(PrimitiveKind::Triangle, st.tri, Some(screen), Vec3::new(1.0 - b1 - b2, b1, b2), key, stored, passed, i, x, y);
         }
     }
@@ -327,7 +327,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
     }
 
     /// `triangle_row` eight samples at a time, from buffer index `i` (pixel
-    /// `x0`): `screen_weights`, `inv_z_at`, the F32 key, the depth test and
+    /// `x0`): `screen_weights`, `affine_depth_at`, the F32 key, the depth test and
     /// `bary_at` in lanes, each with the scalar code's operations in its
     /// order, so every stored value is the one `triangle_fragment` stores.
     #[inline(always)]
@@ -338,8 +338,9 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         let qy = f32x8::splat(simd, y as f32 + ft.sample_off.y);
         // The scalar fragment's arithmetic, eight samples at a time.
         let l = st.screen_weights_lanes(qx, qy);
-        let inv_z = st.inv_z_lanes(&l);
-        let key = -inv_z;
+        let depth = st.affine_depth_lanes(&l);
+        // The F32 key: -1/z, or z itself along parallel rays.
+        let key = if self.enc.orthographic { depth } else { -depth };
         let stored = f32x8::from_slice(simd, &self.depth[i..i + 8]);
         let passed = mask_bits(key.simd_lt(stored)) & bits;
         self.counts.samples_covered += bits.count_ones() as u64;
@@ -347,7 +348,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         if passed == 0 {
             return;
         }
-        let [b1, b2] = st.bary_lanes(&l, inv_z);
+        let [b1, b2] = st.bary_lanes(&l, depth);
         // The samples that pass take the new values, the others keep
         // theirs: each buffer's eight entries blended and stored whole, not
         // written one passing sample at a time.
@@ -406,7 +407,7 @@ impl<'j, 'a, Q: SceneQuery, R: FragmentRecorder> VisBuffer<'j, 'a, Q, R> {
         self.count_work(i);
         let p = self.job.sample_position(x, y);
         let depth = self.job.view.near + t / self.job.view.camera_dir(p.x, p.y).length();
-        let key = self.enc.key(1.0 / depth);
+        let key = self.enc.key_at_depth(depth);
         let stored = self.depth[i];
         let passed = self.paint || key < stored;
         if passed {

@@ -661,7 +661,7 @@ fn setup_face_triangle(view: &CameraView, ortho: bool, t: &Triangle, index: u32,
     let off = Vec2::splat(0.5);
     let soff = snap_offset(off);
     let mut push = |p: [Vec2; 3], z: [f32; 3]| {
-        let Some(st) = ScreenTri::new(index, p, [1.0; 3], [Vec3::X, Vec3::Y, Vec3::Z], off, size, size) else { return };
+        let Some(st) = ScreenTri::new(index, p, [1.0; 3], [Vec3::X, Vec3::Y, Vec3::Z], true, off, size, size) else { return };
         let Some(ft) = FixedTri::new(&st, soff, off, size, size) else { return };
         let (z_lo, z_hi) = (z[0].min(z[1]).min(z[2]), z[0].max(z[1]).max(z[2]));
         out.push(FaceTri { ft, n, k, z_lo, z_hi });

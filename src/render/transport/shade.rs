@@ -259,11 +259,11 @@ fn secondary_sampled<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &S
 pub fn shade_gouraud<Q: SceneQuery, R: Recorder>(
     sh: &mut Shading<Q, R>,
     hit: &SurfaceHit,
-    eye: Vec3,
+    view: &crate::scene::CameraView,
 ) -> Radiance {
     let Shading { scene, .. } = *sh;
     if hit.kind != crate::scene::PrimitiveKind::Triangle {
-        let w_o = (eye - hit.position).normalize_or_zero();
+        let w_o = view.toward_viewer(hit.position).normalize_or_zero();
         return shade(sh, hit, w_o, 0);
     }
     let tri = &scene.triangle(hit.primitive);
@@ -279,7 +279,7 @@ pub fn shade_gouraud<Q: SceneQuery, R: Recorder>(
             uv: tri.uv[k],
             ..*hit
         };
-        let w_o = (eye - tri.v[k]).normalize_or_zero();
+        let w_o = view.toward_viewer(tri.v[k]).normalize_or_zero();
         l_o += hit.barycentric[k] * shade(sh, &vertex, w_o, 0);
     }
     l_o
