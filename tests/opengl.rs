@@ -424,7 +424,13 @@ fn textures_filtered_in_the_shader_agree_with_brute_force() {
     // (filter, share within 1e-3, share within 1e-2) required; measured
     // 100/100, 99.96/100 and 100/100% at 160x100 on llvmpipe (GL's own
     // filtering and asin gave 99.98, 98.9 and 98.5% within 1e-3).
-    for (filter, tight, loose) in [(TextureFilter::Nearest, 0.999, 0.999), (TextureFilter::Bilinear, 0.995, 0.999), (TextureFilter::Trilinear, 0.995, 0.999)] {
+    for (filter, tight, loose) in [
+        (TextureFilter::Nearest, 0.999, 0.999),
+        (TextureFilter::Bilinear, 0.995, 0.999),
+        (TextureFilter::Trilinear, 0.995, 0.999),
+        (TextureFilter::MipmapNearest, 0.995, 0.999),
+        (TextureFilter::Anisotropic8, 0.995, 0.999),
+    ] {
         let s = RenderSettings { width: 160, height: 100, texture_filter: filter, reflections: Reflections::Env, ..settings(&sc) };
         gl.check(&sc, &s).unwrap();
         let a = render(gl.as_ref(), &prepared, &s);

@@ -58,6 +58,26 @@ fn filtering_error_on_the_checkerboard() {
     assert!(e(Nearest, 1) > e(Bilinear, 1), "{table}");
     assert!(e(Bilinear, 1) > e(Trilinear, 1), "{table}");
     assert!(e(Trilinear, 1) < e(Nearest, 4), "{table}");
+    // Trilinear reads a receding footprint at the level of its length and
+    // blurs across its width; taps along the length read a finer level.
+    for spp in [1, 4] {
+        assert!(e(Anisotropic8, spp) < e(Trilinear, spp), "{table}");
+        assert!(e(Anisotropic16, spp) <= e(Anisotropic2, spp), "{table}");
+    }
+}
+
+/// The anisotropic read in both families and OpenGL: the rasterizer's
+/// screen derivatives and the ray caster's differentials give the same
+/// taps, and GL's shader reads what the CPU reads.
+#[test]
+fn anisotropic_filtering_agrees_across_the_families() {
+    let prepared = ground_only();
+    let a = render(&prepared, "raytrace", TextureFilter::Anisotropic8, 1);
+    let b = render(&prepared, "rasterize", TextureFilter::Anisotropic8, 1);
+    let trilinear = render(&prepared, "raytrace", TextureFilter::Trilinear, 1);
+    let close = |x: &[Radiance], y: &[Radiance]| x.iter().zip(y).filter(|(p, q)| (**p - **q).abs().max_element() <= 1e-3 * (1.0 + q.max_element())).count() as f64 / x.len() as f64;
+    assert!(close(&a, &b) >= 0.99, "{}", close(&a, &b));
+    assert!(close(&a, &trilinear) < 0.9, "anisotropic reads as trilinear: {}", close(&a, &trilinear));
 }
 
 /// The rasterizer (screen-space derivatives) and the ray caster (ray

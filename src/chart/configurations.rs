@@ -256,9 +256,10 @@ pub fn method_configurations(scene: &Scene, base: &RenderSettings) -> Vec<Config
         }
     }
 
-    // Textures: read from level 0 only (aliasing), at one sample and four.
+    // Textures: read from level 0 only (aliasing), from the nearest level
+    // (seams), or anisotropically (sharper than trilinear), at one sample and four.
     if scene.has_textures() {
-        for filter in [TextureFilter::Nearest, TextureFilter::Bilinear] {
+        for filter in [TextureFilter::Nearest, TextureFilter::Bilinear, TextureFilter::MipmapNearest, TextureFilter::Anisotropic8] {
             for spp in [1, 4] {
                 add("textures", ray, with(&|s| {
                     s.texture_filter = filter;

@@ -118,7 +118,7 @@ pub struct RenderOpts {
     /// --view wireframe: the line algorithm, float (DDA) | integer (Bresenham).
     #[arg(long, default_value_t = defaults().lines.name().to_string())]
     pub lines: String,
-    /// How textures are read: nearest | bilinear | trilinear (mipmapped).
+    /// How textures are read: nearest | bilinear | mipmap-nearest | trilinear (mipmapped) | anisotropic:N (N = 2, 4, 8, 16 taps along the footprint).
     #[arg(long = "texture-filter", default_value_t = defaults().texture_filter.name().to_string(), value_name = "FILTER")]
     pub texture_filter: String,
     /// What mirrors reflect: ray (traced) | env (the environment in the reflected direction, no ray).

@@ -1,6 +1,6 @@
 //! Textures: image files decoded into linear RGB, with a mip pyramid built
-//! once at load time, sampled nearest, bilinear or trilinear (Computer
-//! Graphics from Scratch ch. 14).
+//! once at load time, sampled nearest, bilinear, from the nearest mip level,
+//! trilinear or anisotropically (Computer Graphics from Scratch ch. 14).
 
 use crate::scene::assets::read_asset;
 use crate::input::{decode_image, InputKind, MAX_VALUE};
@@ -16,10 +16,23 @@ named_enum! {
         Nearest = "nearest",
         /// The four nearest texels of level 0, blended by distance.
         Bilinear = "bilinear",
+        /// Bilinear in the one mip level whose texels are nearest the
+        /// sample's footprint in size (GL's LINEAR_MIPMAP_NEAREST): no
+        /// blend, so the level's seams show where the level changes.
+        MipmapNearest = "mipmap-nearest",
         /// Bilinear in the two mip levels whose texels are nearest the
         /// sample's footprint in size, blended by the level of detail.
         #[default]
         Trilinear = "trilinear",
+        /// Up to 2 trilinear taps spread along the footprint's longer
+        /// axis, each read at the level of its share of that axis.
+        Anisotropic2 = "anisotropic:2",
+        /// Up to 4 taps (see `Anisotropic2`).
+        Anisotropic4 = "anisotropic:4",
+        /// Up to 8 taps (see `Anisotropic2`).
+        Anisotropic8 = "anisotropic:8",
+        /// Up to 16 taps (see `Anisotropic2`), as many as GPUs offer.
+        Anisotropic16 = "anisotropic:16",
     }
 }
 
@@ -63,12 +76,26 @@ impl TextureFilter {
     /// sampler may ask for nearest or unmipmapped reads).
     #[inline]
     pub fn at_most(self, finest: TextureFilter) -> TextureFilter {
+        // A sampler that allows mipmapping (trilinear) allows the
+        // anisotropic reads too: they read the same pyramid.
         let rank = |f: TextureFilter| match f {
             TextureFilter::Nearest => 0,
             TextureFilter::Bilinear => 1,
-            TextureFilter::Trilinear => 2,
+            TextureFilter::MipmapNearest => 2,
+            _ => 3,
         };
         if rank(finest) < rank(self) { finest } else { self }
+    }
+
+    /// The most taps an anisotropic read takes (1 for the other filters).
+    pub fn anisotropic_taps(self) -> u32 {
+        match self {
+            TextureFilter::Anisotropic2 => 2,
+            TextureFilter::Anisotropic4 => 4,
+            TextureFilter::Anisotropic8 => 8,
+            TextureFilter::Anisotropic16 => 16,
+            _ => 1,
+        }
     }
 }
 
@@ -184,9 +211,16 @@ impl Texture {
     pub fn level_of_detail(&self, f: &Footprint) -> f32 {
         let size = Vec2::new(self.width() as f32, self.height() as f32);
         let (along_x, along_y) = ((f.duv_dx * size).length(), (f.duv_dy * size).length());
-        let rho = along_x.max(along_y);
-        let top = (self.levels.len() - 1) as f32;
         if along_x.is_nan() || along_y.is_nan() {
+            return (self.levels.len() - 1) as f32;
+        }
+        self.level_of_step(along_x.max(along_y))
+    }
+
+    /// The level of detail of a pixel step `rho` level-0 texels long.
+    fn level_of_step(&self, rho: f32) -> f32 {
+        let top = (self.levels.len() - 1) as f32;
+        if rho.is_nan() {
             return top;
         }
         if rho <= 1.0 {
@@ -195,23 +229,67 @@ impl Texture {
         rho.log2().min(top)
     }
 
+    /// The one level GL's MIPMAP_NEAREST reads at level of detail `lambda`:
+    /// the nearest, level 0 up to 0.5.
+    fn nearest_level(&self, lambda: f32) -> usize {
+        if lambda <= 0.5 { 0 } else { ((lambda + 0.5).ceil() as usize - 1).min(self.levels.len() - 1) }
+    }
+
+    /// Bilinear reads of the two levels around `lambda`, blended.
+    fn trilinear(&self, uv: Vec2, lambda: f32, wrap: [Wrap; 2]) -> Vec3 {
+        let base = lambda.floor();
+        let fine = &self.levels[base as usize];
+        let blend = lambda - base;
+        if blend == 0.0 {
+            fine.bilinear(uv, wrap)
+        } else {
+            let coarse = &self.levels[(base as usize + 1).min(self.levels.len() - 1)];
+            fine.bilinear(uv, wrap).lerp(coarse.bilinear(uv, wrap), blend)
+        }
+    }
+
+    /// The taps and level of detail of an anisotropic read of at most
+    /// `max_taps` taps: a footprint n times longer than wide takes n taps
+    /// (at most `max_taps`) along its longer axis, each covering 1/n of it,
+    /// so each is read at the level of the longer of that share and the
+    /// footprint's width, where trilinear reads the whole length at once
+    /// and blurs across the width. `None` when one trilinear read is the
+    /// same (a round footprint, or an unknown one).
+    fn anisotropic_taps(&self, f: &Footprint, max_taps: u32) -> Option<(Vec2, u32, f32)> {
+        let size = Vec2::new(self.width() as f32, self.height() as f32);
+        let (along_x, along_y) = ((f.duv_dx * size).length(), (f.duv_dy * size).length());
+        if !(along_x.is_finite() && along_y.is_finite()) {
+            return None;
+        }
+        let (major_uv, major, minor) = if along_x >= along_y { (f.duv_dx, along_x, along_y) } else { (f.duv_dy, along_y, along_x) };
+        let taps = (major / minor.max(1e-12)).ceil().min(max_taps as f32) as u32;
+        (taps > 1).then(|| (major_uv, taps, self.level_of_step((major / taps as f32).max(minor))))
+    }
+
+    /// The anisotropic read (see `anisotropic_taps`): the mean of its taps,
+    /// spread evenly over the footprint's longer axis about `uv`.
+    fn anisotropic(&self, uv: Vec2, f: &Footprint, max_taps: u32, wrap: [Wrap; 2]) -> Vec3 {
+        let Some((axis, taps, lambda)) = self.anisotropic_taps(f, max_taps) else {
+            return self.trilinear(uv, self.level_of_detail(f), wrap);
+        };
+        let mut sum = Vec3::ZERO;
+        for k in 0..taps {
+            let offset = (k as f32 + 0.5) / taps as f32 - 0.5;
+            sum += self.trilinear(uv + axis * offset, lambda, wrap);
+        }
+        sum / taps as f32
+    }
+
     /// The texture at `uv` with footprint `f`, read with `filter`; `wrap`
     /// addresses u (columns) and v (rows) outside [0, 1].
     pub fn sample(&self, uv: Vec2, f: &Footprint, filter: TextureFilter, wrap: [Wrap; 2]) -> Vec3 {
         match filter {
             TextureFilter::Nearest => self.levels[0].nearest(uv, wrap),
             TextureFilter::Bilinear => self.levels[0].bilinear(uv, wrap),
-            TextureFilter::Trilinear => {
-                let lambda = self.level_of_detail(f);
-                let base = lambda.floor();
-                let fine = &self.levels[base as usize];
-                let blend = lambda - base;
-                if blend == 0.0 {
-                    fine.bilinear(uv, wrap)
-                } else {
-                    let coarse = &self.levels[(base as usize + 1).min(self.levels.len() - 1)];
-                    fine.bilinear(uv, wrap).lerp(coarse.bilinear(uv, wrap), blend)
-                }
+            TextureFilter::MipmapNearest => self.levels[self.nearest_level(self.level_of_detail(f))].bilinear(uv, wrap),
+            TextureFilter::Trilinear => self.trilinear(uv, self.level_of_detail(f), wrap),
+            TextureFilter::Anisotropic2 | TextureFilter::Anisotropic4 | TextureFilter::Anisotropic8 | TextureFilter::Anisotropic16 => {
+                self.anisotropic(uv, f, filter.anisotropic_taps(), wrap)
             }
         }
     }
@@ -220,6 +298,10 @@ impl Texture {
     pub fn level_used(&self, f: &Footprint, filter: TextureFilter) -> f32 {
         match filter {
             TextureFilter::Trilinear => self.level_of_detail(f),
+            TextureFilter::MipmapNearest => self.nearest_level(self.level_of_detail(f)) as f32,
+            TextureFilter::Anisotropic2 | TextureFilter::Anisotropic4 | TextureFilter::Anisotropic8 | TextureFilter::Anisotropic16 => {
+                self.anisotropic_taps(f, filter.anisotropic_taps()).map_or_else(|| self.level_of_detail(f), |(_, _, lambda)| lambda)
+            }
             TextureFilter::Nearest | TextureFilter::Bilinear => 0.0,
         }
     }
@@ -292,6 +374,30 @@ fn srgb_to_linear(c: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn mipmap_nearest_and_anisotropic_levels_by_hand() {
+        // 64 x 64 texels: levels 0..=6.
+        let t = Texture::new(64, 64, vec![Vec3::ONE; 64 * 64]);
+        // GL's MIPMAP_NEAREST: level 0 up to lambda 0.5, then the nearest.
+        for (lambda, level) in [(0.0, 0), (0.4, 0), (0.6, 1), (1.4, 1), (1.6, 2), (9.0, 6)] {
+            assert_eq!(t.nearest_level(lambda), level, "lambda {lambda}");
+        }
+        // A footprint 8 texels along u and 1 along v: 8 taps of one texel
+        // each read level 0; with at most 4 taps each covers 2 texels,
+        // level 1; trilinear reads the whole length, level 3.
+        let f = Footprint { duv_dx: Vec2::new(8.0 / 64.0, 0.0), duv_dy: Vec2::new(0.0, 1.0 / 64.0) };
+        assert_eq!(t.anisotropic_taps(&f, 16), Some((f.duv_dx, 8, 0.0)));
+        assert_eq!(t.anisotropic_taps(&f, 4), Some((f.duv_dx, 4, 1.0)));
+        assert_eq!(t.level_of_detail(&f), 3.0);
+        // A round footprint takes one trilinear read.
+        let round = Footprint { duv_dx: Vec2::new(4.0 / 64.0, 0.0), duv_dy: Vec2::new(0.0, 4.0 / 64.0) };
+        assert_eq!(t.anisotropic_taps(&round, 16), None);
+        // Anisotropic reads stay within a sampler that allows mipmaps, and
+        // drop to what one that does not allows.
+        assert_eq!(TextureFilter::Anisotropic8.at_most(TextureFilter::Trilinear), TextureFilter::Anisotropic8);
+        assert_eq!(TextureFilter::Anisotropic8.at_most(TextureFilter::Bilinear), TextureFilter::Bilinear);
+    }
 
     fn grey(values: &[f32]) -> Vec<Vec3> {
         values.iter().map(|&v| Vec3::splat(v)).collect()

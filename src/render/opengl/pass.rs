@@ -322,12 +322,16 @@ unsafe fn material_textures(gl: &glow::Context, textures: &crate::render::opengl
             gl.uniform_2_i32(at(name).as_ref(), first, count);
             gl.uniform_1_i32(at(flag).as_ref(), (count > 0) as i32);
         }
-        let filter = match job.settings.texture_filter.at_most(material.finest_filter) {
+        let chosen = job.settings.texture_filter.at_most(material.finest_filter);
+        let filter = match chosen {
             TextureFilter::Nearest => 0,
             TextureFilter::Bilinear => 1,
             TextureFilter::Trilinear => 2,
+            TextureFilter::MipmapNearest => 3,
+            TextureFilter::Anisotropic2 | TextureFilter::Anisotropic4 | TextureFilter::Anisotropic8 | TextureFilter::Anisotropic16 => 4,
         };
         gl.uniform_1_i32(at("texture_filter").as_ref(), filter);
+        gl.uniform_1_i32(at("anisotropic_taps").as_ref(), chosen.anisotropic_taps() as i32);
         gl.uniform_1_i32(at("wrap_clamp").as_ref(), (material.wrap[0] == Wrap::Clamp) as i32);
         gl.uniform_2_f32(at("uv_scale").as_ref(), material.uv_scale.x, material.uv_scale.y);
     }

@@ -81,6 +81,7 @@ uniform ivec2 normal_map;
 uniform vec2 uv_scale;
 // TextureFilter: 0 nearest, 1 bilinear, 2 trilinear.
 uniform int texture_filter;
+uniform int anisotropic_taps;
 // The material's Wrap: clamp to the edge texel, else repeat.
 uniform bool wrap_clamp;
 // Scene::miss_radiance: the latitude-longitude environment, else the background.
@@ -182,14 +183,50 @@ vec3 bilinear_at(ivec2 t, int l, vec2 uv, bool clamp_u, bool clamp_v) {
 
 // Texture::level_of_detail: log2 of the longer pixel step in level-0
 // texels, 0 when magnified, the coarsest level when unknown.
+float level_of_step(ivec2 t, float rho) {
+    float top = float(t.y - 1);
+    if (isnan(rho)) return top;
+    return rho <= 1.0 ? 0.0 : min(log2(rho), top);
+}
+
 float level_of_detail(ivec2 t, vec2 duv_dx, vec2 duv_dy) {
     vec2 size = vec2(level_info[t.x].yz);
-    float top = float(t.y - 1);
     float along_x = length(duv_dx * size);
     float along_y = length(duv_dy * size);
-    if (isnan(along_x) || isnan(along_y)) return top;
-    float rho = max(along_x, along_y);
-    return rho <= 1.0 ? 0.0 : min(log2(rho), top);
+    if (isnan(along_x) || isnan(along_y)) return float(t.y - 1);
+    return level_of_step(t, max(along_x, along_y));
+}
+
+// Texture::trilinear: the two levels around lambda, blended.
+vec3 trilinear_at(ivec2 t, vec2 s, float lambda) {
+    float base = floor(lambda);
+    int fine = int(base);
+    float blend = lambda - base;
+    vec3 a = bilinear_at(t, fine, s, wrap_clamp, wrap_clamp);
+    if (blend == 0.0) return a;
+    int coarse = min(fine + 1, t.y - 1);
+    return lerp3(a, bilinear_at(t, coarse, s, wrap_clamp, wrap_clamp), blend);
+}
+
+// Texture::anisotropic: up to `anisotropic_taps` trilinear taps along the
+// footprint's longer axis, each at the level of its share of that axis.
+vec3 anisotropic_at(ivec2 t, vec2 s, vec2 dx, vec2 dy) {
+    vec2 size = vec2(level_info[t.x].yz);
+    float along_x = length(dx * size);
+    float along_y = length(dy * size);
+    if (isnan(along_x) || isnan(along_y) || isinf(along_x) || isinf(along_y)) return trilinear_at(t, s, level_of_detail(t, dx, dy));
+    vec2 axis = along_x >= along_y ? dx : dy;
+    float major = max(along_x, along_y);
+    float minor = min(along_x, along_y);
+    int taps = int(min(ceil(major / max(minor, 1e-12)), float(anisotropic_taps)));
+    if (taps <= 1) return trilinear_at(t, s, level_of_detail(t, dx, dy));
+    float lambda = level_of_step(t, max(major / float(taps), minor));
+    vec3 sum = vec3(0.0);
+    for (int k = 0; k < taps; k++) {
+        float offset = (float(k) + 0.5) / float(taps) - 0.5;
+        sum += trilinear_at(t, s + axis * offset, lambda);
+    }
+    return sum / float(taps);
 }
 
 // Texture::sample with the material's filter and wrap; `uv` and the
@@ -198,14 +235,15 @@ vec3 sample_texture(ivec2 t, vec2 uv, vec2 duv_dx, vec2 duv_dy) {
     vec2 s = uv * uv_scale;
     if (texture_filter == 0) return nearest_at(t, s, wrap_clamp);
     if (texture_filter == 1) return bilinear_at(t, 0, s, wrap_clamp, wrap_clamp);
-    float lambda = level_of_detail(t, duv_dx * uv_scale, duv_dy * uv_scale);
-    float base = floor(lambda);
-    int fine = int(base);
-    float blend = lambda - base;
-    vec3 a = bilinear_at(t, fine, s, wrap_clamp, wrap_clamp);
-    if (blend == 0.0) return a;
-    int coarse = min(fine + 1, t.y - 1);
-    return lerp3(a, bilinear_at(t, coarse, s, wrap_clamp, wrap_clamp), blend);
+    vec2 dx = duv_dx * uv_scale;
+    vec2 dy = duv_dy * uv_scale;
+    if (texture_filter == 4) return anisotropic_at(t, s, dx, dy);
+    float lambda = level_of_detail(t, dx, dy);
+    if (texture_filter == 3) {
+        int level = lambda <= 0.5 ? 0 : min(int(ceil(lambda + 0.5)) - 1, t.y - 1);
+        return bilinear_at(t, level, s, wrap_clamp, wrap_clamp);
+    }
+    return trilinear_at(t, s, lambda);
 }
 
 vec3 albedo_at(uint m, vec2 uv, vec2 duv_dx, vec2 duv_dy) {
