@@ -70,3 +70,28 @@ fn gouraud_loses_the_interior_highlight_but_matches_at_vertices() {
         assert!((g - ph).length() <= 0.1 * ph.length() + 1e-4, "near vertex {v}: gouraud {g} phong {ph}");
     }
 }
+
+#[test]
+fn faceted_lights_each_triangle_once_at_its_centroid() {
+    // The book's triangle, faceted: every pixel it covers holds one value,
+    // and that value is Phong's at the centroid (the pixel whose centre is
+    // nearest the centroid sees almost the same point, normal and uv).
+    let scene = builtin("one-triangle");
+    let prepared = PreparedScene::new(scene.clone());
+    let s = settings(&scene, Interpolation::Faceted);
+    let background = scene.render.background;
+    for renderer in ["raytrace:bvh", "rasterize"] {
+        let faceted = render(renderer, &prepared, &s);
+        let covered: Vec<Radiance> = faceted.iter().copied().filter(|c| *c != background).collect();
+        assert!(covered.len() > 1000, "{renderer}: {} pixels", covered.len());
+        assert!(covered.iter().all(|c| *c == covered[0]), "{renderer}: more than one value on one triangle");
+        let phong = render(renderer, &prepared, &settings(&scene, Interpolation::Phong));
+        let view = scene.camera.view(s.width, s.height);
+        let centroid = scene.triangles.at(0).v.iter().copied().sum::<Vec3>() / 3.0;
+        let (c, _) = view.project(centroid).unwrap();
+        let i = (c.x as u32 + c.y as u32 * s.width) as usize;
+        assert!((phong[i] - covered[0]).length() <= 0.02 * phong[i].length(), "{renderer}: centroid {} against faceted {}", phong[i], covered[0]);
+        // Phong varies over the same triangle (its highlight), faceted not.
+        assert!(max_lum(&phong) > 1.2 * pinhole::math::luminance(covered[0]));
+    }
+}

@@ -251,7 +251,7 @@ pub fn method_configurations(scene: &Scene, base: &RenderSettings) -> Vec<Config
 
     // Shading interpolation across triangles.
     if !scene.triangles.is_empty() {
-        for i in [Interpolation::Flat, Interpolation::Gouraud] {
+        for i in [Interpolation::Flat, Interpolation::Gouraud, Interpolation::Faceted] {
             add("interpolation", raster, with(&|s| s.interpolation = i));
         }
     }

@@ -42,7 +42,7 @@ pub struct RenderOpts {
     /// Rasterizers: interpolate attributes affinely in screen space (no 1/z correction).
     #[arg(long)]
     pub affine: bool,
-    /// flat | gouraud | phong: how shading varies across a triangle.
+    /// flat | gouraud | phong | faceted: how shading varies across a triangle (faceted: one value per triangle, lit at its centroid).
     #[arg(long, default_value_t = defaults().interpolation.name().to_string())]
     pub interpolation: String,
     /// Mirror and glass recursion limit: reflected and refracted rays followed

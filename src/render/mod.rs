@@ -57,6 +57,9 @@ named_enum! {
         /// Normals interpolated and lighting computed per sample.
         #[default]
         Phong = "phong",
+        /// One lighting value per triangle: `shade()` at its centroid
+        /// (Computer Graphics from Scratch's flat shading).
+        Faceted = "faceted",
     }
 }
 
@@ -586,9 +589,10 @@ fn resolve_with<Q: SceneQuery, R: Recorder>(job: &PassJob, query: &Q, ray: &Ray,
             let mut path = transport::gi::PathState::new(pixel, job.sample, job.settings.spp, &job.settings.gi, job.photons);
             let mut sh = transport::shading::Shading { scene, query, settings: job.settings, path: &mut path, counts, rec };
             let shaded = with_shading_hit(job.settings.interpolation, h, |s| transport::shade::shade(&mut sh, s, -ray.dir, 0));
-            match shaded {
-                Some(radiance) => radiance,
-                None => transport::shade::shade_gouraud(&mut sh, h, job.view),
+            match (shaded, job.settings.interpolation) {
+                (Some(radiance), _) => radiance,
+                (None, Interpolation::Faceted) => transport::shade::shade_faceted(&mut sh, h, job.view),
+                (None, _) => transport::shade::shade_gouraud(&mut sh, h, job.view),
             }
         }
         (inspect::debug::View::Shaded, None) => {
@@ -613,14 +617,15 @@ fn resolve_with<Q: SceneQuery, R: Recorder>(job: &PassJob, query: &Q, ray: &Ray,
 /// `hit`: the hit itself with Phong interpolation, the hit with its
 /// geometric normal as shading normal with flat shading. `None` with
 /// Gouraud, which shades the triangle's vertices instead
-/// (`transport::shade::shade_gouraud`). A callback rather than a returned hit, so the
+/// (`transport::shade::shade_gouraud`), and faceted, which shades its
+/// centroid (`transport::shade::shade_faceted`). A callback rather than a returned hit, so the
 /// Phong case copies nothing.
 #[inline(always)]
 pub fn with_shading_hit<T>(interpolation: Interpolation, hit: &SurfaceHit, f: impl FnOnce(&SurfaceHit) -> T) -> Option<T> {
     match interpolation {
         Interpolation::Phong => Some(f(hit)),
         Interpolation::Flat => Some(f(&SurfaceHit { shading_normal: hit.geometric_normal, ..*hit })),
-        Interpolation::Gouraud => None,
+        Interpolation::Gouraud | Interpolation::Faceted => None,
     }
 }
 

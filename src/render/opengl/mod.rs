@@ -186,8 +186,8 @@ fn unsupported(scene: &Scene, settings: &RenderSettings) -> Result<(), String> {
     if settings.gi.mode != gi::GiMode::None {
         return refuse("supports --gi none only");
     }
-    if settings.interpolation == Interpolation::Gouraud {
-        return refuse("supports --interpolation phong|flat only");
+    if matches!(settings.interpolation, Interpolation::Gouraud | Interpolation::Faceted) {
+        return refuse("supports --interpolation phong|flat only: it shades each fragment where it lies, not a triangle's vertices or centroid");
     }
     // Area lights and the environment are summed over fixed patterns of
     // light samples (`scene_data::area_lights`, `environment_light`): there

@@ -285,6 +285,33 @@ pub fn shade_gouraud<Q: SceneQuery, R: Recorder>(
     l_o
 }
 
+/// Faceted shading: `shade()` once, at the triangle's centroid (its
+/// position, normal and uv there, seen from the eye), for every sample on
+/// the triangle, so each triangle shows one value and the mesh's facets
+/// and the seams between them show. Spheres have no facets and are shaded
+/// per sample.
+pub fn shade_faceted<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &SurfaceHit, view: &crate::scene::CameraView) -> Radiance {
+    let Shading { scene, .. } = *sh;
+    if hit.kind != crate::scene::PrimitiveKind::Triangle {
+        let w_o = view.toward_viewer(hit.position).normalize_or_zero();
+        return shade(sh, hit, w_o, 0);
+    }
+    let tri = &scene.triangle(hit.primitive);
+    let side = if hit.back_face { -1.0 } else { 1.0 };
+    let third = 1.0 / 3.0;
+    let position = (tri.v[0] + tri.v[1] + tri.v[2]) * third;
+    let normal = ((tri.n[0] + tri.n[1] + tri.n[2]) * side).normalize_or(hit.geometric_normal);
+    let centroid = SurfaceHit {
+        position,
+        shading_normal: normal,
+        barycentric: Vec3::splat(third),
+        uv: (tri.uv[0] + tri.uv[1] + tri.uv[2]) * third,
+        ..*hit
+    };
+    let w_o = view.toward_viewer(position).normalize_or_zero();
+    shade(sh, &centroid, w_o, 0)
+}
+
 /// Perfect mirror reflection and Fresnel-weighted refraction.
 fn secondary<Q: SceneQuery, R: Recorder>(sh: &mut Shading<Q, R>, hit: &SurfaceHit, material: &Material, w_o: Vec3, depth: u32) -> Radiance {
     let Shading { settings, .. } = *sh;
