@@ -6,6 +6,7 @@ use crate::render::raster::depth_format::DepthFormat;
 use crate::render::shadow::volume::VolumeMode;
 use crate::render::shadow::ShadowFilter;
 use crate::render::{RenderSettings, ShadowMode};
+use crate::scene::texture::TextureFilter;
 use crate::scene::Scene;
 
 /// One way of rendering a case: a renderer, the knobs changed from the
@@ -357,9 +358,53 @@ pub fn cases() -> Vec<GalleryCase> {
             size: Some((160, 100)),
             noise_tolerance: Some(0.25),
         },
+        GalleryCase {
+            name: "faceted-teapot",
+            scene: "teapot",
+            method: "shading interpolation",
+            knob: "interpolation",
+            explanation: "one lighting value per triangle, taken at its centroid (Computer Graphics from Scratch's flat shading): the teapot's facets and the seams between them show, and highlights smaller than a triangle vanish or fill it",
+            failing: Setting::new("rasterize", "--interpolation faceted", |s| s.interpolation = crate::render::Interpolation::Faceted),
+            cured: Setting::new("rasterize", "--interpolation phong", |s| s.interpolation = crate::render::Interpolation::Phong),
+            truth: Setting::new("raytrace:brute", "raytrace:brute", nothing),
+            threshold: 40,
+            size: Some((160, 100)),
+            noise_tolerance: None,
+        },
+        GalleryCase {
+            name: "trilinear-blur",
+            scene: "textures",
+            method: "texture filtering",
+            knob: "texture-filter",
+            explanation: "trilinear reads a receding footprint at the level of its length and so blurs the far checkerboard across its width too; taps spread along the length read a finer level and keep the squares",
+            failing: Setting { transform: Some(checkerboard_only), ..Setting::new("raytrace", "--texture-filter trilinear (the checkerboard alone)", |s| s.texture_filter = TextureFilter::Trilinear) },
+            cured: Setting { transform: Some(checkerboard_only), ..Setting::new("raytrace", "--texture-filter anisotropic:16", |s| s.texture_filter = TextureFilter::Anisotropic16) },
+            truth: Setting {
+                transform: Some(checkerboard_only),
+                ..Setting::new("raytrace", "--texture-filter nearest --spp 256", |s| {
+                    s.texture_filter = TextureFilter::Nearest;
+                    s.spp = 256;
+                })
+            },
+            // One sample a pixel still aliases at the horizon, where a pixel
+            // spans many squares, with any filter: the threshold leaves that.
+            threshold: 1000,
+            size: Some((160, 100)),
+            noise_tolerance: Some(0.1),
+        },
     ];
     all.extend(area_light_cases());
     all
+}
+
+/// The `textures` scene's checkerboard ground alone (its first object),
+/// under a black sky: what the texture filters differ on, without the
+/// globe's, the mirror's and the sky's own sampling.
+fn checkerboard_only(scene: &mut Scene) {
+    scene.triangles.retain(|t| t.object == 0);
+    scene.spheres.clear();
+    scene.environment = None;
+    scene.render.background = crate::math::Vec3::ZERO;
 }
 
 /// The thin-lens case's camera: focused on the front of the red sphere.
