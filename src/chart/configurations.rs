@@ -91,6 +91,9 @@ pub fn describe(renderer: &str, s: &RenderSettings) -> String {
     if !s.mis {
         knob("mis", "off".to_string());
     }
+    if !s.packets {
+        knob("packets", "off".to_string());
+    }
     if s.depth_buffer != DepthFormat::F32 {
         knob("depth-buffer", s.depth_buffer.name().to_string());
     }
@@ -181,6 +184,9 @@ pub fn method_configurations(scene: &Scene, base: &RenderSettings) -> Vec<Config
     for variant in ["rasterize:tiled", "rasterize:scanline"] {
         add("samples", variant, plain.clone());
     }
+    // The ray caster without its packets: the same image, the time of one
+    // ray at a time.
+    add("samples", ray, with(&|s| s.packets = false));
 
     // Fewer rays than pixels: a grid traced and the rest interpolated, and
     // the same with the cells whose corners differ traced in full.

@@ -136,6 +136,9 @@ pub struct RenderOpts {
     /// Area lights and the environment: combine light and BSDF sampling (on) or sample the lights alone (off).
     #[arg(long, default_value = "on", value_name = "on|off")]
     pub mis: String,
+    /// raytrace:bvh: trace rays as packets (on) or one ray at a time (off); the same pixels, another speed.
+    #[arg(long, default_value = "on", value_name = "on|off")]
+    pub packets: String,
     /// --shadows map: none (hard) | pcf (percentage-closer) | pcss (percentage-closer soft).
     #[arg(long = "shadow-filter", default_value_t = defaults().shadow_filter.name().to_string(), value_name = "none|pcf|pcss")]
     pub shadow_filter: String,
@@ -180,6 +183,11 @@ impl RenderOpts {
             "on" => true,
             "off" => false,
             other => return Err(format!("--mis {other} is neither on nor off")),
+        };
+        s.packets = match self.packets.as_str() {
+            "on" => true,
+            "off" => false,
+            other => return Err(format!("--packets {other} is neither on nor off")),
         };
         s.spp = self.spp;
         s.max_depth = self.max_depth.unwrap_or(s.max_depth);

@@ -166,6 +166,12 @@ pub struct RenderSettings {
     /// sampling by multiple importance sampling (power heuristic); false:
     /// light sampling alone.
     pub mis: bool,
+    /// `raytrace:bvh`: trace frames' rays as packets through the BVH (eye
+    /// rays by tile, shadow rays and path bounces together); false: one ray
+    /// at a time, as a pixel replay does. The same pixels either way (the
+    /// packets answer each ray as it would be answered alone): a switch
+    /// that times the optimisation.
+    pub packets: bool,
     /// `--shadows map`: how the map is read (hard, PCF or PCSS).
     pub shadow_filter: shadow::ShadowFilter,
     /// `--shadow-filter pcf`: the filter's radius in texels of the map.
@@ -211,6 +217,7 @@ impl Default for RenderSettings {
             cull_instances: true,
             light_samples: 1,
             mis: true,
+            packets: true,
             shadow_filter: shadow::ShadowFilter::None,
             pcf_radius: 1.5,
             display: crate::display::DisplaySettings::default(),

@@ -87,6 +87,7 @@ pub fn show(ui: &mut egui::Ui, settings: &mut ViewerSettings, look: &mut RenderD
                 .on_hover_text("shadow rays per area light (and for the sky) per shading point; 0: found by BSDF sampling alone");
             ui.checkbox(&mut s.mis, "MIS").on_hover_text("weight light and BSDF samples by the power heuristic; off: light sampling alone");
         });
+        ui.checkbox(&mut s.packets, "ray packets").on_hover_text("raytrace:bvh: trace rays as packets through the BVH; off: one ray at a time (the same pixels, slower)");
         gi_knobs(ui, &mut s.gi);
         ui.horizontal(|ui| {
             let l = ui.label("samples per pixel");

@@ -26,8 +26,9 @@ impl Renderer for BvhRayTracer {
     }
 
     fn render_pass(&self, job: &PassJob, out: &mut [Radiance]) -> RayCounts {
-        if job.prepared.instances.is_some() {
-            // Packets walk the one BVH; the two-level layer takes rays one at a time.
+        if job.prepared.instances.is_some() || !job.settings.packets {
+            // Packets walk the one BVH; the two-level layer takes rays one at
+            // a time, and so does every frame with `--packets off`.
             return crate::render::raytrace::cast_pass(job, &BvhQuery::new(job.prepared), out);
         }
         cast_pass_packets(job, &BvhQuery::new(job.prepared), out)
@@ -38,7 +39,7 @@ impl Renderer for BvhRayTracer {
     /// are shaded in batches; otherwise one after the other.
     fn render_passes(&self, jobs: &[PassJob], out: &mut [Radiance]) -> RayCounts {
         let passes = match jobs.first() {
-            Some(job) if job.prepared.instances.is_none() => cast_passes_packets(jobs, &BvhQuery::new(job.prepared), out),
+            Some(job) if job.prepared.instances.is_none() && job.settings.packets => cast_passes_packets(jobs, &BvhQuery::new(job.prepared), out),
             _ => None,
         };
         passes.unwrap_or_else(|| crate::render::render_passes_in_turn(self, jobs, out))
