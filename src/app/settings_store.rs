@@ -112,6 +112,7 @@ impl ViewerSettings {
         (r.shadow_map_size, r.shadow_map_bias, r.shadow_map_slope_bias) = (d.shadow_map_size, d.shadow_map_bias, d.shadow_map_slope_bias);
         (r.msaa, r.early_depth, r.affine, r.depth_buffer, r.lines, r.clip) = (d.msaa, d.early_depth, d.affine, d.depth_buffer, d.lines, d.clip);
         (r.near_clip, r.terminator_lift, r.cull_instances, r.adaptive) = (d.near_clip, d.terminator_lift, d.cull_instances, d.adaptive);
+        r.subpixel_bits = d.subpixel_bits;
     }
 
     /// The render settings at `width` x `height`: these knobs, that size.

@@ -94,6 +94,9 @@ pub fn describe(renderer: &str, s: &RenderSettings) -> String {
     if !s.packets {
         knob("packets", "off".to_string());
     }
+    if s.subpixel_bits != RenderSettings::default().subpixel_bits {
+        knob("subpixel-bits", s.subpixel_bits.to_string());
+    }
     if s.depth_buffer != DepthFormat::F32 {
         knob("depth-buffer", s.depth_buffer.name().to_string());
     }

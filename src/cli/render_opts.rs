@@ -112,7 +112,10 @@ pub struct RenderOpts {
     /// contrast ((max - min) / (max + min), per channel) by more than C.
     #[arg(long = "subsample-contrast", value_name = "C")]
     pub subsample_contrast: Option<f32>,
-    /// Rasterizers: what the depth buffer stores: f32 | unorm24 | unorm16 | reversed.
+    /// Rasterizers fixed, tiled and painter: bits of sub-pixel precision of the snapped vertices, 0 to 8.
+    #[arg(long = "subpixel-bits", default_value_t = defaults().subpixel_bits, value_name = "BITS")]
+    pub subpixel_bits: u32,
+    /// Rasterizers: what the depth buffer stores: f32 | unorm24 | unorm16 | reversed | linear-z.
     #[arg(long = "depth-buffer", default_value_t = defaults().depth_buffer.name().to_string(), value_name = "FORMAT")]
     pub depth_buffer: String,
     /// --view wireframe: the line algorithm, float (DDA) | integer (Bresenham).
@@ -202,6 +205,7 @@ impl RenderOpts {
         s.msaa = self.msaa;
         s.early_depth = self.early_depth && !self.forward;
         self.write_gi(&mut s.gi)?;
+        s.subpixel_bits = self.subpixel_bits;
         s.depth_buffer = render::raster::depth_format::DepthFormat::parse(&self.depth_buffer).map_err(|e| format!("--depth-buffer: {e}"))?;
         s.lines = render::inspect::wireframe::LineAlgorithm::parse(&self.lines).map_err(|e| format!("--lines: {e}"))?;
         s.adaptive = self.adaptive.or(s.adaptive);

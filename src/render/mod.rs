@@ -172,6 +172,11 @@ pub struct RenderSettings {
     /// packets answer each ray as it would be answered alone): a switch
     /// that times the optimisation.
     pub packets: bool,
+    /// The fixed-point rasterizers (`fixed`, `tiled`, the painter): bits of
+    /// sub-pixel precision their vertices are snapped to, 0 to
+    /// `raster::subpixel::SUBPIXEL_BITS` (the default, the full grid). Fewer
+    /// bits move edges by up to half a coarse step.
+    pub subpixel_bits: u32,
     /// `--shadows map`: how the map is read (hard, PCF or PCSS).
     pub shadow_filter: shadow::ShadowFilter,
     /// `--shadow-filter pcf`: the filter's radius in texels of the map.
@@ -218,6 +223,7 @@ impl Default for RenderSettings {
             light_samples: 1,
             mis: true,
             packets: true,
+            subpixel_bits: raster::subpixel::SUBPIXEL_BITS,
             shadow_filter: shadow::ShadowFilter::None,
             pcf_radius: 1.5,
             display: crate::display::DisplaySettings::default(),

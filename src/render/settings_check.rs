@@ -79,6 +79,9 @@ pub fn check(s: &RenderSettings) -> Result<(), SettingProblem> {
     if !(s.shadow_map_bias.is_finite() && s.shadow_map_bias >= 0.0) {
         refuse!("--shadow-bias", "shadow_map_bias", |s| s.shadow_map_bias = RenderSettings::default().shadow_map_bias, "{} must be a finite number of texels >= 0", s.shadow_map_bias);
     }
+    if s.subpixel_bits > crate::render::raster::subpixel::SUBPIXEL_BITS {
+        refuse!("--subpixel-bits", "subpixel_bits", |s| s.subpixel_bits = RenderSettings::default().subpixel_bits, "{} is more than {}", s.subpixel_bits, crate::render::raster::subpixel::SUBPIXEL_BITS);
+    }
     if !crate::render::raster::msaa::COUNTS.contains(&s.msaa) {
         refuse!("--msaa", "msaa", |s| s.msaa = RenderSettings::default().msaa, "{} is not one of 1, 2, 4, 8", s.msaa);
     }

@@ -150,6 +150,11 @@ pub fn show(ui: &mut egui::Ui, settings: &mut ViewerSettings, look: &mut RenderD
             ui.checkbox(&mut s.early_depth, "early depth").on_hover_text("depth pass first, then shade once per pixel (CGPP 15.8.3)");
             ui.checkbox(&mut s.affine, "affine uv").on_hover_text("interpolate in screen space without the 1/z correction: try the uv view");
         });
+        ui.horizontal(|ui| {
+            let l = ui.label("rasterizer: sub-pixel bits");
+            ui.add(egui::Slider::new(&mut s.subpixel_bits, 0..=crate::render::raster::subpixel::SUBPIXEL_BITS)).labelled_by(l.id)
+                .on_hover_text("fixed, tiled and painter: the grid vertices are snapped to; fewer bits move edges");
+        });
         // A combo box: "f32" and friends would read oddly as a row of radios.
         egui::ComboBox::from_label("rasterizer: depth buffer").selected_text(s.depth_buffer.name()).show_ui(ui, |ui| {
             for f in DepthFormat::ALL {

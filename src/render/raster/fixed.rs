@@ -11,7 +11,7 @@ use crate::render::raster::rect::{tested_rect, PixelRect, TestCounter};
 use crate::math::lanes::{mask_bits, simd_level};
 use fearless_simd::{dispatch, i32x8, Simd, SimdBase};
 use crate::render::raster::setup::ScreenTri;
-use crate::render::raster::subpixel::{snap, snap_offset, ONE};
+use crate::render::raster::subpixel::{snap_offset, snap_to, ONE, SUBPIXEL_BITS};
 use crate::math::Vec2;
 use std::ops::{Add, Mul, Sub};
 
@@ -59,8 +59,15 @@ fn first_at_or_after(v: i64, off: i64) -> i64 {
 impl FixedTri {
     /// `None` when the snapped triangle has no area or covers no sample of the image.
     pub fn new(st: &ScreenTri, off: [i64; 2], sample_off: Vec2, width: u32, height: u32) -> Option<FixedTri> {
+        FixedTri::on_grid(st, SUBPIXEL_BITS, off, sample_off, width, height)
+    }
+
+    /// `new` with the vertices snapped to `bits` bits of sub-pixel
+    /// precision (`--subpixel-bits`): the edges move with them, while the
+    /// shading weights stay those of the exact vertices.
+    pub fn on_grid(st: &ScreenTri, bits: u32, off: [i64; 2], sample_off: Vec2, width: u32, height: u32) -> Option<FixedTri> {
         let mut st = *st;
-        let mut v = st.p.map(|p| [snap(p.x), snap(p.y)]);
+        let mut v = st.p.map(|p| [snap_to(p.x, bits), snap_to(p.y, bits)]);
         let area = |v: &[[i64; 2]; 3]| -> i128 {
             (v[1][0] - v[0][0]) as i128 * (v[2][1] - v[0][1]) as i128 - (v[1][1] - v[0][1]) as i128 * (v[2][0] - v[0][0]) as i128
         };
@@ -100,14 +107,14 @@ impl FixedTri {
     /// it would hit. Its edge functions are still those of its snapped
     /// vertices (all zero when they are collinear), for the painter's
     /// overlap test.
-    pub fn new_or_small(st: &ScreenTri, off: [i64; 2], sample_off: Vec2, width: u32, height: u32) -> Option<FixedTri> {
-        let v = st.p.map(|p| [snap(p.x), snap(p.y)]);
+    pub fn new_or_small(st: &ScreenTri, bits: u32, off: [i64; 2], sample_off: Vec2, width: u32, height: u32) -> Option<FixedTri> {
+        let v = st.p.map(|p| [snap_to(p.x, bits), snap_to(p.y, bits)]);
         let extent = |i: usize| v.iter().map(|p| p[i]).max().unwrap() - v.iter().map(|p| p[i]).min().unwrap();
         if extent(0).max(extent(1)) >= crate::render::raster::subpixel::SMALL_LIMIT {
-            return FixedTri::new(st, off, sample_off, width, height);
+            return FixedTri::on_grid(st, bits, off, sample_off, width, height);
         }
         let bbox = st.bbox.grown(1, width, height);
-        Some(match FixedTri::new(st, off, sample_off, width, height) {
+        Some(match FixedTri::on_grid(st, bits, off, sample_off, width, height) {
             Some(ft) => FixedTri { bbox, ray: true, ..ft },
             None => FixedTri { st: *st, v, a: [0; 3], b: [0; 3], bias: [1; 3], sample_off, bbox, wide: false, ray: true },
         })
@@ -154,7 +161,8 @@ pub fn setup_snapped_or_small(job: &crate::render::PassJob, sample_off: Vec2, wi
 /// `setup_snapped_or_small`, run by run as the threads made them.
 pub fn setup_snapped_or_small_runs(job: &crate::render::PassJob, sample_off: Vec2, width: u32, height: u32) -> crate::render::raster::runs::Runs<FixedTri> {
     let off = snap_offset(sample_off);
-    crate::render::raster::setup::setup_pass_map(job, |st| FixedTri::new_or_small(&st, off, sample_off, width, height))
+    let bits = job.settings.subpixel_bits;
+    crate::render::raster::setup::setup_pass_map(job, |st| FixedTri::new_or_small(&st, bits, off, sample_off, width, height))
 }
 
 /// Every triangle snapped (in order; dropped when degenerate after snapping).
@@ -359,7 +367,7 @@ mod tests {
     fn triangles_under_half_a_pixel_take_the_ray_test() {
         let st = |p: [Vec2; 3]| ScreenTri::flat(0, p, Vec2::splat(0.5), 16, 16).unwrap();
         let off = snap_offset(Vec2::splat(0.5));
-        let make = |p| FixedTri::new_or_small(&st(p), off, Vec2::splat(0.5), 16, 16);
+        let make = |p| FixedTri::new_or_small(&st(p), SUBPIXEL_BITS, off, Vec2::splat(0.5), 16, 16);
         // 0.49 px across: small, its box that of the float triangle grown by a pixel.
         let tiny = make([Vec2::new(4.3, 4.3), Vec2::new(4.79, 4.3), Vec2::new(4.3, 4.79)]).unwrap();
         assert!(tiny.ray);

@@ -20,6 +20,17 @@ pub fn snap(v: f32) -> i64 {
     crate::math::rounding::round((v as f64) * ONE as f64).clamp(-CLAMP, CLAMP) as i64
 }
 
+/// A coordinate in pixels snapped to a coarser grid of `bits` bits of
+/// sub-pixel precision (`--subpixel-bits`, 0 to `SUBPIXEL_BITS`), in the
+/// units of the full grid: `snap` itself at `SUBPIXEL_BITS`. With fewer
+/// bits a vertex moves up to half a coarse step, and the edges with it.
+#[inline]
+pub fn snap_to(v: f32, bits: u32) -> i64 {
+    let bits = bits.min(SUBPIXEL_BITS);
+    let step = 1i64 << (SUBPIXEL_BITS - bits);
+    crate::math::rounding::round((v as f64) * (1u64 << bits) as f64).clamp(-CLAMP / step as f64, CLAMP / step as f64) as i64 * step
+}
+
 /// The pass's sample offset snapped to the sub-pixel grid.
 pub fn snap_offset(off: Vec2) -> [i64; 2] {
     [snap(off.x), snap(off.y)]
@@ -41,5 +52,20 @@ mod tests {
         // Far off screen: clamped to 2^60 units.
         assert_eq!(snap(1.0e30), 1 << 60);
         assert_eq!(snap(f32::NEG_INFINITY), -(1 << 60));
+    }
+
+    #[test]
+    fn coarser_grids_by_hand() {
+        // Full precision is `snap` itself.
+        for v in [0.3, -7.77, 1.0 / 512.0, 1e30] {
+            assert_eq!(snap_to(v, SUBPIXEL_BITS), snap(v), "{v}");
+        }
+        // 2 bits: quarter pixels, in 1/256 units.
+        assert_eq!(snap_to(0.3, 2), 64);
+        assert_eq!(snap_to(0.4, 2), 128);
+        assert_eq!(snap_to(-0.2, 2), -64);
+        // 0 bits: whole pixels.
+        assert_eq!(snap_to(2.4, 0), 512);
+        assert_eq!(snap_to(2.6, 0), 768);
     }
 }
