@@ -133,6 +133,9 @@ struct ObjectDesc {
     uvs: Option<Vec<F2>>,
     center: Option<F3>,
     radius: Option<f32>,
+    /// sphere only: draw it as a mesh of about this many triangles instead
+    /// of the analytic surface.
+    tessellate: Option<i64>,
     instances: Option<Vec<Spanned<InstanceDesc>>>,
     /// csg only: the operation and its two operands (inline tables).
     op: Option<String>,
@@ -475,6 +478,7 @@ fn add_object(
             ("uvs", o.uvs.is_some()),
             ("center", o.center.is_some()),
             ("radius", o.radius.is_some()),
+            ("tessellate", o.tessellate.is_some()),
             ("instances", o.instances.is_some()),
         ];
         for (key, here) in present {
@@ -651,7 +655,7 @@ fn add_object(
             }
         }
         "sphere" => {
-            only(&["center", "radius"])?;
+            only(&["center", "radius", "tessellate"])?;
             let center = position(o.center, where_, "center")?.ok_or(format!("{where_}: a sphere needs `center`"))?;
             let radius = o.radius.ok_or(format!("{where_}: a sphere needs `radius`"))?;
             if !(radius.is_finite() && radius > 0.0 && radius <= MAX_COORDINATE) {
@@ -661,14 +665,27 @@ fn add_object(
                 Some(m) => m,
                 None => scene.default_material_index(),
             };
-            // A sphere stays analytic, so only uniform scale keeps it a sphere.
-            let (center, radius) = placement.apply_sphere(center, radius).map_err(|e| format!("{where_}: {e}"))?;
-            if center.abs().max_element() > MAX_COORDINATE || radius > MAX_COORDINATE {
-                return Err(format!(
-                    "{where_}: placed, the sphere has centre {center} and radius {radius}; coordinates must be between -{MAX_COORDINATE:e} and {MAX_COORDINATE:e}"
-                ));
+            if let Some(n) = o.tessellate {
+                if !(crate::scene::tessellate::MIN_TRIANGLES as i64..=crate::scene::tessellate::MAX_TRIANGLES as i64).contains(&n) {
+                    return Err(format!(
+                        "{where_}: tessellate must be a triangle count from {} to {}, found {n}",
+                        crate::scene::tessellate::MIN_TRIANGLES,
+                        crate::scene::tessellate::MAX_TRIANGLES
+                    ));
+                }
+                for t in crate::scene::tessellate::sphere_triangles(center, radius, n as u32, material, object, two_sided) {
+                    scene.triangles.push(placement.apply(t));
+                }
+            } else {
+                // A sphere stays analytic, so only uniform scale keeps it a sphere.
+                let (center, radius) = placement.apply_sphere(center, radius).map_err(|e| format!("{where_}: {e}"))?;
+                if center.abs().max_element() > MAX_COORDINATE || radius > MAX_COORDINATE {
+                    return Err(format!(
+                        "{where_}: placed, the sphere has centre {center} and radius {radius}; coordinates must be between -{MAX_COORDINATE:e} and {MAX_COORDINATE:e}"
+                    ));
+                }
+                scene.spheres.push(Sphere { center, radius, material, object });
             }
-            scene.spheres.push(Sphere { center, radius, material, object });
         }
         "csg" => {
             only(&[])?;

@@ -23,6 +23,7 @@ pub mod placement;
 pub mod ply;
 pub mod recentre;
 pub mod tangents;
+pub mod tessellate;
 pub mod texture;
 pub mod triangles;
 
