@@ -164,6 +164,12 @@ pub fn render_option_args(renderer: &str, s: &RenderSettings, camera: Option<&st
     if s.mis != d.mis {
         opt("mis", if s.mis { "on" } else { "off" }.to_string());
     }
+    if s.packets != d.packets {
+        opt("packets", if s.packets { "on" } else { "off" }.to_string());
+    }
+    if s.subpixel_bits != d.subpixel_bits {
+        opt("subpixel-bits", s.subpixel_bits.to_string());
+    }
     if s.shadow_filter != d.shadow_filter {
         opt("shadow-filter", s.shadow_filter.name().to_string());
     }
